@@ -1,0 +1,101 @@
+"""Ball–wall contact: Hertz elastic force with Tsuji damping (MODEL.md section 2).
+
+Pure functions, SI units. The damping pairing c ∝ ζ^{1/4} with the Hertz
+spring makes the restitution of one impact equal the input e at every speed,
+which is why the total force is not clipped by default.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+# Rayleigh-wave speed factor of Eq. 40 (paper): t_R = πR/(0.1631ν + 0.8766)·√(ρ/G)
+_RAYLEIGH_A = 0.1631
+_RAYLEIGH_B = 0.8766
+# Duration of an undamped Hertz impact divided by ζ_max/v (Johnson, Contact Mechanics, §11.4)
+HERTZ_DURATION_FACTOR = 2.9432
+
+
+@njit(cache=True)
+def effective_modulus(e_ball: float, nu_ball: float, e_vial: float, nu_vial: float) -> float:
+    """E* from 1/E* = (1−ν_b²)/E_b + (1−ν_v²)/E_v, in Pa (MODEL.md §2; paper Eq. 8)."""
+    return 1.0 / ((1.0 - nu_ball * nu_ball) / e_ball + (1.0 - nu_vial * nu_vial) / e_vial)
+
+
+@njit(cache=True)
+def overlap_left(x: float, x_left: float, radius: float) -> float:
+    """ζ_L = max(0, R − (x − x_L)) in m (MODEL.md §2; paper Eq. 4)."""
+    return max(0.0, radius - (x - x_left))
+
+
+@njit(cache=True)
+def overlap_right(x: float, x_right: float, radius: float) -> float:
+    """ζ_R = max(0, R − (x_R − x)) in m (MODEL.md §2; paper Eq. 4)."""
+    return max(0.0, radius - (x_right - x))
+
+
+@njit(cache=True)
+def hertz_force(overlap: float, e_star: float, radius: float) -> float:
+    """Elastic force F_e = (4/3)·E*·√R·ζ^{3/2} in N (MODEL.md §2).
+
+    The paper's Eq. 7 prints the square root over the whole product; the
+    standard Hertz law, used here, is MODEL.md difference 1.
+    """
+    return 4.0 / 3.0 * e_star * math.sqrt(radius) * overlap**1.5
+
+
+@njit(cache=True)
+def elastic_energy(overlap: float, e_star: float, radius: float) -> float:
+    """Hertz potential V = (8/15)·E*·√R·ζ^{5/2} in J, so that dV/dζ = F_e (energy audit)."""
+    return 8.0 / 15.0 * e_star * math.sqrt(radius) * overlap**2.5
+
+
+@njit(cache=True)
+def damping_ratio(restitution: float) -> float:
+    """β_e = ln e / √(ln² e + π²) (MODEL.md §2; the paper drops the square root: difference 2)."""
+    log_e = math.log(restitution)
+    return log_e / math.sqrt(log_e * log_e + math.pi * math.pi)
+
+
+@njit(cache=True)
+def damping_coefficient(overlap: float, mass: float, radius: float, e_star: float, beta_e: float) -> float:
+    """c(ζ) = −√(20/3)·β_e·(m²·R·E*²·ζ)^{1/4} in N·s/m, ≥ 0 for e ≤ 1 (MODEL.md §2)."""
+    return -math.sqrt(20.0 / 3.0) * beta_e * (mass * mass * radius * e_star * e_star * overlap) ** 0.25
+
+
+@njit(cache=True)
+def contact_force(elastic: float, damping: float, overlap_rate: float, no_tension: bool) -> float:
+    """Magnitude of the normal force F_e + c·ζ̇ in N, clipped at 0 only with ``no_tension`` (MODEL.md §2)."""
+    total = elastic + damping * overlap_rate
+    if no_tension and total < 0.0:
+        return 0.0
+    return total
+
+
+@njit(cache=True)
+def dissipated_power(force: float, elastic: float, overlap_rate: float) -> float:
+    """P_d = (f − F_e)·ζ̇ in W: the work rate of the non-elastic part of the applied force.
+
+    Equals c·ζ̇² when the force is not clipped (MODEL.md §3); with clipping it
+    uses the force actually applied, as MODEL.md §2 requires.
+    """
+    return (force - elastic) * overlap_rate
+
+
+@njit(cache=True)
+def rayleigh_time(radius: float, density: float, youngs_modulus: float, poisson_ratio: float) -> float:
+    """t_R = πR/(0.1631ν + 0.8766)·√(ρ/G), G = E/(2(1+ν)), in s (MODEL.md §7; paper Eq. 40)."""
+    shear_modulus = youngs_modulus / (2.0 * (1.0 + poisson_ratio))
+    return math.pi * radius / (_RAYLEIGH_A * poisson_ratio + _RAYLEIGH_B) * math.sqrt(density / shear_modulus)
+
+
+def hertz_max_overlap(mass: float, radius: float, e_star: float, speed: float) -> float:
+    """Largest overlap of an undamped Hertz impact, ζ_max = (15 m v² / (16 E* √R))^{2/5}, in m."""
+    return (15.0 * mass * speed**2 / (16.0 * e_star * math.sqrt(radius))) ** 0.4
+
+
+def hertz_contact_time(mass: float, radius: float, e_star: float, speed: float) -> float:
+    """Duration of an undamped Hertz impact, 2.9432·ζ_max/v, in s (Johnson 1985, §11.4)."""
+    return HERTZ_DURATION_FACTOR * hertz_max_overlap(mass, radius, e_star, speed) / speed

@@ -1,0 +1,480 @@
+"""Compiled adaptive Runge–Kutta integration of the full-resolution model (MODEL.md section 7).
+
+The solver is an explicit FSAL Runge–Kutta pair given as data
+(:class:`ButcherTableau`, checked at construction); the default is
+Bogacki–Shampine 3(2), the method of MATLAB's ``ode23`` and SciPy's ``RK23``.
+Step-size control (:class:`StepController`) follows SciPy's RK23: RMS error
+norm over the dynamic state, scale ``atol + rtol·max(|y_n|, |y_n+1|)``.
+
+Contacts are events of the mechanics, handled in the compiled loop:
+
+* In flight the ball moves on a straight line and the walls on a sine, so the
+  gap to each wall is known exactly over a trial step. Its first zero is
+  searched with a curvature bound (|gap''| ≤ X_v·ω²) that rules out a wall
+  touching and leaving within the step; the step is then shortened to land on
+  the contact onset. A contact start is therefore never stepped over.
+* Inside a contact the step is at most ``contact_step_limit`` (0.9 t_R by
+  default) and the usual error control applies.
+* One record per impact is written when the ball leaves the wall.
+
+Everything runs in chunks (:meth:`Integrator.advance`), so a caller can show
+progress and keep what was computed when interrupted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+import numpy as np
+from numba import njit
+
+from .model import (
+    DISSIPATED,
+    HEAT_GENERATED,
+    LEFT_WALL,
+    N_DYNAMIC,
+    N_STATE,
+    NO_WALL,
+    RIGHT_WALL,
+    P,
+    X,
+    Constants,
+    contact_forces,
+    gap,
+    rhs,
+    wall_contact,
+)
+
+# Status codes of the compiled loop (negative: failure).
+REACHED_STOP = 0
+NOT_FINITE = -1
+OVERLAP_TOO_LARGE = -2
+STEP_UNDERFLOW = -3
+
+STATUS_MESSAGES = {
+    REACHED_STOP: "The solver reached the end of the integration interval.",
+    NOT_FINITE: "The state became NaN or infinite.",
+    OVERLAP_TOO_LARGE: "The contact overlap exceeded the allowed fraction of the ball radius.",
+    STEP_UNDERFLOW: "The step size fell below the resolution of the time variable.",
+}
+
+# Columns of the impact records.
+IMPACT_COLUMNS = (
+    "time",
+    "wall",
+    "impact_speed",
+    "rebound_speed",
+    "dissipated_energy",
+    "heat_generated",
+    "max_overlap",
+    "peak_force",
+    "duration",
+)
+_IMPACT_WIDTH = len(IMPACT_COLUMNS)
+# Layout of the impact in progress, carried between chunks.
+_ACTIVE, _WALL, _START, _SPEED_IN, _DISSIPATED0, _HEAT0, _MAX_OVERLAP, _PEAK_FORCE = range(8)
+# Counters.
+STEPS, REJECTED, RHS_EVALUATIONS, IMPACTS, SAMPLES_WRITTEN, WINDOW_POINTS = range(6)
+COUNTER_NAMES = ("steps", "rejected_steps", "rhs_evaluations", "impacts")
+
+_INITIAL_CAPACITY = 1024
+# Relative resolution of the time variable used to stop bisection of a contact onset.
+_TIME_RESOLUTION = 4.0 * np.finfo(float).eps
+
+
+@dataclass(frozen=True)
+class ButcherTableau:
+    """An explicit, first-same-as-last embedded Runge–Kutta pair.
+
+    ``b`` gives the propagated solution (order ``order``), ``b_hat`` the
+    embedded one (order ``error_order``); their difference estimates the error.
+    The order conditions up to ``order`` are checked at construction.
+    """
+
+    name: str
+    order: int
+    error_order: int
+    a: tuple[tuple[Fraction, ...], ...]
+    b: tuple[Fraction, ...]
+    b_hat: tuple[Fraction, ...]
+    c: tuple[Fraction, ...]
+
+    def __post_init__(self) -> None:
+        stages = len(self.c)
+        if len(self.a) != stages or any(len(row) != stages for row in self.a):
+            raise ValueError(f"{self.name}: a must be {stages}x{stages}")
+        for i, row in enumerate(self.a):
+            if any(row[j] != 0 for j in range(i, stages)):
+                raise ValueError(f"{self.name}: a must be strictly lower triangular for an explicit method")
+            if sum(row) != self.c[i]:
+                raise ValueError(f"{self.name}: row {i} of a does not sum to c[{i}]")
+        if tuple(self.a[-1]) != tuple(self.b) or self.c[-1] != 1:
+            raise ValueError(f"{self.name}: not first-same-as-last (last row of a must equal b, c[-1] = 1)")
+        self._check_order(self.b, self.order, "b")
+        self._check_order(self.b_hat, self.error_order, "b_hat")
+
+    def _check_order(self, weights: tuple[Fraction, ...], order: int, label: str) -> None:
+        a, c = self.a, self.c
+        ac = [sum(a[i][j] * c[j] for j in range(len(c))) for i in range(len(c))]
+        conditions = {
+            1: [(sum(weights), Fraction(1))],
+            2: [(sum(w * ci for w, ci in zip(weights, c)), Fraction(1, 2))],
+            3: [
+                (sum(w * ci * ci for w, ci in zip(weights, c)), Fraction(1, 3)),
+                (sum(w * aci for w, aci in zip(weights, ac)), Fraction(1, 6)),
+            ],
+        }
+        if order > max(conditions):
+            raise ValueError(f"{self.name}: order conditions above {max(conditions)} are not implemented")
+        for level in range(1, order + 1):
+            for value, expected in conditions[level]:
+                if value != expected:
+                    raise ValueError(f"{self.name}: {label} violates an order-{level} condition")
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(a, b, error weights b − b_hat, c) as float arrays for the compiled loop."""
+        a = np.array([[float(v) for v in row] for row in self.a])
+        b = np.array([float(v) for v in self.b])
+        error = np.array([float(bi - bh) for bi, bh in zip(self.b, self.b_hat)])
+        c = np.array([float(v) for v in self.c])
+        return a, b, error, c
+
+
+_F = Fraction
+BOGACKI_SHAMPINE = ButcherTableau(
+    name="Bogacki-Shampine 3(2)",
+    order=3,
+    error_order=2,
+    a=(
+        (_F(0), _F(0), _F(0), _F(0)),
+        (_F(1, 2), _F(0), _F(0), _F(0)),
+        (_F(0), _F(3, 4), _F(0), _F(0)),
+        (_F(2, 9), _F(1, 3), _F(4, 9), _F(0)),
+    ),
+    b=(_F(2, 9), _F(1, 3), _F(4, 9), _F(0)),
+    b_hat=(_F(7, 24), _F(1, 4), _F(1, 3), _F(1, 8)),
+    c=(_F(0), _F(1, 2), _F(3, 4), _F(1)),
+)
+
+
+@dataclass(frozen=True)
+class StepController:
+    """Elementary error-per-step controller with SciPy's RK23 constants."""
+
+    safety: float = 0.9
+    min_factor: float = 0.2
+    max_factor: float = 10.0
+
+
+@dataclass
+class Tolerances:
+    rtol: float
+    atol: np.ndarray  # one per dynamic component
+    contact_step_limit: float  # s
+    max_overlap: float  # m
+
+
+@njit(cache=True)
+def _grow(buffer: np.ndarray) -> np.ndarray:
+    larger = np.empty((2 * buffer.shape[0], buffer.shape[1]))
+    larger[: buffer.shape[0]] = buffer
+    return larger
+
+
+@njit(cache=True)
+def _first_touch_of_wall(t: float, h: float, x: float, velocity: float, wall: int, curvature: float, k: Constants) -> float:
+    """Earliest s in [0, h] where the free-flight gap to ``wall`` reaches 0, or −1 if none.
+
+    Intervals are examined left to right; one is discarded only when the bound
+    gap(s) ≥ min(gap(a), gap(b)) − curvature·(b − a)²/8 proves it free of zeros.
+    """
+    resolution = _TIME_RESOLUTION * max(1.0, abs(t) + h)
+    stack = np.empty((256, 4))
+    stack[0, 0] = 0.0
+    stack[0, 1] = h
+    stack[0, 2] = gap(t, x, wall, k)
+    stack[0, 3] = gap(t + h, x + velocity * h, wall, k)
+    if stack[0, 2] < 0.0:
+        return 0.0
+    top = 1
+    while top > 0:
+        top -= 1
+        a, b, gap_a, gap_b = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
+        if min(gap_a, gap_b) - curvature * (b - a) ** 2 / 8.0 > 0.0:
+            continue
+        if b - a <= resolution:
+            if gap_b <= 0.0:
+                return b
+            continue
+        middle = 0.5 * (a + b)
+        gap_middle = gap(t + middle, x + velocity * middle, wall, k)
+        if top + 2 > stack.shape[0]:
+            stack = _grow(stack)
+        # right half below the left half, so the left half is examined first
+        stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = middle, b, gap_middle, gap_b
+        stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2], stack[top + 1, 3] = a, middle, gap_a, gap_middle
+        top += 2
+    return -1.0
+
+
+@njit(cache=True)
+def _hermite(theta: float, h: float, y0: np.ndarray, f0: np.ndarray, y1: np.ndarray, f1: np.ndarray, out: np.ndarray) -> None:
+    """Cubic Hermite interpolant of a step at fraction ``theta`` (the dense output of ode23)."""
+    t2 = theta * theta
+    t3 = t2 * theta
+    h00 = 2.0 * t3 - 3.0 * t2 + 1.0
+    h10 = t3 - 2.0 * t2 + theta
+    h01 = -2.0 * t3 + 3.0 * t2
+    h11 = t3 - t2
+    for i in range(y0.shape[0]):
+        out[i] = h00 * y0[i] + h10 * h * f0[i] + h01 * y1[i] + h11 * h * f1[i]
+
+
+@njit(cache=True)
+def _rk_step(t: float, h: float, y: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, k: Constants,
+             stages: np.ndarray, y_new: np.ndarray, work: np.ndarray) -> None:
+    """One explicit FSAL step: ``stages[0]`` holds f(t, y) on entry, the last stage holds f(t+h, y_new) on exit."""
+    n_stages = c.shape[0]
+    n = y.shape[0]
+    for s in range(1, n_stages - 1):
+        for i in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += a[s, j] * stages[j, i]
+            work[i] = y[i] + h * acc
+        rhs(t + c[s] * h, work, k, stages[s])
+    for i in range(n):
+        acc = 0.0
+        for j in range(n_stages - 1):
+            acc += b[j] * stages[j, i]
+        y_new[i] = y[i] + h * acc
+    rhs(t + h, y_new, k, stages[n_stages - 1])
+
+
+@njit(cache=True)
+def _error_norm(h: float, y: np.ndarray, y_new: np.ndarray, stages: np.ndarray, error_weights: np.ndarray,
+                rtol: float, atol: np.ndarray) -> float:
+    total = 0.0
+    for i in range(atol.shape[0]):
+        estimate = 0.0
+        for j in range(error_weights.shape[0]):
+            estimate += error_weights[j] * stages[j, i]
+        scale = atol[i] + rtol * max(abs(y[i]), abs(y_new[i]))
+        ratio = h * estimate / scale
+        total += ratio * ratio
+    return np.sqrt(total / atol.shape[0])
+
+
+@njit(cache=True)
+def _advance(
+    t_stop, clock, y, f0, a, b, error_weights, c, k, rtol, atol, contact_step_limit, max_overlap,
+    safety, min_factor, max_factor, error_exponent,
+    sample_times, samples, windows, window_buffer, impact_buffer, impact, counters,
+):
+    """Integrate from ``clock[0]`` to ``t_stop``; see :meth:`Integrator.advance`. Returns (status, buffers)."""
+    n = y.shape[0]
+    stages = np.empty((c.shape[0], n))
+    y_new = np.empty(n)
+    work = np.empty(n)
+    point = np.empty(n)
+    curvature = k.amplitude * k.omega * k.omega
+    t = clock[0]
+    h = clock[1]
+    while t < t_stop:
+        in_contact = impact[_ACTIVE] != 0.0
+        h = min(h, t_stop - t)
+        if in_contact:
+            h = min(h, contact_step_limit)
+        if h <= _TIME_RESOLUTION * max(1.0, abs(t)):
+            clock[0], clock[1] = t, h
+            return STEP_UNDERFLOW, window_buffer, impact_buffer
+        stages[0] = f0
+        _rk_step(t, h, y, a, b, c, k, stages, y_new, work)
+        counters[RHS_EVALUATIONS] += c.shape[0] - 1
+        error = _error_norm(h, y, y_new, stages, error_weights, rtol, atol)
+        if not error <= 1.0:  # also rejects NaN
+            counters[REJECTED] += 1
+            factor = min_factor if not np.isfinite(error) else max(min_factor, safety * error**error_exponent)
+            h *= factor
+            continue
+        factor = max_factor if error == 0.0 else min(max_factor, safety * error**error_exponent)
+
+        landed_wall = NO_WALL
+        if not in_contact:
+            velocity = y[P] / k.ball_mass
+            first, wall_hit = -1.0, NO_WALL
+            for wall in (LEFT_WALL, RIGHT_WALL):
+                touch = _first_touch_of_wall(t, h, y[X], velocity, wall, curvature, k)
+                if touch >= 0.0 and (first < 0.0 or touch < first):
+                    first, wall_hit = touch, wall
+            if first >= 0.0:
+                landed_wall = wall_hit
+                if first < h:
+                    # Redo the step up to the onset: every stage is still in flight, so it is exact for x.
+                    h = first
+                    stages[0] = f0
+                    if h > 0.0:
+                        _rk_step(t, h, y, a, b, c, k, stages, y_new, work)
+                        counters[RHS_EVALUATIONS] += c.shape[0] - 1
+                    else:
+                        y_new[:] = y
+                        stages[c.shape[0] - 1] = f0
+
+        t_new = t + h
+        for i in range(n):
+            if not np.isfinite(y_new[i]):
+                clock[0], clock[1] = t, h
+                return NOT_FINITE, window_buffer, impact_buffer
+        f_new = stages[c.shape[0] - 1]
+
+        # Samples on the regular output grid, by dense output.
+        index = counters[SAMPLES_WRITTEN]
+        while index < sample_times.shape[0] and sample_times[index] <= t_new:
+            if h > 0.0:
+                _hermite((sample_times[index] - t) / h, h, y, f0, y_new, f_new, point)
+                samples[index] = point
+            else:
+                samples[index] = y_new
+            index += 1
+        counters[SAMPLES_WRITTEN] = index
+
+        # Full-resolution windows.
+        for w in range(windows.shape[0]):
+            if windows[w, 0] <= t_new <= windows[w, 1]:
+                row = counters[WINDOW_POINTS]
+                if row >= window_buffer.shape[0]:
+                    window_buffer = _grow(window_buffer)
+                window_buffer[row, 0] = t_new
+                window_buffer[row, 1:] = y_new
+                counters[WINDOW_POINTS] = row + 1
+                break
+
+        # Impact bookkeeping.
+        velocity_new = y_new[P] / k.ball_mass
+        if landed_wall != NO_WALL:
+            _, _, _, vial_velocity = wall_contact(t_new, y_new[X], velocity_new, k)
+            approach = vial_velocity - velocity_new if landed_wall == LEFT_WALL else velocity_new - vial_velocity
+            impact[_ACTIVE] = 1.0
+            impact[_WALL] = landed_wall
+            impact[_START] = t_new
+            impact[_SPEED_IN] = approach
+            impact[_DISSIPATED0] = y_new[DISSIPATED]
+            impact[_HEAT0] = y_new[HEAT_GENERATED]
+            impact[_MAX_OVERLAP] = 0.0
+            impact[_PEAK_FORCE] = 0.0
+        elif in_contact:
+            wall = int(impact[_WALL])
+            overlap = -gap(t_new, y_new[X], wall, k)
+            _, _, _, vial_velocity = wall_contact(t_new, y_new[X], velocity_new, k)
+            overlap_rate = vial_velocity - velocity_new if wall == LEFT_WALL else velocity_new - vial_velocity
+            if overlap > 0.0:  # still touching; overlap <= 0 below means it left the wall
+                force, _ = contact_forces(overlap, overlap_rate, k)
+                impact[_MAX_OVERLAP] = max(impact[_MAX_OVERLAP], overlap)
+                impact[_PEAK_FORCE] = max(impact[_PEAK_FORCE], force)
+                if overlap > max_overlap:
+                    t, clock[0], clock[1] = t_new, t_new, h
+                    y[:] = y_new
+                    f0[:] = f_new
+                    return OVERLAP_TOO_LARGE, window_buffer, impact_buffer
+            else:
+                # Left the wall during this step: back-extrapolate the separation on the free flight.
+                separation = t_new - (-overlap) / max(-overlap_rate, 1e-300)
+                separation = max(separation, impact[_START])
+                _, _, _, vial_at_separation = wall_contact(separation, y_new[X], velocity_new, k)
+                rebound = velocity_new - vial_at_separation if wall == LEFT_WALL else vial_at_separation - velocity_new
+                row = counters[IMPACTS]
+                if row >= impact_buffer.shape[0]:
+                    impact_buffer = _grow(impact_buffer)
+                impact_buffer[row, 0] = impact[_START]
+                impact_buffer[row, 1] = wall
+                impact_buffer[row, 2] = impact[_SPEED_IN]
+                impact_buffer[row, 3] = rebound
+                impact_buffer[row, 4] = y_new[DISSIPATED] - impact[_DISSIPATED0]
+                impact_buffer[row, 5] = y_new[HEAT_GENERATED] - impact[_HEAT0]
+                impact_buffer[row, 6] = impact[_MAX_OVERLAP]
+                impact_buffer[row, 7] = impact[_PEAK_FORCE]
+                impact_buffer[row, 8] = separation - impact[_START]
+                counters[IMPACTS] = row + 1
+                impact[_ACTIVE] = 0.0
+
+        t = t_new
+        y[:] = y_new
+        f0[:] = f_new
+        counters[STEPS] += 1
+        # A landing step may be arbitrarily short; restart the contact from its step limit instead.
+        h = h * factor if landed_wall == NO_WALL else contact_step_limit
+    clock[0], clock[1] = t, h
+    return REACHED_STOP, window_buffer, impact_buffer
+
+
+@dataclass
+class Integrator:
+    """Chunked driver of the compiled loop; holds the state between chunks."""
+
+    constants: Constants
+    y: np.ndarray
+    t0: float
+    tolerances: Tolerances
+    sample_times: np.ndarray
+    windows: np.ndarray
+    tableau: ButcherTableau = BOGACKI_SHAMPINE
+    controller: StepController = field(default_factory=StepController)
+    initial_step: float = 1e-5
+
+    def __post_init__(self) -> None:
+        self._a, self._b, self._error_weights, self._c = self.tableau.arrays()
+        self.clock = np.array([self.t0, self.initial_step])
+        self.y = np.array(self.y, dtype=float)
+        self.f = np.empty(N_STATE)
+        rhs(self.t0, self.y, self.constants, self.f)
+        self.samples = np.full((self.sample_times.shape[0], N_STATE), np.nan)
+        self._window_buffer = np.empty((_INITIAL_CAPACITY, N_STATE + 1))
+        self._impact_buffer = np.empty((_INITIAL_CAPACITY, _IMPACT_WIDTH))
+        self._impact = np.zeros(8)
+        self.counters = np.zeros(6, dtype=np.int64)
+        self.counters[RHS_EVALUATIONS] = 1
+
+    @property
+    def t(self) -> float:
+        return float(self.clock[0])
+
+    def advance(self, t_stop: float) -> int:
+        """Integrate up to ``t_stop``; returns a status code (see ``STATUS_MESSAGES``)."""
+        status, self._window_buffer, self._impact_buffer = _advance(
+            t_stop, self.clock, self.y, self.f, self._a, self._b, self._error_weights, self._c, self.constants,
+            self.tolerances.rtol, self.tolerances.atol, self.tolerances.contact_step_limit,
+            self.tolerances.max_overlap, self.controller.safety, self.controller.min_factor,
+            self.controller.max_factor, -1.0 / (self.tableau.error_order + 1),
+            self.sample_times, self.samples, self.windows, self._window_buffer, self._impact_buffer,
+            self._impact, self.counters,
+        )
+        return int(status)
+
+    @property
+    def samples_written(self) -> int:
+        return int(self.counters[SAMPLES_WRITTEN])
+
+    @property
+    def window_points(self) -> np.ndarray:
+        return self._window_buffer[: self.counters[WINDOW_POINTS]].copy()
+
+    @property
+    def impacts(self) -> np.ndarray:
+        return self._impact_buffer[: self.counters[IMPACTS]].copy()
+
+    @property
+    def in_contact(self) -> bool:
+        return bool(self._impact[_ACTIVE])
+
+
+__all__ = [
+    "BOGACKI_SHAMPINE",
+    "ButcherTableau",
+    "IMPACT_COLUMNS",
+    "Integrator",
+    "N_DYNAMIC",
+    "STATUS_MESSAGES",
+    "StepController",
+    "Tolerances",
+]

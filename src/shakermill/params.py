@@ -1,0 +1,336 @@
+"""Validated, immutable run parameters with the canonical keys of MODEL.md section 9.
+
+Every numeric field is SI. Users may give strings with units ("25 mm"); they are
+converted by :mod:`shakermill.units` before validation, so a ``Parameters``
+object only ever holds floats in SI.
+
+Presets are plain mappings from key to :class:`Cited` values, so that every
+default carries its source (the PyBaMM habit of parameter sets with citations).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass
+from typing import Annotated, Any, Literal, Mapping
+
+import annotated_types
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from .units import UnitError, to_si
+
+PAPER = "Son 2025, Mathematics 13, 446"
+
+
+class ParameterError(ValueError):
+    """Bad user input: one line naming the key and what is allowed."""
+
+
+def _quantity(unit: str, description: str, **bounds: float) -> Any:
+    return Field(json_schema_extra={"unit": unit, "description": description}, **bounds)
+
+
+Window = tuple[Annotated[float, annotated_types.Ge(0)], Annotated[float, annotated_types.Gt(0)]]
+
+
+class Parameters(BaseModel):
+    """One run of the one-ball shaker-mill model (MODEL.md sections 1–9)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True)
+
+    # Geometry and drive (MODEL.md section 1)
+    ball_radius: float = _quantity("m", "milling ball radius R", gt=0)
+    vial_length: float = _quantity("m", "inner length of the vial l_v", gt=0)
+    vial_diameter: float = _quantity("m", "inner diameter of the vial d_v", gt=0)
+    amplitude: float = _quantity("m", "vial oscillation amplitude X_v", gt=0)
+    omega: float = _quantity("rad/s", "vial angular frequency ω", gt=0)
+    phase: float = _quantity("rad", "vial phase φ at t = 0")
+    # Materials (Table 2)
+    ball_density: float = _quantity("kg/m^3", "ball density ρ_b", gt=0)
+    vial_density: float = _quantity("kg/m^3", "vial density ρ_v", gt=0)
+    ball_youngs_modulus: float = _quantity("Pa", "ball Young's modulus E_b", gt=0)
+    vial_youngs_modulus: float = _quantity("Pa", "vial Young's modulus E_v", gt=0)
+    ball_poisson_ratio: float = _quantity("", "ball Poisson ratio ν_b", gt=-1, lt=0.5)
+    vial_poisson_ratio: float = _quantity("", "vial Poisson ratio ν_v", gt=-1, lt=0.5)
+    ball_heat_capacity: float = _quantity("J/(kg*K)", "ball specific heat c_b", gt=0)
+    vial_heat_capacity: float = _quantity("J/(kg*K)", "vial specific heat c_v", gt=0)
+    vial_mass: float = _quantity("kg", "thermally active vial mass m_v", gt=0)
+    # Air (Table 3)
+    air_density: float = _quantity("kg/m^3", "air density ρ_a", gt=0)
+    air_viscosity_ref: float = _quantity("Pa*s", "air viscosity μ_r at the reference temperature", gt=0)
+    air_reference_temperature: float = _quantity("K", "reference temperature θ_r of Sutherland's law", gt=0)
+    air_conductivity: float = _quantity("W/(m*K)", "air thermal conductivity k_a", gt=0)
+    air_cp: float = _quantity("J/(kg*K)", "air specific heat at constant pressure c_p,a", gt=0)
+    air_heat_capacity_ratio: float = _quantity("", "c_p/c_v of air", gt=1)
+    sutherland: float = _quantity("K", "Sutherland constant S", ge=0)
+    h_inner: float = _quantity("W/(m^2*K)", "vial-to-inner-air convection coefficient h_i", ge=0)
+    h_outer: float = _quantity("W/(m^2*K)", "vial-to-surroundings convection coefficient h_o", ge=0)
+    # Collision and heat generation (Table 4)
+    restitution: float = _quantity("", "coefficient of restitution e", gt=0, le=1)
+    eta: float = _quantity("", "fraction η of dissipated power turned into heat", ge=0, le=1)
+    lam: float = _quantity("", "fraction λ of the heat that goes to the ball", ge=0, le=1)
+    beta: float = _quantity("", "convection calibration factor β", ge=0)
+    # Run (Table 4 and assumptions)
+    duration: float = _quantity("s", "simulated time", gt=0)
+    ambient_temperature: float = _quantity("K", "temperature of the surroundings θ_amb", gt=0)
+    initial_temperature: float = _quantity("K", "initial temperature θ_0 of ball, vial and air", gt=0)
+    ball_position: float = _quantity("m", "initial ball centre, relative to the vial centre")
+    ball_momentum: float = _quantity("kg*m/s", "initial ball momentum")
+    # Numerics (MODEL.md section 7)
+    rtol: float = _quantity("", "relative tolerance of the integrator", gt=0, lt=1)
+    atol_position: float = _quantity("m", "absolute tolerance on the ball position", gt=0)
+    atol_momentum: float = _quantity("kg*m/s", "absolute tolerance on the ball momentum", gt=0)
+    atol_temperature: float = _quantity("K", "absolute tolerance on temperatures", gt=0)
+    output_interval: float = _quantity("s", "sampling interval of the stored time series", gt=0)
+    # Model options (MODEL.md sections 2-4: the alternatives the spec allows)
+    no_tension: bool = Field(json_schema_extra={"description": "clip the contact force at zero (no adhesion)"})
+    heat_model: Literal["relative", "paper"] = Field(
+        json_schema_extra={"description": "'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed"}
+    )
+    convection_velocity: Literal["ball", "relative"] = Field(
+        json_schema_extra={"description": "velocity in Re: the ball's ('ball', as the paper) or relative to the vial"}
+    )
+    record_windows: tuple[Window, ...] = Field(
+        json_schema_extra={"unit": "s", "description": "(start, length) windows stored at full resolution"}
+    )
+
+    @model_validator(mode="after")
+    def _ball_fits_vial(self) -> "Parameters":
+        diameter = 2.0 * self.ball_radius
+        if diameter >= self.vial_length:
+            raise ValueError(
+                f"ball_radius: a ball of diameter {diameter * 1e3:g} mm does not fit a vial of length "
+                f"{self.vial_length * 1e3:g} mm; allowed ball_radius < vial_length/2 = {self.vial_length / 2:g} m"
+            )
+        if diameter > self.vial_diameter:
+            raise ValueError(
+                f"ball_radius: a ball of diameter {diameter * 1e3:g} mm does not fit a vial of diameter "
+                f"{self.vial_diameter * 1e3:g} mm; allowed ball_radius <= vial_diameter/2 = {self.vial_diameter / 2:g} m"
+            )
+        half_gap = self.vial_length / 2.0 - self.ball_radius
+        if abs(self.ball_position) >= half_gap:
+            raise ValueError(
+                f"ball_position: the ball must start inside the vial, allowed |ball_position| < {half_gap:g} m"
+            )
+        return self
+
+    # Derived geometry used by more than one module (MODEL.md sections 1 and 6)
+    @property
+    def ball_mass(self) -> float:
+        """m_b = ρ_b·4/3·π R³ (kg)."""
+        return self.ball_density * 4.0 / 3.0 * math.pi * self.ball_radius**3
+
+    @property
+    def end_face_area(self) -> float:
+        """A_i = A_o = 2·π·d_v²/4: both circular end faces (m²), MODEL.md section 1."""
+        return 2.0 * math.pi * self.vial_diameter**2 / 4.0
+
+    @property
+    def air_mass(self) -> float:
+        """m_a = ρ_a·(π d_v²/4·l_v − 4/3·π R³) (kg), MODEL.md section 6."""
+        vial_volume = math.pi * self.vial_diameter**2 / 4.0 * self.vial_length
+        ball_volume = 4.0 / 3.0 * math.pi * self.ball_radius**3
+        return self.air_density * (vial_volume - ball_volume)
+
+    @property
+    def air_heat_capacity(self) -> float:
+        """c_a = c_p,a/γ: the trapped air is heated at constant volume (J/(kg·K))."""
+        return self.air_cp / self.air_heat_capacity_ratio
+
+    def replace(self, **changes: Any) -> "Parameters":
+        """A new validated ``Parameters`` with ``changes`` applied (values may carry units)."""
+        return build_parameters(self.model_dump(), changes)
+
+
+FIELD_NAMES: tuple[str, ...] = tuple(Parameters.model_fields)
+
+
+def field_unit(key: str) -> str:
+    extra = Parameters.model_fields[key].json_schema_extra or {}
+    return str(extra.get("unit", ""))
+
+
+def field_description(key: str) -> str:
+    extra = Parameters.model_fields[key].json_schema_extra or {}
+    return str(extra.get("description", ""))
+
+
+def allowed_range(key: str) -> str:
+    """Human-readable allowed range of ``key`` from its field constraints, e.g. '(0, 1]'."""
+    field = Parameters.model_fields[key]
+    low, high, low_open, high_open = "-inf", "inf", True, True
+    for constraint in field.metadata:
+        if isinstance(constraint, annotated_types.Gt):
+            low, low_open = f"{constraint.gt:g}", True
+        elif isinstance(constraint, annotated_types.Ge):
+            low, low_open = f"{constraint.ge:g}", False
+        elif isinstance(constraint, annotated_types.Lt):
+            high, high_open = f"{constraint.lt:g}", True
+        elif isinstance(constraint, annotated_types.Le):
+            high, high_open = f"{constraint.le:g}", False
+    unit = field_unit(key)
+    text = f"{'(' if low_open else '['}{low}, {high}{')' if high_open else ']'}"
+    return f"{text} {unit}".rstrip()
+
+
+@dataclass(frozen=True)
+class Cited:
+    """A preset value with where it comes from."""
+
+    value: Any
+    source: str
+
+
+@dataclass(frozen=True)
+class Preset:
+    name: str
+    description: str
+    values: Mapping[str, Cited]
+
+
+SPEX_8000M = Preset(
+    name="spex8000m",
+    description="SPEX 8000M Mixer/Mill, one 12.7 mm steel ball, as in Son 2025 (published parameters).",
+    values={
+        "ball_radius": Cited(6.35e-3, f"{PAPER}, Table 1"),
+        "vial_length": Cited(58e-3, f"{PAPER}, Table 1"),
+        "vial_diameter": Cited(19e-3, f"{PAPER}, Table 1 (A_i = A_o = 567.06 mm² = 2·π·d_v²/4)"),
+        "amplitude": Cited(25e-3, f"{PAPER}, Table 1 (X_v)"),
+        "omega": Cited(111.0, "assumption: not stated (range 90-130 rad/s); ~1060 cycles/min, the SPEX 8000M on 60 Hz mains"),
+        "phase": Cited(0.0, "assumption"),
+        "ball_density": Cited(7800.0, f"{PAPER}, Table 2"),
+        "vial_density": Cited(7800.0, f"{PAPER}, Table 2"),
+        "ball_youngs_modulus": Cited(200e9, f"{PAPER}, Table 2"),
+        "vial_youngs_modulus": Cited(200e9, f"{PAPER}, Table 2"),
+        "ball_poisson_ratio": Cited(0.3, f"{PAPER}, Table 2"),
+        "vial_poisson_ratio": Cited(0.3, f"{PAPER}, Table 2"),
+        "ball_heat_capacity": Cited(461.0, f"{PAPER}, Table 2"),
+        "vial_heat_capacity": Cited(461.0, f"{PAPER}, Table 2"),
+        "vial_mass": Cited(
+            0.05,
+            "assumption: not printed in the paper; the steel near the two end faces that exchanges heat with the "
+            "inside and outside air. It sets the time constant, not the steady state; calibration fits it",
+        ),
+        "air_density": Cited(1.225, f"{PAPER}, Table 3"),
+        "air_viscosity_ref": Cited(1.716e-5, f"{PAPER}, Table 3 (at 273.15 K)"),
+        "air_reference_temperature": Cited(273.15, f"{PAPER}, Table 3 footnote (0 °C)"),
+        "air_conductivity": Cited(0.0241, f"{PAPER}, Table 3"),
+        "air_cp": Cited(1003.5, f"{PAPER}, Table 3"),
+        "air_heat_capacity_ratio": Cited(1.4, "assumption: diatomic ideal gas; c_a = c_p,a/1.4 (MODEL.md section 6)"),
+        "sutherland": Cited(111.0, f"{PAPER}, Table 3"),
+        "h_inner": Cited(200.0, f"{PAPER}, Table 3"),
+        "h_outer": Cited(45.0, f"{PAPER}, Table 3"),
+        "restitution": Cited(0.7, f"{PAPER}, Table 4 (e)"),
+        "eta": Cited(0.9, f"{PAPER}, Table 4 (η)"),
+        "lam": Cited(0.368, f"{PAPER}, Table 4 (λ)"),
+        "beta": Cited(0.3, f"{PAPER}, Table 4 (β, tuned by hand by the author)"),
+        "duration": Cited(3600.0, f"{PAPER}, Table 4 (60 min)"),
+        "ambient_temperature": Cited(293.15, f"{PAPER}, Table 3 footnote (ambient 20 °C)"),
+        "initial_temperature": Cited(293.15, f"assumption: θ̇_0 of {PAPER} Table 5 implies θ_0 = 20 °C"),
+        "ball_position": Cited(0.0, "assumption: ball starts at the vial centre"),
+        "ball_momentum": Cited(0.0, "assumption: ball starts at rest"),
+        "rtol": Cited(1e-3, "MATLAB ode23 default RelTol, as used by the paper"),
+        "atol_position": Cited(1e-6, "MATLAB ode23 default AbsTol (1e-6, in SI)"),
+        "atol_momentum": Cited(1e-6, "MATLAB ode23 default AbsTol (1e-6, in SI)"),
+        "atol_temperature": Cited(1e-6, "MATLAB ode23 default AbsTol (1e-6, in SI)"),
+        "output_interval": Cited(1.0, "assumption: 1 s sampling of the stored time series"),
+        "no_tension": Cited(False, "MODEL.md section 2: the total force is not clipped by default"),
+        "heat_model": Cited("relative", "MODEL.md section 3: frame-invariant dissipation c·ζ̇²"),
+        "convection_velocity": Cited("ball", f"{PAPER}, section 3.3 (Re from the ball's velocity)"),
+        "record_windows": Cited(
+            ((0.0, 1.0), (600.0, 0.1)),
+            f"the windows of {PAPER} Fig. 4 (first second) and Fig. 5b (100 ms at 10 min)",
+        ),
+    },
+)
+
+PRESETS: dict[str, Preset] = {SPEX_8000M.name: SPEX_8000M}
+DEFAULT_PRESET = SPEX_8000M.name
+
+
+def preset_values(name: str) -> dict[str, Any]:
+    if name not in PRESETS:
+        raise ParameterError(f"preset: unknown preset {name!r}; available: {', '.join(sorted(PRESETS))}")
+    return {key: cited.value for key, cited in PRESETS[name].values.items()}
+
+
+def check_known_keys(keys: list[str] | tuple[str, ...], *, extra_allowed: tuple[str, ...] = ()) -> None:
+    """Raise :class:`ParameterError` with a did-you-mean suggestion for the first unknown key."""
+    known = FIELD_NAMES + extra_allowed
+    for key in keys:
+        if key not in known:
+            close = difflib.get_close_matches(key, known, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else "; `shakermill keys` lists the allowed keys"
+            raise ParameterError(f"{key}: unknown parameter{hint}")
+
+
+def _coerce(key: str, value: Any) -> Any:
+    """Convert a user value for ``key`` to SI (strings with units) or to the option's type."""
+    annotation = Parameters.model_fields[key].annotation
+    if annotation is float:
+        try:
+            return to_si(value, field_unit(key), key=key)
+        except UnitError as exc:
+            raise ParameterError(str(exc)) from None
+    if key == "record_windows":
+        return _coerce_windows(value)
+    if annotation is bool and isinstance(value, str):
+        lowered = value.strip().lower()
+        if lowered in {"true", "1", "yes", "on"}:
+            return True
+        if lowered in {"false", "0", "no", "off"}:
+            return False
+        raise ParameterError(f"{key}: expected true or false, got {value!r}")
+    return value
+
+
+def _coerce_windows(value: Any) -> Any:
+    if isinstance(value, str):
+        # "--set record_windows=0:1,600:0.1" on the command line; "" means none
+        pairs = [item for item in value.split(",") if item.strip()]
+        try:
+            return tuple(
+                (to_si(start, "s", key="record_windows"), to_si(length, "s", key="record_windows"))
+                for start, length in (item.split(":") for item in pairs)
+            )
+        except (ValueError, UnitError):
+            raise ParameterError(
+                f"record_windows: expected START:LENGTH[,START:LENGTH...] in seconds, got {value!r}"
+            ) from None
+    return value
+
+
+def _one_line(error: ValidationError) -> str:
+    first = error.errors()[0]
+    location = first.get("loc") or ()
+    key = str(location[0]) if location else ""
+    if key in Parameters.model_fields:
+        value = first.get("input")
+        if first.get("type") in {"greater_than", "greater_than_equal", "less_than", "less_than_equal"}:
+            return f"{key}: {value!r} is out of range; allowed {allowed_range(key)}"
+        return f"{key}: {first['msg']} (got {value!r})"
+    return str(first["msg"]).removeprefix("Value error, ")
+
+
+def build_parameters(base: Mapping[str, Any], overrides: Mapping[str, Any] | None = None) -> Parameters:
+    """Validate ``base`` updated with ``overrides`` into :class:`Parameters`.
+
+    Raises :class:`ParameterError` with one line that names the offending key.
+    """
+    merged = dict(base)
+    merged.update(overrides or {})
+    check_known_keys(list(merged))
+    missing = [key for key in FIELD_NAMES if key not in merged]
+    if missing:
+        raise ParameterError(f"{missing[0]}: no value given and no preset supplies one")
+    coerced = {key: _coerce(key, value) for key, value in merged.items()}
+    try:
+        return Parameters(**coerced)
+    except ValidationError as exc:
+        raise ParameterError(_one_line(exc)) from None
+
+
+def default_parameters(preset: str = DEFAULT_PRESET, **overrides: Any) -> Parameters:
+    """The parameters of ``preset`` with keyword ``overrides`` (values may carry units)."""
+    return build_parameters(preset_values(preset), overrides)

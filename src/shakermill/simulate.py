@@ -1,0 +1,337 @@
+"""Parameters in, :class:`Result` out: the orchestration layer of a full-resolution run."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from . import contact, model
+from .fit import ExponentialFit, fit_exponential, increment_ratio
+from .integrate import (
+    COUNTER_NAMES,
+    IMPACT_COLUMNS,
+    REACHED_STOP,
+    STATUS_MESSAGES,
+    Integrator,
+    Tolerances,
+)
+from .params import Parameters
+
+# The step inside a contact stays below this fraction of the Rayleigh time (MODEL.md §7).
+RAYLEIGH_FRACTION = 0.9
+# A contact overlap beyond this fraction of the ball radius means the step control failed (issue: "a few percent").
+MAX_OVERLAP_FRACTION = 0.05
+# Simulated seconds per compiled chunk: the granularity of progress reports and of interruption.
+CHUNK_SECONDS = 10.0
+
+INTERRUPTED = 1
+INTERRUPTED_MESSAGE = "Interrupted by the user; the results cover the time simulated so far."
+
+ProgressCallback = Callable[[float, float], None]
+
+
+@dataclass(frozen=True)
+class EnergyAudit:
+    """Where the vial's work went, in J, over the simulated interval.
+
+    work_by_vial = Δkinetic + Δelastic + dissipated
+    dissipated   = heat_generated + not_converted_to_heat
+    heat_generated = Δstored (ball + vial + air) + heat_lost_to_surroundings
+    """
+
+    work_by_vial: float
+    kinetic_energy_change: float
+    elastic_energy_change: float
+    dissipated: float
+    heat_generated: float
+    heat_to_ball: float
+    heat_to_vial: float
+    not_converted_to_heat: float
+    stored_ball: float
+    stored_vial: float
+    stored_air: float
+    heat_lost_to_surroundings: float
+
+    @property
+    def mechanical_residual(self) -> float:
+        return self.work_by_vial - self.kinetic_energy_change - self.elastic_energy_change - self.dissipated
+
+    @property
+    def thermal_residual(self) -> float:
+        stored = self.stored_ball + self.stored_vial + self.stored_air
+        return self.heat_generated - stored - self.heat_lost_to_surroundings
+
+    @property
+    def residual(self) -> float:
+        return self.mechanical_residual + self.thermal_residual
+
+    @property
+    def relative_residual(self) -> float:
+        """|residual| over the largest flow in the balance (0 when nothing flowed)."""
+        scale = max(abs(self.work_by_vial), abs(self.dissipated), abs(self.heat_generated))
+        return abs(self.residual) / scale if scale > 0.0 else 0.0
+
+    def as_dict(self) -> dict[str, float]:
+        values = dict(self.__dict__)
+        values.update(
+            mechanical_residual=self.mechanical_residual,
+            thermal_residual=self.thermal_residual,
+            residual=self.residual,
+            relative_residual=self.relative_residual,
+        )
+        return values
+
+
+@dataclass
+class Result:
+    """Everything a run produced. ``success`` is False when the integrator stopped early."""
+
+    params: Parameters
+    status: int
+    message: str
+    t_end: float
+    timeseries: xr.Dataset
+    windows: xr.Dataset
+    impacts: pd.DataFrame
+    counters: dict[str, int]
+    wall_time: float
+    energy: EnergyAudit
+    ball_fit: ExponentialFit
+    summary: dict[str, float | int | str | bool] = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return self.status == REACHED_STOP
+
+
+def _tolerances(params: Parameters, constants: model.Constants) -> Tolerances:
+    atol = np.empty(model.N_DYNAMIC)
+    atol[model.X] = params.atol_position
+    atol[model.P] = params.atol_momentum
+    atol[model.THETA_BALL : model.THETA_AIR + 1] = params.atol_temperature
+    rayleigh = contact.rayleigh_time(
+        params.ball_radius, params.ball_density, params.ball_youngs_modulus, params.ball_poisson_ratio
+    )
+    return Tolerances(
+        rtol=params.rtol,
+        atol=atol,
+        contact_step_limit=RAYLEIGH_FRACTION * rayleigh,
+        max_overlap=MAX_OVERLAP_FRACTION * constants.radius,
+    )
+
+
+def sample_times(params: Parameters) -> np.ndarray:
+    count = int(math.floor(params.duration / params.output_interval + 1e-9))
+    times = np.arange(count + 1) * params.output_interval
+    if times[-1] < params.duration:
+        times = np.append(times, params.duration)
+    return times
+
+
+def simulate(params: Parameters, progress: ProgressCallback | None = None) -> Result:
+    """Run the full-resolution model for ``params.duration`` seconds.
+
+    ``progress(t, duration)`` is called after every chunk of simulated time. A
+    ``KeyboardInterrupt`` ends the run early with status ``INTERRUPTED`` and
+    keeps everything computed so far; numerical failures are reported through
+    ``status`` and ``message`` likewise, never raised.
+    """
+    constants = model.constants_from(params)
+    y0 = model.initial_state(params)
+    times = sample_times(params)
+    windows = np.array([(start, start + length) for start, length in params.record_windows], dtype=float).reshape(-1, 2)
+    integrator = Integrator(
+        constants=constants,
+        y=y0,
+        t0=0.0,
+        tolerances=_tolerances(params, constants),
+        sample_times=times,
+        windows=windows,
+    )
+    started = time.perf_counter()
+    status = REACHED_STOP
+    try:
+        while integrator.t < params.duration and status == REACHED_STOP:
+            status = integrator.advance(min(params.duration, integrator.t + CHUNK_SECONDS))
+            if progress is not None:
+                progress(integrator.t, params.duration)
+    except KeyboardInterrupt:
+        status = INTERRUPTED
+    wall_time = time.perf_counter() - started
+    message = INTERRUPTED_MESSAGE if status == INTERRUPTED else STATUS_MESSAGES[status]
+    if status < 0:
+        message = f"{message} Stopped at t = {integrator.t:.6g} s; results up to then are kept."
+    return _assemble(params, constants, y0, integrator, status, message, wall_time)
+
+
+def _assemble(
+    params: Parameters,
+    constants: model.Constants,
+    y0: np.ndarray,
+    integrator: Integrator,
+    status: int,
+    message: str,
+    wall_time: float,
+) -> Result:
+    t_end = integrator.t
+    written = integrator.samples_written
+    times = integrator.sample_times[:written]
+    samples = integrator.samples[:written]
+    if written == 0 or times[-1] < t_end:
+        # Close the series with the state where the run stopped, so a failed run shows its last state.
+        times = np.append(times, t_end)
+        samples = np.vstack([samples, integrator.y])
+    timeseries = state_dataset(times, samples, constants, params)
+    window_points = integrator.window_points
+    windows = state_dataset(window_points[:, 0], window_points[:, 1:], constants, params)
+    impacts = impact_table(integrator.impacts, params.lam)
+    counters = {name: int(integrator.counters[i]) for i, name in enumerate(COUNTER_NAMES)}
+    energy = energy_audit(y0, integrator.y, constants, t_end, params)
+    theta_0 = params.initial_temperature
+    ball_fit = fit_exponential(timeseries["time"].values, timeseries["theta_ball"].values, theta_0)
+    result = Result(
+        params=params,
+        status=status,
+        message=message,
+        t_end=t_end,
+        timeseries=timeseries,
+        windows=windows,
+        impacts=impacts,
+        counters=counters,
+        wall_time=wall_time,
+        energy=energy,
+        ball_fit=ball_fit,
+    )
+    result.summary = summarize(result)
+    return result
+
+
+_VARIABLES = {
+    # name: (state index, units, long name)
+    "x": (model.X, "m", "ball centre position"),
+    "p": (model.P, "kg m s-1", "ball momentum"),
+    "theta_ball": (model.THETA_BALL, "K", "ball temperature"),
+    "theta_vial": (model.THETA_VIAL, "K", "vial temperature"),
+    "theta_air": (model.THETA_AIR, "K", "inner air temperature"),
+    "work_vial": (model.WORK_VIAL, "J", "cumulative work done by the vial on the ball"),
+    "dissipated": (model.DISSIPATED, "J", "cumulative energy dissipated in contacts"),
+    "heat_generated": (model.HEAT_GENERATED, "J", "cumulative irreversible heat generated"),
+    "heat_lost": (model.HEAT_LOST, "J", "cumulative heat lost from the vial to the surroundings"),
+}
+
+
+def state_dataset(times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters) -> xr.Dataset:
+    """The state history as an xarray Dataset with units in the attributes."""
+    data_vars = {
+        name: ("time", states[:, index], {"units": units, "long_name": long_name})
+        for name, (index, units, long_name) in _VARIABLES.items()
+    }
+    data_vars["velocity"] = ("time", states[:, model.P] / constants.ball_mass, {"units": "m s-1", "long_name": "ball velocity"})
+    data_vars["vial_position"] = (
+        "time",
+        params.amplitude * np.sin(params.omega * times + params.phase),
+        {"units": "m", "long_name": "vial centre position"},
+    )
+    return xr.Dataset(
+        data_vars,
+        coords={"time": ("time", times, {"units": "s", "long_name": "simulated time"})},
+    )
+
+
+def impact_table(records: np.ndarray, lam: float) -> pd.DataFrame:
+    """One row per impact with SI units (see :data:`IMPACT_UNITS`)."""
+    table = pd.DataFrame(records, columns=list(IMPACT_COLUMNS))
+    table["wall"] = np.where(table["wall"].to_numpy() == model.LEFT_WALL, "left", "right")
+    table["heat_to_ball"] = lam * table["heat_generated"]
+    table["heat_to_vial"] = (1.0 - lam) * table["heat_generated"]
+    return table
+
+
+IMPACT_UNITS = {
+    "time": "s",
+    "wall": "",
+    "impact_speed": "m/s",
+    "rebound_speed": "m/s",
+    "dissipated_energy": "J",
+    "heat_generated": "J",
+    "max_overlap": "m",
+    "peak_force": "N",
+    "duration": "s",
+    "heat_to_ball": "J",
+    "heat_to_vial": "J",
+}
+
+
+def energy_audit(y0: np.ndarray, y1: np.ndarray, constants: model.Constants, t_end: float, params: Parameters) -> EnergyAudit:
+    kinetic = lambda y: 0.5 * y[model.P] ** 2 / constants.ball_mass  # noqa: E731
+    mechanical_change = model.mechanical_energy(t_end, y1, constants) - model.mechanical_energy(0.0, y0, constants)
+    kinetic_change = kinetic(y1) - kinetic(y0)
+    heat = y1[model.HEAT_GENERATED] - y0[model.HEAT_GENERATED]
+    dissipated = y1[model.DISSIPATED] - y0[model.DISSIPATED]
+
+    def stored(index: int, capacity: float) -> float:
+        return capacity * (y1[index] - y0[index])
+
+    return EnergyAudit(
+        work_by_vial=y1[model.WORK_VIAL] - y0[model.WORK_VIAL],
+        kinetic_energy_change=kinetic_change,
+        elastic_energy_change=mechanical_change - kinetic_change,
+        dissipated=dissipated,
+        heat_generated=heat,
+        heat_to_ball=params.lam * heat,
+        heat_to_vial=(1.0 - params.lam) * heat,
+        not_converted_to_heat=dissipated - heat,
+        stored_ball=stored(model.THETA_BALL, constants.capacity_ball),
+        stored_vial=stored(model.THETA_VIAL, constants.capacity_vial),
+        stored_air=stored(model.THETA_AIR, constants.capacity_air),
+        heat_lost_to_surroundings=y1[model.HEAT_LOST] - y0[model.HEAT_LOST],
+    )
+
+
+def kelvin_to_celsius(kelvin: float) -> float:
+    return kelvin - 273.15
+
+
+def summarize(result: Result) -> dict[str, float | int | str | bool]:
+    """The flat summary printed by ``run --json`` and stored as ``summary.json``."""
+    params = result.params
+    series = result.timeseries
+    last = series.isel(time=-1)
+    fit = result.ball_fit
+    theta_0 = params.initial_temperature
+    impacts = result.impacts
+    duration = max(result.t_end, 1e-300)
+    return {
+        "status": result.status,
+        "success": result.success,
+        "message": result.message,
+        "simulated_s": result.t_end,
+        "theta_inf_C": kelvin_to_celsius(fit.theta_inf),
+        "theta_inf_stderr_K": fit.theta_inf_stderr,
+        "tau_min": fit.tau / 60.0,
+        "tau_stderr_min": fit.tau_stderr / 60.0,
+        "rate0_C_per_min": fit.initial_rate * 60.0,
+        "fit_rms_residual_K": fit.rms_residual,
+        "ball_C": kelvin_to_celsius(float(last["theta_ball"])),
+        "vial_C": kelvin_to_celsius(float(last["theta_vial"])),
+        "air_C": kelvin_to_celsius(float(last["theta_air"])),
+        "vial_ball_ratio": increment_ratio(float(last["theta_vial"]), float(last["theta_ball"]), theta_0),
+        "impacts": int(len(impacts)),
+        "impact_rate_hz": len(impacts) / duration,
+        "heat_power_W": result.energy.heat_generated / duration,
+        "dissipated_power_W": result.energy.dissipated / duration,
+        "mean_impact_speed_m_s": float(impacts["impact_speed"].mean()) if len(impacts) else math.nan,
+        "max_impact_speed_m_s": float(impacts["impact_speed"].max()) if len(impacts) else math.nan,
+        "mean_dissipated_per_impact_J": float(impacts["dissipated_energy"].mean()) if len(impacts) else math.nan,
+        "steps": result.counters["steps"],
+        "rejected_steps": result.counters["rejected_steps"],
+        "rhs_evaluations": result.counters["rhs_evaluations"],
+        "wall_time_s": result.wall_time,
+        "energy_audit_residual": result.energy.relative_residual,
+    }
