@@ -43,7 +43,7 @@ def hertz_force(overlap: float, e_star: float, radius: float) -> float:
     The paper's Eq. 7 prints the square root over the whole product; the
     standard Hertz law, used here, is MODEL.md difference 1.
     """
-    return 4.0 / 3.0 * e_star * math.sqrt(radius) * overlap**1.5
+    return 4.0 / 3.0 * e_star * math.sqrt(radius) * overlap * math.sqrt(overlap)
 
 
 @njit(cache=True)
@@ -62,7 +62,7 @@ def damping_ratio(restitution: float) -> float:
 @njit(cache=True)
 def damping_coefficient(overlap: float, mass: float, radius: float, e_star: float, beta_e: float) -> float:
     """c(ζ) = −√(20/3)·β_e·(m²·R·E*²·ζ)^{1/4} in N·s/m, ≥ 0 for e ≤ 1 (MODEL.md §2)."""
-    return -math.sqrt(20.0 / 3.0) * beta_e * (mass * mass * radius * e_star * e_star * overlap) ** 0.25
+    return -math.sqrt(20.0 / 3.0) * beta_e * math.sqrt(math.sqrt(mass * mass * radius * e_star * e_star * overlap))
 
 
 @njit(cache=True)
@@ -91,11 +91,13 @@ def rayleigh_time(radius: float, density: float, youngs_modulus: float, poisson_
     return math.pi * radius / (_RAYLEIGH_A * poisson_ratio + _RAYLEIGH_B) * math.sqrt(density / shear_modulus)
 
 
+@njit(cache=True)
 def hertz_max_overlap(mass: float, radius: float, e_star: float, speed: float) -> float:
     """Largest overlap of an undamped Hertz impact, ζ_max = (15 m v² / (16 E* √R))^{2/5}, in m."""
     return (15.0 * mass * speed**2 / (16.0 * e_star * math.sqrt(radius))) ** 0.4
 
 
+@njit(cache=True)
 def hertz_contact_time(mass: float, radius: float, e_star: float, speed: float) -> float:
     """Duration of an undamped Hertz impact, 2.9432·ζ_max/v, in s (Johnson 1985, §11.4)."""
     return HERTZ_DURATION_FACTOR * hertz_max_overlap(mass, radius, e_star, speed) / speed

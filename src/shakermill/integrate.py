@@ -29,6 +29,8 @@ from fractions import Fraction
 import numpy as np
 from numba import njit
 
+from . import drive
+from .contact import elastic_energy, hertz_contact_time
 from .model import (
     DISSIPATED,
     HEAT_GENERATED,
@@ -41,9 +43,10 @@ from .model import (
     X,
     Constants,
     contact_forces,
+    WORK_VIAL,
+    mechanical_energy,
     gap,
     rhs,
-    wall_contact,
 )
 
 # Status codes of the compiled loop (negative: failure).
@@ -73,12 +76,24 @@ IMPACT_COLUMNS = (
 )
 _IMPACT_WIDTH = len(IMPACT_COLUMNS)
 # Layout of the impact in progress, carried between chunks.
-_ACTIVE, _WALL, _START, _SPEED_IN, _DISSIPATED0, _HEAT0, _MAX_OVERLAP, _PEAK_FORCE = range(8)
+_ACTIVE, _WALL, _START, _SPEED_IN, _DISSIPATED0, _HEAT0, _MAX_OVERLAP, _PEAK_FORCE, _FLIGHT_STEP = range(9)
 # Counters.
 STEPS, REJECTED, RHS_EVALUATIONS, IMPACTS, SAMPLES_WRITTEN, WINDOW_POINTS = range(6)
 COUNTER_NAMES = ("steps", "rejected_steps", "rhs_evaluations", "impacts")
+# Diagnostics of the energy projection: total |ΔKE| applied (J) and steps left unprojected.
+_CORRECTION, _UNPROJECTED = range(2)
 
 _INITIAL_CAPACITY = 1024
+# Pending intervals of the contact-onset search: one per halving of a step, and a step halves at most
+# ~60 times before reaching the resolution of the time variable.
+_STACK_ROWS = 128
+# Safeguarded Newton converges in a handful of iterations; bisection alone would need ~60.
+_ROOT_ITERATIONS = 100
+# First step of a contact as a fraction of the Hertz duration at the approach speed. The damping
+# force grows like ζ^{1/4} from the onset, so the error estimate of a step that starts there is
+# unreliable; a short first step followed by the controller's geometric growth grades the mesh
+# towards the singular point and keeps its error negligible.
+ONSET_STEP_FRACTION = 1e-2
 # Relative resolution of the time variable used to stop bisection of a contact onset.
 _TIME_RESOLUTION = 4.0 * np.finfo(float).eps
 
@@ -183,14 +198,48 @@ def _grow(buffer: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _first_touch_of_wall(t: float, h: float, x: float, velocity: float, wall: int, curvature: float, k: Constants) -> float:
+def _gap_rate(t: float, velocity: float, wall: int, k: Constants) -> float:
+    """d(gap)/dt in free flight (m/s)."""
+    vial_velocity = drive.vial_velocity(t, k.amplitude, k.omega, k.phase)
+    return velocity - vial_velocity if wall == LEFT_WALL else vial_velocity - velocity
+
+
+@njit(cache=True)
+def _refine_root(t: float, x: float, velocity: float, wall: int, k: Constants,
+                 a: float, b: float, resolution: float) -> float:
+    """The single zero of a monotone gap on [a, b] (gap(a) > 0 ≥ gap(b)), by safeguarded Newton.
+
+    Returns the upper end of the final bracket, so the landing point touches (gap ≤ 0).
+    """
+    s = b
+    for _ in range(_ROOT_ITERATIONS):
+        if b - a <= resolution:
+            break
+        gap_s = gap(t + s, x + velocity * s, wall, k)
+        if gap_s > 0.0:
+            a = s
+        else:
+            b = s
+        rate = _gap_rate(t + s, velocity, wall, k)
+        newton = s - gap_s / rate if rate != 0.0 else a
+        # Step a little past the Newton point so the bracket closes from both sides.
+        newton += resolution if gap_s > 0.0 else -resolution
+        s = newton if a < newton < b else 0.5 * (a + b)
+    return b
+
+
+@njit(cache=True)
+def _first_touch_of_wall(t: float, h: float, x: float, velocity: float, wall: int, curvature: float,
+                         k: Constants, stack: np.ndarray) -> float:
     """Earliest s in [0, h] where the free-flight gap to ``wall`` reaches 0, or −1 if none.
 
-    Intervals are examined left to right; one is discarded only when the bound
-    gap(s) ≥ min(gap(a), gap(b)) − curvature·(b − a)²/8 proves it free of zeros.
+    Intervals are examined left to right. One is discarded only when the bound
+    gap(s) ≥ min(gap(a), gap(b)) − curvature·(b − a)²/8 proves it free of zeros;
+    a sign change is refined once the slope bound |gap'(b)| > curvature·(b − a)
+    proves the gap monotone there, so the zero found is the first one.
+    ``stack`` is scratch space of at least 2 × 64 rows: each halving leaves one pending interval.
     """
     resolution = _TIME_RESOLUTION * max(1.0, abs(t) + h)
-    stack = np.empty((256, 4))
     stack[0, 0] = 0.0
     stack[0, 1] = h
     stack[0, 2] = gap(t, x, wall, k)
@@ -201,16 +250,15 @@ def _first_touch_of_wall(t: float, h: float, x: float, velocity: float, wall: in
     while top > 0:
         top -= 1
         a, b, gap_a, gap_b = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
-        if min(gap_a, gap_b) - curvature * (b - a) ** 2 / 8.0 > 0.0:
+        width = b - a
+        if min(gap_a, gap_b) - curvature * width * width / 8.0 > 0.0:
             continue
-        if b - a <= resolution:
-            if gap_b <= 0.0:
-                return b
+        if gap_b <= 0.0 and (width <= resolution or abs(_gap_rate(t + b, velocity, wall, k)) > curvature * width):
+            return _refine_root(t, x, velocity, wall, k, a, b, resolution)
+        if width <= resolution:
             continue
         middle = 0.5 * (a + b)
         gap_middle = gap(t + middle, x + velocity * middle, wall, k)
-        if top + 2 > stack.shape[0]:
-            stack = _grow(stack)
         # right half below the left half, so the left half is examined first
         stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = middle, b, gap_middle, gap_b
         stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2], stack[top + 1, 3] = a, middle, gap_a, gap_middle
@@ -267,10 +315,39 @@ def _error_norm(h: float, y: np.ndarray, y_new: np.ndarray, stages: np.ndarray, 
 
 
 @njit(cache=True)
+def _project_momentum(energy_before: float, y: np.ndarray, y_new: np.ndarray, elastic_new: float,
+                      k: Constants, diagnostics: np.ndarray) -> None:
+    """Project |p| of a contact step onto the mechanical energy balance of that step.
+
+    ΔE_mech = W_vial − E_diss must hold over the step, with W_vial and E_diss the
+    step's quadratures (the standard projection method, Hairer, Lubich & Wanner,
+    Geometric Numerical Integration, §IV.4). The order of the method is kept; the
+    dissipated energy, which makes the heat, is untouched. The size of every
+    correction is accumulated in ``diagnostics`` so the truncation error stays visible.
+    """
+    target = energy_before + (y_new[WORK_VIAL] - y[WORK_VIAL]) - (y_new[DISSIPATED] - y[DISSIPATED])
+    kinetic_now = 0.5 * y_new[P] * y_new[P] / k.ball_mass
+    kinetic_target = target - elastic_new
+    if kinetic_target > 0.0 and y_new[P] != 0.0:
+        y_new[P] = np.sign(y_new[P]) * np.sqrt(2.0 * k.ball_mass * kinetic_target)
+        diagnostics[_CORRECTION] += abs(kinetic_target - kinetic_now)
+    else:
+        # At a turning point the balance may ask for negative kinetic energy; leave that step alone.
+        diagnostics[_UNPROJECTED] += 1.0
+
+
+@njit(cache=True)
+def _rate_into_wall(wall: int, velocity: float, vial_velocity: float) -> float:
+    """ζ̇ for ``wall``: positive while the ball and the wall approach (MODEL.md §2)."""
+    return vial_velocity - velocity if wall == LEFT_WALL else velocity - vial_velocity
+
+
+@njit(cache=True)
 def _advance(
     t_stop, clock, y, f0, a, b, error_weights, c, k, rtol, atol, contact_step_limit, max_overlap,
     safety, min_factor, max_factor, error_exponent,
     sample_times, samples, windows, window_buffer, impact_buffer, impact, counters,
+    project_energy, diagnostics,
 ):
     """Integrate from ``clock[0]`` to ``t_stop``; see :meth:`Integrator.advance`. Returns (status, buffers)."""
     n = y.shape[0]
@@ -278,50 +355,64 @@ def _advance(
     y_new = np.empty(n)
     work = np.empty(n)
     point = np.empty(n)
+    stack = np.empty((_STACK_ROWS, 4))
     curvature = k.amplitude * k.omega * k.omega
     t = clock[0]
     h = clock[1]
+    rejected_last = False
+    flight_proposal = h
+    energy = mechanical_energy(t, y, k)
     while t < t_stop:
         in_contact = impact[_ACTIVE] != 0.0
         h = min(h, t_stop - t)
+        landed_wall = NO_WALL
         if in_contact:
             h = min(h, contact_step_limit)
-        if h <= _TIME_RESOLUTION * max(1.0, abs(t)):
+        else:
+            # Shorten a flight step to the first contact onset: the flight path is exact, so this
+            # costs no right-hand-side evaluations and no trial step ever runs into a wall.
+            velocity = y[P] / k.ball_mass
+            flight_proposal = h
+            for wall in (LEFT_WALL, RIGHT_WALL):
+                touch = _first_touch_of_wall(t, h, y[X], velocity, wall, curvature, k, stack)
+                if touch >= 0.0 and (landed_wall == NO_WALL or touch < h):
+                    h, landed_wall = touch, wall
+        if landed_wall == NO_WALL and h <= _TIME_RESOLUTION * max(1.0, abs(t)):
             clock[0], clock[1] = t, h
             return STEP_UNDERFLOW, window_buffer, impact_buffer
         stages[0] = f0
-        _rk_step(t, h, y, a, b, c, k, stages, y_new, work)
-        counters[RHS_EVALUATIONS] += c.shape[0] - 1
-        error = _error_norm(h, y, y_new, stages, error_weights, rtol, atol)
+        if h > 0.0:
+            _rk_step(t, h, y, a, b, c, k, stages, y_new, work)
+            counters[RHS_EVALUATIONS] += c.shape[0] - 1
+            error = _error_norm(h, y, y_new, stages, error_weights, rtol, atol)
+        else:
+            y_new[:] = y
+            stages[c.shape[0] - 1] = f0
+            error = 0.0
         if not error <= 1.0:  # also rejects NaN
             counters[REJECTED] += 1
             factor = min_factor if not np.isfinite(error) else max(min_factor, safety * error**error_exponent)
             h *= factor
+            rejected_last = True
             continue
         factor = max_factor if error == 0.0 else min(max_factor, safety * error**error_exponent)
-
-        landed_wall = NO_WALL
-        if not in_contact:
-            velocity = y[P] / k.ball_mass
-            first, wall_hit = -1.0, NO_WALL
-            for wall in (LEFT_WALL, RIGHT_WALL):
-                touch = _first_touch_of_wall(t, h, y[X], velocity, wall, curvature, k)
-                if touch >= 0.0 and (first < 0.0 or touch < first):
-                    first, wall_hit = touch, wall
-            if first >= 0.0:
-                landed_wall = wall_hit
-                if first < h:
-                    # Redo the step up to the onset: every stage is still in flight, so it is exact for x.
-                    h = first
-                    stages[0] = f0
-                    if h > 0.0:
-                        _rk_step(t, h, y, a, b, c, k, stages, y_new, work)
-                        counters[RHS_EVALUATIONS] += c.shape[0] - 1
-                    else:
-                        y_new[:] = y
-                        stages[c.shape[0] - 1] = f0
+        if rejected_last:
+            factor = min(1.0, factor)
+        rejected_last = False
 
         t_new = t + h
+        touching = in_contact or landed_wall != NO_WALL
+        elastic_new = 0.0
+        if touching:
+            wall = int(impact[_WALL]) if in_contact else landed_wall
+            overlap = -gap(t_new, y_new[X], wall, k)
+            vial_velocity = drive.vial_velocity(t_new, k.amplitude, k.omega, k.phase)
+            if overlap > 0.0:
+                elastic_new = elastic_energy(overlap, k.e_star, k.radius)
+            if in_contact and project_energy:
+                _project_momentum(energy, y, y_new, elastic_new, k, diagnostics)
+                rhs(t_new, y_new, k, stages[c.shape[0] - 1])
+                counters[RHS_EVALUATIONS] += 1
         for i in range(n):
             if not np.isfinite(y_new[i]):
                 clock[0], clock[1] = t, h
@@ -351,24 +442,20 @@ def _advance(
                 break
 
         # Impact bookkeeping.
-        velocity_new = y_new[P] / k.ball_mass
-        if landed_wall != NO_WALL:
-            _, _, _, vial_velocity = wall_contact(t_new, y_new[X], velocity_new, k)
-            approach = vial_velocity - velocity_new if landed_wall == LEFT_WALL else velocity_new - vial_velocity
-            impact[_ACTIVE] = 1.0
-            impact[_WALL] = landed_wall
-            impact[_START] = t_new
-            impact[_SPEED_IN] = approach
-            impact[_DISSIPATED0] = y_new[DISSIPATED]
-            impact[_HEAT0] = y_new[HEAT_GENERATED]
-            impact[_MAX_OVERLAP] = 0.0
-            impact[_PEAK_FORCE] = 0.0
-        elif in_contact:
-            wall = int(impact[_WALL])
-            overlap = -gap(t_new, y_new[X], wall, k)
-            _, _, _, vial_velocity = wall_contact(t_new, y_new[X], velocity_new, k)
-            overlap_rate = vial_velocity - velocity_new if wall == LEFT_WALL else velocity_new - vial_velocity
-            if overlap > 0.0:  # still touching; overlap <= 0 below means it left the wall
+        if touching:
+            velocity_new = y_new[P] / k.ball_mass
+            overlap_rate = _rate_into_wall(wall, velocity_new, vial_velocity)
+            if landed_wall != NO_WALL:
+                impact[_ACTIVE] = 1.0
+                impact[_WALL] = landed_wall
+                impact[_START] = t_new
+                impact[_SPEED_IN] = overlap_rate
+                impact[_DISSIPATED0] = y_new[DISSIPATED]
+                impact[_HEAT0] = y_new[HEAT_GENERATED]
+                impact[_MAX_OVERLAP] = 0.0
+                impact[_PEAK_FORCE] = 0.0
+                impact[_FLIGHT_STEP] = flight_proposal
+            elif overlap > 0.0:  # still touching; overlap <= 0 below means it left the wall
                 force, _ = contact_forces(overlap, overlap_rate, k)
                 impact[_MAX_OVERLAP] = max(impact[_MAX_OVERLAP], overlap)
                 impact[_PEAK_FORCE] = max(impact[_PEAK_FORCE], force)
@@ -379,17 +466,15 @@ def _advance(
                     return OVERLAP_TOO_LARGE, window_buffer, impact_buffer
             else:
                 # Left the wall during this step: back-extrapolate the separation on the free flight.
-                separation = t_new - (-overlap) / max(-overlap_rate, 1e-300)
-                separation = max(separation, impact[_START])
-                _, _, _, vial_at_separation = wall_contact(separation, y_new[X], velocity_new, k)
-                rebound = velocity_new - vial_at_separation if wall == LEFT_WALL else vial_at_separation - velocity_new
+                separation = max(t_new - (-overlap) / max(-overlap_rate, 1e-300), impact[_START])
+                vial_at_separation = drive.vial_velocity(separation, k.amplitude, k.omega, k.phase)
                 row = counters[IMPACTS]
                 if row >= impact_buffer.shape[0]:
                     impact_buffer = _grow(impact_buffer)
                 impact_buffer[row, 0] = impact[_START]
                 impact_buffer[row, 1] = wall
                 impact_buffer[row, 2] = impact[_SPEED_IN]
-                impact_buffer[row, 3] = rebound
+                impact_buffer[row, 3] = -_rate_into_wall(wall, velocity_new, vial_at_separation)
                 impact_buffer[row, 4] = y_new[DISSIPATED] - impact[_DISSIPATED0]
                 impact_buffer[row, 5] = y_new[HEAT_GENERATED] - impact[_HEAT0]
                 impact_buffer[row, 6] = impact[_MAX_OVERLAP]
@@ -401,9 +486,17 @@ def _advance(
         t = t_new
         y[:] = y_new
         f0[:] = f_new
+        energy = 0.5 * y[P] * y[P] / k.ball_mass + elastic_new
         counters[STEPS] += 1
-        # A landing step may be arbitrarily short; restart the contact from its step limit instead.
-        h = h * factor if landed_wall == NO_WALL else contact_step_limit
+        if landed_wall == NO_WALL:
+            h = h * factor
+            if in_contact and impact[_ACTIVE] == 0.0:
+                # Just left the wall: flight is exact for the mechanics, so resume the flight step
+                # the controller had reached before this contact instead of growing from contact scale.
+                h = max(h, impact[_FLIGHT_STEP])
+        else:
+            expected = hertz_contact_time(k.ball_mass, k.radius, k.e_star, max(impact[_SPEED_IN], 1e-12))
+            h = min(contact_step_limit, ONSET_STEP_FRACTION * expected)
     clock[0], clock[1] = t, h
     return REACHED_STOP, window_buffer, impact_buffer
 
@@ -421,6 +514,7 @@ class Integrator:
     tableau: ButcherTableau = BOGACKI_SHAMPINE
     controller: StepController = field(default_factory=StepController)
     initial_step: float = 1e-5
+    project_energy: bool = True
 
     def __post_init__(self) -> None:
         self._a, self._b, self._error_weights, self._c = self.tableau.arrays()
@@ -431,9 +525,19 @@ class Integrator:
         self.samples = np.full((self.sample_times.shape[0], N_STATE), np.nan)
         self._window_buffer = np.empty((_INITIAL_CAPACITY, N_STATE + 1))
         self._impact_buffer = np.empty((_INITIAL_CAPACITY, _IMPACT_WIDTH))
-        self._impact = np.zeros(8)
+        self._impact = np.zeros(9)
         self.counters = np.zeros(6, dtype=np.int64)
         self.counters[RHS_EVALUATIONS] = 1
+        self.diagnostics = np.zeros(2)
+
+    @property
+    def energy_correction(self) -> float:
+        """Total |ΔKE| applied by the energy projection so far (J)."""
+        return float(self.diagnostics[_CORRECTION])
+
+    @property
+    def unprojected_steps(self) -> int:
+        return int(self.diagnostics[_UNPROJECTED])
 
     @property
     def t(self) -> float:
@@ -447,7 +551,7 @@ class Integrator:
             self.tolerances.max_overlap, self.controller.safety, self.controller.min_factor,
             self.controller.max_factor, -1.0 / (self.tableau.error_order + 1),
             self.sample_times, self.samples, self.windows, self._window_buffer, self._impact_buffer,
-            self._impact, self.counters,
+            self._impact, self.counters, self.project_energy, self.diagnostics,
         )
         return int(status)
 

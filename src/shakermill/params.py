@@ -83,6 +83,9 @@ class Parameters(BaseModel):
     atol_momentum: float = _quantity("kg*m/s", "absolute tolerance on the ball momentum", gt=0)
     atol_temperature: float = _quantity("K", "absolute tolerance on temperatures", gt=0)
     output_interval: float = _quantity("s", "sampling interval of the stored time series", gt=0)
+    energy_projection: bool = Field(
+        json_schema_extra={"description": "enforce the mechanical energy balance of each contact step by projection"}
+    )
     # Model options (MODEL.md sections 2-4: the alternatives the spec allows)
     no_tension: bool = Field(json_schema_extra={"description": "clip the contact force at zero (no adhesion)"})
     heat_model: Literal["relative", "paper"] = Field(
@@ -235,6 +238,7 @@ SPEX_8000M = Preset(
         "atol_momentum": Cited(1e-6, "MATLAB ode23 default AbsTol (1e-6, in SI)"),
         "atol_temperature": Cited(1e-6, "MATLAB ode23 default AbsTol (1e-6, in SI)"),
         "output_interval": Cited(1.0, "assumption: 1 s sampling of the stored time series"),
+        "energy_projection": Cited(True, "numerical choice: projection method (Hairer, Lubich & Wanner 2006, §IV.4)"),
         "no_tension": Cited(False, "MODEL.md section 2: the total force is not clipped by default"),
         "heat_model": Cited("relative", "MODEL.md section 3: frame-invariant dissipation c·ζ̇²"),
         "convection_velocity": Cited("ball", f"{PAPER}, section 3.3 (Re from the ball's velocity)"),

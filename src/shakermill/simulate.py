@@ -153,6 +153,7 @@ def simulate(params: Parameters, progress: ProgressCallback | None = None) -> Re
         tolerances=_tolerances(params, constants),
         sample_times=times,
         windows=windows,
+        project_energy=params.energy_projection,
     )
     started = time.perf_counter()
     status = REACHED_STOP

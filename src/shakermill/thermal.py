@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 
 @njit(cache=True)
 def sutherland_viscosity(temperature: float, mu_ref: float, t_ref: float, sutherland: float) -> float:
     """μ(θ) = μ_r·(θ/θ_r)^{3/2}·(θ_r + S)/(θ + S) in Pa·s (MODEL.md §4; paper Eq. 14)."""
-    return mu_ref * (temperature / t_ref) ** 1.5 * (t_ref + sutherland) / (temperature + sutherland)
+    ratio = temperature / t_ref
+    return mu_ref * ratio * math.sqrt(ratio) * (t_ref + sutherland) / (temperature + sutherland)
 
 
 @njit(cache=True)
@@ -28,7 +30,8 @@ def prandtl_number(cp: float, viscosity: float, conductivity: float) -> float:
 @njit(cache=True)
 def whitaker_velocity_term(reynolds: float) -> float:
     """The velocity-dependent part of Whitaker's correlation, 0.4·Re^{1/2} + 0.06·Re^{2/3}."""
-    return 0.4 * math.sqrt(reynolds) + 0.06 * reynolds ** (2.0 / 3.0)
+    root = math.sqrt(reynolds)
+    return 0.4 * root + 0.06 * np.cbrt(reynolds * reynolds)
 
 
 @njit(cache=True)
@@ -37,7 +40,7 @@ def whitaker_nusselt(reynolds: float, prandtl: float, viscosity_ratio: float) ->
 
     ``viscosity_ratio`` is μ(θ_b)/μ_r exactly as the paper prints it.
     """
-    return 2.0 + whitaker_velocity_term(reynolds) * prandtl**0.4 * viscosity_ratio**-0.25
+    return 2.0 + whitaker_velocity_term(reynolds) * prandtl**0.4 / math.sqrt(math.sqrt(viscosity_ratio))
 
 
 @njit(cache=True)
