@@ -44,7 +44,6 @@ from .model import (
     Constants,
     contact_forces,
     WORK_VIAL,
-    mechanical_energy,
     gap,
     rhs,
 )
@@ -76,7 +75,8 @@ IMPACT_COLUMNS = (
 )
 _IMPACT_WIDTH = len(IMPACT_COLUMNS)
 # Layout of the impact in progress, carried between chunks.
-_ACTIVE, _WALL, _START, _SPEED_IN, _DISSIPATED0, _HEAT0, _MAX_OVERLAP, _PEAK_FORCE, _FLIGHT_STEP = range(9)
+(_ACTIVE, _WALL, _START, _SPEED_IN, _DISSIPATED0, _HEAT0, _MAX_OVERLAP, _PEAK_FORCE, _FLIGHT_STEP, _ENERGY0,
+ _WORK0) = range(11)
 # Counters.
 STEPS, REJECTED, RHS_EVALUATIONS, IMPACTS, SAMPLES_WRITTEN, WINDOW_POINTS = range(6)
 COUNTER_NAMES = ("steps", "rejected_steps", "rhs_evaluations", "impacts")
@@ -315,24 +315,30 @@ def _error_norm(h: float, y: np.ndarray, y_new: np.ndarray, stages: np.ndarray, 
 
 
 @njit(cache=True)
-def _project_momentum(energy_before: float, y: np.ndarray, y_new: np.ndarray, elastic_new: float,
-                      k: Constants, diagnostics: np.ndarray) -> None:
-    """Project |p| of a contact step onto the mechanical energy balance of that step.
+def _project_momentum(impact: np.ndarray, y_new: np.ndarray, elastic_new: float, k: Constants,
+                      diagnostics: np.ndarray) -> None:
+    """Project |p| onto the mechanical energy balance of the contact so far.
 
-    ΔE_mech = W_vial − E_diss must hold over the step, with W_vial and E_diss the
-    step's quadratures (the standard projection method, Hairer, Lubich & Wanner,
-    Geometric Numerical Integration, §IV.4). The order of the method is kept; the
-    dissipated energy, which makes the heat, is untouched. The size of every
-    correction is accumulated in ``diagnostics`` so the truncation error stays visible.
+    E_mech(now) = E_mech(onset) + W_vial − E_diss over the contact, with W_vial
+    and E_diss the quadratures integrated with the same stages (the standard
+    projection method, Hairer, Lubich & Wanner, Geometric Numerical Integration,
+    §IV.4). It is applied when the ball leaves the wall (and at the end of a
+    chunk inside a contact), keeps the order of the method and leaves the
+    dissipated energy, which makes the heat, untouched. Every correction is
+    accumulated in ``diagnostics`` so the truncation error stays visible.
     """
-    target = energy_before + (y_new[WORK_VIAL] - y[WORK_VIAL]) - (y_new[DISSIPATED] - y[DISSIPATED])
+    target = (
+        impact[_ENERGY0]
+        + (y_new[WORK_VIAL] - impact[_WORK0])
+        - (y_new[DISSIPATED] - impact[_DISSIPATED0])
+    )
     kinetic_now = 0.5 * y_new[P] * y_new[P] / k.ball_mass
     kinetic_target = target - elastic_new
     if kinetic_target > 0.0 and y_new[P] != 0.0:
         y_new[P] = np.sign(y_new[P]) * np.sqrt(2.0 * k.ball_mass * kinetic_target)
         diagnostics[_CORRECTION] += abs(kinetic_target - kinetic_now)
     else:
-        # At a turning point the balance may ask for negative kinetic energy; leave that step alone.
+        # At a turning point the balance may ask for negative kinetic energy; leave that state alone.
         diagnostics[_UNPROJECTED] += 1.0
 
 
@@ -361,7 +367,6 @@ def _advance(
     h = clock[1]
     rejected_last = False
     flight_proposal = h
-    energy = mechanical_energy(t, y, k)
     while t < t_stop:
         in_contact = impact[_ACTIVE] != 0.0
         h = min(h, t_stop - t)
@@ -409,8 +414,8 @@ def _advance(
             vial_velocity = drive.vial_velocity(t_new, k.amplitude, k.omega, k.phase)
             if overlap > 0.0:
                 elastic_new = elastic_energy(overlap, k.e_star, k.radius)
-            if in_contact and project_energy:
-                _project_momentum(energy, y, y_new, elastic_new, k, diagnostics)
+            if in_contact and project_energy and (overlap <= 0.0 or t_new >= t_stop):
+                _project_momentum(impact, y_new, elastic_new, k, diagnostics)
                 rhs(t_new, y_new, k, stages[c.shape[0] - 1])
                 counters[RHS_EVALUATIONS] += 1
         for i in range(n):
@@ -455,6 +460,8 @@ def _advance(
                 impact[_MAX_OVERLAP] = 0.0
                 impact[_PEAK_FORCE] = 0.0
                 impact[_FLIGHT_STEP] = flight_proposal
+                impact[_ENERGY0] = 0.5 * y_new[P] * y_new[P] / k.ball_mass + elastic_new
+                impact[_WORK0] = y_new[WORK_VIAL]
             elif overlap > 0.0:  # still touching; overlap <= 0 below means it left the wall
                 force, _ = contact_forces(overlap, overlap_rate, k)
                 impact[_MAX_OVERLAP] = max(impact[_MAX_OVERLAP], overlap)
@@ -486,7 +493,6 @@ def _advance(
         t = t_new
         y[:] = y_new
         f0[:] = f_new
-        energy = 0.5 * y[P] * y[P] / k.ball_mass + elastic_new
         counters[STEPS] += 1
         if landed_wall == NO_WALL:
             h = h * factor
@@ -525,7 +531,7 @@ class Integrator:
         self.samples = np.full((self.sample_times.shape[0], N_STATE), np.nan)
         self._window_buffer = np.empty((_INITIAL_CAPACITY, N_STATE + 1))
         self._impact_buffer = np.empty((_INITIAL_CAPACITY, _IMPACT_WIDTH))
-        self._impact = np.zeros(9)
+        self._impact = np.zeros(11)
         self.counters = np.zeros(6, dtype=np.int64)
         self.counters[RHS_EVALUATIONS] = 1
         self.diagnostics = np.zeros(2)

@@ -151,6 +151,36 @@ def gap(t: float, x: float, wall: int, k: Constants) -> float:
 
 
 @njit(cache=True)
+def thermal_network(
+    t_ball: float, t_vial: float, t_air: float, heat_generated: float, velocity_term: float, k: Constants
+) -> tuple[float, float, float, float]:
+    """(θ̇_b, θ̇_v, θ̇_a, Q̇_vo) of the three-node network (MODEL.md §§4–6).
+
+    ``heat_generated`` is Q̇_irr (W), split λ : (1 − λ) between ball and vial;
+    ``velocity_term`` is the velocity-dependent part of Whitaker's correlation,
+    0.4 Re^{1/2} + 0.06 Re^{2/3}, so that the temperature dependence through
+    Sutherland's law is evaluated here, at the current ball temperature.
+    """
+    viscosity_ratio = thermal.sutherland_viscosity(t_ball, k.mu_ref, k.t_ref, k.sutherland) / k.mu_ref
+    nusselt = thermal.nusselt_from_velocity_term(velocity_term, k.prandtl, viscosity_ratio)
+    h_ball = thermal.heat_transfer_coefficient(nusselt, k.air_conductivity, k.radius)
+    ball_to_air = thermal.ball_air_heat_flow(k.radius, k.beta, h_ball, t_ball, t_air)
+    vial_to_air = thermal.newton_cooling(k.h_inner, k.face_area, t_vial, t_air)
+    vial_to_outside = thermal.newton_cooling(k.h_outer, k.face_area, t_vial, k.t_ambient)
+    rate_ball, rate_vial, rate_air = thermal.temperature_rates(
+        k.lam * heat_generated,
+        (1.0 - k.lam) * heat_generated,
+        ball_to_air,
+        vial_to_air,
+        vial_to_outside,
+        k.capacity_ball,
+        k.capacity_vial,
+        k.capacity_air,
+    )
+    return rate_ball, rate_vial, rate_air, vial_to_outside
+
+
+@njit(cache=True)
 def rhs(t: float, y: np.ndarray, k: Constants, dydt: np.ndarray) -> None:
     """Write dy/dt of the state (module docstring) into ``dydt`` (MODEL.md §§2–6; paper Eqs. 32–36)."""
     velocity = y[P] / k.ball_mass
@@ -172,21 +202,8 @@ def rhs(t: float, y: np.ndarray, k: Constants, dydt: np.ndarray) -> None:
 
     convection_speed = velocity - vial_velocity if k.relative_convection else velocity
     reynolds = thermal.reynolds_number(k.radius, k.air_density, convection_speed, k.viscosity_ambient)
-    viscosity_ratio = thermal.sutherland_viscosity(y[THETA_BALL], k.mu_ref, k.t_ref, k.sutherland) / k.mu_ref
-    nusselt = thermal.whitaker_nusselt(reynolds, k.prandtl, viscosity_ratio)
-    h_ball = thermal.heat_transfer_coefficient(nusselt, k.air_conductivity, k.radius)
-    ball_to_air = thermal.ball_air_heat_flow(k.radius, k.beta, h_ball, y[THETA_BALL], y[THETA_AIR])
-    vial_to_air = thermal.newton_cooling(k.h_inner, k.face_area, y[THETA_VIAL], y[THETA_AIR])
-    vial_to_outside = thermal.newton_cooling(k.h_outer, k.face_area, y[THETA_VIAL], k.t_ambient)
-    rate_ball, rate_vial, rate_air = thermal.temperature_rates(
-        k.lam * heat_generated,
-        (1.0 - k.lam) * heat_generated,
-        ball_to_air,
-        vial_to_air,
-        vial_to_outside,
-        k.capacity_ball,
-        k.capacity_vial,
-        k.capacity_air,
+    rate_ball, rate_vial, rate_air, vial_to_outside = thermal_network(
+        y[THETA_BALL], y[THETA_VIAL], y[THETA_AIR], heat_generated, thermal.whitaker_velocity_term(reynolds), k
     )
     dydt[X] = velocity
     dydt[P] = force_on_ball
@@ -212,12 +229,3 @@ def rhs_numpy(t: float, y: np.ndarray, k: Constants) -> np.ndarray:
     dydt = np.empty_like(y)
     rhs(t, y, k, dydt)
     return dydt
-
-
-def stored_heat(y: np.ndarray, k: Constants, initial_temperature: float) -> float:
-    """Heat stored in ball, vial and air relative to the initial temperature, in J."""
-    return (
-        k.capacity_ball * (y[THETA_BALL] - initial_temperature)
-        + k.capacity_vial * (y[THETA_VIAL] - initial_temperature)
-        + k.capacity_air * (y[THETA_AIR] - initial_temperature)
-    )

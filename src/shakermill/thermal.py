@@ -40,7 +40,13 @@ def whitaker_nusselt(reynolds: float, prandtl: float, viscosity_ratio: float) ->
 
     ``viscosity_ratio`` is μ(θ_b)/μ_r exactly as the paper prints it.
     """
-    return 2.0 + whitaker_velocity_term(reynolds) * prandtl**0.4 / math.sqrt(math.sqrt(viscosity_ratio))
+    return nusselt_from_velocity_term(whitaker_velocity_term(reynolds), prandtl, viscosity_ratio)
+
+
+@njit(cache=True)
+def nusselt_from_velocity_term(velocity_term: float, prandtl: float, viscosity_ratio: float) -> float:
+    """Whitaker's Nu from its velocity-dependent part, so that a time average of that part can be used."""
+    return 2.0 + velocity_term * prandtl**0.4 / math.sqrt(math.sqrt(viscosity_ratio))
 
 
 @njit(cache=True)
