@@ -184,8 +184,15 @@ class StepController:
 
 @dataclass
 class Tolerances:
+    """Error control of the dynamic components: |error| ≤ atol + rtol·|y − origin|.
+
+    ``origin`` lets the relative tolerance act on a temperature rise rather than on
+    an absolute temperature in kelvin, as ode23 did on the paper's internal energies.
+    """
+
     rtol: float
     atol: np.ndarray  # one per dynamic component
+    origin: np.ndarray  # one per dynamic component
     contact_step_limit: float  # s
     max_overlap: float  # m
 
@@ -302,13 +309,14 @@ def _rk_step(t: float, h: float, y: np.ndarray, a: np.ndarray, b: np.ndarray, c:
 
 @njit(cache=True)
 def _error_norm(h: float, y: np.ndarray, y_new: np.ndarray, stages: np.ndarray, error_weights: np.ndarray,
-                rtol: float, atol: np.ndarray) -> float:
+                rtol: float, atol: np.ndarray, origin: np.ndarray) -> float:
+    """RMS of the error estimate over the dynamic components, in units of atol + rtol·|y − origin|."""
     total = 0.0
     for i in range(atol.shape[0]):
         estimate = 0.0
         for j in range(error_weights.shape[0]):
             estimate += error_weights[j] * stages[j, i]
-        scale = atol[i] + rtol * max(abs(y[i]), abs(y_new[i]))
+        scale = atol[i] + rtol * max(abs(y[i] - origin[i]), abs(y_new[i] - origin[i]))
         ratio = h * estimate / scale
         total += ratio * ratio
     return np.sqrt(total / atol.shape[0])
@@ -350,7 +358,7 @@ def _rate_into_wall(wall: int, velocity: float, vial_velocity: float) -> float:
 
 @njit(cache=True)
 def _advance(
-    t_stop, clock, y, f0, a, b, error_weights, c, k, rtol, atol, contact_step_limit, max_overlap,
+    t_stop, clock, y, f0, a, b, error_weights, c, k, rtol, atol, origin, contact_step_limit, max_overlap,
     safety, min_factor, max_factor, error_exponent,
     sample_times, samples, windows, window_buffer, impact_buffer, impact, counters,
     project_energy, diagnostics,
@@ -389,7 +397,7 @@ def _advance(
         if h > 0.0:
             _rk_step(t, h, y, a, b, c, k, stages, y_new, work)
             counters[RHS_EVALUATIONS] += c.shape[0] - 1
-            error = _error_norm(h, y, y_new, stages, error_weights, rtol, atol)
+            error = _error_norm(h, y, y_new, stages, error_weights, rtol, atol, origin)
         else:
             y_new[:] = y
             stages[c.shape[0] - 1] = f0
@@ -553,7 +561,7 @@ class Integrator:
         """Integrate up to ``t_stop``; returns a status code (see ``STATUS_MESSAGES``)."""
         status, self._window_buffer, self._impact_buffer = _advance(
             t_stop, self.clock, self.y, self.f, self._a, self._b, self._error_weights, self._c, self.constants,
-            self.tolerances.rtol, self.tolerances.atol, self.tolerances.contact_step_limit,
+            self.tolerances.rtol, self.tolerances.atol, self.tolerances.origin, self.tolerances.contact_step_limit,
             self.tolerances.max_overlap, self.controller.safety, self.controller.min_factor,
             self.controller.max_factor, -1.0 / (self.tableau.error_order + 1),
             self.sample_times, self.samples, self.windows, self._window_buffer, self._impact_buffer,

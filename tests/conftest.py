@@ -1,0 +1,44 @@
+"""Shared fixtures: parameter sets for analytic cases and one cached default run."""
+
+from __future__ import annotations
+
+import pytest
+
+import shakermill as sm
+from shakermill.params import Parameters
+
+# A vial amplitude this small makes the walls effectively stationary (velocity ~1e-10 m/s) while
+# keeping the parameter valid (amplitude must be positive).
+RESTING_WALL_AMPLITUDE = 1e-12
+
+
+def single_impact_parameters(speed: float, restitution: float = 0.7, **overrides) -> Parameters:
+    """The ball leaves the vial centre at ``speed`` towards the right wall, which is at rest.
+
+    The run lasts until shortly after the rebound, so exactly one impact happens.
+    """
+    base = sm.default_parameters()
+    gap = base.vial_length / 2.0 - base.ball_radius
+    settings = dict(
+        amplitude=RESTING_WALL_AMPLITUDE,
+        restitution=restitution,
+        ball_momentum=base.ball_mass * speed,
+        duration=1.5 * gap / speed,
+        record_windows=(),
+        # Absolute tolerances far below the motion's scale so that rtol alone controls the error.
+        atol_position=1e-12,
+        atol_momentum=1e-12,
+    )
+    settings.update(overrides)
+    return base.replace(**settings)
+
+
+@pytest.fixture(name="single_impact")
+def single_impact_fixture():
+    return single_impact_parameters
+
+
+@pytest.fixture(scope="session")
+def default_run_20s() -> sm.Result:
+    """The default preset over 20 simulated seconds (shared by several tests)."""
+    return sm.simulate(sm.default_parameters(duration=20.0))
