@@ -75,8 +75,7 @@ IMPACT_COLUMNS = (
 )
 _IMPACT_WIDTH = len(IMPACT_COLUMNS)
 # Layout of the impact in progress, carried between chunks.
-(_ACTIVE, _WALL, _START, _SPEED_IN, _DISSIPATED0, _HEAT0, _MAX_OVERLAP, _PEAK_FORCE, _FLIGHT_STEP, _ENERGY0,
- _WORK0) = range(11)
+_ACTIVE, _WALL, _START, _SPEED_IN, _DISSIPATED0, _HEAT0, _MAX_OVERLAP, _PEAK_FORCE, _ENERGY0, _WORK0 = range(10)
 # Counters.
 STEPS, REJECTED, RHS_EVALUATIONS, IMPACTS, SAMPLES_WRITTEN, WINDOW_POINTS = range(6)
 COUNTER_NAMES = ("steps", "rejected_steps", "rhs_evaluations", "impacts")
@@ -216,7 +215,9 @@ def _refine_root(t: float, x: float, velocity: float, wall: int, k: Constants,
                  a: float, b: float, resolution: float) -> float:
     """The single zero of a monotone gap on [a, b] (gap(a) > 0 ≥ gap(b)), by safeguarded Newton.
 
-    Returns the upper end of the final bracket, so the landing point touches (gap ≤ 0).
+    Returns the lower end of the final bracket: the landing point is a hair before the onset
+    (gap > 0), so the step that lands feels no contact force. A force in its last stage would
+    enter the error estimate through the embedded weights and get the step rejected.
     """
     s = b
     for _ in range(_ROOT_ITERATIONS):
@@ -232,7 +233,7 @@ def _refine_root(t: float, x: float, velocity: float, wall: int, k: Constants,
         # Step a little past the Newton point so the bracket closes from both sides.
         newton += resolution if gap_s > 0.0 else -resolution
         s = newton if a < newton < b else 0.5 * (a + b)
-    return b
+    return a
 
 
 @njit(cache=True)
@@ -371,10 +372,10 @@ def _advance(
     point = np.empty(n)
     stack = np.empty((_STACK_ROWS, 4))
     curvature = k.amplitude * k.omega * k.omega
+    drive_period = 2.0 * np.pi / k.omega
     t = clock[0]
     h = clock[1]
     rejected_last = False
-    flight_proposal = h
     while t < t_stop:
         in_contact = impact[_ACTIVE] != 0.0
         h = min(h, t_stop - t)
@@ -385,7 +386,6 @@ def _advance(
             # Shorten a flight step to the first contact onset: the flight path is exact, so this
             # costs no right-hand-side evaluations and no trial step ever runs into a wall.
             velocity = y[P] / k.ball_mass
-            flight_proposal = h
             for wall in (LEFT_WALL, RIGHT_WALL):
                 touch = _first_touch_of_wall(t, h, y[X], velocity, wall, curvature, k, stack)
                 if touch >= 0.0 and (landed_wall == NO_WALL or touch < h):
@@ -467,7 +467,6 @@ def _advance(
                 impact[_HEAT0] = y_new[HEAT_GENERATED]
                 impact[_MAX_OVERLAP] = 0.0
                 impact[_PEAK_FORCE] = 0.0
-                impact[_FLIGHT_STEP] = flight_proposal
                 impact[_ENERGY0] = 0.5 * y_new[P] * y_new[P] / k.ball_mass + elastic_new
                 impact[_WORK0] = y_new[WORK_VIAL]
             elif overlap > 0.0:  # still touching; overlap <= 0 below means it left the wall
@@ -505,9 +504,9 @@ def _advance(
         if landed_wall == NO_WALL:
             h = h * factor
             if in_contact and impact[_ACTIVE] == 0.0:
-                # Just left the wall: flight is exact for the mechanics, so resume the flight step
-                # the controller had reached before this contact instead of growing from contact scale.
-                h = max(h, impact[_FLIGHT_STEP])
+                # Just left the wall. Flight is exact for the mechanics and smooth for the temperatures,
+                # so offer a whole drive period: the onset search cuts it at the next contact.
+                h = max(h, drive_period)
         else:
             expected = hertz_contact_time(k.ball_mass, k.radius, k.e_star, max(impact[_SPEED_IN], 1e-12))
             h = min(contact_step_limit, ONSET_STEP_FRACTION * expected)
@@ -539,7 +538,7 @@ class Integrator:
         self.samples = np.full((self.sample_times.shape[0], N_STATE), np.nan)
         self._window_buffer = np.empty((_INITIAL_CAPACITY, N_STATE + 1))
         self._impact_buffer = np.empty((_INITIAL_CAPACITY, _IMPACT_WIDTH))
-        self._impact = np.zeros(11)
+        self._impact = np.zeros(10)
         self.counters = np.zeros(6, dtype=np.int64)
         self.counters[RHS_EVALUATIONS] = 1
         self.diagnostics = np.zeros(2)
