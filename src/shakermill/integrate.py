@@ -35,7 +35,6 @@ from .model import (
     DISSIPATED,
     HEAT_GENERATED,
     LEFT_WALL,
-    N_DYNAMIC,
     N_STATE,
     NO_WALL,
     RIGHT_WALL,
@@ -579,19 +578,3 @@ class Integrator:
     @property
     def impacts(self) -> np.ndarray:
         return self._impact_buffer[: self.counters[IMPACTS]].copy()
-
-    @property
-    def in_contact(self) -> bool:
-        return bool(self._impact[_ACTIVE])
-
-
-__all__ = [
-    "BOGACKI_SHAMPINE",
-    "ButcherTableau",
-    "IMPACT_COLUMNS",
-    "Integrator",
-    "N_DYNAMIC",
-    "STATUS_MESSAGES",
-    "StepController",
-    "Tolerances",
-]
