@@ -14,8 +14,9 @@ from numba import njit
 # Rayleigh-wave speed factor of Eq. 40 (paper): t_R = πR/(0.1631ν + 0.8766)·√(ρ/G)
 _RAYLEIGH_A = 0.1631
 _RAYLEIGH_B = 0.8766
-# Duration of an undamped Hertz impact divided by ζ_max/v (Johnson, Contact Mechanics, §11.4)
-HERTZ_DURATION_FACTOR = 2.9432
+# Duration of an undamped Hertz impact divided by ζ_max/v: 2·Γ(7/5)·√π/Γ(9/10) ≈ 2.9433
+# (Johnson, Contact Mechanics, §11.4)
+HERTZ_DURATION_FACTOR = 2.0 * math.gamma(1.4) * math.sqrt(math.pi) / math.gamma(0.9)
 
 
 @njit(cache=True)
@@ -99,5 +100,5 @@ def hertz_max_overlap(mass: float, radius: float, e_star: float, speed: float) -
 
 @njit(cache=True)
 def hertz_contact_time(mass: float, radius: float, e_star: float, speed: float) -> float:
-    """Duration of an undamped Hertz impact, 2.9432·ζ_max/v, in s (Johnson 1985, §11.4)."""
+    """Duration of an undamped Hertz impact, 2.9433·ζ_max/v, in s (Johnson 1985, §11.4)."""
     return HERTZ_DURATION_FACTOR * hertz_max_overlap(mass, radius, e_star, speed) / speed

@@ -1,0 +1,341 @@
+"""Parameters, presets and validation (MODEL.md §9) against the paper's tables and hand values."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+import pydantic
+import pytest
+
+import shakermill as sm
+from shakermill.params import (
+    FIELD_NAMES,
+    PRESETS,
+    SPEX_8000M,
+    ParameterError,
+    Parameters,
+    allowed_range,
+    build_parameters,
+    default_parameters,
+    preset_values,
+)
+
+# The repository sits beside ../shared (here /work/main and /work/shared; the same in CI clones).
+PAPER_TOML = Path(__file__).resolve().parents[2] / "shared" / "reference-data" / "paper.toml"
+
+
+@pytest.fixture(scope="module")
+def paper() -> dict:
+    if not PAPER_TOML.is_file():
+        pytest.skip(f"paper tables not found at {PAPER_TOML}")
+    with PAPER_TOML.open("rb") as handle:
+        return tomllib.load(handle)
+
+
+@pytest.fixture(scope="module")
+def defaults() -> Parameters:
+    return default_parameters()
+
+
+# --- preset values against the paper's tables ------------------------------------------------------
+
+# (parameter key, paper.toml table, paper.toml key)
+PAPER_VALUES = [
+    ("ball_radius", "geometry", "ball_radius"),
+    ("vial_length", "geometry", "vial_length"),
+    ("vial_diameter", "geometry", "vial_diameter"),
+    ("amplitude", "drive", "amplitude"),
+    ("ball_density", "steel", "density"),
+    ("vial_density", "steel", "density"),
+    ("ball_youngs_modulus", "steel", "youngs_modulus"),
+    ("vial_youngs_modulus", "steel", "youngs_modulus"),
+    ("ball_poisson_ratio", "steel", "poisson_ratio"),
+    ("vial_poisson_ratio", "steel", "poisson_ratio"),
+    ("ball_heat_capacity", "steel", "heat_capacity"),
+    ("vial_heat_capacity", "steel", "heat_capacity"),
+    ("air_density", "air", "density"),
+    ("air_viscosity_ref", "air", "viscosity_ref"),
+    ("air_reference_temperature", "air", "reference_temperature"),
+    ("air_conductivity", "air", "conductivity"),
+    ("air_cp", "air", "cp"),
+    ("sutherland", "air", "sutherland"),
+    ("h_inner", "air", "h_inner"),
+    ("h_outer", "air", "h_outer"),
+    ("ambient_temperature", "air", "ambient_temperature"),
+    ("duration", "simulation", "duration"),
+    ("restitution", "simulation", "restitution"),
+    ("eta", "simulation", "eta"),
+    ("lam", "simulation", "lam"),
+    ("beta", "simulation", "beta"),
+]
+
+
+def test_paper_toml_is_found_beside_the_repository() -> None:
+    if not PAPER_TOML.is_file():
+        pytest.skip("no ../shared beside this clone")
+    assert PAPER_TOML.parent.name == "reference-data"
+
+
+@pytest.mark.parametrize("key, table, name", PAPER_VALUES)
+def test_default_equals_the_paper(paper: dict, defaults: Parameters, key: str, table: str, name: str) -> None:
+    assert getattr(defaults, key) == pytest.approx(paper[table][name], rel=1e-12)
+
+
+def test_default_omega_is_inside_the_papers_range(paper: dict, defaults: Parameters) -> None:
+    assert paper["drive"]["omega_min"] <= defaults.omega <= paper["drive"]["omega_max"]
+    # MODEL.md §9: 111 rad/s ≈ 1060 cycles/min (1060·2π/60 = 111.003)
+    assert defaults.omega == pytest.approx(111.0, rel=1e-12)
+
+
+def test_end_face_area_matches_the_papers_table_1(paper: dict, defaults: Parameters) -> None:
+    assert defaults.end_face_area == pytest.approx(paper["geometry"]["inner_area"], rel=1e-4)
+    assert defaults.end_face_area == pytest.approx(paper["geometry"]["outer_area"], rel=1e-4)
+
+
+def test_initial_temperature_is_20_celsius(defaults: Parameters) -> None:
+    assert defaults.initial_temperature == pytest.approx(293.15, rel=1e-12)
+    assert defaults.ambient_temperature == pytest.approx(293.15, rel=1e-12)
+
+
+def test_default_options(defaults: Parameters) -> None:
+    assert defaults.no_tension is False
+    assert defaults.heat_model == "relative"
+    assert defaults.convection_velocity == "ball"
+    assert defaults.ball_position == 0.0
+    assert defaults.ball_momentum == 0.0
+    assert defaults.rtol == pytest.approx(1e-3, rel=1e-12)
+
+
+# --- derived quantities ---------------------------------------------------------------------------
+
+
+def test_ball_mass_hand_value(defaults: Parameters) -> None:
+    # 4/3·π·(6.35e-3)³ = 4.18879 · 2.560479e-7 = 1.072534e-6 m³; · 7800 = 8.36574e-3 kg
+    assert defaults.ball_mass == pytest.approx(8.36574e-3, rel=1e-5)
+    assert defaults.ball_mass == pytest.approx(7800.0 * 4.0 / 3.0 * math.pi * 6.35e-3**3, rel=1e-12)
+
+
+def test_end_face_area_hand_value(defaults: Parameters) -> None:
+    # 2 · π · 0.019² / 4 = 2 · 2.835287e-4 = 5.670575e-4 m² = 567.06 mm² (Table 1)
+    assert defaults.end_face_area == pytest.approx(567.06e-6, rel=1e-4)
+    assert defaults.end_face_area == pytest.approx(5.670575e-4, rel=1e-6)
+
+
+def test_air_mass_hand_value(defaults: Parameters) -> None:
+    # vial: π·0.019²/4·0.058 = 2.835287e-4·0.058 = 1.644466e-5 m³; ball 1.072534e-6 m³
+    # m_a = 1.225·(1.644466e-5 − 1.072534e-6) = 1.225·1.537213e-5 = 1.88309e-5 kg ≈ 18.8 mg (MODEL.md §6)
+    assert defaults.air_mass == pytest.approx(1.88309e-5, rel=1e-5)
+    assert defaults.air_mass * 1e6 == pytest.approx(18.8, abs=0.05)
+
+
+def test_air_heat_capacity_at_constant_volume(defaults: Parameters) -> None:
+    # c_a = 1003.5/1.4 = 716.7857 J/(kg·K) (MODEL.md §6)
+    assert defaults.air_heat_capacity == pytest.approx(716.7857, rel=1e-6)
+
+
+# --- preset bookkeeping ---------------------------------------------------------------------------
+
+
+def test_every_preset_value_has_a_source() -> None:
+    for preset in PRESETS.values():
+        for key, cited in preset.values.items():
+            assert isinstance(cited.source, str) and cited.source.strip(), f"{preset.name}.{key} has no source"
+
+
+def test_preset_covers_every_field() -> None:
+    assert set(SPEX_8000M.values) == set(FIELD_NAMES)
+
+
+def test_paper_values_cite_the_paper() -> None:
+    for key, _, _ in PAPER_VALUES:
+        assert "Son 2025" in SPEX_8000M.values[key].source, key
+
+
+def test_unstated_values_are_marked_as_assumptions() -> None:
+    # MODEL.md §9 difference 5: ω and vial_mass are not printed in the paper
+    for key in ("omega", "vial_mass"):
+        assert "assumption" in SPEX_8000M.values[key].source.lower(), key
+
+
+def test_unknown_preset() -> None:
+    with pytest.raises(ParameterError, match="unknown preset"):
+        preset_values("spex9000")
+
+
+# --- validation -----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("value", [0, 0.0, 1.5, -0.2])
+def test_restitution_out_of_range(value: float) -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(restitution=value)
+    message = str(info.value)
+    assert "restitution" in message
+    assert "(0, 1]" in message
+
+
+def test_allowed_range_text() -> None:
+    assert allowed_range("restitution") == "(0, 1]"
+    assert allowed_range("ball_radius") == "(0, inf) m"
+    assert allowed_range("eta") == "[0, 1]"
+
+
+def test_restitution_of_one_is_allowed() -> None:
+    assert default_parameters(restitution=1.0).restitution == 1.0
+
+
+@pytest.mark.parametrize(
+    "key, value",
+    [
+        ("ball_radius", -1e-3),
+        ("ball_radius", 0.0),
+        ("vial_length", 0.0),
+        ("vial_length", "-5 mm"),
+        ("vial_diameter", -0.019),
+        ("amplitude", 0.0),
+        ("amplitude", "-25 mm"),
+        ("vial_mass", 0.0),
+        ("vial_mass", -0.05),
+        ("ball_density", 0.0),
+        ("omega", 0.0),
+        ("omega", -111.0),
+        ("duration", 0.0),
+    ],
+)
+def test_non_positive_values_are_rejected(key: str, value: object) -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(**{key: value})
+    message = str(info.value)
+    assert message.startswith(f"{key}:")
+    assert "(0, inf)" in message
+
+
+def test_ball_longer_than_the_vial_is_rejected() -> None:
+    # diameter 60 mm > 58 mm vial length
+    with pytest.raises(ParameterError, match="ball_radius") as info:
+        default_parameters(ball_radius=0.03)
+    assert "does not fit" in str(info.value)
+
+
+def test_ball_wider_than_the_vial_is_rejected() -> None:
+    # diameter 19.4 mm > 19 mm vial diameter
+    with pytest.raises(ParameterError, match="ball_radius") as info:
+        default_parameters(ball_radius=9.7e-3)
+    assert "does not fit" in str(info.value)
+
+
+def test_ball_must_start_inside_the_vial() -> None:
+    # half gap = 29 − 6.35 = 22.65 mm
+    with pytest.raises(ParameterError, match="ball_position"):
+        default_parameters(ball_position=0.023)
+    assert default_parameters(ball_position=0.022).ball_position == pytest.approx(0.022, rel=1e-12)
+
+
+def test_unknown_key_suggests_the_closest() -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(ball_radus=1e-3)
+    message = str(info.value)
+    assert message.startswith("ball_radus:")
+    assert "did you mean 'ball_radius'" in message
+
+
+def test_unknown_key_via_build_parameters() -> None:
+    with pytest.raises(ParameterError, match="did you mean 'restitution'"):
+        build_parameters(preset_values("spex8000m"), {"restitutoin": 0.5})
+
+
+def test_missing_key_is_reported() -> None:
+    values = preset_values("spex8000m")
+    del values["vial_mass"]
+    with pytest.raises(ParameterError, match="vial_mass"):
+        build_parameters(values)
+
+
+def test_wrong_dimension_names_the_key() -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(ball_radius="3 kg")
+    assert str(info.value).startswith("ball_radius:")
+
+
+def test_parameter_error_is_exported_and_a_value_error() -> None:
+    assert sm.ParameterError is ParameterError
+    assert issubclass(ParameterError, ValueError)
+
+
+# --- immutability and replace ---------------------------------------------------------------------
+
+
+def test_parameters_are_immutable(defaults: Parameters) -> None:
+    with pytest.raises((pydantic.ValidationError, TypeError, AttributeError)):
+        defaults.ball_radius = 1e-3  # type: ignore[misc]
+    assert defaults.ball_radius == pytest.approx(6.35e-3, rel=1e-12)
+
+
+def test_replace_returns_a_new_object(defaults: Parameters) -> None:
+    changed = defaults.replace(restitution=0.5, amplitude="20 mm")
+    assert changed is not defaults
+    assert changed.restitution == 0.5
+    assert changed.amplitude == pytest.approx(0.020, rel=1e-12)
+    assert defaults.restitution == pytest.approx(0.7, rel=1e-12)
+    assert defaults.amplitude == pytest.approx(0.025, rel=1e-12)
+    # everything else is carried over
+    assert changed.ball_radius == defaults.ball_radius
+    assert changed.record_windows == defaults.record_windows
+
+
+def test_replace_validates(defaults: Parameters) -> None:
+    with pytest.raises(ParameterError, match="restitution"):
+        defaults.replace(restitution=1.5)
+    with pytest.raises(ParameterError, match="did you mean"):
+        defaults.replace(omegaa=100.0)
+
+
+def test_extra_fields_are_forbidden_on_direct_construction(defaults: Parameters) -> None:
+    with pytest.raises(pydantic.ValidationError):
+        Parameters(**defaults.model_dump(), colour="red")
+
+
+# --- units through build_parameters ---------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "key, text, expected, rel",
+    [
+        ("amplitude", "25 mm", 0.025, 1e-12),
+        ("ball_radius", "6.35 mm", 6.35e-3, 1e-12),
+        ("omega", "17.7 Hz", 2.0 * math.pi * 17.7, 1e-12),  # 111.2124 rad/s
+        ("duration", "60 min", 3600.0, 1e-12),
+        ("ambient_temperature", "20 degC", 293.15, 1e-12),
+        ("initial_temperature", "25 degC", 298.15, 1e-12),
+        ("ball_youngs_modulus", "210 GPa", 210e9, 1e-12),
+    ],
+)
+def test_values_with_units(key: str, text: str, expected: float, rel: float) -> None:
+    params = build_parameters(preset_values("spex8000m"), {key: text})
+    assert getattr(params, key) == pytest.approx(expected, rel=rel)
+
+
+def test_rpm_omega() -> None:
+    # 1060 rev/min · 2π/60 = 111.003 rad/s
+    params = build_parameters(preset_values("spex8000m"), {"omega": "1060 rpm"})
+    assert params.omega == pytest.approx(111.0, abs=0.01)
+
+
+def test_boolean_options_from_strings() -> None:
+    assert default_parameters(no_tension="yes").no_tension is True
+    assert default_parameters(no_tension="off").no_tension is False
+    with pytest.raises(ParameterError, match="no_tension"):
+        default_parameters(no_tension="maybe")
+
+
+def test_record_windows_from_a_string() -> None:
+    params = default_parameters(record_windows="0:1,600:0.1")
+    assert params.record_windows == ((0.0, 1.0), (600.0, 0.1))
+    assert default_parameters(record_windows="").record_windows == ()
+
+
+def test_unknown_option_value_is_rejected() -> None:
+    with pytest.raises(ParameterError, match="heat_model"):
+        default_parameters(heat_model="lab")
