@@ -11,6 +11,8 @@ State vector (SI)::
     6 E_diss   energy dissipated in contacts, ∫P_d dt (J)  }  quadratures: integrated
     7 Q_irr    irreversible heat generated, ∫Q̇_irr dt (J)  }  with the same stages,
     8 Q_out    heat lost to the surroundings, ∫Q̇_vo dt (J) }  not error-controlled
+    9 ∫w dt    integral of Whitaker's velocity term w = 0.4 Re^{1/2} + 0.06 Re^{2/3} (s);
+               its time average drives the averaged solver's convection
 
 Temperatures are used instead of the paper's internal energies (U = m·c·θ with
 constant c, so the two are equivalent); they are better scaled for the error
@@ -31,10 +33,21 @@ from numba import njit
 from . import contact, drive, thermal
 from .params import Parameters
 
-X, P, THETA_BALL, THETA_VIAL, THETA_AIR, WORK_VIAL, DISSIPATED, HEAT_GENERATED, HEAT_LOST = range(9)
+X, P, THETA_BALL, THETA_VIAL, THETA_AIR, WORK_VIAL, DISSIPATED, HEAT_GENERATED, HEAT_LOST, VELOCITY_TERM = range(10)
 N_DYNAMIC = 5
-N_STATE = 9
-STATE_NAMES = ("x", "p", "theta_ball", "theta_vial", "theta_air", "work_vial", "dissipated", "heat_generated", "heat_lost")
+N_STATE = 10
+STATE_NAMES = (
+    "x",
+    "p",
+    "theta_ball",
+    "theta_vial",
+    "theta_air",
+    "work_vial",
+    "dissipated",
+    "heat_generated",
+    "heat_lost",
+    "velocity_term_integral",
+)
 
 NO_WALL, LEFT_WALL, RIGHT_WALL = 0, 1, 2
 
@@ -202,8 +215,9 @@ def rhs(t: float, y: np.ndarray, k: Constants, dydt: np.ndarray) -> None:
 
     convection_speed = velocity - vial_velocity if k.relative_convection else velocity
     reynolds = thermal.reynolds_number(k.radius, k.air_density, convection_speed, k.viscosity_ambient)
+    velocity_term = thermal.whitaker_velocity_term(reynolds)
     rate_ball, rate_vial, rate_air, vial_to_outside = thermal_network(
-        y[THETA_BALL], y[THETA_VIAL], y[THETA_AIR], heat_generated, thermal.whitaker_velocity_term(reynolds), k
+        y[THETA_BALL], y[THETA_VIAL], y[THETA_AIR], heat_generated, velocity_term, k
     )
     dydt[X] = velocity
     dydt[P] = force_on_ball
@@ -214,6 +228,7 @@ def rhs(t: float, y: np.ndarray, k: Constants, dydt: np.ndarray) -> None:
     dydt[DISSIPATED] = power_dissipated
     dydt[HEAT_GENERATED] = heat_generated
     dydt[HEAT_LOST] = vial_to_outside
+    dydt[VELOCITY_TERM] = velocity_term
 
 
 @njit(cache=True)

@@ -235,6 +235,11 @@ _VARIABLES = {
     "dissipated": (model.DISSIPATED, "J", "cumulative energy dissipated in contacts"),
     "heat_generated": (model.HEAT_GENERATED, "J", "cumulative irreversible heat generated"),
     "heat_lost": (model.HEAT_LOST, "J", "cumulative heat lost from the vial to the surroundings"),
+    "velocity_term_integral": (
+        model.VELOCITY_TERM,
+        "s",
+        "time integral of Whitaker's velocity term 0.4 Re^(1/2) + 0.06 Re^(2/3)",
+    ),
 }
 
 
