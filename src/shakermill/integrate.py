@@ -56,7 +56,10 @@ STEP_UNDERFLOW = -3
 STATUS_MESSAGES = {
     REACHED_STOP: "The solver reached the end of the integration interval.",
     NOT_FINITE: "The state became NaN or infinite.",
-    OVERLAP_TOO_LARGE: "The contact overlap exceeded the allowed fraction of the ball radius.",
+    OVERLAP_TOO_LARGE: (
+        "The contact overlap exceeded the allowed fraction of the ball radius: the materials are too soft for "
+        "this impact speed (check ball_youngs_modulus and vial_youngs_modulus), or the step control failed."
+    ),
     STEP_UNDERFLOW: "The step size fell below the resolution of the time variable.",
 }
 

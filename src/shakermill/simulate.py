@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 import pandas as pd
@@ -22,6 +22,9 @@ from .integrate import (
     Tolerances,
 )
 from .params import Parameters
+
+if TYPE_CHECKING:
+    from .averaged import MechanicsAverages
 
 # The step inside a contact stays below this fraction of the Rayleigh time (MODEL.md §7).
 RAYLEIGH_FRACTION = 0.9
@@ -109,6 +112,9 @@ class Result:
     wall_time: float
     energy: EnergyAudit
     ball_fit: ExponentialFit
+    solver: str = "full"
+    impact_window: float | None = None  # s covered by ``impacts``; None means the whole run
+    averages: MechanicsAverages | None = None
     summary: dict[str, float | int | str | bool] = field(default_factory=dict)
 
     @property
@@ -146,6 +152,31 @@ def sample_times(params: Parameters) -> np.ndarray:
 
 
 def simulate(params: Parameters, progress: ProgressCallback | None = None) -> Result:
+    """Run ``params`` with the solver it names (``params.solver``): see :func:`simulate_full` and
+    :func:`shakermill.averaged.simulate_averaged`."""
+    if params.solver == "averaged":
+        from .averaged import simulate_averaged  # the averaged solver builds on this module
+
+        return simulate_averaged(params, progress)
+    return simulate_full(params, progress)
+
+
+def integrator_for(params: Parameters, sample_times: np.ndarray) -> Integrator:
+    """A compiled integrator set up for ``params`` from its initial state."""
+    constants = model.constants_from(params)
+    windows = np.array([(start, start + length) for start, length in params.record_windows], dtype=float).reshape(-1, 2)
+    return Integrator(
+        constants=constants,
+        y=model.initial_state(params),
+        t0=0.0,
+        tolerances=_tolerances(params, constants),
+        sample_times=sample_times,
+        windows=windows,
+        project_energy=params.energy_projection,
+    )
+
+
+def simulate_full(params: Parameters, progress: ProgressCallback | None = None) -> Result:
     """Run the full-resolution model for ``params.duration`` seconds.
 
     ``progress(t, duration)`` is called after every chunk of simulated time. A
@@ -153,19 +184,8 @@ def simulate(params: Parameters, progress: ProgressCallback | None = None) -> Re
     keeps everything computed so far; numerical failures are reported through
     ``status`` and ``message`` likewise, never raised.
     """
-    constants = model.constants_from(params)
-    y0 = model.initial_state(params)
-    times = sample_times(params)
-    windows = np.array([(start, start + length) for start, length in params.record_windows], dtype=float).reshape(-1, 2)
-    integrator = Integrator(
-        constants=constants,
-        y=y0,
-        t0=0.0,
-        tolerances=_tolerances(params, constants),
-        sample_times=times,
-        windows=windows,
-        project_energy=params.energy_projection,
-    )
+    integrator = integrator_for(params, sample_times(params))
+    y0 = integrator.y.copy()
     started = time.perf_counter()
     status = REACHED_STOP
     try:
@@ -179,7 +199,7 @@ def simulate(params: Parameters, progress: ProgressCallback | None = None) -> Re
     message = INTERRUPTED_MESSAGE if status == INTERRUPTED else STATUS_MESSAGES[status]
     if status < 0:
         message = f"{message} Stopped at t = {integrator.t:.6g} s; results up to then are kept."
-    return _assemble(params, constants, y0, integrator, status, message, wall_time)
+    return _assemble(params, integrator.constants, y0, integrator, status, message, wall_time)
 
 
 def _assemble(
@@ -210,7 +230,7 @@ def _assemble(
     result = Result(
         params=params,
         status=status,
-        message=message,
+        message=message + no_impact_note(params, len(impacts)),
         t_end=t_end,
         timeseries=timeseries,
         windows=windows,
@@ -222,6 +242,20 @@ def _assemble(
     )
     result.summary = summarize(result)
     return result
+
+
+def no_impact_note(params: Parameters, impacts: int) -> str:
+    """A hint for the surprising case of a run without impacts, empty otherwise."""
+    if impacts:
+        return ""
+    free_gap = params.vial_length / 2.0 - params.ball_radius
+    if params.amplitude < free_gap:
+        return (
+            f" No impact happened: the amplitude ({params.amplitude * 1e3:g} mm) is smaller than the free gap "
+            f"({free_gap * 1e3:g} mm), so in one dimension a slow ball is never reached; "
+            "give it an initial ball_momentum or ball_position."
+        )
+    return " No impact happened."
 
 
 _VARIABLES = {
@@ -331,7 +365,9 @@ def summarize(result: Result) -> dict[str, float | int | str | bool]:
     theta_0 = params.initial_temperature
     impacts = result.impacts
     duration = max(result.t_end, 1e-300)
-    return {
+    impact_window = result.impact_window if result.impact_window else duration
+    impact_rate = len(impacts) / impact_window if impact_window > 0 else math.nan
+    summary = {
         "status": result.status,
         "success": result.success,
         "message": result.message,
@@ -346,8 +382,9 @@ def summarize(result: Result) -> dict[str, float | int | str | bool]:
         "vial_C": kelvin_to_celsius(float(last["theta_vial"])),
         "air_C": kelvin_to_celsius(float(last["theta_air"])),
         "vial_ball_ratio": increment_ratio(float(last["theta_vial"]), float(last["theta_ball"]), theta_0),
-        "impacts": int(len(impacts)),
-        "impact_rate_hz": len(impacts) / duration,
+        "solver": result.solver,
+        "impacts": int(len(impacts)) if result.impact_window is None else int(round(impact_rate * duration)),
+        "impact_rate_hz": impact_rate,
         "heat_power_W": result.energy.heat_generated / duration,
         "dissipated_power_W": result.energy.dissipated / duration,
         "mean_impact_speed_m_s": float(impacts["impact_speed"].mean()) if len(impacts) else math.nan,
@@ -362,3 +399,6 @@ def summarize(result: Result) -> dict[str, float | int | str | bool]:
             result.energy.projection_correction / result.energy.dissipated if result.energy.dissipated > 0 else 0.0
         ),
     }
+    if result.averages is not None:
+        summary.update(result.averages.as_summary())
+    return summary

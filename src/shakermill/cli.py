@@ -1,0 +1,297 @@
+"""The ``shakermill`` command line: parse, call the library, write files. No physics here.
+
+Exit codes: 0 success; 1 the integrator stopped early (the run folder is still
+written); 2 bad input (one ``error: ...`` line on stderr, no traceback); 130
+interrupted by the user (partial results are written).
+
+A progress bar is drawn on stderr for runs of at least a minute of simulated
+time, and only when stderr is a terminal, so pipes and logs stay clean.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from contextlib import contextmanager
+from datetime import datetime
+from pathlib import Path
+from typing import Annotated, Any, Iterator, Literal, NoReturn, get_args, get_origin
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+from rich.text import Text
+
+from . import __version__
+from .config import load_config
+from .params import (
+    DEFAULT_PRESET,
+    FIELD_NAMES,
+    PRESETS,
+    ParameterError,
+    Parameters,
+    allowed_range,
+    field_description,
+    field_unit,
+    preset_values,
+)
+from .plotting import plot_run
+from .simulate import INTERRUPTED, Result, simulate
+from .storage import StorageError, check_target, to_jsonable, write_run
+
+EXIT_FAILED_RUN = 1
+EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130
+PROGRESS_MIN_DURATION_S = 60.0
+FIGURES_FOLDER = "figures"
+PIPED_TABLE_WIDTH = 160
+DEFAULT_RESULTS_FOLDER = Path("results")
+
+app = typer.Typer(
+    name="shakermill",
+    help="Simulate a high-energy shaker mill (SPEX 8000M type): ball motion, impacts and temperatures.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+
+def main() -> None:
+    """Entry point of the ``shakermill`` console script."""
+    app()
+
+
+def _version(show: bool) -> None:
+    if show:
+        typer.echo(f"shakermill {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
+    ] = False,
+) -> None:
+    """Simulate a high-energy shaker mill (SPEX 8000M type): ball motion, impacts and temperatures."""
+
+
+def _stdout_console() -> Console:
+    # Piped into a file, tables are read later at any width; 80 columns would wrap every source citation.
+    console = Console()
+    return console if console.is_terminal else Console(width=PIPED_TABLE_WIDTH)
+
+
+def _add_plain_row(table: Table, *cells: str) -> None:
+    # Plain text: values such as "[0, 1]" or "[start ≥ 0, ...]" would otherwise be parsed as rich markup.
+    table.add_row(*(Text(cell) for cell in cells))
+
+
+def _fail(message: str, code: int = EXIT_USAGE) -> NoReturn:
+    # typer.echo, not rich: rich would wrap a long message over several lines and read "[...]" as markup.
+    typer.echo(f"error: {' '.join(message.splitlines())}", err=True)
+    raise typer.Exit(code)
+
+
+@contextmanager
+def _user_errors() -> Iterator[None]:
+    """Turn bad input into one ``error:`` line and exit code 2."""
+    try:
+        yield
+    except (ParameterError, StorageError) as exc:
+        _fail(str(exc))
+
+
+@app.command()
+def run(
+    config: Annotated[
+        Path | None,
+        typer.Argument(metavar="CONFIG", help="TOML file with canonical keys (and optionally preset = NAME)."),
+    ] = None,
+    preset: Annotated[
+        str | None, typer.Option("--preset", "-p", show_default=DEFAULT_PRESET, help="Preset to start from.")
+    ] = None,
+    settings: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--set", "-s", metavar="KEY=VALUE", help="Override one key, units allowed: --set ball_radius='5 mm'."
+        ),
+    ] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", show_default="results/run-<timestamp>", help="Run folder to write."),
+    ] = None,
+    json_output: Annotated[
+        bool, typer.Option("--json", help="Print the summary as one JSON object on stdout, nothing else.")
+    ] = False,
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
+) -> None:
+    """Run one simulation and write its run folder (data, summary, configuration, figures)."""
+    overrides = settings or []
+    with _user_errors():
+        run_config = load_config(config, preset=preset, overrides=overrides)
+        target = out if out is not None else default_output_folder()
+        check_target(target)
+    result = simulate_with_progress(run_config.params)
+    provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
+    target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots)
+    if json_output:
+        summary = to_jsonable({**result.summary, "output_dir": str(target)})
+        typer.echo(json.dumps(summary, sort_keys=True, allow_nan=False))
+    else:
+        _stdout_console().print(summary_table(result, target))
+    _exit_for_status(result, target)
+
+
+def default_output_folder() -> Path:
+    """``results/run-<local timestamp>``, with a counter if a run started in the same second."""
+    stem = f"run-{datetime.now():%Y%m%d-%H%M%S}"
+    candidate = DEFAULT_RESULTS_FOLDER / stem
+    counter = 1
+    while candidate.exists():
+        candidate = DEFAULT_RESULTS_FOLDER / f"{stem}-{counter}"
+        counter += 1
+    return candidate
+
+
+def simulate_with_progress(params: Parameters) -> Result:
+    """``simulate``, with a transient progress bar on stderr for long runs when stderr is a terminal."""
+    console = Console(stderr=True)
+    if params.duration < PROGRESS_MIN_DURATION_S or not console.is_terminal:
+        return simulate(params)
+    columns = (
+        TextColumn("simulating"),
+        BarColumn(),
+        TextColumn("{task.completed:.0f}/{task.total:.0f} s simulated"),
+        TimeRemainingColumn(),
+    )
+    with Progress(*columns, console=console, transient=True) as bar:
+        task = bar.add_task("simulate", total=params.duration)
+        return simulate(params, progress=lambda t, _duration: bar.update(task, completed=t))
+
+
+def _write(result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool) -> Path:
+    """Write the run folder (with figures unless told not to); return its absolute path."""
+
+    def add_figures(folder: Path) -> None:
+        plot_run(result, folder / FIGURES_FOLDER)
+
+    try:
+        return write_run(
+            result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None
+        )
+    except StorageError as exc:
+        _fail(str(exc))
+    except OSError as exc:
+        _fail(f"{target}: cannot write the run folder ({exc.strerror or exc})")
+    except KeyboardInterrupt:
+        _fail(f"interrupted while writing {target}; no partial folder was left there", EXIT_INTERRUPTED)
+
+
+def _exit_for_status(result: Result, target: Path) -> None:
+    if result.status == INTERRUPTED:
+        typer.echo(f"interrupted: {result.message} Partial results in {target}", err=True)
+        raise typer.Exit(EXIT_INTERRUPTED)
+    if not result.success:
+        typer.echo(f"error: {result.message} Results so far in {target}", err=True)
+        raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def _number(value: Any, spec: str) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "n/a"
+    return format(value, spec)
+
+
+def summary_table(result: Result, target: Path) -> Table:
+    """The human summary of a run: fitted and final temperatures, impacts, power, numerics."""
+    s = result.summary
+    table = Table(title="shakermill run", show_header=True)
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    table.add_column("unit")
+    rows = [
+        ("status", s["message"] if not result.success else "ok", ""),
+        ("simulated time", _number(s["simulated_s"], ".6g"), "s"),
+        ("ball θ∞ (exponential fit)", _number(s["theta_inf_C"], ".2f"), "°C"),
+        ("time constant τ", _number(s["tau_min"], ".2f"), "min"),
+        ("initial heating rate θ̇₀", _number(s["rate0_C_per_min"], ".3f"), "°C/min"),
+        ("ball at the end", _number(s["ball_C"], ".2f"), "°C"),
+        ("vial at the end", _number(s["vial_C"], ".2f"), "°C"),
+        ("air at the end", _number(s["air_C"], ".2f"), "°C"),
+        ("vial/ball increment ratio", _number(s["vial_ball_ratio"], ".3f"), ""),
+        ("impacts", _number(s["impacts"], "d"), ""),
+        ("impact rate", _number(s["impact_rate_hz"], ".2f"), "Hz"),
+        ("mean impact speed", _number(s["mean_impact_speed_m_s"], ".3f"), "m/s"),
+        ("heat generated", _number(s["heat_power_W"], ".3f"), "W"),
+        ("steps (rejected)", f"{s['steps']} ({s['rejected_steps']})", ""),
+        ("wall time", _number(s["wall_time_s"], ".2f"), "s"),
+        ("energy audit residual", _number(s["energy_audit_residual"], ".2e"), "relative"),
+        ("output folder", str(target), ""),
+    ]
+    for row in rows:
+        _add_plain_row(table, *row)
+    return table
+
+
+@app.command()
+def presets(
+    name: Annotated[str | None, typer.Argument(help="Show every value of this preset with its source.")] = None,
+) -> None:
+    """List the presets, or show one preset's values, units and sources."""
+    console = _stdout_console()
+    if name is None:
+        table = Table("preset", "description", title="presets")
+        for preset in PRESETS.values():
+            marker = " (default)" if preset.name == DEFAULT_PRESET else ""
+            _add_plain_row(table, preset.name + marker, preset.description)
+        console.print(table)
+        return
+    with _user_errors():
+        preset_values(name)  # validates the name with the library's one-line message
+    preset = PRESETS[name]
+    table = Table("key", "value", "source", title=f"{preset.name}: {preset.description}")
+    for key, cited in preset.values.items():
+        _add_plain_row(table, key, format_value(key, cited.value), cited.source)
+    console.print(table)
+
+
+@app.command()
+def keys() -> None:
+    """List the canonical parameter keys with unit, allowed values, default and description."""
+    defaults = preset_values(DEFAULT_PRESET)
+    table = Table("key", "allowed (SI)", f"default ({DEFAULT_PRESET})", "description", title="parameter keys")
+    for key in FIELD_NAMES:
+        default = format_value(key, defaults[key]) if key in defaults else ""
+        _add_plain_row(table, key, allowed_values(key), default, field_description(key))
+    _stdout_console().print(table)
+
+
+def allowed_values(key: str) -> str:
+    """What ``key`` accepts, for the ``keys`` listing."""
+    annotation = Parameters.model_fields[key].annotation
+    if annotation is bool:
+        return "true | false"
+    if get_origin(annotation) is Literal:
+        return " | ".join(str(choice) for choice in get_args(annotation))
+    if key == "record_windows":
+        return f"[start ≥ 0, length > 0] pairs, {field_unit(key)}"
+    return allowed_range(key)
+
+
+def format_value(key: str, value: Any) -> str:
+    """A preset value with its unit, e.g. '0.00635 m', 'true', '[0, 1], [600, 0.1] s'."""
+    unit = field_unit(key)
+    if isinstance(value, bool):
+        return str(value).lower()
+    if key == "record_windows":
+        pairs = ", ".join(f"[{start:g}, {length:g}]" for start, length in value)
+        return f"{pairs} {unit}" if pairs else "none"
+    if isinstance(value, (int, float)):
+        return f"{value:g} {unit}".rstrip()
+    return str(value)
+
+
+if __name__ == "__main__":
+    main()

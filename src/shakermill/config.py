@@ -1,0 +1,179 @@
+"""Run configuration: a preset, an optional TOML file and ``--set KEY=VALUE`` overrides.
+
+Precedence, lowest first: the preset (``spex8000m`` unless the file's ``preset``
+or the command line's ``--preset`` names another, the command line winning),
+then the file's values, then the ``--set`` overrides. The TOML file holds the
+canonical keys at top level; values may be numbers, booleans, strings with
+units ("25 mm") and, for ``record_windows``, an array of ``[start, length]``
+pairs. A ``[provenance]`` table, as written by :func:`write_config_toml`, is
+ignored on loading, so a stored run's ``config.toml`` reproduces its parameters.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import secrets
+import tomllib
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import tomli_w
+
+from . import __version__
+from .params import (
+    DEFAULT_PRESET,
+    ParameterError,
+    Parameters,
+    build_parameters,
+    field_description,
+    field_unit,
+    preset_values,
+)
+from .units import UnitError, to_si
+
+PRESET_KEY = "preset"
+PROVENANCE_TABLE = "provenance"
+SI_NOTE = "all values are SI (m, kg, s, K, rad, Pa, J, W); strings with units are accepted on input"
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """Validated parameters and where they came from."""
+
+    params: Parameters
+    preset: str
+    source: Path | None
+
+
+def load_config(
+    path: Path | str | None = None,
+    *,
+    preset: str | None = None,
+    overrides: Sequence[str] = (),
+) -> RunConfig:
+    """Resolve ``preset`` < file at ``path`` < ``overrides`` ("KEY=VALUE" strings) into parameters.
+
+    Raises :class:`ParameterError` with one line for any bad input: a missing or
+    malformed file, a bad override, an unknown key or a value out of range.
+    """
+    file_values: dict[str, Any] = {}
+    file_preset: str | None = None
+    source = Path(path) if path is not None else None
+    if source is not None:
+        file_values = read_config_file(source)
+        file_preset = _file_preset(file_values, source)
+    chosen_preset = preset or file_preset or DEFAULT_PRESET
+    base = preset_values(chosen_preset)
+    base.update(file_values)
+    params = build_parameters(base, parse_overrides(overrides))
+    return RunConfig(params=params, preset=chosen_preset, source=source)
+
+
+def read_config_file(path: Path) -> dict[str, Any]:
+    """The parameter entries of a TOML configuration (``preset`` included, ``[provenance]`` dropped)."""
+    try:
+        with path.open("rb") as stream:
+            document = tomllib.load(stream)
+    except FileNotFoundError:
+        raise ParameterError(f"{path}: no such configuration file") from None
+    except IsADirectoryError:
+        raise ParameterError(f"{path}: is a directory, expected a TOML configuration file") from None
+    except OSError as exc:
+        raise ParameterError(f"{path}: cannot read the configuration file ({exc.strerror})") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        # tomllib's message already ends with "(at line L, column C)".
+        raise ParameterError(f"{path}: malformed TOML: {exc}") from None
+    document.pop(PROVENANCE_TABLE, None)
+    if "record_windows" in document:
+        document["record_windows"] = _windows_from_toml(document["record_windows"])
+    return document
+
+
+def _file_preset(values: dict[str, Any], path: Path) -> str | None:
+    """Remove and return the file's ``preset`` entry; it names a preset, it is not a parameter."""
+    name = values.pop(PRESET_KEY, None)
+    if name is not None and not isinstance(name, str):
+        raise ParameterError(f"{path}: preset must be a string naming a preset, got {name!r}")
+    return name
+
+
+def _windows_from_toml(value: Any) -> Any:
+    """Convert the strings with units inside a TOML array of windows; the shape is checked by ``Parameters``."""
+    if not isinstance(value, list):
+        return value
+    try:
+        return [
+            [to_si(item, "s", key="record_windows") if isinstance(item, str) else item for item in pair]
+            if isinstance(pair, list)
+            else pair
+            for pair in value
+        ]
+    except UnitError as exc:
+        raise ParameterError(str(exc)) from None
+
+
+def parse_overrides(items: Sequence[str]) -> dict[str, str]:
+    """``["restitution=0.8", "duration=2 min"]`` -> ``{"restitution": "0.8", "duration": "2 min"}``; later wins."""
+    overrides: dict[str, str] = {}
+    for item in items:
+        key, separator, value = item.partition("=")
+        key = key.strip()
+        if not separator or not key:
+            raise ParameterError(f"--set {item!r}: expected KEY=VALUE, for example --set restitution=0.8")
+        overrides[key] = value.strip()
+    return overrides
+
+
+def config_toml_text(
+    params: Parameters,
+    *,
+    preset: str,
+    extra_provenance: Mapping[str, Any] | None = None,
+) -> str:
+    """The TOML text of :func:`write_config_toml`: one commented entry per key, then ``[provenance]``."""
+    entries = [f"# shakermill run configuration; {SI_NOTE}.", tomli_w.dumps({PRESET_KEY: preset})]
+    for key, value in params.model_dump().items():
+        unit = field_unit(key)
+        comment = f"# {field_description(key)}" + (f" [{unit}]" if unit else "")
+        entries.append(comment + "\n" + tomli_w.dumps({key: value}))
+    entries.append(tomli_w.dumps({PROVENANCE_TABLE: _provenance(preset, extra_provenance or {})}))
+    return "\n".join(entries)
+
+
+def _provenance(preset: str, extra: Mapping[str, Any]) -> dict[str, Any]:
+    provenance: dict[str, Any] = {
+        "shakermill_version": __version__,
+        "preset": preset,
+        "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "python": platform.python_version(),
+        "units": SI_NOTE,
+    }
+    # TOML has no null; absent values are simply left out.
+    provenance.update({key: value for key, value in extra.items() if value is not None})
+    return provenance
+
+
+def write_config_toml(
+    params: Parameters,
+    path: Path | str,
+    *,
+    preset: str,
+    extra_provenance: Mapping[str, Any] | None = None,
+) -> Path:
+    """Write ``params`` as a TOML file that :func:`load_config` turns back into equal parameters.
+
+    Floats are written with their shortest exact representation, so the round
+    trip is exact. The file replaces any previous one atomically.
+    """
+    path = Path(path)
+    text = config_toml_text(params, preset=preset, extra_provenance=extra_provenance)
+    partial = path.with_name(f".{path.name}.partial-{secrets.token_hex(4)}")
+    try:
+        partial.write_text(text, encoding="utf-8")
+        os.replace(partial, path)
+    finally:
+        partial.unlink(missing_ok=True)
+    return path

@@ -1,0 +1,253 @@
+"""Run folders: everything a run produced, written atomically, and read back for later tools.
+
+A run folder holds
+
+* ``timeseries.nc``   the sampled state history (NetCDF4 via h5netcdf; kelvin, SI units in attributes),
+* ``windows.nc``      the full-resolution state inside the record windows,
+* ``impacts.parquet`` one row per impact, units as JSON in the schema metadata under ``units``,
+* ``summary.json``    summary, energy audit, exponential fit, counters, status and message,
+* ``config.toml``     the resolved parameters with provenance; ``shakermill run config.toml`` repeats the run,
+
+plus whatever ``add_files`` puts there (the command line adds ``figures/``).
+
+The folder is built in a hidden sibling ``.<name>.partial-<random>`` and moved
+into place only when complete, so an interrupted write never leaves a folder at
+the target path that looks like a finished run.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import secrets
+import shutil
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+import xarray as xr
+
+from . import __version__
+from .config import load_config, write_config_toml
+from .fit import ExponentialFit
+from .integrate import REACHED_STOP
+from .params import Parameters
+from .simulate import IMPACT_UNITS, Result
+
+TIMESERIES_FILE = "timeseries.nc"
+WINDOWS_FILE = "windows.nc"
+IMPACTS_FILE = "impacts.parquet"
+SUMMARY_FILE = "summary.json"
+CONFIG_FILE = "config.toml"
+RUN_FILES = (TIMESERIES_FILE, WINDOWS_FILE, IMPACTS_FILE, SUMMARY_FILE, CONFIG_FILE)
+# Key of the impact table's units in the Parquet schema metadata.
+UNITS_METADATA_KEY = b"units"
+NETCDF_ENGINE = "h5netcdf"
+
+
+class StorageError(Exception):
+    """A run folder cannot be written to, or read from, the given path."""
+
+
+@dataclass(frozen=True)
+class RunData:
+    """A run read back from its folder; attribute names follow :class:`shakermill.simulate.Result`."""
+
+    path: Path
+    params: Parameters
+    preset: str
+    status: int
+    message: str
+    timeseries: xr.Dataset
+    windows: xr.Dataset
+    impacts: pd.DataFrame
+    impact_units: dict[str, str]
+    summary: dict[str, Any]
+    energy: dict[str, Any]
+    ball_fit: ExponentialFit
+    counters: dict[str, int]
+
+    @property
+    def success(self) -> bool:
+        return self.status == REACHED_STOP
+
+
+def to_jsonable(value: Any) -> Any:
+    """``value`` with numpy scalars made plain and non-finite floats made ``None`` (JSON has no NaN)."""
+    if isinstance(value, Mapping):
+        return {str(key): to_jsonable(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(item) for item in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def check_target(path: Path) -> None:
+    """Raise :class:`StorageError` unless ``path`` is free, an empty folder or a run folder to replace.
+
+    Replacing deletes the old folder, so anything else (a file, a folder of the
+    user's own) is refused rather than destroyed.
+    """
+    if not path.exists() and not path.is_symlink():
+        return
+    if path.is_symlink() or not path.is_dir():
+        raise StorageError(f"{path}: exists and is not a folder; choose another --out")
+    if any(path.iterdir()) and not (path / SUMMARY_FILE).is_file():
+        raise StorageError(f"{path}: a non-empty folder that is not a shakermill run; choose another --out")
+
+
+def write_run(
+    result: Result,
+    path: Path | str,
+    *,
+    preset: str,
+    extra_provenance: Mapping[str, Any] | None = None,
+    add_files: Callable[[Path], object] | None = None,
+) -> Path:
+    """Write ``result`` as a run folder at ``path``, replacing a previous run folder there.
+
+    ``add_files(folder)`` may add more files (figures) before the folder is
+    moved into place. Returns the folder's absolute path.
+    """
+    # Absolute, so that "." has a name to derive the sibling folders from.
+    target = Path(path).absolute()
+    check_target(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    partial = target.with_name(f".{target.name}.partial-{secrets.token_hex(4)}")
+    partial.mkdir()
+    try:
+        _write_contents(result, partial, preset=preset, extra_provenance=extra_provenance or {})
+        if add_files is not None:
+            add_files(partial)
+        _move_into_place(partial, target)
+    except BaseException:
+        # KeyboardInterrupt included: the half-written folder must not survive.
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
+    return target
+
+
+def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenance: Mapping[str, Any]) -> None:
+    attributes = _run_attributes(result, preset)
+    write_dataset(result.timeseries, folder / TIMESERIES_FILE, title="shakermill sampled state history", **attributes)
+    windows_title = "shakermill full-resolution state in the record windows"
+    write_dataset(result.windows, folder / WINDOWS_FILE, title=windows_title, **attributes)
+    write_impacts(result.impacts, folder / IMPACTS_FILE)
+    (folder / SUMMARY_FILE).write_text(summary_json(result, preset), encoding="utf-8")
+    provenance = {"status": result.status, "message": result.message, "simulated_s": result.t_end, **extra_provenance}
+    write_config_toml(result.params, folder / CONFIG_FILE, preset=preset, extra_provenance=provenance)
+
+
+def _run_attributes(result: Result, preset: str) -> dict[str, Any]:
+    # NetCDF attributes cannot be booleans, hence the integer status only.
+    return {
+        "shakermill_version": __version__,
+        "preset": preset,
+        "status": int(result.status),
+        "message": result.message,
+        "simulated_s": float(result.t_end),
+        "temperature_note": "temperatures in kelvin",
+    }
+
+
+def write_dataset(dataset: xr.Dataset, path: Path, *, title: str, **attributes: Any) -> None:
+    """Write ``dataset`` with global attributes; per-variable ``units`` and ``long_name`` are kept as they are."""
+    stored = dataset.copy()
+    stored.attrs.update(title=title, **attributes)
+    stored.to_netcdf(path, engine=NETCDF_ENGINE)
+
+
+def write_impacts(impacts: pd.DataFrame, path: Path) -> None:
+    """Write the impact table with the column units as JSON in the Parquet schema metadata."""
+    table = pa.Table.from_pandas(impacts, preserve_index=False)
+    units = {column: IMPACT_UNITS.get(column, "") for column in impacts.columns}
+    metadata = dict(table.schema.metadata or {})
+    metadata[UNITS_METADATA_KEY] = json.dumps(units).encode()
+    pq.write_table(table.replace_schema_metadata(metadata), path)
+
+
+def summary_document(result: Result, preset: str) -> dict[str, Any]:
+    """The content of ``summary.json``, JSON-ready (NaN as ``None``)."""
+    return to_jsonable(
+        {
+            "status": result.status,
+            "success": result.success,
+            "message": result.message,
+            "preset": preset,
+            "shakermill_version": __version__,
+            "summary": result.summary,
+            "energy_audit": result.energy.as_dict(),
+            "ball_fit": result.ball_fit.as_dict(),
+            "counters": result.counters,
+        }
+    )
+
+
+def summary_json(result: Result, preset: str) -> str:
+    return json.dumps(summary_document(result, preset), sort_keys=True, indent=2, allow_nan=False) + "\n"
+
+
+def _move_into_place(partial: Path, target: Path) -> None:
+    """Rename ``partial`` to ``target``; an old run folder there is set aside first and deleted after."""
+    if not target.exists():
+        os.rename(partial, target)
+        return
+    aside = target.with_name(f".{target.name}.old-{secrets.token_hex(4)}")
+    os.rename(target, aside)
+    try:
+        os.rename(partial, target)
+    except BaseException:
+        os.rename(aside, target)
+        raise
+    shutil.rmtree(aside, ignore_errors=True)
+
+
+def load_run(path: Path | str) -> RunData:
+    """Read a run folder written by :func:`write_run` (datasets are loaded into memory, files closed)."""
+    folder = Path(path)
+    summary_path = folder / SUMMARY_FILE
+    if not summary_path.is_file():
+        raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
+    document = json.loads(summary_path.read_text(encoding="utf-8"))
+    config = load_config(folder / CONFIG_FILE)
+    impacts, impact_units = read_impacts(folder / IMPACTS_FILE)
+    return RunData(
+        path=folder,
+        params=config.params,
+        preset=config.preset,
+        status=int(document["status"]),
+        message=str(document["message"]),
+        timeseries=xr.load_dataset(folder / TIMESERIES_FILE, engine=NETCDF_ENGINE),
+        windows=xr.load_dataset(folder / WINDOWS_FILE, engine=NETCDF_ENGINE),
+        impacts=impacts,
+        impact_units=impact_units,
+        summary=document["summary"],
+        energy=document["energy_audit"],
+        ball_fit=_fit_from_dict(document["ball_fit"]),
+        counters=document["counters"],
+    )
+
+
+def read_impacts(path: Path) -> tuple[pd.DataFrame, dict[str, str]]:
+    """The impact table and its column units."""
+    table = pq.read_table(path)
+    metadata = table.schema.metadata or {}
+    units = json.loads(metadata.get(UNITS_METADATA_KEY, b"{}"))
+    return table.to_pandas(), units
+
+
+def _fit_from_dict(values: Mapping[str, Any]) -> ExponentialFit:
+    # summary.json stores NaN as null; the fit's fields are floats again here.
+    arguments = {
+        field.name: math.nan if values.get(field.name) is None else values[field.name]
+        for field in fields(ExponentialFit)
+    }
+    return ExponentialFit(**arguments)

@@ -1,0 +1,265 @@
+"""The command line: run folders, --json output, exit codes and one-line errors for bad input."""
+
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from rich.console import Console
+from typer.testing import CliRunner
+
+import shakermill as sm
+from shakermill import cli
+from shakermill.config import load_config
+from shakermill.params import FIELD_NAMES
+from shakermill.storage import RUN_FILES, load_run
+
+# Short runs with small windows keep every invocation well under a second once Numba's cache is warm.
+SHORT = ["--set", "duration=2", "--set", "record_windows=0:0.2"]
+REQUIRED_SUMMARY_KEYS = {
+    "theta_inf_C",
+    "tau_min",
+    "rate0_C_per_min",
+    "ball_C",
+    "vial_C",
+    "air_C",
+    "vial_ball_ratio",
+    "impacts",
+    "impact_rate_hz",
+    "heat_power_W",
+    "mean_impact_speed_m_s",
+    "steps",
+    "wall_time_s",
+    "energy_audit_residual",
+    "status",
+    "success",
+    "message",
+    "output_dir",
+}
+SHAKERMILL = Path(sys.executable).parent / "shakermill"
+
+runner = CliRunner()
+
+
+def invoke(*args: str):
+    return runner.invoke(cli.app, list(args))
+
+
+def assert_one_error_line(stderr: str, *fragments: str) -> None:
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
+    assert lines[0].startswith("error: ")
+    for fragment in fragments:
+        assert fragment in lines[0], (fragment, lines[0])
+    assert "Traceback" not in stderr
+
+
+def test_run_json_prints_exactly_one_object_matching_the_stored_summary(tmp_path):
+    out = tmp_path / "run"
+    result = invoke("run", *SHORT, "--out", str(out), "--json", "--no-plots")
+    assert result.exit_code == 0, result.stderr
+    assert result.stdout.count("\n") == 1  # one line, one object
+    summary = json.loads(result.stdout)
+    assert isinstance(summary, dict)
+    assert REQUIRED_SUMMARY_KEYS <= set(summary)
+    assert summary["success"] is True and summary["status"] == 0
+    assert summary["impacts"] > 0
+    assert summary["output_dir"] == str(out)
+    stored = json.loads((out / "summary.json").read_text(encoding="utf-8"))["summary"]
+    for key in ("theta_inf_C", "tau_min", "ball_C", "impacts", "steps"):
+        assert summary[key] == stored[key]
+    assert sorted(entry.name for entry in out.iterdir()) == sorted(RUN_FILES)  # --no-plots: no figures
+
+
+def test_run_writes_figures_and_prints_a_human_summary(tmp_path):
+    out = tmp_path / "run"
+    result = invoke("run", *SHORT, "--out", str(out))
+    assert result.exit_code == 0, result.stderr
+    ball_celsius = load_run(out).summary["ball_C"]
+    units = ("°C", "min", "Hz", "m/s", "W")
+    expected = ("θ∞", *units, "steps", "energy audit residual", f"{ball_celsius:.2f}", str(out))
+    for text in expected:
+        assert text in result.stdout, text
+    figures = sorted(path.name for path in (out / "figures").iterdir())
+    names = ("ball_heating_zoom", "ball_motion", "temperatures")
+    assert figures == sorted(f"{name}.{fmt}" for name in names for fmt in ("png", "svg"))
+
+
+def test_config_file_and_set_overrides_end_up_in_the_stored_configuration(tmp_path):
+    config = tmp_path / "mill.toml"
+    config.write_text(
+        'restitution = 0.8\nvial_mass = "60 g"\nduration = 5\nrecord_windows = [[0, 0.1]]\n', encoding="utf-8"
+    )
+    out = tmp_path / "run"
+    result = invoke("run", str(config), "--set", "duration=2", "--out", str(out), "--json", "--no-plots")
+    assert result.exit_code == 0, result.stderr
+    params = load_config(out / "config.toml").params
+    assert params.restitution == 0.8
+    assert params.vial_mass == pytest.approx(0.06)
+    assert params.duration == 2.0  # --set beats the file
+    assert json.loads(result.stdout)["simulated_s"] == 2.0
+    assert str(config) in (out / "config.toml").read_text(encoding="utf-8")  # provenance names the file
+
+
+@pytest.mark.parametrize(
+    "setting, fragments",
+    [
+        ("restitution=1.5", ("restitution", "allowed (0, 1]")),
+        ("restitution=0", ("restitution", "allowed (0, 1]")),
+        ("ball_radius=40 mm", ("ball_radius", "does not fit", "allowed ball_radius < vial_length/2 = 0.029 m")),
+        ("vial_mass=-1", ("vial_mass", "allowed (0, inf) kg")),
+        ("omega=0", ("omega", "allowed (0, inf) rad/s")),
+        ("amplitude=3 kg", ("amplitude", "'3 kg'", "expected m")),
+        ("restitutoin=0.5", ("restitutoin", "did you mean 'restitution'")),
+        ("duration=abc", ("duration", "'abc'")),
+        ("duration", ("'duration'", "expected KEY=VALUE")),
+        ("heat_model=exact", ("heat_model", "'relative' or 'paper'")),
+    ],
+)
+def test_bad_setting_exits_2_with_one_line_naming_the_key(tmp_path, setting, fragments):
+    out = tmp_path / "run"
+    result = invoke("run", "--set", setting, "--out", str(out))
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, *fragments)
+    assert result.stdout == ""
+    assert not out.exists()
+
+
+def test_malformed_toml_exits_2_naming_file_and_line(tmp_path):
+    config = tmp_path / "broken.toml"
+    config.write_text("duration = 2\nrestitution = \neta = 0.5\n", encoding="utf-8")
+    result = invoke("run", str(config), "--out", str(tmp_path / "run"))
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, "broken.toml", "malformed TOML", "line 2")
+
+
+def test_missing_config_file_exits_2(tmp_path):
+    result = invoke("run", str(tmp_path / "absent.toml"))
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, "absent.toml", "no such configuration file")
+
+
+def test_unknown_preset_exits_2():
+    result = invoke("run", "--preset", "spex9000")
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, "unknown preset 'spex9000'", "spex8000m")
+
+
+def test_output_over_a_foreign_folder_is_refused_before_running(tmp_path, monkeypatch):
+    (tmp_path / "notes.txt").write_text("mine")
+    monkeypatch.setattr(cli, "simulate", lambda *_args, **_kwargs: pytest.fail("must not run"))
+    result = invoke("run", *SHORT, "--out", str(tmp_path))
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, str(tmp_path), "not a shakermill run")
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
+def test_usage_error_from_the_parser_exits_2():
+    result = invoke("run", "--no-such-option")
+    assert result.exit_code == 2
+    assert "No such option" in result.stderr
+
+
+def test_numerical_failure_keeps_the_results_and_exits_1(tmp_path):
+    # A soft ball and vial overlap by more than the integrator allows at the first impact.
+    out = tmp_path / "run"
+    soft = ["--set", "ball_youngs_modulus=1e7", "--set", "vial_youngs_modulus=1e7"]
+    result = invoke("run", *SHORT, *soft, "--out", str(out), "--json")
+    assert result.exit_code == 1
+    summary = json.loads(result.stdout)
+    assert summary["success"] is False and summary["status"] < 0
+    assert summary["simulated_s"] < 2.0
+    assert "overlap" in result.stderr and str(out) in result.stderr
+    assert load_run(out).status == summary["status"]
+    assert (out / "figures" / "temperatures.png").is_file()
+
+
+def test_interruption_writes_partial_results_and_exits_130(tmp_path, monkeypatch):
+    real_simulate = sm.simulate
+
+    def press_ctrl_c(_t: float, _duration: float) -> None:
+        raise KeyboardInterrupt
+
+    # The interruption arrives after the first chunk, inside the library, as a real Ctrl-C would.
+    monkeypatch.setattr(cli, "simulate", lambda params, progress=None: real_simulate(params, progress=press_ctrl_c))
+    out = tmp_path / "run"
+    result = invoke("run", "--set", "duration=30", "--set", "record_windows=0:0.2", "--out", str(out), "--no-plots")
+    assert result.exit_code == 130
+    assert "interrupted" in result.stderr.lower()
+    run = load_run(out)
+    assert run.status == 1
+    assert 0 < float(run.timeseries["time"].max()) < 30.0
+
+
+def test_progress_bar_is_drawn_on_a_terminal_for_long_runs(monkeypatch):
+    screen = io.StringIO()
+    real_console = Console
+
+    def console(**kwargs):
+        if kwargs.get("stderr"):
+            return real_console(file=screen, force_terminal=True, width=100)
+        return real_console(**kwargs)
+
+    monkeypatch.setattr(cli, "Console", console)
+    result = cli.simulate_with_progress(sm.default_parameters(duration=60.0, record_windows=()))
+    assert result.success
+    assert "s simulated" in screen.getvalue()
+
+
+def test_presets_lists_and_shows_values_with_units_and_sources():
+    listing = invoke("presets")
+    assert listing.exit_code == 0
+    assert "spex8000m" in listing.stdout and "SPEX 8000M" in listing.stdout
+    shown = invoke("presets", "spex8000m")
+    assert shown.exit_code == 0
+    for text in ("ball_radius", "0.00635 m", "111 rad/s", "[0, 1], [600, 0.1] s", "Table 1", "Son 2025"):
+        assert text in shown.stdout, text
+    missing = invoke("presets", "nope")
+    assert missing.exit_code == 2
+    assert_one_error_line(missing.stderr, "unknown preset 'nope'")
+
+
+def test_keys_lists_every_key_with_its_allowed_range():
+    result = invoke("keys")
+    assert result.exit_code == 0
+    lines = result.stdout.splitlines()
+    for key in FIELD_NAMES:
+        assert any(f" {key} " in line for line in lines), key
+    restitution = next(line for line in lines if " restitution " in line)
+    assert "(0, 1]" in restitution and "0.7" in restitution
+    assert "relative | paper" in result.stdout
+
+
+def test_version_option():
+    result = invoke("--version")
+    assert result.exit_code == 0
+    assert result.stdout.strip() == f"shakermill {sm.__version__}"
+
+
+def test_installed_command_reports_bad_input_without_traceback(tmp_path):
+    completed = subprocess.run(
+        [str(SHAKERMILL), "run", "--set", "restitution=1.5", "--out", str(tmp_path / "run")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert completed.returncode == 2
+    assert completed.stdout == ""
+    assert completed.stderr == "error: restitution: 1.5 is out of range; allowed (0, 1]\n"
+
+
+def test_installed_command_json_output_is_clean(tmp_path):
+    completed = subprocess.run(
+        [str(SHAKERMILL), "run", *SHORT, "--out", str(tmp_path / "run"), "--json", "--no-plots"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert completed.returncode == 0, completed.stderr
+    summary = json.loads(completed.stdout)
+    assert REQUIRED_SUMMARY_KEYS <= set(summary)
+    assert summary["success"] is True

@@ -1,0 +1,159 @@
+"""Run configuration: precedence of preset, file and --set; errors; exact TOML round trip."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from shakermill import params as params_module
+from shakermill.config import load_config, parse_overrides, write_config_toml
+from shakermill.params import DEFAULT_PRESET, Cited, ParameterError, Preset, default_parameters
+
+
+def write_toml(tmp_path: Path, text: str, name: str = "run.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+@pytest.fixture(name="other_preset")
+def other_preset_fixture(monkeypatch: pytest.MonkeyPatch) -> str:
+    """A second preset, differing from the default in restitution and duration."""
+    values = dict(params_module.PRESETS[DEFAULT_PRESET].values)
+    values["restitution"] = Cited(0.5, "test")
+    values["duration"] = Cited(7.0, "test")
+    monkeypatch.setitem(params_module.PRESETS, "other", Preset("other", "test preset", values))
+    return "other"
+
+
+def test_no_file_no_overrides_gives_the_default_preset():
+    config = load_config()
+    assert config.params == default_parameters()
+    assert config.preset == DEFAULT_PRESET
+    assert config.source is None
+
+
+def test_file_overrides_preset_and_set_overrides_file(tmp_path):
+    path = write_toml(
+        tmp_path,
+        'restitution = 0.8\nduration = "2 min"\nomega = 100\nrecord_windows = [[0, "200 ms"], [30, 0.1]]\n',
+    )
+    config = load_config(path, overrides=["restitution=0.6", "vial_mass=40 g"])
+    assert config.params.restitution == 0.6  # --set beats the file
+    assert config.params.duration == pytest.approx(120.0)  # file with units beats the preset
+    assert config.params.omega == 100.0
+    assert config.params.vial_mass == pytest.approx(0.04)
+    assert config.params.record_windows == ((0.0, pytest.approx(0.2)), (30.0, 0.1))
+    assert config.params.eta == default_parameters().eta  # untouched keys come from the preset
+    assert config.source == path
+
+
+def test_preset_named_in_file_is_used(tmp_path, other_preset):
+    path = write_toml(tmp_path, f'preset = "{other_preset}"\neta = 0.5\n')
+    config = load_config(path)
+    assert config.preset == other_preset
+    assert (config.params.restitution, config.params.duration, config.params.eta) == (0.5, 7.0, 0.5)
+
+
+def test_command_line_preset_beats_the_file_preset(tmp_path, other_preset):
+    path = write_toml(tmp_path, f'preset = "{DEFAULT_PRESET}"\n')
+    config = load_config(path, preset=other_preset)
+    assert config.preset == other_preset
+    assert config.params.restitution == 0.5
+
+
+def test_unknown_preset_is_reported(tmp_path):
+    with pytest.raises(ParameterError, match=r"unknown preset 'nope'.*spex8000m"):
+        load_config(write_toml(tmp_path, 'preset = "nope"\n'))
+
+
+def test_preset_entry_must_be_a_string(tmp_path):
+    with pytest.raises(ParameterError, match="preset must be a string"):
+        load_config(write_toml(tmp_path, "preset = 3\n"))
+
+
+def test_malformed_toml_names_file_line_and_column(tmp_path):
+    path = write_toml(tmp_path, "duration = 2\nrestitution = \n", name="broken.toml")
+    with pytest.raises(ParameterError) as caught:
+        load_config(path)
+    message = str(caught.value)
+    assert "broken.toml" in message and "malformed TOML" in message
+    assert "line 2" in message and "column" in message
+    assert "\n" not in message
+
+
+def test_missing_file_is_one_clear_line(tmp_path):
+    with pytest.raises(ParameterError, match="no such configuration file"):
+        load_config(tmp_path / "absent.toml")
+
+
+def test_unknown_key_in_file_suggests_the_right_one(tmp_path):
+    with pytest.raises(ParameterError, match="restitutoin: unknown parameter; did you mean 'restitution'"):
+        load_config(write_toml(tmp_path, "restitutoin = 0.5\n"))
+
+
+def test_window_with_wrong_unit_in_file_names_the_key(tmp_path):
+    with pytest.raises(ParameterError, match="record_windows: .*expected s"):
+        load_config(write_toml(tmp_path, 'record_windows = [[0, "1 kg"]]\n'))
+
+
+def test_provenance_table_is_ignored_on_loading(tmp_path):
+    path = write_toml(tmp_path, 'eta = 0.7\n[provenance]\nshakermill_version = "0.0"\nanything = 1\n')
+    assert load_config(path).params.eta == 0.7
+
+
+@pytest.mark.parametrize("item", ["duration", "=3", " = 3"])
+def test_set_item_without_key_and_equals_sign_is_rejected(item):
+    with pytest.raises(ParameterError, match="expected KEY=VALUE"):
+        parse_overrides([item])
+
+
+def test_later_set_items_win_and_values_keep_their_spaces_and_equals_signs():
+    assert parse_overrides(["eta=0.5", " eta = 0.6 ", "heat_model=a=b"]) == {"eta": "0.6", "heat_model": "a=b"}
+
+
+@pytest.mark.parametrize(
+    "changes",
+    [
+        # Floats without a short decimal form, changed options and the opposite booleans.
+        dict(
+            ball_radius=1e-2 / 3,
+            omega=2 * 3.141592653589793 * 17.7,
+            phase=-0.1,
+            ball_momentum=-1e-7,
+            energy_projection=False,
+            no_tension=True,
+            heat_model="paper",
+            convection_velocity="relative",
+            record_windows=((0.1 / 3, 0.7), (12.5, 1e-3)),
+        ),
+        dict(record_windows=()),
+    ],
+)
+def test_written_config_loads_back_to_identical_parameters(tmp_path, changes):
+    original = default_parameters().replace(**changes)
+    path = write_config_toml(original, tmp_path / "config.toml", preset=DEFAULT_PRESET)
+    loaded = load_config(path)
+    assert loaded.params == original
+    assert loaded.params.model_dump() == original.model_dump()
+    assert loaded.preset == DEFAULT_PRESET
+
+
+def test_written_config_has_provenance_and_no_leftover_temporary_file(tmp_path):
+    path = write_config_toml(
+        default_parameters(),
+        tmp_path / "config.toml",
+        preset=DEFAULT_PRESET,
+        extra_provenance={"status": 0, "config_file": None, "overrides": ["eta=0.5"]},
+    )
+    document = tomllib.loads(path.read_text(encoding="utf-8"))
+    provenance = document["provenance"]
+    assert provenance["preset"] == DEFAULT_PRESET
+    assert provenance["shakermill_version"]
+    assert "SI" in provenance["units"]
+    assert provenance["created_utc"].endswith("+00:00")
+    assert provenance["status"] == 0 and provenance["overrides"] == ["eta=0.5"]
+    assert "config_file" not in provenance  # None has no TOML form and is left out
+    assert [entry.name for entry in tmp_path.iterdir()] == ["config.toml"]

@@ -1,0 +1,188 @@
+"""Run folders: content of every file, read-back, atomic replacement and interrupted writes."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+import xarray as xr
+
+import shakermill as sm
+from shakermill import storage
+from shakermill.config import load_config
+from shakermill.params import DEFAULT_PRESET
+from shakermill.simulate import IMPACT_UNITS
+from shakermill.storage import StorageError, load_run, to_jsonable, write_run
+
+
+@pytest.fixture(scope="module")
+def short_result() -> sm.Result:
+    return sm.simulate(sm.default_parameters(duration=2.0, record_windows="0:0.2"))
+
+
+@pytest.fixture(name="run_folder")
+def run_folder_fixture(short_result, tmp_path) -> Path:
+    return write_run(short_result, tmp_path / "run", preset=DEFAULT_PRESET, extra_provenance={"note": "test"})
+
+
+def strict_json(text: str):
+    """json.loads that refuses NaN and Infinity, which are not JSON."""
+
+    def refuse(constant: str):
+        raise ValueError(f"not JSON: {constant}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_run_folder_holds_exactly_the_documented_files(run_folder):
+    assert sorted(entry.name for entry in run_folder.iterdir()) == sorted(storage.RUN_FILES)
+    assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]  # no partial or old folders left
+
+
+@pytest.mark.parametrize("file_name, attribute", [("timeseries.nc", "timeseries"), ("windows.nc", "windows")])
+def test_netcdf_files_hold_the_result_values_with_units(run_folder, short_result, file_name, attribute):
+    expected: xr.Dataset = getattr(short_result, attribute)
+    assert expected.sizes["time"] > 2
+    with xr.open_dataset(run_folder / file_name, engine="h5netcdf") as stored:
+        assert set(stored.data_vars) == set(expected.data_vars)
+        np.testing.assert_array_equal(stored["time"].values, expected["time"].values)
+        for name in expected.data_vars:
+            np.testing.assert_array_equal(stored[name].values, expected[name].values)
+            assert stored[name].attrs["units"] == expected[name].attrs["units"]
+            assert stored[name].attrs["long_name"] == expected[name].attrs["long_name"]
+        assert stored["theta_ball"].attrs["units"] == "K"
+        assert stored["time"].attrs["units"] == "s"
+        assert stored.attrs["shakermill_version"] == sm.__version__
+        assert stored.attrs["status"] == short_result.status
+        assert stored.attrs["message"] == short_result.message
+        assert "shakermill" in stored.attrs["title"]
+
+
+def test_parquet_holds_every_impact_and_the_units(run_folder, short_result):
+    table = pq.read_table(run_folder / "impacts.parquet")
+    assert json.loads(table.schema.metadata[b"units"]) == IMPACT_UNITS
+    stored = table.to_pandas()
+    assert len(stored) == len(short_result.impacts) > 10
+    assert list(stored.columns) == list(short_result.impacts.columns)
+    assert list(stored["wall"]) == list(short_result.impacts["wall"])
+    numeric = [column for column in stored.columns if column != "wall"]
+    np.testing.assert_array_equal(stored[numeric].to_numpy(), short_result.impacts[numeric].to_numpy())
+
+
+def test_summary_json_is_strict_json_matching_the_result(run_folder, short_result):
+    document = strict_json((run_folder / "summary.json").read_text(encoding="utf-8"))
+    assert document["status"] == short_result.status == 0
+    assert document["success"] is True
+    assert document["message"] == short_result.message
+    assert document["counters"] == short_result.counters
+    for key, value in short_result.summary.items():
+        if isinstance(value, str):
+            assert document["summary"][key] == value
+        else:
+            assert document["summary"][key] == pytest.approx(float(value), rel=1e-15), key
+    assert document["energy_audit"]["relative_residual"] == pytest.approx(short_result.energy.relative_residual)
+    assert document["ball_fit"]["theta_inf"] == pytest.approx(short_result.ball_fit.theta_inf)
+
+
+def test_config_toml_reproduces_the_parameters_and_records_provenance(run_folder, short_result):
+    assert load_config(run_folder / "config.toml").params == short_result.params
+    text = (run_folder / "config.toml").read_text(encoding="utf-8")
+    assert 'note = "test"' in text and f'shakermill_version = "{sm.__version__}"' in text
+
+
+def test_load_run_returns_what_was_written(run_folder, short_result):
+    run = load_run(run_folder)
+    assert run.params == short_result.params
+    assert run.preset == DEFAULT_PRESET
+    assert run.success and run.status == 0
+    assert run.ball_fit == short_result.ball_fit
+    assert run.impact_units == IMPACT_UNITS
+    assert run.counters == short_result.counters
+    assert run.summary["impacts"] == short_result.summary["impacts"]
+    xr.testing.assert_identical(run.timeseries.drop_attrs(), short_result.timeseries.drop_attrs())
+    pd.testing.assert_frame_equal(run.impacts, short_result.impacts, check_dtype=False)
+
+
+def test_load_run_refuses_a_folder_without_summary(tmp_path):
+    with pytest.raises(StorageError, match="not a shakermill run folder"):
+        load_run(tmp_path)
+
+
+def test_nan_values_are_written_as_null(tmp_path):
+    # Too short to fit an exponential and without impacts: the summary holds NaNs.
+    result = sm.simulate(sm.default_parameters(duration=0.001, record_windows=()))
+    assert math.isnan(result.summary["theta_inf_C"])
+    folder = write_run(result, tmp_path / "short", preset=DEFAULT_PRESET)
+    document = strict_json((folder / "summary.json").read_text(encoding="utf-8"))
+    assert document["summary"]["theta_inf_C"] is None
+    assert document["summary"]["mean_impact_speed_m_s"] is None
+    run = load_run(folder)
+    assert math.isnan(run.ball_fit.tau)
+    assert run.windows.sizes["time"] == 0 and len(run.impacts) == 0
+
+
+def test_to_jsonable_makes_numpy_values_plain_and_non_finite_values_null():
+    converted = to_jsonable({"a": np.float64("nan"), "b": [np.int64(3), np.float64(-np.inf)], "c": np.bool_(True)})
+    assert converted == {"a": None, "b": [3, None], "c": True}
+    assert type(converted["b"][0]) is int and type(converted["c"]) is bool
+
+
+def test_writing_again_replaces_the_old_run_completely(run_folder, short_result):
+    (run_folder / "stale.txt").write_text("from the old run")
+    def add_extra(folder: Path) -> None:
+        (folder / "extra.txt").write_text("new")
+
+    write_run(short_result, run_folder, preset=DEFAULT_PRESET, add_files=add_extra)
+    assert not (run_folder / "stale.txt").exists()
+    assert (run_folder / "extra.txt").read_text() == "new"
+    assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]
+
+
+@pytest.mark.parametrize("existing", ["file", "foreign folder"])
+def test_refuses_to_replace_what_is_not_a_run_folder(short_result, tmp_path, existing):
+    target = tmp_path / "target"
+    if existing == "file":
+        target.write_text("precious")
+        precious = target
+    else:
+        target.mkdir()
+        precious = target / "thesis.tex"
+        precious.write_text("precious")
+    with pytest.raises(StorageError, match="choose another --out"):
+        write_run(short_result, target, preset=DEFAULT_PRESET)
+    assert precious.read_text() == "precious"
+
+
+def fail_midway(*_args, **_kwargs):
+    raise KeyboardInterrupt
+
+
+def test_interrupted_write_leaves_no_folder_at_all(short_result, tmp_path, monkeypatch):
+    monkeypatch.setattr(storage, "write_impacts", fail_midway)
+    with pytest.raises(KeyboardInterrupt):
+        write_run(short_result, tmp_path / "run", preset=DEFAULT_PRESET)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_failure_in_added_files_leaves_no_folder(short_result, tmp_path):
+    def broken_figures(folder: Path) -> None:
+        (folder / "figures").mkdir()
+        raise RuntimeError("plotting failed")
+
+    with pytest.raises(RuntimeError):
+        write_run(short_result, tmp_path / "run", preset=DEFAULT_PRESET, add_files=broken_figures)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_interrupted_replacement_keeps_the_previous_run(run_folder, short_result, monkeypatch):
+    before = (run_folder / "summary.json").read_text(encoding="utf-8")
+    monkeypatch.setattr(storage, "write_impacts", fail_midway)
+    with pytest.raises(KeyboardInterrupt):
+        write_run(short_result, run_folder, preset=DEFAULT_PRESET)
+    assert (run_folder / "summary.json").read_text(encoding="utf-8") == before
+    assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]
