@@ -263,3 +263,14 @@ def test_installed_command_json_output_is_clean(tmp_path):
     summary = json.loads(completed.stdout)
     assert REQUIRED_SUMMARY_KEYS <= set(summary)
     assert summary["success"] is True
+
+
+def test_compare_solvers_reports_both_solvers_and_the_speed_ratio():
+    outcome = runner.invoke(cli.app, ["compare-solvers", "--set", "duration=300", "--set", "record_windows=", "--json"])
+    assert outcome.exit_code == 0, outcome.output
+    payload = json.loads(outcome.stdout)
+    assert payload["averaged_solver_used"] == "averaged"
+    assert payload["speed_ratio"] > 1.0
+    full, averaged = payload["full"], payload["averaged"]
+    assert averaged["ball_C"] == pytest.approx(full["ball_C"], abs=0.2)
+    assert averaged["heat_power_W"] == pytest.approx(full["heat_power_W"], rel=0.005)

@@ -15,7 +15,7 @@ import math
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
-from typing import Annotated, Any, Iterator, Literal, NoReturn, get_args, get_origin
+from typing import Annotated, Any, Iterator, NoReturn
 
 import typer
 from rich.console import Console
@@ -213,6 +213,7 @@ def summary_table(result: Result, target: Path) -> Table:
     table.add_column("unit")
     rows = [
         ("status", s["message"] if not result.success else "ok", ""),
+        ("solver", s["solver"], ""),
         ("simulated time", _number(s["simulated_s"], ".6g"), "s"),
         ("ball θ∞ (exponential fit)", _number(s["theta_inf_C"], ".2f"), "°C"),
         ("time constant τ", _number(s["tau_min"], ".2f"), "min"),
@@ -233,6 +234,57 @@ def summary_table(result: Result, target: Path) -> Table:
     for row in rows:
         _add_plain_row(table, *row)
     return table
+
+
+COMPARED_QUANTITIES = (
+    ("theta_inf_C", "ball θ∞", "°C"),
+    ("tau_min", "time constant τ", "min"),
+    ("rate0_C_per_min", "initial heating rate θ̇₀", "°C/min"),
+    ("ball_C", "ball at the end", "°C"),
+    ("vial_C", "vial at the end", "°C"),
+    ("air_C", "air at the end", "°C"),
+    ("vial_ball_ratio", "vial/ball increment ratio", ""),
+    ("heat_power_W", "heat generated", "W"),
+    ("impact_rate_hz", "impact rate", "Hz"),
+    ("mean_impact_speed_m_s", "mean impact speed", "m/s"),
+    ("wall_time_s", "wall time", "s"),
+)
+
+
+@app.command("compare-solvers")
+def compare_solvers(
+    config: Annotated[Path | None, typer.Argument(metavar="CONFIG", help="TOML file, as for `run`.")] = None,
+    preset: Annotated[str | None, typer.Option("--preset", "-p", show_default=DEFAULT_PRESET)] = None,
+    settings: Annotated[list[str] | None, typer.Option("--set", "-s", metavar="KEY=VALUE")] = None,
+    json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+) -> None:
+    """Run the same configuration with the full and the averaged solver; print both, the differences and the speed ratio."""
+    with _user_errors():
+        params = load_config(config, preset=preset, overrides=settings or []).params
+    full = simulate_with_progress(params.replace(solver="full"))
+    averaged = simulate(params.replace(solver="averaged"))
+    rows = [
+        (label, unit, full.summary[key], averaged.summary[key], averaged.summary[key] - full.summary[key])
+        for key, label, unit in COMPARED_QUANTITIES
+    ]
+    speed_ratio = full.wall_time / averaged.wall_time if averaged.wall_time > 0 else math.inf
+    if json_output:
+        payload = {
+            "full": {key: full.summary[key] for key, _, _ in COMPARED_QUANTITIES},
+            "averaged": {key: averaged.summary[key] for key, _, _ in COMPARED_QUANTITIES},
+            "averaged_solver_used": averaged.solver,
+            "averaged_message": averaged.message,
+            "speed_ratio": speed_ratio,
+        }
+        typer.echo(json.dumps(to_jsonable(payload), sort_keys=True, allow_nan=False))
+        return
+    table = Table("quantity", "full", "averaged", "averaged − full", "unit", title="full vs averaged solver")
+    for label, unit, full_value, averaged_value, difference in rows:
+        _add_plain_row(table, label, _number(full_value, ".4g"), _number(averaged_value, ".4g"), _number(difference, "+.3g"), unit)
+    console = _stdout_console()
+    console.print(table)
+    console.print(Text(f"averaged solver: {averaged.message}"))
+    console.print(Text(f"speed ratio full/averaged: {speed_ratio:.0f}x"))
 
 
 @app.command()
@@ -264,20 +316,8 @@ def keys() -> None:
     table = Table("key", "allowed (SI)", f"default ({DEFAULT_PRESET})", "description", title="parameter keys")
     for key in FIELD_NAMES:
         default = format_value(key, defaults[key]) if key in defaults else ""
-        _add_plain_row(table, key, allowed_values(key), default, field_description(key))
+        _add_plain_row(table, key, allowed_range(key), default, field_description(key))
     _stdout_console().print(table)
-
-
-def allowed_values(key: str) -> str:
-    """What ``key`` accepts, for the ``keys`` listing."""
-    annotation = Parameters.model_fields[key].annotation
-    if annotation is bool:
-        return "true | false"
-    if get_origin(annotation) is Literal:
-        return " | ".join(str(choice) for choice in get_args(annotation))
-    if key == "record_windows":
-        return f"[start ≥ 0, length > 0] pairs, {field_unit(key)}"
-    return allowed_range(key)
 
 
 def format_value(key: str, value: Any) -> str:

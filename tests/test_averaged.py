@@ -1,0 +1,79 @@
+"""The averaged (multiscale) solver against full resolution, and its refusals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import shakermill as sm
+from shakermill.averaged import AVERAGING_FAILED, mser_truncation
+
+NUDGE_SPEED = 1.0  # m/s: with amplitudes below the free gap a ball at rest is never hit
+
+
+def _operating_point(omega: float, amplitude: float) -> sm.Parameters:
+    base = sm.default_parameters(omega=omega, amplitude=amplitude, record_windows=())
+    return base.replace(ball_momentum=base.ball_mass * NUDGE_SPEED)
+
+
+@pytest.mark.parametrize("omega, amplitude", [(111.0, 25e-3), (90.0, 30e-3), (120.0, 25e-3)])
+def test_averaged_solver_matches_full_resolution(omega: float, amplitude: float) -> None:
+    params = _operating_point(omega, amplitude)
+    full = sm.simulate(params)
+    averaged = sm.simulate(params.replace(solver="averaged"))
+    assert averaged.solver == "averaged", averaged.message
+    f, a = full.summary, averaged.summary
+    rise = f["theta_inf_C"] - 20.0
+    assert abs(a["theta_inf_C"] - f["theta_inf_C"]) < 0.005 * rise
+    assert a["tau_min"] == pytest.approx(f["tau_min"], rel=0.005)
+    for key in ("ball_C", "vial_C", "air_C"):
+        assert a[key] == pytest.approx(f[key], abs=0.2)
+    assert a["heat_power_W"] == pytest.approx(f["heat_power_W"], rel=0.005)
+    assert a["impact_rate_hz"] == pytest.approx(f["impact_rate_hz"], rel=0.01)
+    # The uncertainty it reports must cover the actual difference with a reasonable factor.
+    assert abs(a["averaged_heat_power_W"] - f["heat_power_W"]) < 0.005 * f["heat_power_W"]
+    assert 0 < a["averaged_heat_power_stderr_W"] < 1e-3 * a["averaged_heat_power_W"]
+
+
+def test_averaged_run_has_the_variables_of_a_full_run() -> None:
+    params = sm.default_parameters(duration=600.0, record_windows=((0.0, 1.0),))
+    full = sm.simulate(params)
+    averaged = sm.simulate(params.replace(solver="averaged"))
+    assert set(averaged.timeseries.data_vars) == set(full.timeseries.data_vars)
+    np.testing.assert_allclose(averaged.timeseries["time"].values, full.timeseries["time"].values)
+    assert np.all(np.isnan(averaged.timeseries["x"].values))  # no within-impact detail
+    assert averaged.timeseries["theta_ball"].attrs["units"] == "K"
+    assert len(averaged.impacts) > 100 and len(averaged.windows["time"]) > 100
+    assert averaged.energy.relative_residual < 1e-6
+    for key in ("averaged_heat_power_W", "averaged_velocity_term_stderr", "averaging_window_s", "averaging_transient_s"):
+        assert np.isfinite(averaged.summary[key])
+    assert averaged.summary["solver"] == "averaged"
+
+
+def test_temperatures_that_follow_single_impacts_are_refused() -> None:
+    # A ball with almost no heat capacity jumps in temperature at each impact: averaging is invalid.
+    params = sm.default_parameters(duration=30.0, ball_heat_capacity=1e-3, solver="averaged", record_windows=())
+    fallback = sm.simulate(params)
+    assert fallback.solver == "full" and fallback.success
+    assert "Averaging is not valid" in fallback.message and "ball's thermal time constant" in fallback.message
+    failed = sm.simulate(params.replace(averaging_fallback="fail"))
+    assert failed.status == AVERAGING_FAILED and not failed.success
+    assert "ball's thermal time constant" in failed.message
+
+
+def test_statistics_that_do_not_converge_are_refused() -> None:
+    params = sm.default_parameters(
+        duration=30.0, solver="averaged", averaging_rel_error=1e-9, averaging_max_time=25.0, record_windows=()
+    )
+    result = sm.simulate(params)
+    assert result.solver == "full"
+    assert "did not converge" in result.message
+    assert result.summary["averaging_converged"] is False
+
+
+def test_mser_cuts_the_transient() -> None:
+    rng = np.random.default_rng(1)
+    settled = 1.0 + 1e-3 * rng.standard_normal(60)
+    transient = np.linspace(0.5, 0.95, 8)
+    assert mser_truncation(np.concatenate([transient, settled])) == pytest.approx(8, abs=1)
+    assert mser_truncation(settled) <= 5
