@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 OUT ?= results/default
 
-.PHONY: install run test bench clean clean-cache
+.PHONY: install run test bench clean
 
 install: $(STAMP)
 
@@ -25,10 +25,6 @@ test: install
 bench: install
 	$(BIN)/python benchmarks/bench_full_run.py
 	$(BIN)/python benchmarks/bench_averaged.py
-
-# Numba only notices changes to the file of a compiled function, not to the functions it calls.
-clean-cache:
-	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
 
 clean:
 	rm -rf $(VENV) results

@@ -231,7 +231,7 @@ def test_keys_lists_every_key_with_its_allowed_range():
         assert any(f" {key} " in line for line in lines), key
     restitution = next(line for line in lines if " restitution " in line)
     assert "(0, 1]" in restitution and "0.7" in restitution
-    assert "relative | paper" in result.stdout
+    assert "one of 'relative', 'paper'" in result.stdout
 
 
 def test_version_option():

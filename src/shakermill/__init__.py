@@ -6,8 +6,12 @@ MODEL.md; ``shakermill.default_parameters()`` gives the ``spex8000m`` preset.
 
 from importlib.metadata import PackageNotFoundError, version
 
-from .params import Parameters, ParameterError, build_parameters, default_parameters
-from .simulate import Result, simulate
+from ._numba_cache import drop_stale_cache
+
+drop_stale_cache()
+
+from .params import Parameters, ParameterError, build_parameters, default_parameters  # noqa: E402
+from .simulate import Result, simulate  # noqa: E402
 
 try:
     __version__ = version("shakermill")
