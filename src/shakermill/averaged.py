@@ -236,7 +236,7 @@ def integrate_thermal_network(params: Parameters, averages: MechanicsAverages, t
         )
         return [rate_ball, rate_vial, rate_air, vial_to_outside]
 
-    initial = [params.initial_temperature] * 3 + [0.0]
+    initial = [*model.initial_state(params)[model.THETA_BALL : model.THETA_AIR + 1], 0.0]
     return solve_ivp(
         rates,
         (0.0, params.duration),
@@ -289,7 +289,7 @@ def simulate_averaged(params: Parameters, progress: ProgressCallback | None = No
     capacities = (constants.capacity_ball, constants.capacity_vial, constants.capacity_air)
     heat = averages.heat_power * params.duration
     dissipated = averages.dissipated_power * params.duration
-    stored = [capacity * (thermal.y[i, -1] - params.initial_temperature) for i, capacity in enumerate(capacities)]
+    stored = [capacity * (thermal.y[i, -1] - thermal.y[i, 0]) for i, capacity in enumerate(capacities)]
     energy = EnergyAudit(
         work_by_vial=dissipated,
         kinetic_energy_change=0.0,

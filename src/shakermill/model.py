@@ -83,6 +83,7 @@ class Constants(NamedTuple):
     capacity_vial: float
     capacity_air: float
     t_ambient: float
+    ball_only: bool
 
 
 def constants_from(params: Parameters) -> Constants:
@@ -121,6 +122,7 @@ def constants_from(params: Parameters) -> Constants:
         capacity_vial=params.vial_mass * params.vial_heat_capacity,
         capacity_air=params.air_mass * params.air_heat_capacity,
         t_ambient=params.ambient_temperature,
+        ball_only=params.model == "ball_only",
     )
 
 
@@ -129,6 +131,9 @@ def initial_state(params: Parameters) -> np.ndarray:
     y[X] = drive.vial_position(0.0, params.amplitude, params.omega, params.phase) + params.ball_position
     y[P] = params.ball_momentum
     y[THETA_BALL] = y[THETA_VIAL] = y[THETA_AIR] = params.initial_temperature
+    if params.model == "ball_only":
+        # The predecessor model has no vial reservoir and keeps the air at ambient.
+        y[THETA_VIAL] = y[THETA_AIR] = params.ambient_temperature
     return y
 
 
@@ -167,16 +172,23 @@ def gap(t: float, x: float, wall: int, k: Constants) -> float:
 def thermal_network(
     t_ball: float, t_vial: float, t_air: float, heat_generated: float, velocity_term: float, k: Constants
 ) -> tuple[float, float, float, float]:
-    """(θ̇_b, θ̇_v, θ̇_a, Q̇_vo) of the three-node network (MODEL.md §§4–6).
+    """(θ̇_b, θ̇_v, θ̇_a, heat lost) of the three-node network (MODEL.md §§4–6).
 
     ``heat_generated`` is Q̇_irr (W), split λ : (1 − λ) between ball and vial;
     ``velocity_term`` is the velocity-dependent part of Whitaker's correlation,
     0.4 Re^{1/2} + 0.06 Re^{2/3}, so that the temperature dependence through
-    Sutherland's law is evaluated here, at the current ball temperature.
+    Sutherland's law is evaluated here, at the current ball temperature. The
+    heat lost is Q̇_vo; in the ``ball_only`` model (air held at ambient, no vial
+    reservoir, the paper's 2023 predecessor) it is everything that leaves the
+    ball plus the vial's share of the impact heat.
     """
     viscosity_ratio = thermal.sutherland_viscosity(t_ball, k.mu_ref, k.t_ref, k.sutherland) / k.mu_ref
     nusselt = thermal.nusselt_from_velocity_term(velocity_term, k.prandtl, viscosity_ratio)
     h_ball = thermal.heat_transfer_coefficient(nusselt, k.air_conductivity, k.radius)
+    if k.ball_only:
+        ball_to_ambient = thermal.ball_air_heat_flow(k.radius, k.beta, h_ball, t_ball, k.t_ambient)
+        rate_ball = (k.lam * heat_generated - ball_to_ambient) / k.capacity_ball
+        return rate_ball, 0.0, 0.0, ball_to_ambient + (1.0 - k.lam) * heat_generated
     ball_to_air = thermal.ball_air_heat_flow(k.radius, k.beta, h_ball, t_ball, t_air)
     vial_to_air = thermal.newton_cooling(k.h_inner, k.face_area, t_vial, t_air)
     vial_to_outside = thermal.newton_cooling(k.h_outer, k.face_area, t_vial, k.t_ambient)
@@ -216,7 +228,7 @@ def rhs(t: float, y: np.ndarray, k: Constants, dydt: np.ndarray) -> None:
     convection_speed = velocity - vial_velocity if k.relative_convection else velocity
     reynolds = thermal.reynolds_number(k.radius, k.air_density, convection_speed, k.viscosity_ambient)
     velocity_term = thermal.whitaker_velocity_term(reynolds)
-    rate_ball, rate_vial, rate_air, vial_to_outside = thermal_network(
+    rate_ball, rate_vial, rate_air, heat_lost = thermal_network(
         y[THETA_BALL], y[THETA_VIAL], y[THETA_AIR], heat_generated, velocity_term, k
     )
     dydt[X] = velocity
@@ -227,7 +239,7 @@ def rhs(t: float, y: np.ndarray, k: Constants, dydt: np.ndarray) -> None:
     dydt[WORK_VIAL] = force_on_ball * vial_velocity
     dydt[DISSIPATED] = power_dissipated
     dydt[HEAT_GENERATED] = heat_generated
-    dydt[HEAT_LOST] = vial_to_outside
+    dydt[HEAT_LOST] = heat_lost
     dydt[VELOCITY_TERM] = velocity_term
 
 

@@ -10,10 +10,13 @@ default carries its source (the PyBaMM habit of parameter sets with citations).
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
+import tomllib
 import math
 import typing
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Annotated, Any, Literal, Mapping
 
 import annotated_types
@@ -103,6 +106,12 @@ class Parameters(BaseModel):
         json_schema_extra={"description": "averaged solver: what to do when averaging is not valid"}
     )
     # Model options (MODEL.md sections 2-4: the alternatives the spec allows)
+    model: Literal["three_node", "ball_only"] = Field(
+        json_schema_extra={
+            "description": "'three_node': ball, vial and air (this paper); 'ball_only': air held at ambient and no vial "
+            "reservoir, the author's 2023 predecessor"
+        }
+    )
     no_tension: bool = Field(json_schema_extra={"description": "clip the contact force at zero (no adhesion)"})
     heat_model: Literal["relative", "paper"] = Field(
         json_schema_extra={"description": "'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed"}
@@ -210,9 +219,13 @@ class Cited:
 
 @dataclass(frozen=True)
 class Preset:
+    """A named parameter set. ``fitted`` names the keys a calibration set, ``provenance`` says how."""
+
     name: str
     description: str
     values: Mapping[str, Cited]
+    fitted: tuple[str, ...] = ()
+    provenance: Mapping[str, Any] = dataclasses.field(default_factory=dict)
 
 
 SPEX_8000M = Preset(
@@ -268,6 +281,7 @@ SPEX_8000M = Preset(
         "averaging_max_time": Cited(120.0, "numerical choice: 2 simulated minutes of mechanics at most"),
         "averaging_fallback": Cited("full", "numerical choice: fall back to full resolution and say so"),
         "energy_projection": Cited(True, "numerical choice: projection method (Hairer, Lubich & Wanner 2006, §IV.4)"),
+        "model": Cited("three_node", f"{PAPER}: ball, vial and inner air as three lumped reservoirs"),
         "no_tension": Cited(False, "MODEL.md section 2: the total force is not clipped by default"),
         "heat_model": Cited("relative", "MODEL.md section 3: frame-invariant dissipation c·ζ̇²"),
         "convection_velocity": Cited("ball", f"{PAPER}, section 3.3 (Re from the ball's velocity)"),
@@ -278,7 +292,34 @@ SPEX_8000M = Preset(
     },
 )
 
+# Presets produced by a calibration ship as TOML files next to this module: a base preset, the fitted
+# values and a [provenance] table that records the fit (command, targets, residuals, date, version).
+PRESET_FOLDER = Path(__file__).parent / "presets"
+
+
+def load_preset_file(path: Path, known: Mapping[str, Preset]) -> Preset:
+    """A preset from a calibration TOML file, on top of the preset it names as its base."""
+    with path.open("rb") as handle:
+        data = tomllib.load(handle)
+    provenance = dict(data.pop("provenance", {}))
+    base = known[data.pop("preset")]
+    fitted = tuple(provenance.get("fitted", ()))
+    note = f"fitted by calibration ({path.name}, [provenance])"
+    values = dict(base.values)
+    for key, value in data.items():
+        values[key] = Cited(tuple(map(tuple, value)) if key == "record_windows" else value, note if key in fitted else f"set in {path.name}")
+    return Preset(
+        name=path.stem,
+        description=str(provenance.get("description", f"{base.name} with values from {path.name}")),
+        values=values,
+        fitted=fitted,
+        provenance=provenance,
+    )
+
+
 PRESETS: dict[str, Preset] = {SPEX_8000M.name: SPEX_8000M}
+for _preset_file in sorted(PRESET_FOLDER.glob("*.toml")):
+    PRESETS[_preset_file.stem] = load_preset_file(_preset_file, PRESETS)
 DEFAULT_PRESET = SPEX_8000M.name
 
 

@@ -1,0 +1,89 @@
+"""Calibration against targets and curves, and the shipped calibrated preset (paper Table 5)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import shakermill as sm
+from shakermill.calibrate import Curve, calibrate, parse_free, parse_targets, write_preset
+from shakermill.config import load_config
+from shakermill.params import PRESETS, ParameterError
+from shakermill.validation import TABLE5
+
+TABLE5_TARGETS = {entry.key: entry.experiment for entry in TABLE5 if entry.key != "vial_ball_ratio"}
+
+
+def test_recovers_known_parameters_from_a_noisy_simulated_curve() -> None:
+    truth = {"beta": 0.6, "vial_mass": 0.1}
+    generator = sm.default_parameters(solver="averaged", output_interval=30.0, **truth)
+    series = sm.simulate(generator).timeseries
+    rng = np.random.default_rng(2026)
+    measured = series["theta_ball"].values - 273.15 + rng.normal(0.0, 0.05, series["time"].size)
+    curve = Curve(series["time"].values, measured, "simulated with noise")
+    start = sm.default_parameters(beta=0.3, vial_mass=0.05)
+    fit = calibrate(start, ("beta", "vial_mass"), curve=curve)
+    assert fit.success, fit.message
+    for key, value in truth.items():
+        assert fit.fitted[key] == pytest.approx(value, rel=0.01)
+        assert 0 < fit.parameter_stderr[key] < 0.01 * value
+    assert fit.curve_rms_K == pytest.approx(0.05, rel=0.2)
+
+
+def test_table5_calibration_meets_the_targets_and_round_trips_as_a_preset(tmp_path) -> None:
+    fit = calibrate(sm.default_parameters(), ("beta", "vial_mass"), TABLE5_TARGETS)
+    assert fit.success, fit.message
+    for key, residual in fit.relative_residuals.items():
+        assert abs(residual) < 1e-3, key
+    assert set(fit.sensitivities) == set(TABLE5_TARGETS)
+    path = write_preset(fit, tmp_path / "mine.toml", base_preset="spex8000m", command="test", description="test fit")
+    params = load_config(path).params
+    assert params.beta == fit.fitted["beta"] and params.vial_mass == fit.fitted["vial_mass"]
+    assert params.restitution == sm.default_parameters().restitution
+
+
+def test_shipped_calibrated_preset_reproduces_the_experiment_at_full_resolution() -> None:
+    preset = PRESETS["spex8000m-calibrated"]
+    assert preset.fitted == ("beta", "vial_mass")
+    assert preset.provenance["targets"] == TABLE5_TARGETS
+    result = sm.simulate(sm.default_parameters("spex8000m-calibrated", record_windows=()))
+    assert result.solver == "full"
+    for key, target in TABLE5_TARGETS.items():
+        assert result.summary[key] == pytest.approx(target, rel=0.005), key
+
+
+def test_unreachable_targets_are_reported_not_hidden() -> None:
+    # vial_mass sets time constants, not temperatures: it cannot bring θ∞ down to 25 °C.
+    fit = calibrate(sm.default_parameters(), ("vial_mass",), {"theta_inf_C": 25.0})
+    assert not fit.success
+    assert abs(fit.relative_residuals["theta_inf_C"]) > 0.1
+    assert "cannot be met" in fit.message and "theta_inf_C is off by" in fit.message
+
+
+@pytest.mark.parametrize(
+    "items, fragment",
+    [(["theta_inf=48"], "unknown target"), (["tau_min"], "NAME=VALUE"), (["tau_min=abc"], "needs a number")],
+)
+def test_bad_targets_get_one_clear_line(items, fragment) -> None:
+    with pytest.raises(ParameterError, match=fragment):
+        parse_targets(items)
+
+
+def test_free_keys_are_checked() -> None:
+    assert parse_free([]) == ("beta", "vial_mass")
+    assert parse_free(["eta, vial_mass"]) == ("eta", "vial_mass")
+    with pytest.raises(ParameterError, match="did you mean 'beta'"):
+        parse_free(["bta"])
+    with pytest.raises(ParameterError, match="not a numeric parameter"):
+        parse_free(["heat_model"])
+
+
+def test_curve_csv_is_read_in_minutes_or_seconds(tmp_path) -> None:
+    path = tmp_path / "curve.csv"
+    path.write_text("time_min,ball_C\n0,20\n1,21.5\n")
+    curve = Curve.from_csv(path)
+    np.testing.assert_allclose(curve.times, [0.0, 60.0])
+    np.testing.assert_allclose(curve.ball_C, [20.0, 21.5])
+    (tmp_path / "bad.csv").write_text("t,T\n0,20\n")
+    with pytest.raises(ParameterError, match="needs columns"):
+        Curve.from_csv(tmp_path / "bad.csv")
