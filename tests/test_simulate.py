@@ -123,3 +123,19 @@ def test_interrupted_run_keeps_what_was_computed() -> None:
     assert result.timeseries["time"].values[-1] == pytest.approx(20.0)
     assert len(result.impacts) > 500
     assert result.energy.relative_residual < 1e-6
+
+
+@pytest.mark.parametrize("solver", ["full", "averaged"])
+def test_ball_only_model_holds_air_and_vial_at_ambient(solver: str) -> None:
+    params = sm.default_parameters(model="ball_only", solver=solver, duration=1200.0, record_windows=())
+    result = sm.simulate(params)
+    assert result.success
+    np.testing.assert_allclose(result.timeseries["theta_air"].values, params.ambient_temperature, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(result.timeseries["theta_vial"].values, params.ambient_temperature, rtol=0, atol=1e-9)
+    assert result.summary["ball_C"] > 30.0
+    # Everything the ball does not keep leaves the system.
+    audit = result.energy
+    assert audit.stored_vial == pytest.approx(0.0, abs=1e-9) and audit.stored_air == pytest.approx(0.0, abs=1e-9)
+    assert audit.relative_residual < 1e-6
+    three_node = sm.simulate(params.replace(model="three_node"))
+    assert three_node.summary["ball_C"] > result.summary["ball_C"]

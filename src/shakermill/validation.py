@@ -66,3 +66,40 @@ class ComparisonRow:
 def compare(summary: Mapping[str, float], fitted_keys: tuple[str, ...] = ()) -> list[ComparisonRow]:
     """This model's Table 5 quantities from a run summary, marked fitted or predicted."""
     return [ComparisonRow(entry, float(summary[entry.key]), entry.key in fitted_keys) for entry in TABLE5]
+
+
+VALIDATION_PRESETS = ("spex8000m", "spex8000m-calibrated")
+
+
+@dataclass(frozen=True)
+class ValidationRun:
+    preset: str
+    fitted: tuple[str, ...]
+    rows: list[ComparisonRow]
+    summary: Mapping[str, float]
+
+    @property
+    def statement(self) -> str:
+        """One sentence on what was fitted and what was predicted."""
+        predicted = [row.quantity.key for row in self.rows if not row.fitted]
+        if not self.fitted:
+            return f"{self.preset}: published parameters, nothing fitted; {', '.join(predicted)} are predictions."
+        targets = [row.quantity.key for row in self.rows if row.fitted]
+        return (
+            f"{self.preset}: {', '.join(self.fitted)} fitted to {', '.join(targets)} of the experiment; "
+            f"{', '.join(predicted)} predicted."
+        )
+
+
+def validate(solver: str = "full") -> list[ValidationRun]:
+    """Run the published and the calibrated preset and compare both with Table 5."""
+    from .params import PRESETS, default_parameters
+    from .simulate import simulate
+
+    runs = []
+    for name in VALIDATION_PRESETS:
+        preset = PRESETS[name]
+        targets = tuple(preset.provenance.get("targets", {}))
+        result = simulate(default_parameters(name, solver=solver, record_windows=()))
+        runs.append(ValidationRun(name, preset.fitted, compare(result.summary, targets), result.summary))
+    return runs
