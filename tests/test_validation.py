@@ -1,0 +1,37 @@
+"""Table 5 comparison: what is fitted and what is predicted is stated, and the numbers are this model's."""
+
+from __future__ import annotations
+
+import pytest
+
+from shakermill.validation import TABLE5, compare, relative_error, validate
+
+
+def test_table5_holds_the_published_numbers() -> None:
+    by_key = {entry.key: entry for entry in TABLE5}
+    assert by_key["theta_inf_C"].experiment == 48.0 and by_key["theta_inf_C"].paper_model == 47.89
+    assert by_key["tau_min"].experiment == 16.7
+    assert by_key["rate0_C_per_min"].paper_model == 1.6702
+    assert by_key["vial_ball_ratio"].experiment == 0.46 and "five balls" in by_key["vial_ball_ratio"].experiment_note
+
+
+def test_compare_marks_fitted_and_predicted_rows() -> None:
+    summary = {"theta_inf_C": 50.0, "tau_min": 16.7, "rate0_C_per_min": 1.8, "vial_ball_ratio": 0.5}
+    rows = compare(summary, fitted_keys=("theta_inf_C",))
+    assert [row.role for row in rows] == ["fitted", "predicted", "predicted", "predicted"]
+    assert rows[0].error_vs_experiment == pytest.approx(relative_error(50.0, 48.0)) == pytest.approx(2.0 / 48.0)
+
+
+def test_validation_of_published_and_calibrated_presets() -> None:
+    published, calibrated = validate(solver="averaged")
+    assert all(row.role == "predicted" for row in published.rows)
+    assert "nothing fitted" in published.statement
+    # With the paper's β the model overshoots the measured θ∞ by far: that must show, not be hidden.
+    assert published.rows[0].value > 60.0
+    fitted = {row.quantity.key: row for row in calibrated.rows if row.fitted}
+    assert set(fitted) == {"theta_inf_C", "tau_min", "rate0_C_per_min"}
+    for row in fitted.values():
+        assert abs(row.error_vs_experiment) < 0.005
+    ratio = next(row for row in calibrated.rows if row.quantity.key == "vial_ball_ratio")
+    assert ratio.role == "predicted"
+    assert "vial_ball_ratio predicted" in calibrated.statement
