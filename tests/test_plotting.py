@@ -3,19 +3,31 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from typer.testing import CliRunner
+
 import shakermill as sm
+from shakermill import cli
 from shakermill.params import DEFAULT_PRESET
 from shakermill.plotting import (
+    IMPACT_FIGURES,
+    PAPER_FIGURES,
     heating_zoom_figure,
     heating_zoom_window,
+    impact_figures,
     motion_figure,
     plot_run,
+    png_bytes,
+    rate_bin_edges,
+    run_figures,
     temperature_figure,
     window_data,
 )
@@ -23,6 +35,9 @@ from shakermill.storage import load_run, write_run
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 ALL_FIGURES = ("ball_heating_zoom", "ball_motion", "temperatures")
+IMPACT_FIGURE_NAMES = ("impact_energy_histogram", "impact_speed_histogram", "impacts_per_second")
+# "quantity (unit)": every axis label ends with its unit in parentheses.
+LABEL_WITH_UNIT = re.compile(r"^\S.* \([^()]+\)$")
 
 
 @pytest.fixture(scope="module")
@@ -125,3 +140,157 @@ def test_window_without_enough_points_is_skipped(result):
     run = dataclasses.replace(result, params=params)
     assert window_data(run, 1) is None
     assert window_data(run, 2) is None
+
+
+def all_axes(figures):
+    return [(name, axis) for name, figure in figures.items() for axis in figure.axes]
+
+
+def test_figure_names_are_the_documented_ones():
+    assert sorted(PAPER_FIGURES) == sorted(ALL_FIGURES)
+    assert sorted(IMPACT_FIGURES) == sorted(IMPACT_FIGURE_NAMES)
+
+
+def test_every_axis_of_every_figure_is_labelled_with_its_unit(result):
+    figures = run_figures(result, impacts=True)
+    assert sorted(figures) == sorted(ALL_FIGURES + IMPACT_FIGURE_NAMES)
+    for name, axis in all_axes(figures):
+        # Shared time axes label only the bottom panel.
+        xlabel_expected = axis.get_subplotspec().is_last_row()
+        if xlabel_expected:
+            assert LABEL_WITH_UNIT.match(axis.get_xlabel()), (name, axis.get_xlabel())
+        assert LABEL_WITH_UNIT.match(axis.get_ylabel()), (name, axis.get_ylabel())
+    temperature_labels = [axis.get_ylabel() for name, axis in all_axes(figures) if "temperature" in axis.get_ylabel()]
+    assert temperature_labels and all(label.endswith("(°C)") for label in temperature_labels)
+
+
+def test_paper_figures_say_which_figure_of_the_paper_they_are(result):
+    figures = run_figures(result)
+    assert "Fig. 5a" in figures["temperatures"].axes[0].get_title()
+    assert "Fig. 4" in figures["ball_motion"].get_suptitle()
+    assert "t = 0–0.2 s" in figures["ball_motion"].get_suptitle()  # the record window, not the last stored step
+    assert "Fig. 5b" in figures["ball_heating_zoom"].axes[0].get_title()
+
+
+def test_plot_run_with_impacts_writes_the_impact_figures_too(result, tmp_path):
+    paths = plot_run(result, tmp_path, impacts=True)
+    expected = sorted(f"{name}.{fmt}" for name in ALL_FIGURES + IMPACT_FIGURE_NAMES for fmt in ("png", "svg"))
+    assert written_names(paths) == expected
+
+
+def test_impact_histograms_count_every_impact_by_wall(result):
+    figures = impact_figures(result)
+    impacts = result.impacts
+    for name, column, scale in (
+        ("impact_speed_histogram", "impact_speed", 1.0),
+        ("impact_energy_histogram", "dissipated_energy", 1e3),
+    ):
+        (axis,) = figures[name].axes
+        assert sum(patch.get_height() for patch in axis.patches) == len(impacts)
+        edges = [patch.get_x() for patch in axis.patches]
+        assert min(edges) == pytest.approx(impacts[column].min() * scale)
+        labels = [text.get_text() for text in axis.get_legend().get_texts()]
+        assert labels == [
+            f"left end face ({(impacts['wall'] == 'left').sum()})",
+            f"right end face ({(impacts['wall'] == 'right').sum()})",
+        ]
+    assert figures["impact_energy_histogram"].axes[0].get_xlabel() == "energy dissipated per impact (mJ)"
+    assert figures["impact_speed_histogram"].axes[0].get_xlabel() == "impact speed relative to the end face (m/s)"
+
+
+def test_impacts_per_second_integrate_to_the_impacts_at_each_wall(result):
+    (axis,) = impact_figures(result)["impacts_per_second"].axes
+    assert axis.get_ylabel() == "impacts per second (1/s)"
+    assert axis.get_xlabel() == "time (s)"
+    steps = axis.patches
+    assert len(steps) == 2
+    for wall, step in zip(("left", "right"), steps):
+        rates, edges, _ = step.get_data()
+        assert np.sum(rates * np.diff(edges)) == pytest.approx((result.impacts["wall"] == wall).sum())
+
+
+def test_rate_bins_span_the_impacts_in_bins_of_at_least_a_second_and_at_most_120():
+    assert np.allclose(np.diff(rate_bin_edges(0.0, 30.0)), 1.0)
+    hour = rate_bin_edges(0.01, 3600.0)
+    assert len(hour) == 121 and hour[0] == 0.01 and hour[-1] == 3600.0
+    assert rate_bin_edges(3.6, 18.1)[0] == 3.6  # the averaged solver's impacts start after its transient
+    assert np.allclose(rate_bin_edges(0.1, 0.4), [0.1, 1.1])  # one bin of a second for a very short run
+
+
+def test_no_impacts_no_impact_figures(result):
+    run = dataclasses.replace(result, impacts=result.impacts.iloc[:0])
+    assert impact_figures(run) == {}
+
+
+def test_ball_only_temperature_figure_draws_vial_and_air_as_one_ambient_line(result):
+    run = dataclasses.replace(result, params=result.params.replace(model="ball_only"))
+    (axis,) = temperature_figure(run).axes
+    labels = [line.get_label() for line in axis.get_lines()]
+    assert labels == ["ball", "vial and air (held at ambient: ball_only model)", "ball, exponential fit"]
+
+
+def test_png_bytes_is_a_png(result):
+    assert png_bytes(temperature_figure(result), dpi=50).startswith(PNG_SIGNATURE)
+
+
+def test_matplotlib_is_imported_lazily_and_pyplot_never():
+    script = (
+        "import sys\n"
+        "import shakermill as sm, shakermill.cli, shakermill.report\n"
+        "assert 'matplotlib' not in sys.modules, 'imported at package import'\n"
+        "from shakermill.plotting import run_figures\n"
+        "run = sm.simulate(sm.default_parameters(duration=0.5, record_windows='0:0.2'))\n"
+        "run_figures(run, impacts=True)\n"
+        "assert 'matplotlib' in sys.modules\n"
+        "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot imported'\n"
+    )
+    completed = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert completed.returncode == 0, completed.stderr
+
+
+runner = CliRunner()
+
+
+def test_plot_command_writes_every_figure_into_the_run_folder(result, tmp_path):
+    folder = write_run(result, tmp_path / "run", preset=DEFAULT_PRESET)
+    outcome = runner.invoke(cli.app, ["plot", str(folder)])
+    assert outcome.exit_code == 0, outcome.stderr
+    figures = folder / "figures"
+    expected = sorted(f"{name}.{fmt}" for name in ALL_FIGURES + IMPACT_FIGURE_NAMES for fmt in ("png", "svg"))
+    assert sorted(path.name for path in figures.iterdir()) == expected
+    for path in figures.iterdir():
+        assert path.stat().st_size > 10_000, path.name
+        if path.suffix == ".png":
+            width, height = png_size(path)
+            assert width > 600 and height > 300
+    assert str(figures) in outcome.stdout
+
+
+def test_plot_command_out_and_dpi(result, tmp_path):
+    folder = write_run(result, tmp_path / "run", preset=DEFAULT_PRESET)
+    outcome = runner.invoke(cli.app, ["plot", str(folder), "--out", str(tmp_path / "small"), "--dpi", "60"])
+    assert outcome.exit_code == 0, outcome.stderr
+    width, _ = png_size(tmp_path / "small" / "temperatures.png")
+    assert width < 600
+    assert not (folder / "figures").exists()
+
+
+@pytest.mark.parametrize("existing", [False, True])
+def test_plot_command_refuses_a_folder_that_is_not_a_run(tmp_path, existing):
+    folder = tmp_path / "nothing_here"
+    if existing:
+        folder.mkdir()
+    outcome = runner.invoke(cli.app, ["plot", str(folder)])
+    assert outcome.exit_code == 2
+    lines = outcome.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and "not a shakermill run folder" in lines[0]
+    assert not (folder / "figures").exists()
+
+
+def test_plot_command_refuses_a_damaged_run_folder(result, tmp_path):
+    folder = write_run(result, tmp_path / "run", preset=DEFAULT_PRESET)
+    (folder / "timeseries.nc").unlink()
+    outcome = runner.invoke(cli.app, ["plot", str(folder)])
+    assert outcome.exit_code == 2
+    lines = outcome.stderr.strip().splitlines()
+    assert len(lines) == 1 and "not a readable shakermill run folder" in lines[0] and "Traceback" not in outcome.stderr

@@ -36,9 +36,10 @@ from .params import (
     field_unit,
     preset_values,
 )
-from .plotting import plot_run
+from .plotting import PNG_DPI, plot_run
+from .report import REPORT_FILE, save_report
 from .simulate import INTERRUPTED, Result, simulate
-from .storage import StorageError, check_target, to_jsonable, write_run
+from .storage import RunData, StorageError, check_target, load_run, to_jsonable, write_run
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
@@ -318,6 +319,58 @@ def keys() -> None:
         default = format_value(key, defaults[key]) if key in defaults else ""
         _add_plain_row(table, key, allowed_range(key), default, field_description(key))
     _stdout_console().print(table)
+
+
+def _load_run_or_fail(folder: Path) -> RunData:
+    """The run folder at ``folder``, or one ``error:`` line and exit code 2."""
+    try:
+        return load_run(folder)
+    except StorageError as exc:
+        _fail(str(exc))
+    except (OSError, ValueError, KeyError) as exc:
+        # A folder with summary.json but damaged or missing data files, or a configuration that no longer validates.
+        _fail(f"{folder}: not a readable shakermill run folder ({exc})")
+
+
+@app.command()
+def plot(
+    run_dir: Annotated[Path, typer.Argument(metavar="RUN_DIR", help="A run folder written by `shakermill run`.")],
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", show_default="RUN_DIR/figures", help="Folder for the figures.")
+    ] = None,
+    dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG files.")] = PNG_DPI,
+) -> None:
+    """Draw every figure of a run folder as PNG and SVG: the paper's Figs. 4, 5a, 5b and the impact statistics."""
+    run_data = _load_run_or_fail(run_dir)
+    target = out if out is not None else run_dir / FIGURES_FOLDER
+    try:
+        paths = plot_run(run_data, target, impacts=True, dpi=dpi)
+    except OSError as exc:
+        _fail(f"{target}: cannot write the figures ({exc.strerror or exc})")
+    typer.echo(f"{len(paths)} files written to {target}")
+
+
+@app.command()
+def report(
+    run_dir: Annotated[Path, typer.Argument(metavar="RUN_DIR", help="A run folder written by `shakermill run`.")],
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", metavar="FILE", show_default=f"RUN_DIR/{REPORT_FILE}", help="HTML file to write."),
+    ] = None,
+    compare: Annotated[
+        Path | None,
+        typer.Option("--compare", metavar="OTHER_RUN_DIR", help="Add a side-by-side comparison with this run folder."),
+    ] = None,
+) -> None:
+    """Write one self-contained HTML report of a run folder (figures embedded, no external resources)."""
+    run_data = _load_run_or_fail(run_dir)
+    other = _load_run_or_fail(compare) if compare is not None else None
+    target = out if out is not None else run_dir / REPORT_FILE
+    try:
+        save_report(run_data, target, other)
+    except OSError as exc:
+        _fail(f"{target}: cannot write the report ({exc.strerror or exc})")
+    typer.echo(f"report written to {target}")
 
 
 def format_value(key: str, value: Any) -> str:

@@ -1,4 +1,12 @@
-"""Figures of a run, as PNG and SVG: temperatures, ball motion in the first window, heating zoom.
+"""Figures of a run, as PNG and SVG: the paper's Figs. 4, 5a and 5b, and the impact statistics.
+
+The paper's figures (Son 2025, section 4): ``ball_motion`` is Fig. 4 (position
+and momentum over the first recorded window, the first second by default),
+``temperatures`` is Fig. 5a (ball, vial and air with the ball's fitted
+exponential) and ``ball_heating_zoom`` is Fig. 5b (100 ms at 10 min: heating at
+each impact, convective cooling between). The impact figures are this
+package's own: histograms of impact speed and dissipated energy per impact, and
+the impacts per second at each end face.
 
 Matplotlib is imported inside the functions, so that importing :mod:`shakermill`
 stays fast. Figures are drawn on the Agg canvas directly, without pyplot: that
@@ -7,6 +15,7 @@ needs no display and leaves the backend of an interactive session untouched.
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import secrets
@@ -24,6 +33,9 @@ from .params import Parameters
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+# Figure names (file stems): the paper's Figs. 5a, 4, 5b, and this package's impact statistics.
+PAPER_FIGURES = ("temperatures", "ball_motion", "ball_heating_zoom")
+IMPACT_FIGURES = ("impact_speed_histogram", "impact_energy_histogram", "impacts_per_second")
 FORMATS = ("png", "svg")
 PNG_DPI = 150
 KELVIN_OFFSET = 273.15
@@ -52,33 +64,46 @@ class RunLike(Protocol):
     def ball_fit(self) -> ExponentialFit: ...
 
 
-def plot_run(run: RunLike, out_dir: Path | str) -> list[Path]:
-    """Write every figure of ``run`` into ``out_dir`` (created if needed); return the files written."""
+def plot_run(run: RunLike, out_dir: Path | str, *, impacts: bool = False, dpi: int = PNG_DPI) -> list[Path]:
+    """Write the paper's figures of ``run`` (and the impact figures if asked) into ``out_dir``; return the files."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    for name, figure in run_figures(run, impacts=impacts).items():
+        written.extend(save_figure(figure, out / name, dpi=dpi))
+    return written
+
+
+def run_figures(run: RunLike, *, impacts: bool = False) -> dict[str, Figure]:
+    """The figures of ``run`` by name: those of :data:`PAPER_FIGURES` its data allow, then the impact figures."""
+    figures = paper_figures(run)
+    if impacts:
+        figures.update(impact_figures(run))
+    return figures
+
+
+def paper_figures(run: RunLike) -> dict[str, Figure]:
+    """Fig. 5a always; Fig. 4 and Fig. 5b only when their record windows hold enough points."""
     figures = {"temperatures": temperature_figure(run)}
     first_window = window_data(run, 0)
     if first_window is not None:
-        figures["ball_motion"] = motion_figure(run.params, first_window)
+        figures["ball_motion"] = motion_figure(run.params, first_window, run.params.record_windows[0])
     zoom_index = heating_zoom_window(run.params)
     zoom = window_data(run, zoom_index) if zoom_index is not None else None
     if zoom is not None:
         zoom_start = run.params.record_windows[zoom_index][0]
         figures["ball_heating_zoom"] = heating_zoom_figure(run, zoom, zoom_start)
-    written: list[Path] = []
-    for name, figure in figures.items():
-        written.extend(save_figure(figure, out / name))
-    return written
+    return figures
 
 
-def save_figure(figure: Figure, stem: Path) -> list[Path]:
+def save_figure(figure: Figure, stem: Path, *, dpi: int = PNG_DPI) -> list[Path]:
     """Save ``figure`` as ``stem.png`` and ``stem.svg``, each through a temporary file and an atomic rename."""
     paths = []
     for fmt in FORMATS:
         path = stem.with_suffix(f".{fmt}")
         partial = path.with_name(f".{path.name}.partial-{secrets.token_hex(4)}")
         try:
-            figure.savefig(partial, format=fmt, dpi=PNG_DPI, bbox_inches="tight")
+            figure.savefig(partial, format=fmt, dpi=dpi, bbox_inches="tight")
             os.replace(partial, path)
         finally:
             partial.unlink(missing_ok=True)
@@ -101,15 +126,11 @@ def to_celsius(kelvin: np.ndarray) -> np.ndarray:
 
 
 def temperature_figure(run: RunLike) -> Figure:
-    """Ball, vial and air temperatures in °C against minutes, with the ball's fitted exponential."""
+    """Paper Fig. 5a: ball, vial and air temperatures in °C against minutes, with the ball's fitted exponential."""
     figure, (axis,) = _new_figure()
     series = run.timeseries
     minutes = series["time"].values / 60.0
-    for name, label, colour in (
-        ("theta_ball", "ball", "tab:red"),
-        ("theta_vial", "vial", "tab:blue"),
-        ("theta_air", "air", "tab:green"),
-    ):
+    for name, label, colour in temperature_curves(run.params):
         axis.plot(minutes, to_celsius(series[name].values), color=colour, label=label)
     fit = run.ball_fit
     if math.isfinite(fit.theta_inf) and math.isfinite(fit.tau):
@@ -120,10 +141,23 @@ def temperature_figure(run: RunLike) -> Figure:
     )
     axis.set_xlabel("time (min)")
     axis.set_ylabel("temperature (°C)")
-    axis.set_title("Temperatures of ball, vial and inner air")
+    axis.set_title("Temperatures of ball, vial and inner air (cf. paper Fig. 5a)")
     axis.legend(loc="upper left")
     axis.grid(alpha=0.3)
     return figure
+
+
+def model_of(params: Parameters) -> str:
+    """The thermal model of a run; parameters from before the model option existed are three-node runs."""
+    return str(getattr(params, "model", "three_node"))
+
+
+def temperature_curves(params: Parameters) -> tuple[tuple[str, str, str], ...]:
+    """(variable, legend label, colour) of the temperatures to draw; ``ball_only`` holds vial and air at ambient."""
+    ball = ("theta_ball", "ball", "tab:red")
+    if model_of(params) == "ball_only":
+        return ball, ("theta_air", "vial and air (held at ambient: ball_only model)", "tab:green")
+    return ball, ("theta_vial", "vial", "tab:blue"), ("theta_air", "air", "tab:green")
 
 
 def _fit_text(fit: ExponentialFit) -> str:
@@ -155,13 +189,20 @@ def heating_zoom_window(params: Parameters) -> int | None:
     return int(np.argmin([abs(start - HEATING_ZOOM_TIME) for start in starts]))
 
 
-def motion_figure(params: Parameters, window: xr.Dataset) -> Figure:
-    """Ball centre with the centre positions at contact with either end face, and the ball's momentum."""
+def motion_figure(
+    params: Parameters, window: xr.Dataset, record_window: tuple[float, float] | None = None
+) -> Figure:
+    """Paper Fig. 4: ball centre (with its positions at contact with either end face) and ball momentum.
+
+    ``record_window`` (start, length) in s sets the time axis; without it the stored points do. The
+    last stored step usually ends before the window does, the next step landing after it.
+    """
     figure, (position_axis, momentum_axis) = _new_figure(rows=2, height=6.0)
     time = window["time"].values
+    start, end = (record_window[0], sum(record_window)) if record_window else (time[0], time[-1])
     # Step points are sparse in flight, where the ball moves in straight lines but the vial does not:
     # the end faces are drawn on a grid of their own.
-    drive_time = np.linspace(time[0], time[-1], DRIVE_CURVE_POINTS)
+    drive_time = np.linspace(start, end, DRIVE_CURVE_POINTS)
     vial = np.array([drive.vial_position(t, params.amplitude, params.omega, params.phase) for t in drive_time])
     # The ball touches an end face (at x_v ± l_v/2) when its centre is one radius away from it.
     reach = params.vial_length / 2.0 - params.ball_radius
@@ -170,7 +211,7 @@ def motion_figure(params: Parameters, window: xr.Dataset) -> Figure:
     position_axis.plot(drive_time, (vial - reach) * 1e3, color="0.4", lw=1, label=contact_label)
     position_axis.plot(drive_time, (vial + reach) * 1e3, color="0.4", lw=1)
     position_axis.set_ylabel("position (mm)")
-    figure.suptitle("Ball motion in the first recorded window")
+    figure.suptitle(f"Ball position and momentum, t = {start:g}–{end:g} s (cf. paper Fig. 4a, 4b)")
     # Above the axes: inside, it would hide the turning points at the end faces.
     position_axis.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=2, fontsize="small", frameon=False)
     momentum_axis.plot(time, window["p"].values, color="tab:purple")
@@ -182,7 +223,10 @@ def motion_figure(params: Parameters, window: xr.Dataset) -> Figure:
 
 
 def heating_zoom_figure(run: RunLike, window: xr.Dataset, start: float) -> Figure:
-    """Ball temperature in °C inside the window starting at ``start`` (s), impacts marked: the heating at each."""
+    """Paper Fig. 5b: ball temperature in °C in the window starting at ``start`` (s), impacts marked.
+
+    Each impact heats the ball in a few tens of microseconds; convection cools it between impacts.
+    """
     figure, (axis,) = _new_figure()
     time = window["time"].values
     axis.plot((time - start) * 1e3, to_celsius(window["theta_ball"].values), color="tab:red", lw=1.2)
@@ -193,6 +237,121 @@ def heating_zoom_figure(run: RunLike, window: xr.Dataset, start: float) -> Figur
     axis.ticklabel_format(axis="y", useOffset=False)
     axis.set_xlabel(f"time after t = {start:g} s (ms)")
     axis.set_ylabel("ball temperature (°C)")
-    axis.set_title(f"Ball heating at each impact ({len(inside)} impacts, dotted)")
+    axis.set_title(f"Ball heating at each of {len(inside)} impacts (dotted), cooling between (cf. paper Fig. 5b)")
     axis.grid(alpha=0.3)
     return figure
+
+
+WALLS = (("left", "left end face", "tab:blue"), ("right", "right end face", "tab:orange"))
+HISTOGRAM_BINS = 60
+HISTOGRAM_HEADROOM = 1.35
+# Impacts per second are counted in bins of at least a second (a few drive periods), at most this many bins.
+RATE_BINS = 120
+MIN_RATE_BIN_S = 1.0
+# Beyond this span the rate is plotted against minutes, as the temperatures are.
+MINUTES_AXIS_FROM_S = 300.0
+
+
+def impact_figures(run: RunLike) -> dict[str, Figure]:
+    """Histograms of impact speed and dissipated energy, and impacts per second at each wall (none without impacts)."""
+    impacts = run.impacts
+    if impacts.empty:
+        return {}
+    return {
+        "impact_speed_histogram": impact_histogram_figure(
+            impacts, "impact_speed", 1.0, "impact speed relative to the end face", "m/s"
+        ),
+        "impact_energy_histogram": impact_histogram_figure(
+            impacts, "dissipated_energy", 1e3, "energy dissipated per impact", "mJ"
+        ),
+        "impacts_per_second": impact_rate_figure(impacts),
+    }
+
+
+def impact_histogram_figure(impacts: pd.DataFrame, column: str, scale: float, quantity: str, unit: str) -> Figure:
+    """Histogram of ``column`` × ``scale`` (in ``unit``), stacked by end face, with the mean and maximum in a box."""
+    figure, (axis,) = _new_figure(height=4.0)
+    values = impacts[column].to_numpy() * scale
+    edges = np.histogram_bin_edges(values, bins=HISTOGRAM_BINS)
+    per_wall = [values[impacts["wall"].to_numpy() == wall] for wall, _, _ in WALLS]
+    axis.hist(
+        per_wall,
+        bins=edges,
+        stacked=True,
+        color=[colour for _, _, colour in WALLS],
+        label=[f"{label} ({len(part)})" for (_, label, _), part in zip(WALLS, per_wall)],
+    )
+    axis.text(
+        0.98, 0.96, f"mean {values.mean():.3g} {unit}\nmax {values.max():.3g} {unit}",
+        transform=axis.transAxes, ha="right", va="top",
+        bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
+    )
+    # Headroom above the highest bar for the legend and the statistics box.
+    axis.set_ylim(0.0, axis.get_ylim()[1] * HISTOGRAM_HEADROOM)
+    axis.set_xlabel(f"{quantity} ({unit})")
+    axis.set_ylabel("impacts per bin (count)")
+    axis.set_title(f"Distribution of the {quantity} ({len(values)} impacts)")
+    axis.legend(loc="upper left")
+    axis.grid(alpha=0.3)
+    return figure
+
+
+def rate_bin_edges(first_impact: float, last_impact: float) -> np.ndarray:
+    """Equal bins from the first to the last impact: at least :data:`MIN_RATE_BIN_S` wide, :data:`RATE_BINS` at most.
+
+    The averaged solver keeps only the impacts after its start-up transient, so the bins start at the
+    first impact, not at t = 0.
+    """
+    span = max(last_impact - first_impact, MIN_RATE_BIN_S)
+    bins = int(min(RATE_BINS, max(1.0, span // MIN_RATE_BIN_S)))
+    return np.linspace(first_impact, first_impact + span, bins + 1)
+
+
+def impact_rate_figure(impacts: pd.DataFrame) -> Figure:
+    """Impacts per second at each end face against time, counted in the bins of :func:`rate_bin_edges`."""
+    figure, (axis,) = _new_figure(height=4.0)
+    times = impacts["time"].to_numpy()
+    edges = rate_bin_edges(float(times.min()), float(times.max()))
+    width = edges[1] - edges[0]
+    in_minutes = edges[-1] >= MINUTES_AXIS_FROM_S
+    time_scale = 60.0 if in_minutes else 1.0
+    for wall, label, colour in WALLS:
+        counts, _ = np.histogram(times[impacts["wall"].to_numpy() == wall], bins=edges)
+        rates = counts / width
+        legend = f"{label} (mean {rates.mean():.3g}/s)"
+        # No baseline: the vertical edges down to zero at both ends would read as a drop in the rate.
+        axis.stairs(rates, edges / time_scale, baseline=None, color=colour, lw=1.5, label=legend)
+    axis.set_ylim(bottom=0.0)
+    axis.set_xlabel("time (min)" if in_minutes else "time (s)")
+    axis.set_ylabel("impacts per second (1/s)")
+    axis.set_title(f"Impacts per second at each end face (bins of {width:.3g} s)")
+    axis.legend(loc="best")
+    axis.grid(alpha=0.3)
+    return figure
+
+
+def comparison_temperature_figure(runs: dict[str, RunLike]) -> Figure:
+    """Ball (solid) and vial (dashed) temperatures in °C of up to four runs, labelled by the keys of ``runs``.
+
+    The vial of a ``ball_only`` run is held at ambient and is left out.
+    """
+    figure, (axis,) = _new_figure()
+    for (label, run), colour in zip(runs.items(), ("tab:red", "tab:blue", "tab:green", "tab:purple")):
+        minutes = run.timeseries["time"].values / 60.0
+        axis.plot(minutes, to_celsius(run.timeseries["theta_ball"].values), color=colour, label=f"{label}: ball")
+        if model_of(run.params) != "ball_only":
+            vial = to_celsius(run.timeseries["theta_vial"].values)
+            axis.plot(minutes, vial, color=colour, ls="--", label=f"{label}: vial")
+    axis.set_xlabel("time (min)")
+    axis.set_ylabel("temperature (°C)")
+    axis.set_title("Ball and vial temperatures of the compared runs")
+    axis.legend(loc="upper left", fontsize="small")
+    axis.grid(alpha=0.3)
+    return figure
+
+
+def png_bytes(figure: Figure, dpi: int = PNG_DPI) -> bytes:
+    """``figure`` rendered as PNG, in memory (for embedding in a report)."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
+    return buffer.getvalue()
