@@ -274,3 +274,39 @@ def test_compare_solvers_reports_both_solvers_and_the_speed_ratio():
     full, averaged = payload["full"], payload["averaged"]
     assert averaged["ball_C"] == pytest.approx(full["ball_C"], abs=0.2)
     assert averaged["heat_power_W"] == pytest.approx(full["heat_power_W"], rel=0.005)
+
+
+def test_validate_prints_table5_with_fitted_and_predicted_roles():
+    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--json"])
+    assert outcome.exit_code == 0, outcome.output
+    payload = json.loads(outcome.stdout)
+    published, calibrated = payload["runs"]["spex8000m"], payload["runs"]["spex8000m-calibrated"]
+    assert set(published["role"].values()) == {"predicted"}
+    assert calibrated["role"]["vial_ball_ratio"] == "predicted"
+    assert calibrated["fitted_parameters"] == ["beta", "vial_mass"]
+    for key in ("theta_inf_C", "tau_min", "rate0_C_per_min"):
+        assert calibrated["role"][key] == "fitted"
+        assert abs(calibrated["relative_error_vs_experiment"][key]) < 0.005
+    assert payload["quantities"]["theta_inf_C"]["experiment"] == 48.0
+
+
+def test_calibrate_writes_a_preset_that_run_accepts(tmp_path):
+    preset_file = tmp_path / "fitted.toml"
+    outcome = runner.invoke(
+        cli.app,
+        ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", str(preset_file), "--json"],
+    )
+    assert outcome.exit_code == 0, outcome.output
+    payload = json.loads(outcome.stdout)
+    assert abs(payload["relative_residuals"]["theta_inf_C"]) < 0.005
+    params = load_config(preset_file).params
+    assert params.beta == pytest.approx(payload["fitted"]["beta"])
+    run = runner.invoke(cli.app, ["run", str(preset_file), "--set", "solver=averaged", "--json", "--no-plots", "--out", str(tmp_path / "run")])
+    assert run.exit_code == 0, run.output
+    assert json.loads(run.stdout)["theta_inf_C"] == pytest.approx(100.0, rel=0.005)
+
+
+def test_calibrate_that_cannot_meet_its_targets_exits_1(tmp_path):
+    outcome = runner.invoke(cli.app, ["calibrate", "--target", "theta_inf_C=25", "--free", "vial_mass"])
+    assert outcome.exit_code == 1
+    assert "cannot be met" in outcome.stderr

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
@@ -24,6 +25,8 @@ from rich.table import Table
 from rich.text import Text
 
 from . import __version__
+from .calibrate import Curve, parse_free, parse_targets, write_preset
+from .calibrate import calibrate as fit_parameters
 from .config import load_config
 from .params import (
     DEFAULT_PRESET,
@@ -40,6 +43,8 @@ from .plotting import PNG_DPI, plot_run
 from .report import REPORT_FILE, save_report
 from .simulate import INTERRUPTED, Result, simulate
 from .storage import RunData, StorageError, check_target, load_run, to_jsonable, write_run
+from .validation import EXPERIMENT, TABLE5, TARGET_KEYS
+from .validation import validate as run_validation
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
@@ -384,6 +389,122 @@ def format_value(key: str, value: Any) -> str:
     if isinstance(value, (int, float)):
         return f"{value:g} {unit}".rstrip()
     return str(value)
+
+
+@app.command()
+def validate(
+    solver: Annotated[
+        str, typer.Option("--solver", help="'full' (default, as the paper) or 'averaged' (seconds instead of minutes).")
+    ] = "full",
+    json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+) -> None:
+    """Paper Table 5 side by side: experiment, the paper's model, this model with published and calibrated parameters."""
+    if solver not in ("full", "averaged"):
+        _fail(f"solver: {solver!r} is not allowed; allowed: one of 'full', 'averaged'")
+    runs = run_validation(solver)
+    if json_output:
+        payload = {
+            "experiment_source": EXPERIMENT,
+            "solver": solver,
+            "quantities": {
+                entry.key: {"label": entry.label, "unit": entry.unit, "experiment": entry.experiment, "paper_model": entry.paper_model}
+                for entry in TABLE5
+            },
+            "runs": {
+                run.preset: {
+                    "fitted_parameters": list(run.fitted),
+                    "statement": run.statement,
+                    "values": {row.quantity.key: row.value for row in run.rows},
+                    "relative_error_vs_experiment": {row.quantity.key: row.error_vs_experiment for row in run.rows},
+                    "role": {row.quantity.key: row.role for row in run.rows},
+                }
+                for run in runs
+            },
+        }
+        typer.echo(json.dumps(to_jsonable(payload), sort_keys=True, allow_nan=False))
+        return
+    table = Table("quantity", "unit", "experiment", "paper's model", title=f"Table 5 ({EXPERIMENT})")
+    for run in runs:
+        table.add_column(f"{run.preset}", justify="right")
+        table.add_column("vs exp.", justify="right")
+    for index, entry in enumerate(TABLE5):
+        cells = [entry.label, entry.unit, f"{entry.experiment:g}", f"{entry.paper_model:g}"]
+        for run in runs:
+            row = run.rows[index]
+            cells += [f"{row.value:.4g} ({row.role})", f"{100 * row.error_vs_experiment:+.2f} %"]
+        _add_plain_row(table, *cells)
+    console = _stdout_console()
+    console.print(table)
+    for run in runs:
+        console.print(Text(run.statement))
+    console.print(Text(f"The experiment's ratio is for five balls: {TABLE5[-1].experiment_note}."))
+
+
+@app.command()
+def calibrate(
+    config: Annotated[Path | None, typer.Argument(metavar="CONFIG", help="TOML file to start from, as for `run`.")] = None,
+    preset: Annotated[str | None, typer.Option("--preset", "-p", show_default=DEFAULT_PRESET)] = None,
+    settings: Annotated[list[str] | None, typer.Option("--set", "-s", metavar="KEY=VALUE")] = None,
+    target: Annotated[
+        list[str] | None,
+        typer.Option("--target", "-t", metavar="NAME=VALUE", help=f"A target: {', '.join(TARGET_KEYS)}."),
+    ] = None,
+    curve: Annotated[
+        Path | None, typer.Option("--curve", help="CSV with time_s (or time_min) and ball_C columns to fit.")
+    ] = None,
+    free: Annotated[
+        list[str] | None, typer.Option("--free", "-f", metavar="KEY[,KEY]", help="Keys to fit (default: beta,vial_mass).")
+    ] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
+    full_resolution: Annotated[
+        bool, typer.Option("--full-resolution", help="Use the full-resolution solver (default: averaged).")
+    ] = False,
+    json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+) -> None:
+    """Fit free parameters to Table 5 targets and/or a measured curve by bounded least squares."""
+    with _user_errors():
+        run_config = load_config(config, preset=preset, overrides=settings or [])
+        targets = parse_targets(target or [])
+        free_keys = parse_free(free or [])
+        measured = Curve.from_csv(curve) if curve is not None else None
+        if out is not None and out.exists() and out.is_dir():
+            raise ParameterError(f"out: {out} is a folder; give a .toml file name")
+        calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
+    if out is not None:
+        command = "shakermill calibrate " + " ".join(sys.argv[2:])
+        description = (
+            f"{run_config.preset} with {', '.join(free_keys)} fitted to "
+            f"{', '.join([*targets, *(['curve ' + measured.source] if measured else [])])}"
+        )
+        write_preset(calibration, out, base_preset=run_config.preset, command=command, description=description)
+    if json_output:
+        typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False))
+    else:
+        console = _stdout_console()
+        table = Table("parameter", "start", "fitted", "std. error", title="calibration")
+        for key in free_keys:
+            _add_plain_row(
+                table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}",
+                _number(calibration.parameter_stderr[key], ".3g"),
+            )
+        console.print(table)
+        if targets:
+            residuals = Table("target", "wanted", "achieved", "residual", *[f"∂ln/∂ln {key}" for key in free_keys])
+            for key, wanted in targets.items():
+                sensitivities = [f"{calibration.sensitivities[key][name]:+.3f}" for name in free_keys]
+                _add_plain_row(
+                    residuals, key, f"{wanted:g}", f"{calibration.achieved[key]:.6g}",
+                    f"{100 * calibration.relative_residuals[key]:+.3f} %", *sensitivities,
+                )
+            console.print(residuals)
+        if calibration.curve_rms_K is not None:
+            console.print(Text(f"curve: rms residual {calibration.curve_rms_K:.3g} K"))
+        console.print(Text(f"{calibration.evaluations} model evaluations ({calibration.solver} solver): {calibration.message}"))
+        if out is not None:
+            console.print(Text(f"preset written to {out}; use it with `shakermill run {out}`"))
+    if not calibration.success:
+        typer.echo(f"error: calibration did not meet its targets: {calibration.message}", err=True)
+        raise typer.Exit(EXIT_FAILED_RUN)
 
 
 if __name__ == "__main__":
