@@ -156,3 +156,14 @@ def test_contact_steps_respect_the_rayleigh_limit() -> None:
     steps = np.diff(times)
     assert in_contact.sum() > 100
     assert steps[in_contact].max() <= limit * (1 + 1e-12)
+
+
+def test_record_windows_span_exactly_the_requested_interval() -> None:
+    params = sm.default_parameters(duration=12.0, record_windows=((0.0, 1.0), (10.0, 0.1)))
+    times = sm.simulate(params).windows["time"].values
+    first = times[times <= 1.0]
+    second = times[times >= 10.0]
+    assert first[-1] == pytest.approx(1.0, abs=1e-12) and times[0] >= 0.0
+    assert second[0] == pytest.approx(10.0, abs=1e-12) and second[-1] == pytest.approx(10.1, abs=1e-12)
+    assert np.all(np.diff(times) >= 0)
+    assert len(second) > 20  # the contacts inside the window are resolved step by step

@@ -326,6 +326,17 @@ def _error_norm(h: float, y: np.ndarray, y_new: np.ndarray, stages: np.ndarray, 
 
 
 @njit(cache=True)
+def _append_window_point(buffer: np.ndarray, counters: np.ndarray, time: float, state: np.ndarray) -> np.ndarray:
+    row = counters[WINDOW_POINTS]
+    if row >= buffer.shape[0]:
+        buffer = _grow(buffer)
+    buffer[row, 0] = time
+    buffer[row, 1:] = state
+    counters[WINDOW_POINTS] = row + 1
+    return buffer
+
+
+@njit(cache=True)
 def _project_momentum(impact: np.ndarray, y_new: np.ndarray, elastic_new: float, k: Constants,
                       diagnostics: np.ndarray) -> None:
     """Project |p| onto the mechanical energy balance of the contact so far.
@@ -445,16 +456,18 @@ def _advance(
             index += 1
         counters[SAMPLES_WRITTEN] = index
 
-        # Full-resolution windows.
+        # Full-resolution windows: every step point inside, and the edges by dense output, so that a
+        # window spans exactly the interval asked for even when flight steps are long.
         for w in range(windows.shape[0]):
-            if windows[w, 0] <= t_new <= windows[w, 1]:
-                row = counters[WINDOW_POINTS]
-                if row >= window_buffer.shape[0]:
-                    window_buffer = _grow(window_buffer)
-                window_buffer[row, 0] = t_new
-                window_buffer[row, 1:] = y_new
-                counters[WINDOW_POINTS] = row + 1
-                break
+            start, end = windows[w, 0], windows[w, 1]
+            if h > 0.0 and t < start < t_new:
+                _hermite((start - t) / h, h, y, f0, y_new, f_new, point)
+                window_buffer = _append_window_point(window_buffer, counters, start, point)
+            if start <= t_new <= end:
+                window_buffer = _append_window_point(window_buffer, counters, t_new, y_new)
+            elif h > 0.0 and t < end < t_new:
+                _hermite((end - t) / h, h, y, f0, y_new, f_new, point)
+                window_buffer = _append_window_point(window_buffer, counters, end, point)
 
         # Impact bookkeeping.
         if touching:
@@ -576,7 +589,9 @@ class Integrator:
 
     @property
     def window_points(self) -> np.ndarray:
-        return self._window_buffer[: self.counters[WINDOW_POINTS]].copy()
+        """(time, state...) rows of all windows in time order (overlapping windows are merged)."""
+        points = self._window_buffer[: self.counters[WINDOW_POINTS]]
+        return points[np.argsort(points[:, 0], kind="stable")]
 
     @property
     def impacts(self) -> np.ndarray:
