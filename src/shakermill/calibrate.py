@@ -27,7 +27,8 @@ import tomli_w
 from scipy.optimize import least_squares
 
 from . import __version__
-from .params import FIELD_NAMES, ParameterError, Parameters, check_known_keys
+from .atomic import write_text_atomically
+from .params import ParameterError, Parameters, check_known_keys
 from .simulate import Result, simulate
 from .validation import TARGET_KEYS
 
@@ -295,13 +296,7 @@ def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str
     }
     if calibration.curve_rms_K is not None:
         document["provenance"]["curve_rms_K"] = calibration.curve_rms_K
-    temporary = path.with_name(f".{path.name}.partial")
-    temporary.write_text(
-        f"# shakermill preset fitted by calibration; keys not listed come from {base_preset!r}.\n"
-        + tomli_w.dumps(document)
-    )
-    temporary.replace(path)
-    return path
+    header = f"# shakermill preset fitted by calibration; keys not listed come from {base_preset!r}.\n"
+    return write_text_atomically(path, header + tomli_w.dumps(document))
 
 
-__all__ = ["Calibration", "Curve", "DEFAULT_FREE", "FIELD_NAMES", "calibrate", "parse_free", "parse_targets", "write_preset"]

@@ -11,9 +11,7 @@ ignored on loading, so a stored run's ``config.toml`` reproduces its parameters.
 
 from __future__ import annotations
 
-import os
 import platform
-import secrets
 import tomllib
 from dataclasses import dataclass
 from datetime import datetime, timezone
@@ -23,6 +21,7 @@ from typing import Any, Mapping, Sequence
 import tomli_w
 
 from . import __version__
+from .atomic import write_text_atomically
 from .params import (
     DEFAULT_PRESET,
     ParameterError,
@@ -168,12 +167,4 @@ def write_config_toml(
     Floats are written with their shortest exact representation, so the round
     trip is exact. The file replaces any previous one atomically.
     """
-    path = Path(path)
-    text = config_toml_text(params, preset=preset, extra_provenance=extra_provenance)
-    partial = path.with_name(f".{path.name}.partial-{secrets.token_hex(4)}")
-    try:
-        partial.write_text(text, encoding="utf-8")
-        os.replace(partial, path)
-    finally:
-        partial.unlink(missing_ok=True)
-    return path
+    return write_text_atomically(path, config_toml_text(params, preset=preset, extra_provenance=extra_provenance))

@@ -18,7 +18,6 @@ from __future__ import annotations
 import io
 import math
 import os
-import secrets
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
@@ -27,6 +26,7 @@ import pandas as pd
 import xarray as xr
 
 from . import drive
+from .atomic import partial_path
 from .fit import ExponentialFit
 from .params import Parameters
 
@@ -101,7 +101,7 @@ def save_figure(figure: Figure, stem: Path, *, dpi: int = PNG_DPI) -> list[Path]
     paths = []
     for fmt in FORMATS:
         path = stem.with_suffix(f".{fmt}")
-        partial = path.with_name(f".{path.name}.partial-{secrets.token_hex(4)}")
+        partial = partial_path(path)
         try:
             figure.savefig(partial, format=fmt, dpi=dpi, bbox_inches="tight")
             os.replace(partial, path)

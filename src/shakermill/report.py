@@ -16,13 +16,12 @@ import base64
 import errno
 import html
 import math
-import os
-import secrets
 import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
 from . import __version__
+from .atomic import write_text_atomically
 from .params import PRESETS, Preset, field_description, field_unit
 from .plotting import (
     PAPER_FIGURES,
@@ -156,16 +155,6 @@ def save_report(run: RunData, target: Path, other: RunData | None = None) -> Pat
     target.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomically(target, render_report(run, other))
     return target
-
-
-def write_text_atomically(path: Path, text: str) -> None:
-    """Write through a temporary sibling and a rename, so a reader never sees half a report."""
-    partial = path.with_name(f".{path.name}.partial-{secrets.token_hex(4)}")
-    try:
-        partial.write_text(text, encoding="utf-8")
-        os.replace(partial, path)
-    finally:
-        partial.unlink(missing_ok=True)
 
 
 def render_report(run: RunData, other: RunData | None = None) -> str:

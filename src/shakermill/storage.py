@@ -33,6 +33,7 @@ import pyarrow.parquet as pq
 import xarray as xr
 
 from . import __version__
+from .atomic import partial_path
 from .config import load_config, write_config_toml
 from .fit import ExponentialFit
 from .integrate import REACHED_STOP
@@ -121,7 +122,7 @@ def write_run(
     target = Path(path).absolute()
     check_target(target)
     target.parent.mkdir(parents=True, exist_ok=True)
-    partial = target.with_name(f".{target.name}.partial-{secrets.token_hex(4)}")
+    partial = partial_path(target)
     partial.mkdir()
     try:
         _write_contents(result, partial, preset=preset, extra_provenance=extra_provenance or {})
