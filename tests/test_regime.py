@@ -1,0 +1,63 @@
+"""Regime classification from impact phases, and the bifurcation scan."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import shakermill as sm
+from shakermill.regime import IRREGULAR, NO_IMPACTS, bifurcation, classify
+
+OMEGA = 100.0
+PERIOD = 2 * math.pi / OMEGA
+
+
+def _fake_result(times: list[float], walls: list[str]) -> SimpleNamespace:
+    impacts = pd.DataFrame({"time": times, "wall": walls})
+    params = SimpleNamespace(omega=OMEGA, phase=0.0)
+    return SimpleNamespace(impacts=impacts, params=params, solver="averaged", t_end=max(times, default=0.0))
+
+
+def _repeat(pattern: list[tuple[float, str]], periods: int, every: int) -> SimpleNamespace:
+    """Impacts at fractions of the drive period, the pattern repeating every ``every`` periods."""
+    times, walls = [], []
+    for k in range(0, periods, every):
+        for fraction, wall in pattern:
+            times.append((k + fraction) * PERIOD)
+            walls.append(wall)
+    return _fake_result(times, walls)
+
+
+def test_period_one_and_period_two_are_recognised() -> None:
+    assert classify(_repeat([(0.2, "left"), (0.7, "right")], 40, 1)) == ("period-1", 1)
+    two = _repeat([(0.2, "left"), (0.7, "right"), (1.3, "left"), (1.75, "right")], 40, 2)
+    assert classify(two) == ("period-2", 2)
+
+
+def test_wall_sequence_matters_not_only_phases() -> None:
+    result = _repeat([(0.2, "left"), (1.2, "right")], 40, 2)  # same phase, alternating walls
+    assert classify(result) == ("period-2", 2)
+
+
+def test_random_impacts_are_irregular_and_none_is_no_impacts() -> None:
+    rng = np.random.default_rng(7)
+    times = np.sort(rng.uniform(0, 60 * PERIOD, 150)).tolist()
+    walls = rng.choice(["left", "right"], 150).tolist()
+    assert classify(_fake_result(times, walls)) == (IRREGULAR, None)
+    assert classify(_fake_result([], [])) == (NO_IMPACTS, None)
+
+
+def test_default_motion_is_periodic_and_bifurcation_records_phases() -> None:
+    base = sm.default_parameters(solver="averaged", duration=60.0, record_windows=())
+    label, period = classify(sm.simulate(base))
+    assert label == f"period-{period}" and 1 <= period <= 4
+    scan = bifurcation(base, [95.0, 111.0, 125.0])
+    assert list(scan.regimes["omega"]) == [95.0, 111.0, 125.0]
+    assert set(scan.regimes["regime"]) <= {IRREGULAR, *(f"period-{n}" for n in range(1, 17))}
+    assert scan.phases["phase"].between(0.0, 2 * math.pi).all()
+    assert set(scan.phases["omega"]) == {95.0, 111.0, 125.0}
+    assert scan.regimes.loc[scan.regimes["omega"] == 111.0, "period"].item() == period
