@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import contact, model
+from . import model
 from .params import Parameters
-from .simulate import RAYLEIGH_FRACTION
+from .simulate import tolerances_for
 
 # Flight segments: SciPy only sees a contact if the gap changes sign between two steps, so the step is
 # bounded to a small part of the drive period to make a grazing touch unlikely to be missed.
@@ -65,13 +65,10 @@ def simulate_scipy(params: Parameters, t_end: float | None = None, method: str =
     """Integrate ``params`` with ``solve_ivp`` up to ``t_end`` (default: the full duration)."""
     k = model.constants_from(params)
     t_end = params.duration if t_end is None else t_end
+    tolerances = tolerances_for(params, k)
     atol = np.full(model.N_STATE, _QUADRATURE_ATOL)
-    atol[model.X] = params.atol_position
-    atol[model.P] = params.atol_momentum
-    atol[model.THETA_BALL : model.THETA_AIR + 1] = params.atol_temperature
-    contact_step = RAYLEIGH_FRACTION * contact.rayleigh_time(
-        params.ball_radius, params.ball_density, params.ball_youngs_modulus, params.ball_poisson_ratio
-    )
+    atol[: model.N_DYNAMIC] = tolerances.atol
+    contact_step = tolerances.contact_step_limit
     flight_step = 2.0 * np.pi / params.omega / FLIGHT_STEPS_PER_PERIOD
     onsets = [_wall_event(wall, k, -1.0) for wall in (model.LEFT_WALL, model.RIGHT_WALL)]
     separations = {wall: [_wall_event(wall, k, +1.0)] for wall in (model.LEFT_WALL, model.RIGHT_WALL)}

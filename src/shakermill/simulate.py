@@ -122,7 +122,8 @@ class Result:
         return self.status == REACHED_STOP
 
 
-def _tolerances(params: Parameters, constants: model.Constants) -> Tolerances:
+def tolerances_for(params: Parameters, constants: model.Constants) -> Tolerances:
+    """Error control and contact limits of a run (MODEL.md §7)."""
     atol = np.empty(model.N_DYNAMIC)
     atol[model.X] = params.atol_position
     atol[model.P] = params.atol_momentum
@@ -169,7 +170,7 @@ def integrator_for(params: Parameters, sample_times: np.ndarray) -> Integrator:
         constants=constants,
         y=model.initial_state(params),
         t0=0.0,
-        tolerances=_tolerances(params, constants),
+        tolerances=tolerances_for(params, constants),
         sample_times=sample_times,
         windows=windows,
         project_energy=params.energy_projection,
