@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
 import pytest
 from rich.console import Console
 from typer.testing import CliRunner
@@ -17,6 +19,7 @@ from shakermill import cli
 from shakermill.config import load_config
 from shakermill.params import FIELD_NAMES
 from shakermill.storage import RUN_FILES, load_run
+from shakermill.sweep import load_sweep
 
 # Short runs with small windows keep every invocation well under a second once Numba's cache is warm.
 SHORT = ["--set", "duration=2", "--set", "record_windows=0:0.2"]
@@ -195,19 +198,35 @@ def test_interruption_writes_partial_results_and_exits_130(tmp_path, monkeypatch
     assert 0 < float(run.timeseries["time"].max()) < 30.0
 
 
-def test_progress_bar_is_drawn_on_a_terminal_for_long_runs(monkeypatch):
+@pytest.fixture(name="terminal")
+def terminal_fixture(monkeypatch) -> io.StringIO:
+    """What the command draws on stderr, as if stderr were a terminal."""
     screen = io.StringIO()
     real_console = Console
 
     def console(**kwargs):
         if kwargs.get("stderr"):
-            return real_console(file=screen, force_terminal=True, width=100)
+            return real_console(file=screen, force_terminal=True, width=120)
         return real_console(**kwargs)
 
     monkeypatch.setattr(cli, "Console", console)
+    return screen
+
+
+def test_progress_bar_is_drawn_on_a_terminal_for_long_runs(terminal):
     result = cli.simulate_with_progress(sm.default_parameters(duration=60.0, record_windows=()))
     assert result.success
-    assert "s simulated" in screen.getvalue()
+    assert "s simulated" in terminal.getvalue()
+
+
+def test_sweep_progress_bar_shows_points_done_running_and_failed(terminal, tmp_path):
+    outcome = invoke(
+        "sweep", *QUICK_BASE, "--grid", "restitution=0.8:1.1:3", "--workers", "1", "--out", str(tmp_path / "s")
+    )
+    assert outcome.exit_code == 1  # restitution 1.1 is out of range: that point fails
+    drawn = terminal.getvalue()
+    assert "3/3 points · 0 running · 1 failed" in drawn
+    assert "0/3 points" in drawn
 
 
 def test_presets_lists_and_shows_values_with_units_and_sources():
@@ -310,3 +329,83 @@ def test_calibrate_that_cannot_meet_its_targets_exits_1(tmp_path):
     outcome = runner.invoke(cli.app, ["calibrate", "--target", "theta_inf_C=25", "--free", "vial_mass"])
     assert outcome.exit_code == 1
     assert "cannot be met" in outcome.stderr
+
+
+# Sweep folders and bifurcation scans ------------------------------------------------------------------
+
+QUICK_BASE = ["--set", "duration=60", "--set", "record_windows="]
+
+
+@pytest.fixture(scope="module")
+def sweep_folder(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("sweeps") / "omega_amplitude"
+    outcome = invoke(
+        "sweep", *QUICK_BASE, "--grid", "omega=100:120:2", "--grid", "amplitude=24mm:26mm:2",
+        "--workers", "1", "--out", str(folder),
+    )
+    assert outcome.exit_code == 0, outcome.stderr
+    return folder
+
+
+def test_plot_of_a_sweep_folder_draws_maps_with_the_contour(sweep_folder, tmp_path):
+    table = load_sweep(sweep_folder).table
+    level = float(table["theta_inf_C"].median())
+    outcome = invoke("plot", str(sweep_folder), "--out", str(tmp_path / "maps"), "--contour", f"theta_inf_C={level}")
+    assert outcome.exit_code == 0, outcome.stderr
+    stems = {path.stem for path in (tmp_path / "maps").iterdir()}
+    assert stems == {"sweep_theta_inf_C", "sweep_tau_min", "sweep_impact_rate_hz", "sweep_heat_power_W",
+                     "sweep_mean_impact_speed_m_s", "sweep_regime"}
+    assert "12 files written" in outcome.stdout
+
+
+@pytest.mark.parametrize(
+    ("extra", "fragments"),
+    [
+        (["--contour", "theta_inf_C"], ("contour", "COLUMN=VALUE")),
+        (["--contour", "warmth=60"], ("warmth is not a numeric column",)),
+        (["--impacts"], ("--impacts", "sweep folder")),
+    ],
+)
+def test_plot_of_a_sweep_folder_refuses_bad_options_with_one_line(sweep_folder, tmp_path, extra, fragments):
+    outcome = invoke("plot", str(sweep_folder), "--out", str(tmp_path / "maps"), *extra)
+    assert outcome.exit_code == 2
+    assert_one_error_line(outcome.stderr, *fragments)
+    assert not (tmp_path / "maps").exists()
+
+
+def test_contour_on_a_run_folder_is_refused(tmp_path):
+    assert invoke("run", *SHORT, "--no-plots", "--out", str(tmp_path / "run")).exit_code == 0
+    outcome = invoke("plot", str(tmp_path / "run"), "--contour", "theta_inf_C=60")
+    assert outcome.exit_code == 2
+    assert_one_error_line(outcome.stderr, "--contour", "sweep folder")
+
+
+def test_bifurcation_writes_regimes_phases_and_the_diagram(tmp_path):
+    folder = tmp_path / "scan"
+    outcome = invoke("bifurcation", *QUICK_BASE, "--grid", "omega=100:120:3", "--out", str(folder))
+    assert outcome.exit_code == 0, outcome.stderr
+    regimes = pd.read_parquet(folder / "bifurcation_regimes.parquet")
+    phases = pd.read_parquet(folder / "bifurcation_phases.parquet")
+    assert list(regimes["omega"]) == [100.0, 110.0, 120.0]
+    assert regimes["solver"].eq("averaged").all()  # the scan defaults to the averaged solver
+    assert set(phases["omega"]) == {100.0, 110.0, 120.0}
+    assert phases["phase"].between(0.0, 2 * np.pi).all() and set(phases["wall"]) <= {"left", "right"}
+    assert pd.read_csv(folder / "bifurcation_regimes.csv")["regime"].tolist() == regimes["regime"].tolist()
+    assert (folder / "bifurcation.png").read_bytes().startswith(b"\x89PNG")
+    for label in regimes["regime"].unique():
+        assert label in outcome.stdout
+
+
+@pytest.mark.parametrize(
+    ("grid", "fragments"),
+    [
+        ("omega=90:130", ("KEY=START:STOP:N",)),
+        ("speed=1:2:3", ("speed", "unknown parameter")),
+        ("omega=-10:10:3", ("omega",)),
+    ],
+)
+def test_bifurcation_bad_grid_exits_2_with_one_line(tmp_path, grid, fragments):
+    outcome = invoke("bifurcation", "--grid", grid, "--out", str(tmp_path / "scan"))
+    assert outcome.exit_code == 2
+    assert_one_error_line(outcome.stderr, *fragments)
+    assert not (tmp_path / "scan").exists()

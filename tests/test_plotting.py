@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from typer.testing import CliRunner
@@ -20,14 +21,18 @@ from shakermill.params import DEFAULT_PRESET
 from shakermill.plotting import (
     IMPACT_FIGURES,
     PAPER_FIGURES,
+    SWEEP_QUANTITIES,
+    bifurcation_figure,
     heating_zoom_figure,
     heating_zoom_window,
     impact_figures,
     motion_figure,
+    parse_contour,
     plot_run,
     png_bytes,
     rate_bin_edges,
     run_figures,
+    sweep_figures,
     temperature_figure,
     window_data,
 )
@@ -35,7 +40,7 @@ from shakermill.storage import load_run, write_run
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 ALL_FIGURES = ("ball_heating_zoom", "ball_motion", "temperatures")
-IMPACT_FIGURE_NAMES = ("impact_energy_histogram", "impact_speed_histogram", "impacts_per_second")
+IMPACT_FIGURE_NAMES = ("impact_energy_histogram", "impact_phase_histogram", "impact_speed_histogram", "impacts_per_second")
 # "quantity (unit)": every axis label ends with its unit in parentheses.
 LABEL_WITH_UNIT = re.compile(r"^\S.* \([^()]+\)$")
 
@@ -294,3 +299,120 @@ def test_plot_command_refuses_a_damaged_run_folder(result, tmp_path):
     assert outcome.exit_code == 2
     lines = outcome.stderr.strip().splitlines()
     assert len(lines) == 1 and "not a readable shakermill run folder" in lines[0] and "Traceback" not in outcome.stderr
+
+
+# Impact phases, sweeps and the bifurcation diagram -------------------------------------------------
+
+
+def test_impact_phase_histogram_counts_the_settled_impacts_by_wall(result):
+    (axis,) = impact_figures(result)["impact_phase_histogram"].axes
+    settled = result.impacts[result.impacts["time"] >= 0.5 * result.t_end]  # a full run: its second half
+    assert sum(patch.get_height() for patch in axis.patches) == len(settled)
+    labels = [text.get_text() for text in axis.get_legend().get_texts()]
+    assert labels == [f"{name} end face ({(settled['wall'] == name).sum()})" for name in ("left", "right")]
+    assert [tick.get_text() for tick in axis.get_xticklabels()] == ["0", "π/2", "π", "3π/2", "2π"]
+    assert axis.get_xlim() == pytest.approx((0.0, 2 * np.pi))
+    assert f"{len(settled)} impacts" in axis.get_title()
+
+
+def test_plot_command_impacts_draws_only_the_impact_figures(result, tmp_path):
+    folder = write_run(result, tmp_path / "run", preset=DEFAULT_PRESET)
+    outcome = runner.invoke(cli.app, ["plot", str(folder), "--impacts", "--out", str(tmp_path / "impacts")])
+    assert outcome.exit_code == 0, outcome.stderr
+    expected = sorted(f"{name}.{fmt}" for name in IMPACT_FIGURE_NAMES for fmt in ("png", "svg"))
+    assert sorted(path.name for path in (tmp_path / "impacts").iterdir()) == expected
+
+
+def synthetic_sweep(failed_index: int | None = None) -> pd.DataFrame:
+    """A 3 × 2 grid over omega and amplitude whose results are simple functions of the two keys."""
+    omega, amplitude = np.meshgrid([90.0, 110.0, 130.0], [0.024, 0.028], indexing="ij")
+    table = pd.DataFrame({"omega": omega.ravel(), "amplitude": amplitude.ravel()})
+    table["theta_inf_C"] = table["omega"] - 40.0 + 1000.0 * (table["amplitude"] - 0.024)  # 50 … 94 °C
+    for column, _, _ in SWEEP_QUANTITIES[1:]:
+        table[column] = table["omega"] / 100.0
+    table["regime"] = ["period-1", "period-2", "period-2", "irregular", "period-1", "period-2"]
+    table["error"] = None
+    if failed_index is not None:
+        table.loc[failed_index, "error"] = "restitution: 2 is out of range"
+    return table
+
+
+def test_sweep_maps_fill_the_grid_and_blank_the_failed_point():
+    table = synthetic_sweep(failed_index=3)
+    figures = sweep_figures(table, ("omega", "amplitude"))
+    assert sorted(figures) == sorted([f"sweep_{column}" for column, _, _ in SWEEP_QUANTITIES] + ["sweep_regime"])
+    axis, colourbar = figures["sweep_theta_inf_C"].axes
+    assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "amplitude (mm)"
+    assert colourbar.get_ylabel() == "ball θ∞ (°C)"
+    (mesh,) = axis.collections
+    cells = mesh.get_array()
+    # Rows are amplitudes, columns omegas; the failed point (omega 110, amplitude 28 mm) is masked.
+    expected = np.array([[50.0, 70.0, 90.0], [54.0, np.nan, 94.0]])
+    np.testing.assert_allclose(np.ma.filled(cells, np.nan).reshape(2, 3), expected)
+    assert cells.mask.reshape(2, 3)[1, 1] and cells.mask.sum() == 1
+    # Cell edges half-way between the grid values, in mm on the amplitude axis.
+    assert axis.get_ylim() == pytest.approx((22.0, 30.0))
+
+
+def test_sweep_contour_is_drawn_at_its_level_on_every_map():
+    table = synthetic_sweep()
+    figures = sweep_figures(table, ("omega", "amplitude"), [("theta_inf_C", 60.0)])
+    for name in ("sweep_theta_inf_C", "sweep_impact_rate_hz"):
+        axis = figures[name].axes[0]
+        contours = [collection for collection in axis.collections if hasattr(collection, "levels")]
+        assert len(contours) == 1 and list(contours[0].levels) == [60.0]
+        vertices = np.concatenate([path.vertices for path in contours[0].get_paths()])
+        # θ∞ = omega − 40 + 1000 (amplitude − 0.024): 60 °C at omega = 100 − 1000 (amplitude − 0.024).
+        np.testing.assert_allclose(vertices[:, 0], 100.0 - (vertices[:, 1] / 1e3 - 0.024) * 1e3, atol=1e-9)
+
+
+def test_one_key_sweep_is_a_line_with_the_contour_crossing_marked():
+    table = synthetic_sweep().iloc[[4, 0, 2]]  # amplitude 24 mm only, out of order
+    figures = sweep_figures(table.drop(columns="amplitude"), ("omega",), [("theta_inf_C", 60.0)])
+    (axis,) = figures["sweep_theta_inf_C"].axes
+    curve, crossing, level = axis.get_lines()[:3]
+    np.testing.assert_allclose(curve.get_xdata(), [90.0, 110.0, 130.0])
+    np.testing.assert_allclose(curve.get_ydata(), [50.0, 70.0, 90.0])
+    assert crossing.get_xdata()[0] == pytest.approx(100.0)  # linear between (90, 50) and (110, 70)
+    assert level.get_ydata()[0] == pytest.approx(60.0)
+    assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "ball θ∞ (°C)"
+
+
+def test_regime_map_counts_each_regime_and_the_failed_points():
+    figures = sweep_figures(synthetic_sweep(failed_index=0), ("omega", "amplitude"))
+    (axis,) = figures["sweep_regime"].axes
+    labels = [text.get_text() for text in axis.get_legend().get_texts()]
+    assert labels == ["period-1 (1)", "period-2 (3)", "irregular (1)", "failed (1)"]
+
+
+def test_sweeps_over_three_keys_are_refused_with_one_line():
+    with pytest.raises(sm.ParameterError, match="3 keys"):
+        sweep_figures(synthetic_sweep(), ("omega", "amplitude", "restitution"))
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [("theta_inf_C", "expected COLUMN=VALUE"), ("nope=3", "nope is not a numeric column"), ("theta_inf_C=hot", "not a number")],
+)
+def test_bad_contours_name_the_problem(spec, message):
+    with pytest.raises(sm.ParameterError, match=message):
+        parse_contour(spec, ["theta_inf_C", "tau_min"])
+    assert parse_contour(" theta_inf_C = 60 ", ["theta_inf_C"]) == ("theta_inf_C", 60.0)
+
+
+def test_bifurcation_figure_plots_every_phase_and_the_periods():
+    phases = pd.DataFrame(
+        {"omega": [100.0, 100.0, 100.0, 110.0, 110.0], "phase": [0.5, 4.0, 5.9, 1.0, 3.0], "wall": ["left", "right", "left", "left", "right"]}
+    )
+    regimes = pd.DataFrame({"omega": [100.0, 110.0], "regime": ["period-1", "irregular"], "period": pd.array([1, None], dtype="Int64")})
+    figure = bifurcation_figure(phases, regimes, "omega")
+    phase_axis, period_axis = figure.axes
+    left, right = phase_axis.collections
+    np.testing.assert_allclose(left.get_offsets()[:, 1], [0.5, 5.9, 1.0])
+    np.testing.assert_allclose(right.get_offsets()[:, 1], [4.0, 3.0])
+    assert phase_axis.get_ylim() == pytest.approx((0.0, 2 * np.pi))
+    periodic, irregular = period_axis.get_lines()
+    np.testing.assert_allclose(periodic.get_ydata(), [1.0, np.nan])
+    np.testing.assert_allclose(irregular.get_xdata(), [110.0])
+    assert period_axis.get_xlabel() == "omega (rad/s)"
+    assert phase_axis.get_ylabel() == "impact phase ωt + φ mod 2π (rad)"

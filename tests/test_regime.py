@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 import shakermill as sm
-from shakermill.regime import IRREGULAR, NO_IMPACTS, bifurcation, classify
+from shakermill.regime import IRREGULAR, NO_IMPACTS, bifurcation, classify, settled_impacts, write_bifurcation
 
 OMEGA = 100.0
 PERIOD = 2 * math.pi / OMEGA
@@ -61,3 +61,22 @@ def test_default_motion_is_periodic_and_bifurcation_records_phases() -> None:
     assert scan.phases["phase"].between(0.0, 2 * math.pi).all()
     assert set(scan.phases["omega"]) == {95.0, 111.0, 125.0}
     assert scan.regimes.loc[scan.regimes["omega"] == 111.0, "period"].item() == period
+
+
+def test_bifurcation_scans_any_numeric_key_and_writes_its_tables(tmp_path) -> None:
+    base = sm.default_parameters(solver="averaged", duration=60.0, record_windows=())
+    scan = bifurcation(base, [0.024, 0.026], key="amplitude")
+    assert scan.key == "amplitude"
+    assert list(scan.regimes["amplitude"]) == [0.024, 0.026]
+    assert str(scan.regimes["period"].dtype) == "Int64"  # whole drive periods, missing for irregular motion
+    paths = write_bifurcation(scan, tmp_path)
+    assert sorted(path.name for path in paths) == sorted(
+        f"bifurcation_{table}.{suffix}" for table in ("regimes", "phases") for suffix in ("parquet", "csv")
+    )
+    pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "bifurcation_phases.parquet"), scan.phases)
+
+
+def test_settled_impacts_of_a_full_run_are_its_second_half() -> None:
+    impacts = pd.DataFrame({"time": [0.1, 0.4, 0.6, 0.9], "wall": ["left", "right", "left", "right"]})
+    assert settled_impacts(impacts, "full", 1.0)["time"].tolist() == [0.6, 0.9]
+    assert settled_impacts(impacts, "averaged", 1.0)["time"].tolist() == [0.1, 0.4, 0.6, 0.9]

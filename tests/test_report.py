@@ -18,6 +18,7 @@ from typer.testing import CliRunner
 import shakermill as sm
 from shakermill import cli
 from shakermill.params import DEFAULT_PRESET, FIELD_NAMES, PRESETS
+from shakermill.regime import classify_impacts, settled_run_impacts
 from shakermill.report import REPORT_FILE, fitted_targets, number, render_report, write_report
 from shakermill.storage import load_run, write_run
 from shakermill.validation import TABLE5
@@ -141,6 +142,9 @@ def test_report_shows_impact_statistics_and_numerics(run_folder, report_html):
         count = int((run.impacts["wall"] == wall).sum())
         assert f"impacts at the {wall} end face</td><td class=\"num\">{count} (" in impacts
     assert "contact duration: mean / min / max" in impacts and "µs" in impacts
+    regime, _ = classify_impacts(settled_run_impacts(run), run.params.omega, run.params.phase)
+    assert f"regime of the settled motion</td><td class=\"num\">{regime}<" in impacts
+    assert "Drive phase ωt + φ (mod 2π) at the impacts of the settled motion" in report_html
     numerics = "\n".join(rows_of_table_after(report_html, "Numerics"))
     for label in ("accepted steps", "rejected steps", "right-hand-side evaluations", "wall time"):
         assert label in numerics

@@ -16,8 +16,9 @@ import sys
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
-from typing import Annotated, Any, Iterator, NoReturn
+from typing import Annotated, Any, Callable, Iterator, NoReturn, Sequence
 
+import pandas as pd
 import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -39,9 +40,23 @@ from .params import (
     field_unit,
     preset_values,
 )
-from .plotting import PNG_DPI, plot_run
+from .plotting import PNG_DPI, bifurcation_figure, impact_figures, parse_contour, plot_figures, plot_run, run_figures, sweep_figures
+from .regime import bifurcation as regime_scan
+from .regime import write_bifurcation
 from .report import REPORT_FILE, save_report
 from .simulate import INTERRUPTED, Result, simulate
+from .sweep import (
+    DEFAULT_SCHEDULER_TIMEOUT_S,
+    TABLE_CSV,
+    TABLE_PARQUET,
+    failed_points,
+    is_sweep_folder,
+    load_sweep,
+    parse_grid,
+    plan_sweep,
+    sweep_parameters,
+)
+from .sweep import sweep as run_sweep
 from .storage import RunData, StorageError, check_target, load_run, to_jsonable, write_run
 from .validation import EXPERIMENT, TABLE5, TARGET_KEYS
 from .validation import validate as run_validation
@@ -109,35 +124,41 @@ def _user_errors() -> Iterator[None]:
         _fail(str(exc))
 
 
+# Options shared by several commands, declared once.
+ConfigArgument = Annotated[
+    Path | None,
+    typer.Argument(metavar="CONFIG", help="TOML file with canonical keys (and optionally preset = NAME)."),
+]
+PresetOption = Annotated[
+    str | None, typer.Option("--preset", "-p", show_default=DEFAULT_PRESET, help="Preset to start from.")
+]
+SettingsOption = Annotated[
+    list[str] | None,
+    typer.Option("--set", "-s", metavar="KEY=VALUE", help="Override one key, units allowed: --set ball_radius='5 mm'."),
+]
+JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")]
+FullResolutionOption = Annotated[
+    bool, typer.Option("--full-resolution", help="Use the full-resolution solver (default: averaged).")
+]
+
+
 @app.command()
 def run(
-    config: Annotated[
-        Path | None,
-        typer.Argument(metavar="CONFIG", help="TOML file with canonical keys (and optionally preset = NAME)."),
-    ] = None,
-    preset: Annotated[
-        str | None, typer.Option("--preset", "-p", show_default=DEFAULT_PRESET, help="Preset to start from.")
-    ] = None,
-    settings: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--set", "-s", metavar="KEY=VALUE", help="Override one key, units allowed: --set ball_radius='5 mm'."
-        ),
-    ] = None,
+    config: ConfigArgument = None,
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
     out: Annotated[
         Path | None,
         typer.Option("--out", "-o", show_default="results/run-<timestamp>", help="Run folder to write."),
     ] = None,
-    json_output: Annotated[
-        bool, typer.Option("--json", help="Print the summary as one JSON object on stdout, nothing else.")
-    ] = False,
+    json_output: JsonOption = False,
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
     overrides = settings or []
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=overrides)
-        target = out if out is not None else default_output_folder()
+        target = out if out is not None else timestamped_folder("run")
         check_target(target)
     result = simulate_with_progress(run_config.params)
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
@@ -150,9 +171,9 @@ def run(
     _exit_for_status(result, target)
 
 
-def default_output_folder() -> Path:
-    """``results/run-<local timestamp>``, with a counter if a run started in the same second."""
-    stem = f"run-{datetime.now():%Y%m%d-%H%M%S}"
+def timestamped_folder(kind: str) -> Path:
+    """``results/<kind>-<local timestamp>``, with a counter if one started in the same second."""
+    stem = f"{kind}-{datetime.now():%Y%m%d-%H%M%S}"
     candidate = DEFAULT_RESULTS_FOLDER / stem
     counter = 1
     while candidate.exists():
@@ -163,18 +184,26 @@ def default_output_folder() -> Path:
 
 def simulate_with_progress(params: Parameters) -> Result:
     """``simulate``, with a transient progress bar on stderr for long runs when stderr is a terminal."""
-    console = Console(stderr=True)
-    if params.duration < PROGRESS_MIN_DURATION_S or not console.is_terminal:
+    if params.duration < PROGRESS_MIN_DURATION_S:
         return simulate(params)
-    columns = (
-        TextColumn("simulating"),
-        BarColumn(),
-        TextColumn("{task.completed:.0f}/{task.total:.0f} s simulated"),
-        TimeRemainingColumn(),
-    )
+    with _progress_bar("simulating", "{task.completed:.0f}/{task.total:.0f} s simulated", params.duration) as update:
+        return simulate(params, progress=None if update is None else lambda t, _duration: update(t))
+
+
+@contextmanager
+def _progress_bar(verb: str, counter: str, total: float, **fields: Any) -> Iterator[Callable[..., None] | None]:
+    """``update(completed, **fields)`` of a transient progress bar with an ETA on stderr; None when stderr is not a terminal.
+
+    Pipes and logs stay clean: a bar redrawn many times a second would fill them.
+    """
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        yield None
+        return
+    columns = (TextColumn(verb), BarColumn(), TextColumn(counter), TimeRemainingColumn())
     with Progress(*columns, console=console, transient=True) as bar:
-        task = bar.add_task("simulate", total=params.duration)
-        return simulate(params, progress=lambda t, _duration: bar.update(task, completed=t))
+        task = bar.add_task(verb, total=total, **fields)
+        yield lambda completed, **updates: bar.update(task, completed=completed, **updates)
 
 
 def _write(result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool) -> Path:
@@ -259,10 +288,10 @@ COMPARED_QUANTITIES = (
 
 @app.command("compare-solvers")
 def compare_solvers(
-    config: Annotated[Path | None, typer.Argument(metavar="CONFIG", help="TOML file, as for `run`.")] = None,
-    preset: Annotated[str | None, typer.Option("--preset", "-p", show_default=DEFAULT_PRESET)] = None,
-    settings: Annotated[list[str] | None, typer.Option("--set", "-s", metavar="KEY=VALUE")] = None,
-    json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+    config: ConfigArgument = None,
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
+    json_output: JsonOption = False,
 ) -> None:
     """Run the same configuration with the full and the averaged solver; print both, the differences and the speed ratio."""
     with _user_errors():
@@ -339,17 +368,38 @@ def _load_run_or_fail(folder: Path) -> RunData:
 
 @app.command()
 def plot(
-    run_dir: Annotated[Path, typer.Argument(metavar="RUN_DIR", help="A run folder written by `shakermill run`.")],
+    folder: Annotated[
+        Path, typer.Argument(metavar="RUN_DIR|SWEEP_DIR", help="A run folder (`shakermill run`) or a sweep folder (`shakermill sweep`).")
+    ],
     out: Annotated[
-        Path | None, typer.Option("--out", "-o", show_default="RUN_DIR/figures", help="Folder for the figures.")
+        Path | None, typer.Option("--out", "-o", show_default="DIR/figures", help="Folder for the figures.")
+    ] = None,
+    impacts: Annotated[
+        bool, typer.Option("--impacts", help="Run folder: only the impact statistics (speed, energy, rate, phase).")
+    ] = False,
+    contour: Annotated[
+        list[str] | None,
+        typer.Option("--contour", metavar="COLUMN=VALUE", help="Sweep folder: draw this level on every map, e.g. theta_inf_C=60."),
     ] = None,
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG files.")] = PNG_DPI,
 ) -> None:
-    """Draw every figure of a run folder as PNG and SVG: the paper's Figs. 4, 5a, 5b and the impact statistics."""
-    run_data = _load_run_or_fail(run_dir)
-    target = out if out is not None else run_dir / FIGURES_FOLDER
+    """Draw the figures of a run folder (paper Figs. 4, 5a, 5b, impact statistics) or of a sweep folder (maps or lines)."""
+    target = out if out is not None else folder / FIGURES_FOLDER
+    if is_sweep_folder(folder):
+        if impacts:
+            _fail("--impacts: a sweep folder has no impacts of its own; plot one run (sweep --keep-runs writes them)")
+        with _user_errors():
+            data = load_sweep(folder)
+            numeric = list(data.table.select_dtypes("number").columns)
+            levels = [parse_contour(spec, numeric) for spec in contour or []]
+            figures = sweep_figures(data.table, data.keys, levels)
+    else:
+        if contour:
+            _fail("--contour: contours are drawn on the maps of a sweep folder, not on a run")
+        run_data = _load_run_or_fail(folder)
+        figures = impact_figures(run_data) if impacts else run_figures(run_data, impacts=True)
     try:
-        paths = plot_run(run_data, target, impacts=True, dpi=dpi)
+        paths = plot_figures(figures, target, dpi=dpi)
     except OSError as exc:
         _fail(f"{target}: cannot write the figures ({exc.strerror or exc})")
     typer.echo(f"{len(paths)} files written to {target}")
@@ -378,6 +428,158 @@ def report(
     typer.echo(f"report written to {target}")
 
 
+SWEEP_PREVIEW_ROWS = 20
+SWEEP_PREVIEW_COLUMNS = (
+    ("regime", "regime", ""),
+    ("theta_inf_C", "θ∞", "°C"),
+    ("tau_min", "τ", "min"),
+    ("impact_rate_hz", "impact rate", "Hz"),
+    ("heat_power_W", "heat", "W"),
+    ("mean_impact_speed_m_s", "mean speed", "m/s"),
+)
+
+
+@app.command()
+def sweep(
+    config: ConfigArgument = None,
+    grid: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--grid", "-g", metavar="KEY=START:STOP:N",
+            help="N equally spaced values of a numeric key, units allowed (amplitude=20mm:30mm:6); several grids combine as a product.",
+        ),
+    ] = None,
+    points: Annotated[
+        Path | None,
+        typer.Option("--points", metavar="FILE.csv", help="Explicit points: a header of keys, one point per row (combined with --grid as a product)."),
+    ] = None,
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", show_default="results/sweep-<timestamp>", help="Sweep folder; re-run into it to resume.")
+    ] = None,
+    workers: Annotated[
+        int | None, typer.Option("--workers", "-w", show_default="one per core", help="Local worker processes.")
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option("--scheduler", metavar="ADDRESS", help="Run on this Dask distributed scheduler (tcp://host:8786).")
+    ] = None,
+    scheduler_timeout: Annotated[
+        float, typer.Option("--scheduler-timeout", min=0.1, metavar="SECONDS", help="Give up connecting to the scheduler after this long.")
+    ] = DEFAULT_SCHEDULER_TIMEOUT_S,
+    keep_runs: Annotated[bool, typer.Option("--keep-runs", help="Also write each point's run folder under DIR/runs.")] = False,
+    full_resolution: FullResolutionOption = False,
+    json_output: JsonOption = False,
+) -> None:
+    """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
+    with _user_errors():
+        run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
+        plan = plan_sweep(grid or [], points)
+    target = out if out is not None else timestamped_folder("sweep")
+    try:
+        counter = "{task.completed}/{task.total} points · {task.fields[running]} running · {task.fields[failed]} failed"
+        with _user_errors(), _progress_bar("sweep", counter, len(plan.points), running=0, failed=0) as update:
+            progress = None if update is None else lambda state: update(state.done, running=state.running, failed=state.failed)
+            table = run_sweep(
+                run_config.params, plan, target, workers=workers, scheduler=scheduler,
+                keep_runs=keep_runs, progress=progress, preset=run_config.preset, scheduler_timeout=scheduler_timeout,
+            )
+    except KeyboardInterrupt:
+        _fail(f"interrupted; the finished points are stored in {target}; re-run with --out {target} to finish", EXIT_INTERRUPTED)
+    except OSError as exc:
+        _fail(f"{target}: cannot write the sweep ({exc.strerror or exc})")
+    failed = failed_points(table)
+    if json_output:
+        payload = {
+            "output_dir": str(target.absolute()),
+            "points": len(table),
+            "failed": len(failed),
+            "keys": list(plan.keys),
+            "table_parquet": str((target / TABLE_PARQUET).absolute()),
+            "table_csv": str((target / TABLE_CSV).absolute()),
+        }
+        typer.echo(json.dumps(payload, sort_keys=True))
+    else:
+        _stdout_console().print(sweep_preview(table, plan.keys, target))
+    if not failed.empty:
+        first = failed.iloc[0]
+        typer.echo(
+            f"error: {len(failed)} of {len(table)} points failed (first: {first['point_id']}: {first['error']}); "
+            f"see the error column of {target / TABLE_CSV}",
+            err=True,
+        )
+        raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path) -> Table:
+    """The first rows of a sweep table: swept values, regime and the main results."""
+    preview = Table(title=f"shakermill sweep: {len(table)} points, {len(failed_points(table))} failed")
+    for key in keys:
+        preview.add_column(f"{key} ({field_unit(key)})" if field_unit(key) else key, justify="right")
+    for _, label, unit in SWEEP_PREVIEW_COLUMNS:
+        preview.add_column(f"{label} ({unit})" if unit else label, justify="right")
+    for _, row in table.head(SWEEP_PREVIEW_ROWS).iterrows():
+        values = [_cell(row[key], ".4g") for key in keys]
+        if pd.notna(row["error"]):
+            results = ["failed", *([""] * (len(SWEEP_PREVIEW_COLUMNS) - 1))]
+        else:
+            results = [_cell(row.get(column), ".4g") for column, _, _ in SWEEP_PREVIEW_COLUMNS]
+        _add_plain_row(preview, *values, *results)
+    more = len(table) - SWEEP_PREVIEW_ROWS
+    preview.caption = (f"{more} more rows; " if more > 0 else "") + f"table: {target / TABLE_PARQUET} and {TABLE_CSV}"
+    return preview
+
+
+def _cell(value: Any, spec: str) -> str:
+    if value is None or (not isinstance(value, str) and pd.isna(value)):
+        return "n/a"
+    return value if isinstance(value, str) else _number(value, spec)
+
+
+@app.command()
+def bifurcation(
+    config: ConfigArgument = None,
+    grid: Annotated[
+        str, typer.Option("--grid", "-g", metavar="KEY=START:STOP:N", help="The scanned key and its values.")
+    ] = "omega=90:130:200",
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", show_default="results/bifurcation-<timestamp>", help="Folder for tables and figure.")
+    ] = None,
+    full_resolution: Annotated[
+        bool, typer.Option("--full-resolution", help="Settle with the full-resolution solver (default: averaged).")
+    ] = False,
+    dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG file.")] = PNG_DPI,
+) -> None:
+    """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
+    with _user_errors():
+        run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
+        key, values = parse_grid(grid)
+        # Checked before the scan: a value out of range would otherwise stop it midway.
+        for value in (values[0], values[-1]):
+            run_config.params.replace(**{key: float(value)})
+    target = out if out is not None else timestamped_folder("bifurcation")
+    with _progress_bar("scanning", "{task.completed}/{task.total} runs", len(values)) as update:
+        try:
+            scan = regime_scan(run_config.params, values, key, progress=None if update is None else lambda done, _total: update(done))
+        except KeyboardInterrupt:
+            _fail("interrupted; nothing was written (a scan is quick to repeat)", EXIT_INTERRUPTED)
+    try:
+        paths = write_bifurcation(scan, target)
+        paths += plot_figures({"bifurcation": bifurcation_figure(scan.phases, scan.regimes, key)}, target, dpi=dpi)
+    except OSError as exc:
+        _fail(f"{target}: cannot write the results ({exc.strerror or exc})")
+    counts = scan.regimes["regime"].value_counts()
+    table = Table("regime", "runs", f"{key} ({field_unit(key)})", title=f"bifurcation scan over {key}: {len(values)} runs")
+    for label, count in counts.items():
+        inside = scan.regimes.loc[scan.regimes["regime"] == label, key]
+        _add_plain_row(table, str(label), str(count), f"{inside.min():.5g} – {inside.max():.5g}")
+    console = _stdout_console()
+    console.print(table)
+    console.print(Text(f"{len(paths)} files written to {target}"))
+
+
 def format_value(key: str, value: Any) -> str:
     """A preset value with its unit, e.g. '0.00635 m', 'true', '[0, 1], [600, 0.1] s'."""
     unit = field_unit(key)
@@ -396,7 +598,7 @@ def validate(
     solver: Annotated[
         str, typer.Option("--solver", help="'full' (default, as the paper) or 'averaged' (seconds instead of minutes).")
     ] = "full",
-    json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+    json_output: JsonOption = False,
 ) -> None:
     """Paper Table 5 side by side: experiment, the paper's model, this model with published and calibrated parameters."""
     if solver not in ("full", "averaged"):
@@ -442,9 +644,9 @@ def validate(
 
 @app.command()
 def calibrate(
-    config: Annotated[Path | None, typer.Argument(metavar="CONFIG", help="TOML file to start from, as for `run`.")] = None,
-    preset: Annotated[str | None, typer.Option("--preset", "-p", show_default=DEFAULT_PRESET)] = None,
-    settings: Annotated[list[str] | None, typer.Option("--set", "-s", metavar="KEY=VALUE")] = None,
+    config: ConfigArgument = None,
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
     target: Annotated[
         list[str] | None,
         typer.Option("--target", "-t", metavar="NAME=VALUE", help=f"A target: {', '.join(TARGET_KEYS)}."),
@@ -456,10 +658,8 @@ def calibrate(
         list[str] | None, typer.Option("--free", "-f", metavar="KEY[,KEY]", help="Keys to fit (default: beta,vial_mass).")
     ] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
-    full_resolution: Annotated[
-        bool, typer.Option("--full-resolution", help="Use the full-resolution solver (default: averaged).")
-    ] = False,
-    json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+    full_resolution: FullResolutionOption = False,
+    json_output: JsonOption = False,
 ) -> None:
     """Fit free parameters to Table 5 targets and/or a measured curve by bounded least squares."""
     with _user_errors():

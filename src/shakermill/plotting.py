@@ -19,7 +19,7 @@ import io
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Protocol, Sequence
 
 import numpy as np
 import pandas as pd
@@ -35,7 +35,7 @@ if TYPE_CHECKING:
 
 # Figure names (file stems): the paper's Figs. 5a, 4, 5b, and this package's impact statistics.
 PAPER_FIGURES = ("temperatures", "ball_motion", "ball_heating_zoom")
-IMPACT_FIGURES = ("impact_speed_histogram", "impact_energy_histogram", "impacts_per_second")
+IMPACT_FIGURES = ("impact_speed_histogram", "impact_energy_histogram", "impacts_per_second", "impact_phase_histogram")
 FORMATS = ("png", "svg")
 PNG_DPI = 150
 KELVIN_OFFSET = 273.15
@@ -66,12 +66,7 @@ class RunLike(Protocol):
 
 def plot_run(run: RunLike, out_dir: Path | str, *, impacts: bool = False, dpi: int = PNG_DPI) -> list[Path]:
     """Write the paper's figures of ``run`` (and the impact figures if asked) into ``out_dir``; return the files."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    written: list[Path] = []
-    for name, figure in run_figures(run, impacts=impacts).items():
-        written.extend(save_figure(figure, out / name, dpi=dpi))
-    return written
+    return plot_figures(run_figures(run, impacts=impacts), out_dir, dpi=dpi)
 
 
 def run_figures(run: RunLike, *, impacts: bool = False) -> dict[str, Figure]:
@@ -265,6 +260,7 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
             impacts, "dissipated_energy", 1e3, "energy dissipated per impact", "mJ"
         ),
         "impacts_per_second": impact_rate_figure(impacts),
+        "impact_phase_histogram": impact_phase_figure(run),
     }
 
 
@@ -273,14 +269,7 @@ def impact_histogram_figure(impacts: pd.DataFrame, column: str, scale: float, qu
     figure, (axis,) = _new_figure(height=4.0)
     values = impacts[column].to_numpy() * scale
     edges = np.histogram_bin_edges(values, bins=HISTOGRAM_BINS)
-    per_wall = [values[impacts["wall"].to_numpy() == wall] for wall, _, _ in WALLS]
-    axis.hist(
-        per_wall,
-        bins=edges,
-        stacked=True,
-        color=[colour for _, _, colour in WALLS],
-        label=[f"{label} ({len(part)})" for (_, label, _), part in zip(WALLS, per_wall)],
-    )
+    _stacked_by_wall(axis, values, impacts["wall"].to_numpy(), edges)
     axis.text(
         0.98, 0.96, f"mean {values.mean():.3g} {unit}\nmax {values.max():.3g} {unit}",
         transform=axis.transAxes, ha="right", va="top",
@@ -294,6 +283,18 @@ def impact_histogram_figure(impacts: pd.DataFrame, column: str, scale: float, qu
     axis.legend(loc="upper left")
     axis.grid(alpha=0.3)
     return figure
+
+
+def _stacked_by_wall(axis: object, values: np.ndarray, walls: np.ndarray, edges: np.ndarray) -> None:
+    """A histogram of ``values`` stacked by end face, each labelled with its count."""
+    per_wall = [values[walls == wall] for wall, _, _ in WALLS]
+    axis.hist(  # type: ignore[attr-defined]
+        per_wall,
+        bins=edges,
+        stacked=True,
+        color=[colour for _, _, colour in WALLS],
+        label=[f"{label} ({len(part)})" for (_, label, _), part in zip(WALLS, per_wall)],
+    )
 
 
 def rate_bin_edges(first_impact: float, last_impact: float) -> np.ndarray:
@@ -330,6 +331,40 @@ def impact_rate_figure(impacts: pd.DataFrame) -> Figure:
     return figure
 
 
+PHASE_BINS = 72  # 5° bins
+
+
+def impact_phase_figure(run: RunLike) -> Figure:
+    """Distribution of the drive phase ωt + φ (mod 2π) at the impacts of the settled motion, by end face.
+
+    A periodic motion hits at a few sharp phases; an irregular one spreads them. The start-up
+    transient is left out (the second half of a full run; the averaged solver's impacts are settled).
+    """
+    from .regime import classify_impacts, impact_phases, settled_run_impacts
+
+    settled = settled_run_impacts(run)
+    params = run.params
+    phases = impact_phases(settled, params.omega, params.phase)
+    regime, _ = classify_impacts(settled, params.omega, params.phase)
+    figure, (axis,) = _new_figure(height=4.0)
+    edges = np.linspace(0.0, 2 * math.pi, PHASE_BINS + 1)
+    _stacked_by_wall(axis, phases.phase, phases.wall, edges)
+    _radian_ticks(axis.xaxis)
+    axis.set_xlim(0.0, 2 * math.pi)
+    axis.set_ylim(0.0, axis.get_ylim()[1] * HISTOGRAM_HEADROOM)
+    axis.set_xlabel("drive phase at impact, ωt + φ mod 2π (rad)")
+    axis.set_ylabel("impacts per 5° bin (count)")
+    axis.set_title(f"Impact phases of the settled motion ({len(settled)} impacts, {regime})")
+    axis.legend(loc="upper left")
+    axis.grid(alpha=0.3)
+    return figure
+
+
+def _radian_ticks(axis: object) -> None:
+    ticks = np.arange(5) * math.pi / 2
+    axis.set_ticks(ticks, ["0", "π/2", "π", "3π/2", "2π"])  # type: ignore[attr-defined]
+
+
 def comparison_temperature_figure(runs: dict[str, RunLike]) -> Figure:
     """Ball (solid) and vial (dashed) temperatures in °C of up to four runs, labelled by the keys of ``runs``.
 
@@ -355,3 +390,253 @@ def png_bytes(figure: Figure, dpi: int = PNG_DPI) -> bytes:
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
     return buffer.getvalue()
+
+
+# Sweeps and regime maps ------------------------------------------------------------------------------
+
+# (column of the sweep table, quantity, unit) drawn by `shakermill plot SWEEP_DIR`.
+SWEEP_QUANTITIES = (
+    ("theta_inf_C", "ball θ∞", "°C"),
+    ("tau_min", "time constant τ", "min"),
+    ("impact_rate_hz", "impact rate", "1/s"),
+    ("heat_power_W", "heat generated", "W"),
+    ("mean_impact_speed_m_s", "mean impact speed", "m/s"),
+)
+# Lengths read better in mm: a vial is a few centimetres long.
+DISPLAY_UNITS = {"m": (1e3, "mm")}
+CONTOUR_STYLE = {"colors": "white", "linewidths": 2.0, "linestyles": "--"}
+REGIME_COLOURS = {"no impacts": "0.85", "irregular": "0.25"}
+# No red: it marks the failed points.
+PERIOD_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
+
+
+def axis_label(key: str) -> str:
+    """``"amplitude (mm)"``: the key with the unit its values are drawn in."""
+    from .params import field_unit
+
+    unit = DISPLAY_UNITS.get(field_unit(key), (1.0, field_unit(key)))[1]
+    return f"{key} ({unit})" if unit else f"{key} (–)"
+
+
+def display_values(key: str, values: np.ndarray) -> np.ndarray:
+    from .params import field_unit
+
+    return np.asarray(values, dtype=float) * DISPLAY_UNITS.get(field_unit(key), (1.0, ""))[0]
+
+
+def parse_contour(spec: str, columns: Sequence[str]) -> tuple[str, float]:
+    """``"theta_inf_C=60"`` -> ``("theta_inf_C", 60.0)``, the column checked against ``columns``."""
+    from .params import ParameterError
+
+    column, separator, level = spec.partition("=")
+    column = column.strip()
+    if not separator or not column:
+        raise ParameterError(f"contour {spec!r}: expected COLUMN=VALUE, for example theta_inf_C=60")
+    if column not in columns:
+        shown = ", ".join(columns)
+        raise ParameterError(f"contour {spec!r}: {column} is not a numeric column of the sweep table; allowed: {shown}")
+    try:
+        value = float(level)
+    except ValueError:
+        raise ParameterError(f"contour {spec!r}: {level.strip()!r} is not a number") from None
+    if not math.isfinite(value):
+        raise ParameterError(f"contour {spec!r}: the level must be a finite number")
+    return column, value
+
+
+def sweep_figures(table: pd.DataFrame, keys: Sequence[str], contours: Sequence[tuple[str, float]] = ()) -> dict[str, Figure]:
+    """Lines (one swept key) or maps (two) of :data:`SWEEP_QUANTITIES` and of the regime, by figure name.
+
+    ``contours`` are (column, level) pairs drawn on every map (on lines: where the column crosses
+    the level), so the 60 °C line of θ∞ can be read off the impact-rate map too. Failed points are
+    gaps. Sweeps over more keys are not drawn: their table is the result.
+    """
+    from .params import ParameterError
+
+    if len(keys) not in (1, 2):
+        raise ParameterError(
+            f"plot: a sweep over {len(keys)} keys ({', '.join(keys)}) has no map; "
+            "1-key sweeps are drawn as lines and 2-key sweeps as maps; read sweep.parquet for the rest"
+        )
+    # A failed point keeps its place in the grid, with no values: a gap in the line, a blank cell.
+    data = table.copy()
+    for column in {column for column, _, _ in SWEEP_QUANTITIES} | {column for column, _ in contours}:
+        data[column] = np.where(table["error"].isna(), _numeric(table, column), np.nan)
+    figures = {}
+    for column, quantity, unit in SWEEP_QUANTITIES:
+        if len(keys) == 1:
+            figures[f"sweep_{column}"] = sweep_line_figure(data, keys[0], column, quantity, unit, contours)
+        else:
+            figures[f"sweep_{column}"] = sweep_map_figure(data, keys, column, quantity, unit, contours)
+    figures["sweep_regime"] = regime_figure(table, keys)
+    return figures
+
+
+def _numeric(table: pd.DataFrame, column: str) -> np.ndarray:
+    return pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float)
+
+
+def sweep_line_figure(
+    table: pd.DataFrame, key: str, column: str, quantity: str, unit: str, contours: Sequence[tuple[str, float]]
+) -> Figure:
+    figure, (axis,) = _new_figure(height=4.0)
+    ordered = table.sort_values(key)
+    x = display_values(key, ordered[key].to_numpy())
+    axis.plot(x, _numeric(ordered, column), "o-", color="tab:red", ms=4)
+    for contour_column, level in contours:
+        values = _numeric(ordered, contour_column)
+        for crossing in _crossings(x, values, level):
+            axis.axvline(crossing, color="0.3", ls="--", lw=1)
+        if contour_column == column:
+            axis.axhline(level, color="0.3", ls=":", lw=1)
+        if len(_crossings(x, values, level)):
+            axis.plot([], [], color="0.3", ls="--", lw=1, label=f"{contour_column} = {level:g}")
+    if axis.get_legend_handles_labels()[0]:
+        axis.legend(loc="best")
+    axis.set_xlabel(axis_label(key))
+    axis.set_ylabel(f"{quantity} ({unit})")
+    axis.set_title(f"{quantity} against {key} ({len(ordered)} points)")
+    axis.grid(alpha=0.3)
+    return figure
+
+
+def _crossings(x: np.ndarray, values: np.ndarray, level: float) -> np.ndarray:
+    """The x at which the piecewise-linear curve through (x, values) crosses ``level``."""
+    above = values - level
+    found = []
+    for i in range(len(x) - 1):
+        a, b = above[i], above[i + 1]
+        if np.isfinite(a) and np.isfinite(b) and a * b < 0:
+            found.append(x[i] + (x[i + 1] - x[i]) * a / (a - b))
+        elif a == 0:
+            found.append(x[i])
+    return np.asarray(found)
+
+
+def _grid_of(table: pd.DataFrame, keys: Sequence[str], column: str) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """(x values, y values, Z[y, x]) when the points form a complete grid over the two keys, else None."""
+    x_key, y_key = keys
+    xs, ys = np.unique(table[x_key].to_numpy(dtype=float)), np.unique(table[y_key].to_numpy(dtype=float))
+    if len(xs) < 2 or len(ys) < 2 or len(table) != len(xs) * len(ys):
+        return None
+    grid = np.full((len(ys), len(xs)), np.nan)
+    for _, row in table.iterrows():
+        grid[np.searchsorted(ys, row[y_key]), np.searchsorted(xs, row[x_key])] = pd.to_numeric(row[column], errors="coerce")
+    return xs, ys, grid
+
+
+def _cell_edges(centres: np.ndarray) -> np.ndarray:
+    middle = (centres[1:] + centres[:-1]) / 2
+    return np.concatenate([[2 * centres[0] - middle[0]], middle, [2 * centres[-1] - middle[-1]]])
+
+
+def sweep_map_figure(
+    table: pd.DataFrame,
+    keys: Sequence[str],
+    column: str,
+    quantity: str,
+    unit: str,
+    contours: Sequence[tuple[str, float]],
+) -> Figure:
+    """A heat map over a grid of the two keys (first key across), or coloured points for scattered points."""
+    figure, (axis,) = _new_figure(height=5.0)
+    x_key, y_key = keys
+    gridded = _grid_of(table, keys, column) if not table.empty else None
+    if gridded is not None:
+        xs, ys, values = gridded
+        x, y = display_values(x_key, xs), display_values(y_key, ys)
+        mesh = axis.pcolormesh(_cell_edges(x), _cell_edges(y), np.ma.masked_invalid(values), cmap="inferno", shading="flat")
+        for contour_column, level in contours:
+            _, _, levels = _grid_of(table, keys, contour_column)  # type: ignore[misc]
+            if np.nanmin(levels) < level < np.nanmax(levels):
+                lines = axis.contour(x, y, levels, levels=[level], **CONTOUR_STYLE)
+                axis.clabel(lines, fmt=f"{contour_column} = {level:g}", fontsize="small")
+    else:
+        # A points file: no cells to fill.
+        x, y = display_values(x_key, table[x_key].to_numpy()), display_values(y_key, table[y_key].to_numpy())
+        mesh = axis.scatter(x, y, c=_numeric(table, column), cmap="inferno", s=60, edgecolors="0.3")
+        for contour_column, level in contours:
+            levels = _numeric(table, contour_column)
+            if len(x) >= 3 and np.nanmin(levels) < level < np.nanmax(levels):
+                lines = axis.tricontour(x, y, levels, levels=[level], colors="0.3", linestyles="--")
+                axis.clabel(lines, fmt=f"{contour_column} = {level:g}", fontsize="small")
+    figure.colorbar(mesh, ax=axis, label=f"{quantity} ({unit})")
+    axis.set_xlabel(axis_label(x_key))
+    axis.set_ylabel(axis_label(y_key))
+    axis.set_title(f"{quantity} over {x_key} and {y_key} ({len(table)} points)")
+    return figure
+
+
+def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
+    """The regime of each point (period-n, irregular, no impacts; failed points open) over the swept keys."""
+    figure, (axis,) = _new_figure(height=4.0 if len(keys) == 1 else 5.0)
+    x = display_values(keys[0], table[keys[0]].to_numpy())
+    y = display_values(keys[1], table[keys[1]].to_numpy()) if len(keys) == 2 else np.zeros(len(table))
+    labels = table["regime"].astype(object).where(table["error"].isna(), "failed")
+    present = sorted(set(labels), key=_regime_order)
+    periods = [label for label in present if label.startswith("period-")]
+    for label in present:
+        inside = (labels == label).to_numpy()
+        if label == "failed":
+            axis.scatter(x[inside], y[inside], marker="x", color="tab:red", s=40, label=f"failed ({inside.sum()})")
+            continue
+        # Colours by rank among the periods present, so that period-4 and period-12 never share one.
+        colour = PERIOD_COLOURS[periods.index(label) % len(PERIOD_COLOURS)] if label in periods else REGIME_COLOURS[label]
+        axis.scatter(x[inside], y[inside], marker="s", s=70, color=colour, label=f"{label} ({inside.sum()})")
+    axis.set_xlabel(axis_label(keys[0]))
+    if len(keys) == 2:
+        axis.set_ylabel(axis_label(keys[1]))
+    else:
+        axis.set_yticks([])
+        axis.set_ylabel("regime (–)")
+    axis.set_title("Regime of the settled motion (from the impact phases)")
+    axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
+    return figure
+
+
+def _regime_order(label: str) -> tuple[int, int]:
+    """period-1, period-2, …, then irregular, no impacts, failed."""
+    if label.startswith("period-"):
+        return 0, int(label.removeprefix("period-"))
+    return 1, ("irregular", "no impacts", "failed").index(label)
+
+
+def bifurcation_figure(phases: pd.DataFrame, regimes: pd.DataFrame, key: str) -> Figure:
+    """Bifurcation diagram: the drive phase of every settled impact against ``key``, by end face, with the regimes."""
+    from matplotlib.ticker import MaxNLocator
+
+    figure, (phase_axis, period_axis) = _new_figure(rows=2, height=6.5)
+    for wall, label, colour in WALLS:
+        inside = phases["wall"] == wall
+        x = display_values(key, phases.loc[inside, key].to_numpy())
+        phase_axis.scatter(x, phases.loc[inside, "phase"], s=1.5, color=colour, alpha=0.6, lw=0, label=label)
+    _radian_ticks(phase_axis.yaxis)
+    phase_axis.set_ylim(0.0, 2 * math.pi)
+    phase_axis.set_ylabel("impact phase ωt + φ mod 2π (rad)")
+    # Above the axes: inside, the legend would hide branches near 0 or 2π.
+    phase_axis.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=2, markerscale=6, fontsize="small", frameon=False)
+    figure.suptitle(f"Bifurcation diagram over {key}: impact phases of the settled motion")
+    x = display_values(key, regimes[key].to_numpy())
+    periods = pd.to_numeric(regimes["period"], errors="coerce").to_numpy(dtype=float)
+    period_axis.plot(x, periods, "o", ms=3, color="tab:blue", label="period-n")
+    irregular = (regimes["regime"] == "irregular").to_numpy()
+    if irregular.any():
+        top = np.nanmax(periods, initial=1.0) + 1
+        period_axis.plot(x[irregular], np.full(irregular.sum(), top), "x", ms=4, color="0.25", label=f"irregular (at {top:g})")
+        period_axis.legend(loc="best", fontsize="small")
+    period_axis.yaxis.set_major_locator(MaxNLocator(integer=True))
+    period_axis.set_ylabel("period n (drive periods)")
+    period_axis.set_xlabel(axis_label(key))
+    for axis in (phase_axis, period_axis):
+        axis.grid(alpha=0.3)
+    return figure
+
+
+def plot_figures(figures: dict[str, Figure], out_dir: Path | str, *, dpi: int = PNG_DPI) -> list[Path]:
+    """Save each of ``figures`` as PNG and SVG in ``out_dir``; return the files."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    for name, figure in figures.items():
+        written.extend(save_figure(figure, out / name, dpi=dpi))
+    return written

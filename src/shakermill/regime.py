@@ -11,10 +11,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import pandas as pd
 
+from .params import Parameters
 from .simulate import Result
 
 # Longest period searched for; motions that repeat more slowly are called irregular.
@@ -38,12 +41,16 @@ class ImpactPhases:
     wall: np.ndarray
 
 
-def settled_impacts(result: Result) -> pd.DataFrame:
-    """The impacts after the start-up transient (the averaged solver already cut it)."""
-    impacts = result.impacts
-    if result.solver == "averaged":
+def settled_impacts(impacts: pd.DataFrame, solver: str, end_time: float) -> pd.DataFrame:
+    """The impacts after the start-up transient: the second half of a full run (the averaged solver already cut it)."""
+    if solver == "averaged":
         return impacts
-    return impacts[impacts["time"] >= 0.5 * result.t_end]
+    return impacts[impacts["time"] >= 0.5 * end_time]
+
+
+def settled_run_impacts(run: Any) -> pd.DataFrame:
+    """:func:`settled_impacts` of a :class:`~shakermill.simulate.Result` or a stored run (from its summary)."""
+    return settled_impacts(run.impacts, str(run.summary["solver"]), float(run.summary["simulated_s"]))
 
 
 def impact_phases(impacts: pd.DataFrame, omega: float, phase: float) -> ImpactPhases:
@@ -56,13 +63,17 @@ def impact_phases(impacts: pd.DataFrame, omega: float, phase: float) -> ImpactPh
 
 
 def _signatures(phases: ImpactPhases) -> list[tuple[tuple[str, ...], np.ndarray]]:
-    """(walls, phases) of each complete drive period, first to last (the partial ends are dropped)."""
+    """(walls, phases) of each complete drive period, first to last (the partial ends are dropped).
+
+    The impacts are in time order, so each period is one slice: linear in the number of impacts,
+    which matters for the ~10^5 impacts of a settled full-resolution hour.
+    """
     first, last = phases.period_index.min() + 1, phases.period_index.max() - 1
-    signatures = []
-    for index in range(first, last + 1):
-        inside = phases.period_index == index
-        signatures.append((tuple(phases.wall[inside]), phases.phase[inside]))
-    return signatures
+    bounds = np.searchsorted(phases.period_index, np.arange(first, last + 2))
+    return [
+        (tuple(phases.wall[start:end]), phases.phase[start:end])
+        for start, end in zip(bounds[:-1], bounds[1:])
+    ]
 
 
 def _matches(a: tuple[tuple[str, ...], np.ndarray], b: tuple[tuple[str, ...], np.ndarray]) -> bool:
@@ -72,13 +83,17 @@ def _matches(a: tuple[tuple[str, ...], np.ndarray], b: tuple[tuple[str, ...], np
     return bool(np.all(np.minimum(difference, 2 * math.pi - difference) <= PHASE_TOLERANCE))
 
 
-def classify(result: Result, omega: float | None = None) -> tuple[str, int | None]:
+def classify(result: Result) -> tuple[str, int | None]:
     """("period-n", n), ("irregular", None) or ("no impacts", None) for the settled motion of ``result``."""
-    omega = result.params.omega if omega is None else omega
-    impacts = settled_impacts(result)
-    if impacts.empty:
+    settled = settled_impacts(result.impacts, result.solver, result.t_end)
+    return classify_impacts(settled, result.params.omega, result.params.phase)
+
+
+def classify_impacts(settled: pd.DataFrame, omega: float, phase: float) -> tuple[str, int | None]:
+    """The regime of a settled motion from its impacts (columns ``time`` and ``wall``), drive ω and φ."""
+    if settled.empty:
         return NO_IMPACTS, None
-    signatures = _signatures(impact_phases(impacts, omega, result.params.phase))
+    signatures = _signatures(impact_phases(settled, omega, phase))
     for period in range(1, MAX_PERIOD + 1):
         if len(signatures) < (MIN_REPEATS + 1) * period:
             break
@@ -89,27 +104,45 @@ def classify(result: Result, omega: float | None = None) -> tuple[str, int | Non
 
 @dataclass(frozen=True)
 class Bifurcation:
-    """Per ω: the regime, and the phases of the settled impacts (long format)."""
+    """Per value of the scanned key: the regime, and the phases of the settled impacts (long format)."""
 
-    regimes: pd.DataFrame  # omega, regime, period, solver
-    phases: pd.DataFrame  # omega, phase, wall
+    key: str
+    regimes: pd.DataFrame  # <key>, regime, period, solver, message
+    phases: pd.DataFrame  # <key>, phase, wall
 
 
-def bifurcation(base, omegas, progress=None) -> Bifurcation:
-    """Settle the motion at each ω and record its impact phases and regime.
+def bifurcation(
+    base: Parameters,
+    values: Sequence[float],
+    key: str = "omega",
+    progress: Callable[[int, int], None] | None = None,
+) -> Bifurcation:
+    """Settle the motion at each value of ``key`` and record its impact phases and regime.
 
-    Uses the averaged solver's mechanics phase (transient cut by MSER) unless ``base`` says
-    otherwise; the thermal part does not matter here, so a short ``duration`` suffices.
+    The impacts are those of the settled motion: the averaged solver's mechanics phase (transient
+    cut by MSER) when ``base`` uses it, the second half of a full run otherwise. The phase of an
+    impact is ωt + φ (mod 2π) with the ω of that run.
     """
     from .simulate import simulate
 
     regimes, phases = [], []
-    for index, omega in enumerate(omegas):
-        result = simulate(base.replace(omega=float(omega)))
+    for index, value in enumerate(values):
+        result = simulate(base.replace(**{key: float(value)}))
         label, period = classify(result)
-        settled = impact_phases(settled_impacts(result), float(omega), result.params.phase)
-        regimes.append({"omega": float(omega), "regime": label, "period": period, "solver": result.solver})
-        phases.append(pd.DataFrame({"omega": float(omega), "phase": settled.phase, "wall": settled.wall}))
+        settled = settled_impacts(result.impacts, result.solver, result.t_end)
+        angles = impact_phases(settled, result.params.omega, result.params.phase)
+        regimes.append({key: float(value), "regime": label, "period": period, "solver": result.solver, "message": result.message})
+        phases.append(pd.DataFrame({key: float(value), "phase": angles.phase, "wall": angles.wall}))
         if progress is not None:
-            progress(index + 1, len(omegas))
-    return Bifurcation(pd.DataFrame(regimes), pd.concat(phases, ignore_index=True))
+            progress(index + 1, len(values))
+    table = pd.DataFrame(regimes)
+    table["period"] = table["period"].astype("Int64")
+    return Bifurcation(key, table, pd.concat(phases, ignore_index=True))
+
+
+def write_bifurcation(scan: Bifurcation, folder: Path) -> list[Path]:
+    """``bifurcation_regimes`` and ``bifurcation_phases`` tables (Parquet and CSV) in ``folder``."""
+    from .sweep import write_table
+
+    folder.mkdir(parents=True, exist_ok=True)
+    return [*write_table(scan.regimes, folder, "bifurcation_regimes"), *write_table(scan.phases, folder, "bifurcation_phases")]

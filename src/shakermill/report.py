@@ -31,6 +31,7 @@ from .plotting import (
     paper_figures,
     png_bytes,
 )
+from .regime import classify_impacts, settled_run_impacts
 from .storage import CONFIG_FILE, RunData, load_run
 from .validation import EXPERIMENT, PAPER, ComparisonRow, compare
 
@@ -59,6 +60,10 @@ FIGURE_CAPTIONS = {
     "impact_speed_histogram": "Impact speed of the ball relative to the end face it hits, by end face.",
     "impact_energy_histogram": "Energy dissipated in each impact (mJ), by end face.",
     "impacts_per_second": "Impacts per second at each end face over the time the impacts were resolved.",
+    "impact_phase_histogram": (
+        "Drive phase ωt + φ (mod 2π) at the impacts of the settled motion, by end face: sharp lines for a "
+        "periodic motion, a spread for an irregular one."
+    ),
 }
 
 # MODEL.md §9: where this implementation departs from the printed paper, on purpose.
@@ -530,6 +535,8 @@ def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
     ]
     if impacts.empty:
         return rows
+    regime, _ = classify_impacts(settled_run_impacts(run), run.params.omega, run.params.phase)
+    rows.append(("regime of the settled motion", regime, ""))
     for wall in ("left", "right"):
         count = int((impacts["wall"] == wall).sum())
         share = count / len(impacts)

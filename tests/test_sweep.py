@@ -1,0 +1,617 @@
+"""Parameter sweeps (issue 5): grids and point files, local pool, Dask cluster, resume, failures, the CLI.
+
+Short runs of the averaged solver (~0.04 s a point once Numba's cache is warm) keep the file fast;
+amplitudes are >= 23 mm so that a ball starting at rest is hit (the free gap is 22.65 mm).
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from pandas.testing import assert_frame_equal
+
+from shakermill.params import ParameterError, default_parameters
+from shakermill.sweep import (
+    MANIFEST_FILE,
+    POINTS_FOLDER,
+    TABLE_CSV,
+    TABLE_PARQUET,
+    SweepPlan,
+    comparable_columns,
+    connect,
+    failed_points,
+    load_sweep,
+    parse_grid,
+    plan_sweep,
+    point_ids,
+    read_points,
+    sweep,
+    sweep_parameters,
+)
+
+DURATION = 60.0  # simulated seconds per point
+GRID = ("omega=100:120:3", "amplitude=23mm:29mm:2")  # 6 points
+SHAKERMILL = Path(sys.executable).parent / "shakermill"
+UNREACHABLE = "tcp://127.0.0.1:1"  # port 1 on loopback: nothing listens, connections are refused
+
+
+@pytest.fixture(scope="module")
+def base():
+    return default_parameters(solver="averaged", duration=DURATION)
+
+
+@pytest.fixture(scope="module")
+def in_process(base, tmp_path_factory):
+    """The small grid computed in this process (workers=1): the reference table."""
+    plan = plan_sweep(GRID)
+    folder = tmp_path_factory.mktemp("in_process")
+    return plan, sweep(base, plan, folder, workers=1), folder
+
+
+def comparable(table: pd.DataFrame) -> pd.DataFrame:
+    return table[comparable_columns(table)].reset_index(drop=True)
+
+
+def point_files(folder: Path) -> list[Path]:
+    return sorted((folder / POINTS_FOLDER).glob("*.json"))
+
+
+def partial_files(folder: Path) -> list[Path]:
+    return [path for path in folder.rglob("*") if "partial" in path.name]
+
+
+def assert_one_error_line(stderr: str, *fragments: str) -> None:
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
+    assert lines[0].startswith("error: "), stderr
+    for fragment in fragments:
+        assert fragment in lines[0], (fragment, lines[0])
+    assert "Traceback" not in stderr
+
+
+def run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run([str(SHAKERMILL), *args], capture_output=True, text=True, timeout=timeout)
+
+
+# Grids and point files ----------------------------------------------------------------------------
+
+
+def test_parse_grid_converts_units_to_si():
+    key, values = parse_grid("amplitude=23mm:30mm:3")
+    assert key == "amplitude"
+    np.testing.assert_allclose(values, [0.023, 0.0265, 0.030], rtol=1e-12)
+    key, values = parse_grid(" omega = 90 : 130 : 5 ")
+    assert key == "omega"
+    np.testing.assert_allclose(values, np.linspace(90.0, 130.0, 5))
+    # Mixed units in START and STOP; Hz on an angular rate is cycles per second.
+    _, values = parse_grid("amplitude=2.3cm:30mm:2")
+    np.testing.assert_allclose(values, [0.023, 0.030])
+    _, values = parse_grid("omega=15Hz:20Hz:2")
+    np.testing.assert_allclose(values, [2 * np.pi * 15, 2 * np.pi * 20])
+    # One point: START.
+    _, values = parse_grid("omega=100:130:1")
+    np.testing.assert_allclose(values, [100.0])
+
+
+def test_plan_is_the_product_with_the_first_grid_slowest():
+    plan = plan_sweep(["omega=90:130:3", "amplitude=23mm:30mm:2"])
+    assert plan.keys == ("omega", "amplitude")
+    assert plan.grids == ("omega=90:130:3", "amplitude=23mm:30mm:2")
+    omegas = parse_grid("omega=90:130:3")[1]
+    amplitudes = parse_grid("amplitude=23mm:30mm:2")[1]
+    expected = [{"omega": w, "amplitude": a} for w, a in itertools.product(omegas, amplitudes)]
+    assert len(plan.points) == 6
+    for point, wanted in zip(plan.points, expected):
+        assert list(point) == ["omega", "amplitude"]
+        assert point == pytest.approx(wanted)
+    # The first grid varies slowest: omega is constant over the first two points.
+    assert plan.points[0]["omega"] == plan.points[1]["omega"] != plan.points[2]["omega"]
+    assert plan.points[0]["amplitude"] != plan.points[1]["amplitude"]
+
+
+@pytest.mark.parametrize(
+    ("spec", "fragments"),
+    [
+        ("omega90:130:3", ["'omega90:130:3'", "KEY=START:STOP:N"]),
+        ("=90:130:3", ["KEY=START:STOP:N"]),
+        ("omega=90:130", ["three fields", "got 2"]),
+        ("omega=90:100:130:3", ["three fields", "got 4"]),
+        ("omega=90:130:0", ["N must be a whole number", "'0'"]),
+        ("omega=90:130:-3", ["N must be a whole number", "'-3'"]),
+        ("omega=90:130:2.5", ["N must be a whole number", "'2.5'"]),
+        ("omega=90:130:many", ["N must be a whole number", "'many'"]),
+        ("omega=90:130:²", ["N must be a whole number", "'²'"]),  # str.isdigit() is true for '²'; int() refuses it
+        ("omgea=90:130:3", ["omgea", "unknown parameter", "did you mean 'omega'"]),
+        ("frobnicate=1:2:3", ["frobnicate", "unknown parameter"]),
+        ("solver=1:2:3", ["solver", "grids are for real-valued parameters", "--points"]),
+        ("amplitude=23 kg:30mm:3", ["amplitude", "kg", "expected m"]),
+        ("amplitude=23mm:30 s:3", ["amplitude", "expected m"]),
+        ("amplitude=23 blorps:30mm:3", ["amplitude", "cannot parse"]),
+        ("omega=nan:130:3", ["START and STOP must be finite"]),
+        ("averaging_batch_periods=8:32:4", ["averaging_batch_periods", "real-valued", "--points"]),
+    ],
+)
+def test_bad_grid_is_one_line_naming_the_problem(spec, fragments):
+    with pytest.raises(ParameterError) as caught:
+        parse_grid(spec)
+    message = str(caught.value)
+    assert "\n" not in message
+    for fragment in fragments:
+        assert fragment in message, (fragment, message)
+    # plan_sweep passes the same error on.
+    with pytest.raises(ParameterError, match="grid"):
+        plan_sweep([spec])
+
+
+def test_plan_refuses_nothing_to_sweep_and_a_key_twice():
+    with pytest.raises(ParameterError, match="nothing to sweep"):
+        plan_sweep([])
+    with pytest.raises(ParameterError, match="omega: more than one"):
+        plan_sweep(["omega=90:100:2", "omega=110:120:2"])
+
+
+def test_read_points_with_units_and_a_byte_order_mark(tmp_path):
+    path = tmp_path / "points.csv"
+    # A spreadsheet's export: BOM, CRLF line ends, a blank line, units in some cells.
+    path.write_bytes("\ufeffomega,amplitude,solver\r\n100,25 mm,averaged\r\n\r\n17 Hz,0.026,full\r\n".encode())
+    points = read_points(path)
+    assert [list(point) for point in points] == [["omega", "amplitude", "solver"]] * 2
+    assert points[0] == pytest.approx({"omega": 100.0, "amplitude": 0.025, "solver": "averaged"})
+    assert points[1]["omega"] == pytest.approx(2 * np.pi * 17)
+    assert points[1]["amplitude"] == pytest.approx(0.026)
+    assert points[1]["solver"] == "full"
+
+
+def test_points_file_times_grid(tmp_path):
+    path = tmp_path / "points.csv"
+    path.write_text("restitution\n0.6\n0.8\n", encoding="utf-8")
+    plan = plan_sweep(["amplitude=23mm:29mm:3"], points_file=path)
+    assert plan.keys == ("restitution", "amplitude")
+    assert plan.points_file == str(path)
+    assert [(p["restitution"], round(p["amplitude"], 6)) for p in plan.points] == [
+        (r, a) for r in (0.6, 0.8) for a in (0.023, 0.026, 0.029)
+    ]
+
+
+@pytest.mark.parametrize(
+    ("text", "fragments"),
+    [
+        ("omega,amplitud\n100,25mm\n", ["amplitud", "unknown parameter", "did you mean 'amplitude'"]),
+        ("omega,amplitude\n100,25mm\n110,\n", ["line 3", "no value for amplitude"]),
+        ("omega,amplitude\n100,25mm\n110,25mm,7\n", ["line 3", "3 values for 2 columns"]),
+        ("omega,amplitude\n100\n", ["line 2", "1 values for 2 columns"]),
+        ("omega,amplitude\n100,25 kg\n", ["line 2", "amplitude", "expected m"]),
+        ("omega,omega\n100,110\n", ["omega", "more than one column"]),
+        ("omega,amplitude\n", ["at least one row"]),
+    ],
+)
+def test_bad_points_file_is_one_line_naming_the_problem(tmp_path, text, fragments):
+    path = tmp_path / "points.csv"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(ParameterError) as caught:
+        read_points(path)
+    message = str(caught.value)
+    assert "\n" not in message
+    assert str(path) in message
+    for fragment in fragments:
+        assert fragment in message, (fragment, message)
+
+
+def test_missing_points_file(tmp_path):
+    with pytest.raises(ParameterError, match="cannot read"):
+        read_points(tmp_path / "absent.csv")
+
+
+# Execution: in process, local pool, Dask cluster ---------------------------------------------------
+
+
+def test_in_process_table(base, in_process, tmp_path):
+    plan, table, _ = in_process
+    ids = point_ids(base, plan)
+    assert list(table["point_id"]) == ids
+    assert len(set(ids)) == len(ids) == 6
+    assert list(table.columns[:6]) == ["point_id", "omega", "amplitude", "regime", "period", "error"]
+    for column in ("omega", "amplitude"):
+        np.testing.assert_array_equal(table[column].to_numpy(), [point[column] for point in plan.points])
+    assert table["success"].all()
+    assert table["error"].isna().all()
+    assert failed_points(table).empty
+    assert (table["impacts"] > 0).all()
+    # The averaged solver ran (the swept keys don't include solver, so the column is `solver`).
+    assert set(table["solver"]) <= {"averaged", "full"}
+    assert "wall_time_s" in table and "wall_time_s" not in comparable_columns(table)
+    assert "output_dir" not in comparable_columns(table)
+    # The same run on its own gives the row's figures: the sweep adds nothing of its own.
+    from shakermill.simulate import simulate
+
+    alone = simulate(base.replace(**plan.points[4])).summary
+    for key in ("theta_inf_C", "tau_min", "impacts", "heat_power_W"):
+        assert table.loc[4, key] == alone[key], key
+
+
+def test_tables_on_disk_match_the_returned_table(in_process):
+    _, table, folder = in_process
+    data = load_sweep(folder)
+    assert data.keys == ("omega", "amplitude")
+    assert_frame_equal(comparable(data.table), comparable(table))
+    assert len(point_files(folder)) == len(table)
+    # sweep.csv holds the same rows as sweep.parquet.
+    assert_csv_matches_parquet(folder)
+
+
+def assert_csv_matches_parquet(folder: Path) -> None:
+    parquet = pd.read_parquet(folder / TABLE_PARQUET)
+    csv = pd.read_csv(folder / TABLE_CSV)
+    assert list(csv.columns) == list(parquet.columns)
+    assert len(csv) == len(parquet)
+    assert list(csv["point_id"].astype(str)) == list(parquet["point_id"])
+    for column in parquet.columns:
+        left, right = csv[column], parquet[column]
+        if pd.api.types.is_bool_dtype(right) or pd.api.types.is_numeric_dtype(right):
+            np.testing.assert_array_equal(
+                left.to_numpy(dtype=float, na_value=np.nan), right.to_numpy(dtype=float, na_value=np.nan), err_msg=column
+            )
+        else:
+            assert [None if pd.isna(v) else str(v) for v in left] == [None if pd.isna(v) else str(v) for v in right], column
+
+
+def test_local_pool_matches_in_process_in_grid_order(base, in_process, tmp_path):
+    plan, reference, _ = in_process
+    table = sweep(base, plan, tmp_path / "pool", workers=2)
+    assert_frame_equal(comparable(table), comparable(reference))
+    assert_frame_equal(comparable(load_sweep(tmp_path / "pool").table), comparable(reference))
+
+
+def test_rows_follow_the_plan_not_the_completion_order(base, tmp_path):
+    # The first point runs at full resolution for 40 simulated minutes (~1.5 s), the others are
+    # one simulated minute with the averaged solver (~0.03 s): with two workers the first finishes last.
+    keys = ("solver", "duration", "amplitude")
+    slow = {"solver": "full", "duration": 2400.0, "amplitude": 0.025}
+    fast = [{"solver": "averaged", "duration": 60.0, "amplitude": a} for a in (0.023, 0.024, 0.026, 0.027, 0.028)]
+    points = [slow, *fast]
+    folder = tmp_path / "order"
+    table = sweep(base, points, folder, workers=2)
+    ids = point_ids(base, SweepPlan(keys, tuple(points)))
+    finished = {path.stem: path.stat().st_mtime_ns for path in point_files(folder)}
+    assert finished[ids[0]] > max(finished[identifier] for identifier in ids[1:]), "the slow point did not finish last"
+    assert list(table["point_id"]) == ids
+    assert list(table.columns[1:4]) == list(keys)
+    for key in keys:
+        assert list(table[key]) == [point[key] for point in points], key
+    # `solver` is swept, so the summary's solver (the one that actually ran) is `solver_used`.
+    assert table.loc[0, "solver_used"] == "full"
+    assert table["success"].all()
+
+
+@pytest.fixture
+def local_cluster():
+    distributed = pytest.importorskip("distributed")
+    cluster = distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+    )
+    try:
+        yield cluster
+    finally:
+        cluster.close()
+
+
+def test_dask_cluster_matches_local_pool(base, in_process, local_cluster, tmp_path):
+    plan, _, _ = in_process
+    pool = sweep(base, plan, tmp_path / "pool", workers=2)
+    reports = []
+    cluster = sweep(base, plan, tmp_path / "cluster", scheduler=local_cluster.scheduler_address, progress=reports.append)
+    assert_frame_equal(comparable(cluster), comparable(pool))
+    assert len(point_files(tmp_path / "cluster")) == len(plan.points)
+    assert reports[-1].done == len(plan.points) and reports[-1].failed == 0
+    # The cluster's two single-threaded workers are its slots.
+    assert reports[0].running == 2
+
+
+def test_workers_and_scheduler_are_exclusive(base, tmp_path):
+    with pytest.raises(ParameterError, match="workers"):
+        sweep(base, plan_sweep(GRID), tmp_path / "x", workers=2, scheduler=UNREACHABLE)
+    with pytest.raises(ParameterError, match="workers: 0"):
+        sweep(base, plan_sweep(GRID), tmp_path / "y", workers=0)
+
+
+def test_unreachable_scheduler_is_one_line(base, tmp_path):
+    started = time.monotonic()
+    with pytest.raises(ParameterError) as caught:
+        connect(UNREACHABLE, timeout=2)
+    message = str(caught.value)
+    assert message.startswith("scheduler: ") and UNREACHABLE in message and "\n" not in message
+    with pytest.raises(ParameterError) as caught:
+        sweep(base, plan_sweep(GRID), tmp_path / "s", scheduler=UNREACHABLE, scheduler_timeout=2)
+    assert "scheduler" in str(caught.value) and "\n" not in str(caught.value)
+    assert time.monotonic() - started < 30, "the timeout was not respected"
+    # Nothing was computed, and no folder was left behind.
+    assert not (tmp_path / "s").exists()
+
+
+def test_unparsable_scheduler_address_is_one_line():
+    with pytest.raises(ParameterError, match="scheduler") as caught:
+        connect("nonsense://::::", timeout=2)
+    assert "\n" not in str(caught.value)
+
+
+# Resume, failures, other sweeps -------------------------------------------------------------------
+
+
+def test_resume_recomputes_only_missing_points(base, in_process, tmp_path):
+    plan, reference, _ = in_process
+    folder = tmp_path / "resume"
+    first = sweep(base, plan, folder, workers=1)
+    assert_frame_equal(comparable(first), comparable(reference))
+    files = point_files(folder)
+    before = {path.name: path.stat().st_mtime_ns for path in files}
+    removed = files[2]
+    removed.unlink()
+    time.sleep(0.01)  # a later mtime for the recomputed file even on coarse clocks
+
+    reports = []
+    second = sweep(base, plan, folder, workers=1, progress=reports.append)
+    total = len(plan.points)
+    assert [report.done for report in reports] == [total - 1, total]
+    assert all(report.total == total and report.failed == 0 for report in reports)
+    after = {path.name: path.stat().st_mtime_ns for path in point_files(folder)}
+    assert set(after) == set(before)
+    assert [name for name in after if after[name] != before[name]] == [removed.name]
+    assert_frame_equal(comparable(second), comparable(first))
+    assert_frame_equal(comparable(load_sweep(folder).table), comparable(first))
+
+    # A finished sweep run again computes nothing.
+    reports.clear()
+    third = sweep(base, plan, folder, workers=2, progress=reports.append)
+    assert [report.done for report in reports] == [total]
+    assert {path.name: path.stat().st_mtime_ns for path in point_files(folder)} == after
+    assert_frame_equal(comparable(third), comparable(first))
+
+
+def test_table_is_rebuilt_from_point_files_if_missing(in_process, base, tmp_path):
+    plan, reference, _ = in_process
+    folder = tmp_path / "rebuild"
+    sweep(base, plan, folder, workers=1)
+    (folder / TABLE_PARQUET).unlink()
+    rebuilt = load_sweep(folder).table
+    assert_frame_equal(comparable(rebuilt), comparable(reference))
+
+
+def test_failing_point_records_its_error_and_the_others_finish(base, tmp_path):
+    # restitution is allowed in (0, 1]: the last point is out of range.
+    plan = plan_sweep(["restitution=0.5:1.3:3", "amplitude=24mm:26mm:2"])
+    reports = []
+    table = sweep(base, plan, tmp_path / "fail", workers=1, progress=reports.append)
+    bad = table["restitution"] > 1
+    assert bad.sum() == 2 and len(table) == 6
+    for _, row in table[bad].iterrows():
+        assert not row["success"]
+        assert "restitution" in row["error"] and "out of range" in row["error"] and "(0, 1]" in row["error"]
+        assert pd.isna(row["regime"])
+    assert table.loc[~bad, "success"].all()
+    assert table.loc[~bad, "error"].isna().all()
+    assert (table.loc[~bad, "impacts"] > 0).all()
+    assert list(failed_points(table)["point_id"]) == list(table.loc[bad, "point_id"])
+    assert reports[-1].done == 6 and reports[-1].failed == 2
+    # Failed points are finished too: a re-run does not retry them.
+    reports.clear()
+    again = sweep(base, plan, tmp_path / "fail", workers=1, progress=reports.append)
+    assert [(report.done, report.failed) for report in reports] == [(6, 2)]
+    assert_frame_equal(comparable(again), comparable(table))
+
+
+def test_points_file_with_one_out_of_range_value(base, tmp_path):
+    path = tmp_path / "points.csv"
+    path.write_text("omega,amplitude\n100,25 mm\n-5,25 mm\n120 rad/s,2.4 cm\n", encoding="utf-8")
+    table = sweep(base, plan_sweep(points_file=path), tmp_path / "sweep", workers=2)
+    assert list(table["success"]) == [True, False, True]
+    assert "omega" in table.loc[1, "error"] and "out of range" in table.loc[1, "error"]
+    assert table.loc[[0, 2], "error"].isna().all()
+    assert table.loc[2, "amplitude"] == pytest.approx(0.024)
+
+
+def test_a_folder_with_another_sweep_is_refused(base, tmp_path):
+    folder = tmp_path / "taken"
+    plan = plan_sweep(["omega=100:110:2"])
+    sweep(base, plan, folder, workers=1)
+    with pytest.raises(ParameterError, match="other points") as caught:
+        sweep(base, plan_sweep(["omega=100:120:2"]), folder, workers=1)
+    assert "\n" not in str(caught.value)
+    with pytest.raises(ParameterError, match="other base parameters") as caught:
+        sweep(base.replace(restitution=0.6), plan, folder, workers=1)
+    assert "restitution" in str(caught.value)
+    # A folder that is not a sweep and is not empty is refused and left alone.
+    other = tmp_path / "mine"
+    other.mkdir()
+    (other / "notes.txt").write_text("keep me", encoding="utf-8")
+    with pytest.raises(ParameterError, match="not a shakermill sweep folder"):
+        sweep(base, plan, other, workers=1)
+    assert sorted(path.name for path in other.iterdir()) == ["notes.txt"]
+
+
+def test_keep_runs_writes_each_point_run_folder(base, tmp_path):
+    from shakermill.storage import load_run
+
+    plan = plan_sweep(["amplitude=24mm:26mm:2"])
+    kept = sweep(base, plan, tmp_path / "kept", workers=1, keep_runs=True)
+    plain = sweep(base, plan, tmp_path / "plain", workers=1)
+    assert_frame_equal(comparable(kept), comparable(plain))
+    assert plain["output_dir"].isna().all()
+    for _, row in kept.iterrows():
+        folder = Path(row["output_dir"])
+        assert folder == tmp_path / "kept" / "runs" / row["point_id"]
+        run = load_run(folder)
+        assert run.summary["impacts"] == row["impacts"]
+        assert run.params.amplitude == row["amplitude"]
+
+
+def test_a_point_listed_twice_is_refused(base, tmp_path):
+    with pytest.raises(ParameterError, match="repeats point 1"):
+        sweep(base, [{"omega": 100.0}, {"omega": "100 rad/s"}], tmp_path / "twice", workers=1)
+
+
+# The command line ---------------------------------------------------------------------------------
+
+
+def test_cli_bad_grid_exits_2_with_one_line(tmp_path):
+    completed = run_cli("sweep", "--grid", "bogus", "--out", str(tmp_path / "s"))
+    assert completed.returncode == 2, completed.stderr
+    assert_one_error_line(completed.stderr, "bogus")
+    completed = run_cli("sweep", "--grid", "omgea=90:130:3", "--out", str(tmp_path / "s"))
+    assert completed.returncode == 2, completed.stderr
+    assert_one_error_line(completed.stderr, "omgea")
+    assert not (tmp_path / "s" / MANIFEST_FILE).exists()
+
+
+def test_cli_unreachable_scheduler_exits_2_with_one_line(tmp_path):
+    folder = tmp_path / "s"
+    completed = run_cli(
+        "sweep", "--grid", "omega=100:110:2", "--set", "duration=60", "--out", str(folder),
+        "--scheduler", UNREACHABLE, "--scheduler-timeout", "2",
+    )  # fmt: skip
+    assert completed.returncode == 2, completed.stderr
+    assert_one_error_line(completed.stderr, "scheduler", UNREACHABLE)
+    assert not folder.exists()  # the connection is tried before the sweep folder is created
+
+
+def test_cli_sweep_writes_matching_csv_and_parquet(base, tmp_path):
+    folder = tmp_path / "cli"
+    completed = run_cli(
+        "sweep", "--grid", "omega=100:120:2", "--grid", "amplitude=23mm:29mm:2", "--set", "duration=60",
+        "--set", "restitution=0.8", "--out", str(folder), "--workers", "2", "--json",
+    )  # fmt: skip
+    assert completed.returncode == 0, completed.stderr
+    assert "Traceback" not in completed.stderr
+    json.loads(completed.stdout)  # --json prints one JSON document
+    table = load_sweep(folder).table
+    assert len(table) == 4 and table["success"].all()
+    assert_csv_matches_parquet(folder)
+    # The command line's base: the default preset, the averaged solver, --set applied.
+    expected = sweep(
+        base.replace(restitution=0.8), plan_sweep(["omega=100:120:2", "amplitude=23mm:29mm:2"]), tmp_path / "api", workers=1
+    )
+    assert_frame_equal(comparable(table), comparable(expected))
+
+
+def test_cli_some_points_failed_exits_1(tmp_path):
+    folder = tmp_path / "cli"
+    completed = run_cli("sweep", "--grid", "restitution=0.9:1.1:2", "--set", "duration=60", "--out", str(folder), "--workers", "1")
+    assert completed.returncode == 1, completed.stderr
+    assert "Traceback" not in completed.stderr
+    table = load_sweep(folder).table
+    assert list(table["success"]) == [True, False]
+    assert "restitution" in table.loc[1, "error"]
+
+
+# Killed and resumed -------------------------------------------------------------------------------
+
+
+def _live_processes_in_group(group: int) -> list[int]:
+    """The processes of ``group`` that are not zombies (Linux /proc)."""
+    live = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            text = stat.read_text()
+        except OSError:
+            continue
+        fields = text[text.rindex(")") + 2 :].split()
+        state, process_group = fields[0], int(fields[2])
+        if process_group == group and state != "Z":
+            live.append(int(stat.parent.name))
+    return live
+
+
+def test_sigkill_mid_sweep_then_resume(tmp_path):
+    # 64 points of one simulated minute: ~0.03 s each, ~1 s on two workers after their start.
+    grid = ["omega=90:130:8", "amplitude=23mm:30mm:8"]
+    settings = ["--set", "duration=60"]
+    folder = tmp_path / "killed"
+    command = [str(SHAKERMILL), "sweep", *(arg for spec in grid for arg in ("--grid", spec)), *settings, "--out", str(folder), "--workers", "2"]
+    total = 64
+
+    process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    try:
+        while True:
+            done = len(point_files(folder)) if (folder / POINTS_FOLDER).is_dir() else 0
+            if done >= 3:
+                os.killpg(process.pid, signal.SIGKILL)
+                break
+            if process.poll() is not None or time.monotonic() > deadline:
+                pytest.fail(f"the sweep ended or stalled before it could be killed (rc {process.poll()}): {process.stderr.read()!r}")
+            time.sleep(0.002)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+        process.wait(timeout=30)
+        process.stderr.close()
+    assert process.returncode == -signal.SIGKILL
+    finished_before = {path.name: path.stat().st_mtime_ns for path in point_files(folder)}
+    print(f"killed after {len(finished_before)} of {total} points")
+    assert 3 <= len(finished_before) < total, f"{len(finished_before)} of {total} points finished: not killed mid-way"
+    if Path("/proc/self/stat").exists():
+        waited = time.monotonic() + 10
+        while _live_processes_in_group(process.pid) and time.monotonic() < waited:
+            time.sleep(0.05)
+        assert _live_processes_in_group(process.pid) == [], "pool workers outlived the killed sweep"
+
+    completed = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert completed.returncode == 0, completed.stderr
+
+    # Points finished before the kill were kept, not recomputed.
+    after = {path.name: path.stat().st_mtime_ns for path in point_files(folder)}
+    assert {name: after[name] for name in finished_before} == finished_before
+    assert len(after) == total
+    assert partial_files(folder) == []
+
+    manifest = json.loads((folder / MANIFEST_FILE).read_text(encoding="utf-8"))
+    planned = [entry["point_id"] for entry in manifest["points"]]
+    table = pd.read_parquet(folder / TABLE_PARQUET)
+    assert len(planned) == total == len(table)
+    assert table["point_id"].is_unique
+    assert list(table["point_id"]) == planned
+    assert table["success"].all()
+    assert_csv_matches_parquet(folder)
+
+    # The same sweep, uninterrupted, in this process: the same ids (same base) and the same values.
+    base = sweep_parameters(None, preset=None, overrides=["duration=60"], full_resolution=False).params
+    uninterrupted = sweep(base, plan_sweep(grid), tmp_path / "uninterrupted", workers=1)
+    assert list(uninterrupted["point_id"]) == planned
+    assert_frame_equal(comparable(table), comparable(load_sweep(tmp_path / "uninterrupted").table))
+
+
+def test_ctrl_c_keeps_the_finished_points_in_the_table_and_exits_130(tmp_path):
+    # Ctrl-C in a terminal sends SIGINT to the whole foreground group: the sweep and its workers.
+    folder = tmp_path / "interrupted"
+    command = [str(SHAKERMILL), "sweep", "--grid", "omega=90:130:8", "--grid", "amplitude=23mm:30mm:8",
+               "--set", "duration=60", "--out", str(folder), "--workers", "2"]  # fmt: skip
+    process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not ((folder / POINTS_FOLDER).is_dir() and len(point_files(folder)) >= 3):
+        if process.poll() is not None or time.monotonic() > deadline:
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGKILL)
+            pytest.fail(f"the sweep ended or stalled before it could be interrupted: {process.communicate()[1]!r}")
+        time.sleep(0.002)
+    os.killpg(process.pid, signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr
+    assert_one_error_line(stderr, "interrupted", f"--out {folder}")
+    table = pd.read_parquet(folder / TABLE_PARQUET)
+    finished = table["error"].isna()
+    assert finished.sum() == len(point_files(folder)) and 3 <= finished.sum() < 64
+    assert table.loc[~finished, "error"].str.startswith("not finished").all()
+    assert table["point_id"].is_unique and len(table) == 64
+
+    completed = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert completed.returncode == 0, completed.stderr
+    assert load_sweep(folder).table["error"].isna().all()
