@@ -80,3 +80,28 @@ def test_settled_impacts_of_a_full_run_are_its_second_half() -> None:
     impacts = pd.DataFrame({"time": [0.1, 0.4, 0.6, 0.9], "wall": ["left", "right", "left", "right"]})
     assert settled_impacts(impacts, "full", 1.0)["time"].tolist() == [0.6, 0.9]
     assert settled_impacts(impacts, "averaged", 1.0)["time"].tolist() == [0.1, 0.4, 0.6, 0.9]
+
+
+def test_bifurcation_stops_at_ctrl_c_inside_a_run(monkeypatch) -> None:
+    # simulate() turns Ctrl-C into status INTERRUPTED (a full run keeps what it computed); the scan
+    # must raise it rather than go on to the next value.
+    import sys
+
+    from shakermill.simulate import INTERRUPTED
+
+    simulate_module = sys.modules["shakermill.simulate"]
+    real_simulate = simulate_module.simulate
+    calls = []
+
+    def interrupted_second_run(params):
+        calls.append(params.omega)
+        result = real_simulate(params)
+        if len(calls) == 2:
+            result.status = INTERRUPTED
+        return result
+
+    monkeypatch.setattr(simulate_module, "simulate", interrupted_second_run)
+    base = sm.default_parameters(solver="averaged", duration=60.0, record_windows=())
+    with pytest.raises(KeyboardInterrupt):
+        bifurcation(base, [100.0, 110.0, 120.0])
+    assert calls == [100.0, 110.0]

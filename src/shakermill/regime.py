@@ -121,15 +121,19 @@ def bifurcation(
 
     The impacts are those of the settled motion: the averaged solver's mechanics phase (transient
     cut by MSER) when ``base`` uses it, the second half of a full run otherwise. The phase of an
-    impact is ωt + φ (mod 2π) with the ω of that run.
+    impact is ωt + φ (mod 2π) with the ω of that run. Ctrl-C during a run raises
+    ``KeyboardInterrupt``.
     """
-    from .simulate import simulate
+    from .simulate import INTERRUPTED, simulate
 
     regimes, phases = [], []
     for index, value in enumerate(values):
         result = simulate(base.replace(**{key: float(value)}))
-        label, period = classify(result)
+        if result.status == INTERRUPTED:
+            # simulate() turns Ctrl-C into a status; the scan must stop, not go on to the next value.
+            raise KeyboardInterrupt
         settled = settled_impacts(result.impacts, result.solver, result.t_end)
+        label, period = classify_impacts(settled, result.params.omega, result.params.phase)
         angles = impact_phases(settled, result.params.omega, result.params.phase)
         regimes.append({key: float(value), "regime": label, "period": period, "solver": result.solver, "message": result.message})
         phases.append(pd.DataFrame({key: float(value), "phase": angles.phase, "wall": angles.wall}))
