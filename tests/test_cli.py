@@ -356,6 +356,17 @@ def test_plot_of_a_sweep_folder_draws_maps_with_the_contour(sweep_folder, tmp_pa
     assert stems == {"sweep_theta_inf_C", "sweep_tau_min", "sweep_impact_rate_hz", "sweep_heat_power_W",
                      "sweep_mean_impact_speed_m_s", "sweep_regime"}
     assert "12 files written" in outcome.stdout
+    assert "not crossed" not in outcome.stderr
+
+
+def test_plot_says_when_a_contour_level_is_never_reached(sweep_folder, tmp_path):
+    table = load_sweep(sweep_folder).table
+    level = float(table["theta_inf_C"].max()) + 10.0
+    outcome = invoke("plot", str(sweep_folder), "--out", str(tmp_path / "maps"), "--contour", f"theta_inf_C={level}")
+    assert outcome.exit_code == 0, outcome.stderr
+    (line,) = outcome.stderr.strip().splitlines()
+    assert line.startswith(f"note: theta_inf_C = {level:g} not crossed") and "below it at every point" in line
+    assert "12 files written" in outcome.stdout
 
 
 @pytest.mark.parametrize(

@@ -23,6 +23,7 @@ from shakermill.plotting import (
     PAPER_FIGURES,
     SWEEP_QUANTITIES,
     bifurcation_figure,
+    contour_notes,
     heating_zoom_figure,
     heating_zoom_window,
     impact_figures,
@@ -364,6 +365,30 @@ def test_sweep_contour_is_drawn_at_its_level_on_every_map():
         vertices = np.concatenate([path.vertices for path in contours[0].get_paths()])
         # θ∞ = omega − 40 + 1000 (amplitude − 0.024): 60 °C at omega = 100 − 1000 (amplitude − 0.024).
         np.testing.assert_allclose(vertices[:, 0], 100.0 - (vertices[:, 1] / 1e3 - 0.024) * 1e3, atol=1e-9)
+
+
+def test_a_contour_level_outside_the_values_is_said_on_every_figure_not_drawn():
+    # θ∞ is 50 … 94 °C; with the failed point (omega 130, amplitude 28 mm: 94 °C) left out, 90 is the top.
+    table = synthetic_sweep(failed_index=5)
+    contours = [("theta_inf_C", 40.0), ("theta_inf_C", 92.0), ("theta_inf_C", 60.0)]
+    notes = contour_notes(table, contours)
+    assert notes == [
+        "theta_inf_C = 40 not crossed: theta_inf_C is 50 to 90, above it at every point",
+        "theta_inf_C = 92 not crossed: theta_inf_C is 50 to 90, below it at every point",
+    ]
+    for keys, frame in ((("omega", "amplitude"), table), (("omega",), table[table["amplitude"] == 0.024])):
+        figures = sweep_figures(frame.drop(columns=[] if len(keys) == 2 else ["amplitude"]), keys, contours)
+        for column, _, _ in SWEEP_QUANTITIES:
+            axis = figures[f"sweep_{column}"].axes[0]
+            texts = [text.get_text() for text in axis.texts]
+            assert any("theta_inf_C = 40 not crossed" in text for text in texts), (keys, column, texts)
+    # Every level crossed: no note.
+    assert contour_notes(table, [("theta_inf_C", 60.0)]) == []
+    crossed = sweep_figures(table, ("omega", "amplitude"), [("theta_inf_C", 60.0)])["sweep_tau_min"].axes[0]
+    assert [text.get_text() for text in crossed.texts] == ["theta_inf_C = 60"]  # the contour's own label
+    assert contour_notes(synthetic_sweep().assign(error="failed"), [("tau_min", 1.0)]) == [
+        "tau_min = 1: no finished point has a value"
+    ]
 
 
 def test_one_key_sweep_is_a_line_with_the_contour_crossing_marked():

@@ -40,7 +40,7 @@ from .params import (
     field_unit,
     preset_values,
 )
-from .plotting import PNG_DPI, bifurcation_figure, impact_figures, parse_contour, plot_figures, plot_run, run_figures, sweep_figures
+from .plotting import PNG_DPI, bifurcation_figure, contour_notes, impact_figures, parse_contour, plot_figures, plot_run, run_figures, sweep_figures
 from .regime import bifurcation as regime_scan
 from .regime import write_bifurcation
 from .report import REPORT_FILE, save_report
@@ -393,6 +393,8 @@ def plot(
             numeric = list(data.table.select_dtypes("number").columns)
             levels = [parse_contour(spec, numeric) for spec in contour or []]
             figures = sweep_figures(data.table, data.keys, levels)
+        for note in contour_notes(data.table, levels):
+            typer.echo(f"note: {note}; no contour drawn", err=True)
     else:
         if contour:
             _fail("--contour: contours are drawn on the maps of a sweep folder, not on a run")

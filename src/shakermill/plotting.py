@@ -405,6 +405,7 @@ SWEEP_QUANTITIES = (
 # Lengths read better in mm: a vial is a few centimetres long.
 DISPLAY_UNITS = {"m": (1e3, "mm")}
 CONTOUR_STYLE = {"colors": "white", "linewidths": 2.0, "linestyles": "--"}
+NOTE_STYLE = {"fontsize": "small", "ha": "left", "va": "bottom", "bbox": {"facecolor": "white", "alpha": 0.85, "edgecolor": "0.6"}}
 REGIME_COLOURS = {"no impacts": "0.85", "irregular": "0.25"}
 # No red: it marks the failed points.
 PERIOD_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
@@ -461,15 +462,41 @@ def sweep_figures(table: pd.DataFrame, keys: Sequence[str], contours: Sequence[t
     # A failed point keeps its place in the grid, with no values: a gap in the line, a blank cell.
     data = table.copy()
     for column in {column for column, _, _ in SWEEP_QUANTITIES} | {column for column, _ in contours}:
-        data[column] = np.where(table["error"].isna(), _numeric(table, column), np.nan)
+        data[column] = _finished_values(table, column)
+    notes = contour_notes(table, contours)
     figures = {}
     for column, quantity, unit in SWEEP_QUANTITIES:
         if len(keys) == 1:
-            figures[f"sweep_{column}"] = sweep_line_figure(data, keys[0], column, quantity, unit, contours)
+            figure = sweep_line_figure(data, keys[0], column, quantity, unit, contours)
         else:
-            figures[f"sweep_{column}"] = sweep_map_figure(data, keys, column, quantity, unit, contours)
+            figure = sweep_map_figure(data, keys, column, quantity, unit, contours)
+        if notes:
+            # Said on the figure: a map without its 60 °C line would otherwise look like a forgotten option.
+            figure.axes[0].text(0.01, 0.01, "\n".join(notes), transform=figure.axes[0].transAxes, **NOTE_STYLE)
+        figures[f"sweep_{column}"] = figure
     figures["sweep_regime"] = regime_figure(table, keys)
     return figures
+
+
+def contour_notes(table: pd.DataFrame, contours: Sequence[tuple[str, float]]) -> list[str]:
+    """One line per contour level that no pair of finished points straddles, so that none is drawn."""
+    notes = []
+    for column, level in contours:
+        values = _finished_values(table, column)
+        values = values[np.isfinite(values)]
+        if values.size == 0:
+            notes.append(f"{column} = {level:g}: no finished point has a value")
+        elif not values.min() < level < values.max():
+            side = "above" if values.min() >= level else "below"
+            notes.append(
+                f"{column} = {level:g} not crossed: {column} is {values.min():.4g} to {values.max():.4g}, {side} it at every point"
+            )
+    return notes
+
+
+def _finished_values(table: pd.DataFrame, column: str) -> np.ndarray:
+    """``column`` as floats, NaN for the points that failed."""
+    return np.where(table["error"].isna(), _numeric(table, column), np.nan)
 
 
 def _numeric(table: pd.DataFrame, column: str) -> np.ndarray:
