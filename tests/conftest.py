@@ -1,11 +1,26 @@
-"""Shared fixtures: parameter sets for analytic cases and one cached default run."""
+"""Shared fixtures: the paper's tables, parameter sets for analytic cases and one cached default run."""
 
 from __future__ import annotations
+
+import tomllib
+from pathlib import Path
 
 import pytest
 
 import shakermill as sm
 from shakermill.params import Parameters
+
+# The paper's tables as data: a verbatim copy of ../shared/reference-data/paper.toml, kept in the
+# repository so that the tests comparing with it run in a clone with no ../shared beside it.
+PAPER_TOML = Path(__file__).parent / "data" / "paper.toml"
+SHARED_PAPER_TOML = Path(__file__).resolve().parents[2] / "shared" / "reference-data" / "paper.toml"
+
+
+@pytest.fixture(name="paper", scope="session")
+def paper_fixture() -> dict:
+    with PAPER_TOML.open("rb") as handle:
+        return tomllib.load(handle)
+
 
 # A vial amplitude this small makes the walls effectively stationary (velocity ~1e-10 m/s) while
 # keeping the parameter valid (amplitude must be positive).

@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import math
-import tomllib
-from pathlib import Path
 
 import pydantic
 import pytest
 
 import shakermill as sm
+from conftest import PAPER_TOML, SHARED_PAPER_TOML
 from shakermill.params import (
     FIELD_NAMES,
     PRESETS,
@@ -21,18 +20,6 @@ from shakermill.params import (
     default_parameters,
     preset_values,
 )
-
-# The repository sits beside ../shared (here /work/main and /work/shared; the same in CI clones).
-PAPER_TOML = Path(__file__).resolve().parents[2] / "shared" / "reference-data" / "paper.toml"
-
-
-@pytest.fixture(scope="module")
-def paper() -> dict:
-    if not PAPER_TOML.is_file():
-        pytest.skip(f"paper tables not found at {PAPER_TOML}")
-    with PAPER_TOML.open("rb") as handle:
-        return tomllib.load(handle)
-
 
 @pytest.fixture(scope="module")
 def defaults() -> Parameters:
@@ -72,10 +59,10 @@ PAPER_VALUES = [
 ]
 
 
-def test_paper_toml_is_found_beside_the_repository() -> None:
-    if not PAPER_TOML.is_file():
-        pytest.skip("no ../shared beside this clone")
-    assert PAPER_TOML.parent.name == "reference-data"
+def test_the_copy_of_the_paper_tables_is_the_shared_one() -> None:
+    if not SHARED_PAPER_TOML.is_file():
+        pytest.skip("no ../shared beside this clone to compare the copy with")
+    assert PAPER_TOML.read_bytes() == SHARED_PAPER_TOML.read_bytes()
 
 
 @pytest.mark.parametrize("key, table, name", PAPER_VALUES)
