@@ -338,6 +338,55 @@ def test_unreachable_scheduler_is_one_line(base, tmp_path):
     assert not (tmp_path / "s").exists()
 
 
+@pytest.fixture
+def tcp_server():
+    """``serve(reply)``: the address of a loopback TCP server that accepts and sends ``reply`` (b"": says nothing)."""
+    import socket
+    import threading
+
+    listeners, held = [], []
+
+    def serve(reply: bytes) -> str:
+        listener = socket.create_server(("127.0.0.1", 0))
+        listeners.append(listener)
+
+        def accept() -> None:
+            while True:
+                try:
+                    connection, _ = listener.accept()
+                except OSError:  # closed at the end of the test
+                    return
+                held.append(connection)
+                if reply:
+                    connection.sendall(reply)
+
+        threading.Thread(target=accept, daemon=True).start()
+        return f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+
+    yield serve
+    for item in (*held, *listeners):
+        item.close()
+
+
+@pytest.mark.parametrize(
+    ("reply", "fragment"),
+    [
+        (b"", "did not answer as a Dask scheduler"),  # an HTTP server such as the dashboard waits for a request
+        (b"HTTP/1.1 400 Bad Request\r\n\r\n" * 4, "scheduler"),  # another protocol answers
+    ],
+)
+def test_a_server_that_is_not_a_scheduler_is_one_line_within_the_timeout(base, tmp_path, tcp_server, reply, fragment):
+    address = tcp_server(reply)
+    started = time.monotonic()
+    with pytest.raises(ParameterError) as caught:
+        sweep(base, plan_sweep(GRID), tmp_path / "s", scheduler=address, scheduler_timeout=1)
+    message = str(caught.value)
+    assert message.startswith("scheduler: ") and address in message and fragment in message, message
+    assert "\n" not in message
+    assert time.monotonic() - started < 10, "the handshake was not bounded by the timeout"
+    assert not (tmp_path / "s").exists()
+
+
 def test_unparsable_scheduler_address_is_one_line():
     with pytest.raises(ParameterError, match="scheduler") as caught:
         connect("nonsense://::::", timeout=2)

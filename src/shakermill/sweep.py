@@ -630,13 +630,51 @@ def connect(address: str, timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S) -> Clien
         from distributed import Client
     except ImportError:
         raise ParameterError("scheduler: dask.distributed is not installed (pip install 'dask[distributed]')") from None
-    try:
-        with _quiet_dask_logging():
+    with _quiet_dask_logging():
+        _check_scheduler_answers(address, timeout)
+        try:
             return Client(address, timeout=timeout, set_as_default=False)
-    except (OSError, ValueError, TypeError) as exc:
-        # OSError: refused or timed out; ValueError/TypeError: an address Dask cannot parse.
-        reason = " ".join(str(exc).split()) or type(exc).__name__
-        raise ParameterError(f"scheduler: cannot connect to {address}: {reason}") from None
+        except Exception as exc:  # noqa: BLE001 - whatever Dask raises, the user gets one line
+            raise ParameterError(f"scheduler: cannot connect to {address}: {_reason(exc)}") from None
+
+
+def _check_scheduler_answers(address: str, timeout: float) -> None:
+    """Open one connection to ``address`` and complete Dask's handshake, within ``timeout`` for each.
+
+    Done before a :class:`~distributed.Client` is made, because a Client waits for the handshake
+    without limit (a server that never speaks first, such as the HTTP dashboard on port 8787, keeps
+    it waiting forever), and a Client whose start failed hangs the interpreter's exit closing itself.
+    The probe runs on its own event loop in its own thread, so it works inside a running loop (Jupyter).
+    """
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect as open_comm
+
+    async def handshake() -> None:
+        # open_comm bounds the connection by ``timeout`` but not the handshake; wait_for bounds both.
+        comm = await open_comm(address, timeout=timeout)
+        await comm.close()
+
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="scheduler-probe") as probe:
+        try:
+            probe.submit(asyncio.run, asyncio.wait_for(handshake(), 2 * timeout)).result()
+        except asyncio.TimeoutError:
+            raise ParameterError(
+                f"scheduler: {address} accepted the connection but did not answer as a Dask scheduler "
+                f"(waited {2 * timeout:g} s); give the scheduler's address (tcp://HOST:8786), not the dashboard's"
+            ) from None
+        except (OSError, ValueError, TypeError) as exc:
+            # OSError: refused or timed out; ValueError/TypeError: an address Dask cannot parse.
+            raise ParameterError(f"scheduler: cannot connect to {address}: {_reason(exc)}") from None
+        except Exception as exc:  # noqa: BLE001 - a peer speaking another protocol can make Dask raise anything
+            raise ParameterError(
+                f"scheduler: {address} does not answer as a Dask scheduler ({type(exc).__name__} in the handshake)"
+            ) from None
+
+
+def _reason(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
 
 
 @contextmanager
