@@ -486,12 +486,18 @@ def contour_notes(table: pd.DataFrame, contours: Sequence[tuple[str, float]]) ->
         values = values[np.isfinite(values)]
         if values.size == 0:
             notes.append(f"{column} = {level:g}: no finished point has a value")
-        elif not values.min() < level < values.max():
+        elif not _straddled(values, level):
             side = "above" if values.min() >= level else "below"
             notes.append(
                 f"{column} = {level:g} not crossed: {column} is {values.min():.4g} to {values.max():.4g}, {side} it at every point"
             )
     return notes
+
+
+def _straddled(values: np.ndarray, level: float) -> bool:
+    """Whether the finite ``values`` lie on both sides of ``level``: only then is there a contour to draw."""
+    finite = values[np.isfinite(values)]
+    return finite.size > 0 and finite.min() < level < finite.max()
 
 
 def _finished_values(table: pd.DataFrame, column: str) -> np.ndarray:
@@ -575,7 +581,7 @@ def sweep_map_figure(
         mesh = axis.pcolormesh(_cell_edges(x), _cell_edges(y), np.ma.masked_invalid(values), cmap="inferno", shading="flat")
         for contour_column, level in contours:
             _, _, levels = _grid_of(table, keys, contour_column)  # type: ignore[misc]
-            if np.nanmin(levels) < level < np.nanmax(levels):
+            if _straddled(levels, level):
                 lines = axis.contour(x, y, levels, levels=[level], **CONTOUR_STYLE)
                 axis.clabel(lines, fmt=f"{contour_column} = {level:g}", fontsize="small")
     else:
@@ -584,7 +590,7 @@ def sweep_map_figure(
         mesh = axis.scatter(x, y, c=_numeric(table, column), cmap="inferno", s=60, edgecolors="0.3")
         for contour_column, level in contours:
             levels = _numeric(table, contour_column)
-            if len(x) >= 3 and np.nanmin(levels) < level < np.nanmax(levels):
+            if len(x) >= 3 and _straddled(levels, level):
                 lines = axis.tricontour(x, y, levels, levels=[level], colors="0.3", linestyles="--")
                 axis.clabel(lines, fmt=f"{contour_column} = {level:g}", fontsize="small")
     figure.colorbar(mesh, ax=axis, label=f"{quantity} ({unit})")
