@@ -161,6 +161,7 @@ def run(
         target = out if out is not None else timestamped_folder("run")
         check_target(target)
     result = simulate_with_progress(run_config.params)
+    echo_warnings(result.warnings)
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
     target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots)
     if json_output:
@@ -169,6 +170,12 @@ def run(
     else:
         _stdout_console().print(summary_table(result, target))
     _exit_for_status(result, target)
+
+
+def echo_warnings(warnings: Sequence[str]) -> None:
+    """One ``warning: ...`` line on stderr each (stdout stays clean for ``--json``)."""
+    for warning in warnings:
+        typer.echo(f"warning: {' '.join(warning.splitlines())}", err=True)
 
 
 def timestamped_folder(kind: str) -> Path:

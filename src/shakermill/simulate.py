@@ -115,7 +115,9 @@ class Result:
     solver: str = "full"
     impact_window: float | None = None  # s covered by ``impacts``; None means the whole run
     averages: MechanicsAverages | None = None
-    summary: dict[str, float | int | str | bool] = field(default_factory=dict)
+    # One line each, for things a user should know that do not stop the run (stderr and summary.json).
+    warnings: list[str] = field(default_factory=list)
+    summary: dict[str, float | int | str | bool | list[str]] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
@@ -357,7 +359,7 @@ def kelvin_to_celsius(kelvin: float) -> float:
     return kelvin - 273.15
 
 
-def summarize(result: Result) -> dict[str, float | int | str | bool]:
+def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]:
     """The flat summary printed by ``run --json`` and stored as ``summary.json``."""
     params = result.params
     series = result.timeseries
@@ -402,4 +404,5 @@ def summarize(result: Result) -> dict[str, float | int | str | bool]:
     }
     if result.averages is not None:
         summary.update(result.averages.as_summary())
+    summary["warnings"] = list(result.warnings)
     return summary

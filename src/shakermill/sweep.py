@@ -301,6 +301,8 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
     if result.status == INTERRUPTED:
         raise PointInterrupted(result.message)
     summary = {(f"{key}{USED_SUFFIX}" if key in swept else key): value for key, value in result.summary.items()}
+    # A table cell holds one value: the warnings become one string.
+    summary["warnings"] = "; ".join(result.warnings)
     row = {
         **swept,
         "regime": regime,
