@@ -94,9 +94,8 @@ def test_thermal_network_reaches_the_analytic_steady_state() -> None:
     k = model.constants_from(params)
     heat = 0.5  # W
     h_ball = 2.0 * params.air_conductivity / (2.0 * params.ball_radius)
-    area = params.end_face_area
-    vial = params.ambient_temperature + heat / (params.h_outer * area)
-    air = vial + params.lam * heat / (params.h_inner * area)
+    vial = params.ambient_temperature + heat / (params.h_outer * params.outer_area)
+    air = vial + params.lam * heat / (params.h_inner * params.inner_area)
     ball = air + params.lam * heat / (4 * np.pi * params.ball_radius**2 * params.beta * h_ball)
 
     def network(t: float, theta: np.ndarray) -> list[float]:

@@ -40,6 +40,7 @@ from .simulate import (
     EnergyAudit,
     ProgressCallback,
     Result,
+    conclude,
     impact_table,
     integrator_for,
     no_impact_note,
@@ -201,7 +202,7 @@ def impact_heated_time_constants(params: Parameters, averages: MechanicsAverages
     nusselt = 2.0 + averages.velocity_term * k.prandtl**0.4 / viscosity_ratio**0.25
     h_ball = nusselt * k.air_conductivity / (2.0 * k.radius)
     ball_conductance = 4.0 * math.pi * k.radius**2 * k.beta * h_ball
-    vial_conductance = (k.h_inner + k.h_outer) * k.face_area
+    vial_conductance = k.h_inner * k.inner_area + k.h_outer * k.outer_area
     return {
         "ball": k.capacity_ball / ball_conductance if ball_conductance > 0 else math.inf,
         "vial": k.capacity_vial / vial_conductance if vial_conductance > 0 else math.inf,
@@ -324,8 +325,7 @@ def simulate_averaged(params: Parameters, progress: ProgressCallback | None = No
         impact_window=averages.window,
         averages=averages,
     )
-    result.summary = summarize(result)
-    return result
+    return conclude(result, averages.heat_power, averages.velocity_term)
 
 
 def _refuse(

@@ -39,6 +39,7 @@ from .params import (
     field_description,
     field_unit,
     preset_values,
+    unit_slip_warnings,
 )
 from .plotting import PNG_DPI, bifurcation_figure, contour_notes, impact_figures, parse_contour, plot_figures, plot_run, run_figures, sweep_figures
 from .regime import bifurcation as regime_scan
@@ -160,8 +161,11 @@ def run(
         run_config = load_config(config, preset=preset, overrides=overrides)
         target = out if out is not None else timestamped_folder("run")
         check_target(target)
+    # Unit slips are said before a possibly long run, the rest once it is known.
+    said_first = unit_slip_warnings(run_config.params)
+    echo_warnings(said_first)
     result = simulate_with_progress(run_config.params)
-    echo_warnings(result.warnings)
+    echo_warnings([line for line in result.warnings if line not in said_first])
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
     target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots)
     if json_output:
@@ -253,13 +257,20 @@ def summary_table(result: Result, target: Path) -> Table:
     table.add_column("quantity")
     table.add_column("value", justify="right")
     table.add_column("unit")
+    fit_window = f"0–{_number(s['simulated_s'] / 60.0, '.4g')} min"
     rows = [
         ("status", s["message"] if not result.success else "ok", ""),
         ("solver", s["solver"], ""),
+        ("drive ω", f"{_number(s['omega_rad_s'], '.4g')} rad/s = {_number(s['omega_hz'], '.4g')} Hz = {_number(s['omega_rpm'], '.0f')}", "rpm"),
+        ("amplitude; ball radius", f"{_number(s['amplitude_mm'], '.4g')}; {_number(s['ball_radius_mm'], '.4g')}", "mm"),
+        ("ambient; initial temperature", f"{_number(s['ambient_temperature_C'], '.4g')}; {_number(s['initial_temperature_C'], '.4g')}", "°C"),
         ("simulated time", _number(s["simulated_s"], ".6g"), "s"),
-        ("ball θ∞ (exponential fit)", _number(s["theta_inf_C"], ".2f"), "°C"),
-        ("time constant τ", _number(s["tau_min"], ".2f"), "min"),
-        ("initial heating rate θ̇₀", _number(s["rate0_C_per_min"], ".3f"), "°C/min"),
+        ("ball steady state", _number(s["ball_steady_C"], ".2f"), "°C"),
+        ("vial; air steady state", f"{_number(s['vial_steady_C'], '.2f')}; {_number(s['air_steady_C'], '.2f')}", "°C"),
+        ("slowest time constant", _number(s["slowest_time_constant_min"], ".1f"), "min"),
+        (f"ball θ∞ of the exponential fitted over {fit_window}", _number(s["theta_inf_C"], ".2f"), "°C"),
+        ("τ of that fit", _number(s["tau_min"], ".2f"), "min"),
+        ("initial heating rate θ̇₀ of that fit", _number(s["rate0_C_per_min"], ".3f"), "°C/min"),
         ("ball at the end", _number(s["ball_C"], ".2f"), "°C"),
         ("vial at the end", _number(s["vial_C"], ".2f"), "°C"),
         ("air at the end", _number(s["air_C"], ".2f"), "°C"),

@@ -78,7 +78,8 @@ class Constants(NamedTuple):
     beta: float
     h_inner: float
     h_outer: float
-    face_area: float
+    inner_area: float
+    outer_area: float
     capacity_ball: float
     capacity_vial: float
     capacity_air: float
@@ -117,7 +118,8 @@ def constants_from(params: Parameters) -> Constants:
         beta=params.beta,
         h_inner=params.h_inner,
         h_outer=params.h_outer,
-        face_area=params.end_face_area,
+        inner_area=params.inner_area,
+        outer_area=params.outer_area,
         capacity_ball=params.ball_mass * params.ball_heat_capacity,
         capacity_vial=params.vial_mass * params.vial_heat_capacity,
         capacity_air=params.air_mass * params.air_heat_capacity,
@@ -190,8 +192,8 @@ def thermal_network(
         rate_ball = (k.lam * heat_generated - ball_to_ambient) / k.capacity_ball
         return rate_ball, 0.0, 0.0, ball_to_ambient + (1.0 - k.lam) * heat_generated
     ball_to_air = thermal.ball_air_heat_flow(k.radius, k.beta, h_ball, t_ball, t_air)
-    vial_to_air = thermal.newton_cooling(k.h_inner, k.face_area, t_vial, t_air)
-    vial_to_outside = thermal.newton_cooling(k.h_outer, k.face_area, t_vial, k.t_ambient)
+    vial_to_air = thermal.newton_cooling(k.h_inner, k.inner_area, t_vial, t_air)
+    vial_to_outside = thermal.newton_cooling(k.h_outer, k.outer_area, t_vial, k.t_ambient)
     rate_ball, rate_vial, rate_air = thermal.temperature_rates(
         k.lam * heat_generated,
         (1.0 - k.lam) * heat_generated,

@@ -70,6 +70,8 @@ class Parameters(BaseModel):
     sutherland: float = _quantity("K", "Sutherland constant S", ge=0)
     h_inner: float = _quantity("W/(m^2*K)", "vial-to-inner-air convection coefficient h_i", ge=0)
     h_outer: float = _quantity("W/(m^2*K)", "vial-to-surroundings convection coefficient h_o", ge=0)
+    inner_area: float = _quantity("m^2", "vial surface exchanging heat with the inner air A_i", gt=0)
+    outer_area: float = _quantity("m^2", "vial surface exchanging heat with the surroundings A_o", gt=0)
     # Collision and heat generation (Table 4)
     restitution: float = _quantity("", "coefficient of restitution e", gt=0, le=1)
     eta: float = _quantity("", "fraction η of dissipated power turned into heat", ge=0, le=1)
@@ -79,6 +81,9 @@ class Parameters(BaseModel):
     duration: float = _quantity("s", "simulated time", gt=0)
     ambient_temperature: float = _quantity("K", "temperature of the surroundings θ_amb", gt=0)
     initial_temperature: float = _quantity("K", "initial temperature θ_0 of ball, vial and air", gt=0)
+    ball_temperature_limit: float = _quantity(
+        "K", "highest physical ball temperature: a run that exceeds it ends with a non-ok status", gt=0
+    )
     ball_position: float = _quantity("m", "initial ball centre, relative to the vial centre")
     ball_momentum: float = _quantity("kg*m/s", "initial ball momentum")
     # Numerics (MODEL.md section 7)
@@ -151,8 +156,8 @@ class Parameters(BaseModel):
 
     @property
     def end_face_area(self) -> float:
-        """A_i = A_o = 2·π·d_v²/4: both circular end faces (m²), MODEL.md section 1."""
-        return 2.0 * math.pi * self.vial_diameter**2 / 4.0
+        """2·π·d_v²/4: both circular end faces (m²), MODEL.md section 1; the paper's A_i = A_o."""
+        return end_faces_area(self.vial_diameter)
 
     @property
     def air_mass(self) -> float:
@@ -209,6 +214,11 @@ def allowed_range(key: str) -> str:
     return f"{text} {unit}".rstrip()
 
 
+def end_faces_area(vial_diameter: float) -> float:
+    """Area of the two circular end faces of a vial of inner diameter ``vial_diameter`` (m²)."""
+    return 2.0 * math.pi * vial_diameter**2 / 4.0
+
+
 @dataclass(frozen=True)
 class Cited:
     """A preset value with where it comes from."""
@@ -260,6 +270,12 @@ SPEX_8000M = Preset(
         "sutherland": Cited(111.0, f"{PAPER}, Table 3"),
         "h_inner": Cited(200.0, f"{PAPER}, Table 3"),
         "h_outer": Cited(45.0, f"{PAPER}, Table 3"),
+        "inner_area": Cited(end_faces_area(19e-3), f"{PAPER}, Table 1 (A_i = 567.06 mm²: the two end faces, MODEL.md §1)"),
+        "outer_area": Cited(
+            end_faces_area(19e-3),
+            f"{PAPER}, Table 1 (A_o = 567.06 mm²: the two end faces only; a real vial also loses heat through its "
+            "side, MODEL.md §11)",
+        ),
         "restitution": Cited(0.7, f"{PAPER}, Table 4 (e)"),
         "eta": Cited(0.9, f"{PAPER}, Table 4 (η)"),
         "lam": Cited(0.368, f"{PAPER}, Table 4 (λ)"),
@@ -267,6 +283,9 @@ SPEX_8000M = Preset(
         "duration": Cited(3600.0, f"{PAPER}, Table 4 (60 min)"),
         "ambient_temperature": Cited(293.15, f"{PAPER}, Table 3 footnote (ambient 20 °C)"),
         "initial_temperature": Cited(293.15, f"assumption: θ̇_0 of {PAPER} Table 5 implies θ_0 = 20 °C"),
+        "ball_temperature_limit": Cited(
+            1673.15, "assumption: carbon and bearing steels begin to melt near 1400 °C; above it the model does not hold"
+        ),
         "ball_position": Cited(0.0, "assumption: ball starts at the vial centre"),
         "ball_momentum": Cited(0.0, "assumption: ball starts at rest"),
         "rtol": Cited(1e-3, "MATLAB ode23 default RelTol, as used by the paper"),
@@ -339,14 +358,80 @@ def check_known_keys(keys: list[str] | tuple[str, ...], *, extra_allowed: tuple[
             raise ParameterError(f"{key}: unknown parameter{hint}")
 
 
+# Guards against unit slips. Bare numbers are SI, but people give temperatures in °C, lengths in mm and
+# frequencies in rpm or Hz: a bare temperature below this many kelvin is almost surely °C, and is refused.
+BARE_TEMPERATURE_MINIMUM = 200.0
+USER_TEMPERATURE_KEYS = ("ambient_temperature", "initial_temperature", "ball_temperature_limit")
+
+
+@dataclass(frozen=True)
+class PlausibleRange:
+    """Values real mills and laboratories use, in the key's SI unit, and the units people slip into."""
+
+    low: float
+    high: float
+    users: str
+    likely_units: tuple[str, ...]
+
+
+PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
+    # Mixer mills shake at 3-35 Hz, planetary mills turn at up to ~1100 rpm of the sun wheel.
+    "omega": PlausibleRange(30.0, 400.0, "shaker and planetary mills", ("rpm", "Hz")),
+    "amplitude": PlausibleRange(1e-3, 0.1, "shaker mills", ("mm",)),
+    "ball_radius": PlausibleRange(2.5e-4, 0.05, "milling balls", ("mm",)),
+    "vial_length": PlausibleRange(5e-3, 0.5, "milling vials", ("mm",)),
+    "vial_diameter": PlausibleRange(5e-3, 0.5, "milling vials", ("mm",)),
+    "ambient_temperature": PlausibleRange(250.0, 330.0, "laboratories", ("degC",)),
+    "initial_temperature": PlausibleRange(250.0, 400.0, "laboratories", ("degC",)),
+}
+
+
+def unit_slip_warnings(params: Parameters) -> list[str]:
+    """One line per value outside :data:`PLAUSIBLE_RANGES`, naming the unit that was likely meant."""
+    lines = []
+    for key, plausible in PLAUSIBLE_RANGES.items():
+        value = getattr(params, key)
+        if plausible.low <= value <= plausible.high:
+            continue
+        unit = field_unit(key)
+        meant = next(
+            (alt for alt in plausible.likely_units if plausible.low <= to_si(f"{value:g} {alt}", unit, key=key) <= plausible.high),
+            None,
+        )
+        hint = f"; did you mean {value:g} {meant}? Write {key}='{value:g} {meant}'" if meant else ""
+        lines.append(
+            f"{key} = {value:g} {unit} is outside what {plausible.users} use "
+            f"({plausible.low:g} to {plausible.high:g} {unit}); bare numbers are SI{hint}"
+        )
+    return lines
+
+
+def _is_bare_number(value: Any) -> bool:
+    if isinstance(value, bool):
+        return False
+    if isinstance(value, (int, float)):
+        return True
+    try:
+        float(str(value).strip())
+    except ValueError:
+        return False
+    return True
+
+
 def _coerce(key: str, value: Any) -> Any:
     """Convert a user value for ``key`` to SI (strings with units) or to the option's type."""
     annotation = Parameters.model_fields[key].annotation
     if annotation is float:
         try:
-            return to_si(value, field_unit(key), key=key)
+            number = to_si(value, field_unit(key), key=key)
         except UnitError as exc:
             raise ParameterError(str(exc)) from None
+        if key in USER_TEMPERATURE_KEYS and _is_bare_number(value) and number < BARE_TEMPERATURE_MINIMUM:
+            raise ParameterError(
+                f"{key}: a bare {number:g} is read as {number:g} K ({number - 273.15:.2f} °C); bare temperatures below "
+                f"{BARE_TEMPERATURE_MINIMUM:g} are refused: write '{number:g} degC' or '{number + 273.15:g} K'"
+            )
+        return number
     if key == "record_windows":
         return _coerce_windows(value)
     if annotation is bool and isinstance(value, str):

@@ -21,7 +21,8 @@ from .integrate import (
     Integrator,
     Tolerances,
 )
-from .params import Parameters
+from .params import Parameters, unit_slip_warnings
+from .steady import SteadyState, run_length_warning, settled_means, steady_state
 
 if TYPE_CHECKING:
     from .averaged import MechanicsAverages
@@ -35,6 +36,8 @@ CHUNK_SECONDS = 10.0
 
 INTERRUPTED = 1
 INTERRUPTED_MESSAGE = "Interrupted by the user; the results cover the time simulated so far."
+# The run finished, but a temperature left the range where the model means anything.
+OUT_OF_PHYSICAL_BOUNDS = -5
 
 ProgressCallback = Callable[[float, float], None]
 
@@ -115,6 +118,7 @@ class Result:
     solver: str = "full"
     impact_window: float | None = None  # s covered by ``impacts``; None means the whole run
     averages: MechanicsAverages | None = None
+    steady: SteadyState | None = None
     # One line each, for things a user should know that do not stop the run (stderr and summary.json).
     warnings: list[str] = field(default_factory=list)
     summary: dict[str, float | int | str | bool | list[str]] = field(default_factory=dict)
@@ -243,8 +247,58 @@ def _assemble(
         energy=energy,
         ball_fit=ball_fit,
     )
+    heat_power, velocity_term = settled_means(
+        times, timeseries["heat_generated"].values, timeseries["velocity_term_integral"].values
+    )
+    return conclude(result, heat_power, velocity_term)
+
+
+def conclude(result: Result, heat_power: float, velocity_term: float) -> Result:
+    """Steady state, physical bounds and warnings of a finished run of either solver, then its summary.
+
+    ``heat_power`` (W) and ``velocity_term`` are the means of the settled motion that drive the
+    thermal network (MODEL.md §11).
+    """
+    params = result.params
+    result.steady = steady_state(params, heat_power, velocity_term)
+    result.warnings.extend(unit_slip_warnings(params))
+    for line in (run_length_warning(result.t_end, result.steady), steady_state_bound_warning(result)):
+        if line is not None:
+            result.warnings.append(line)
+    problem = physical_bounds_problem(result)
+    if problem is not None and result.status == REACHED_STOP:
+        result.status, result.message = OUT_OF_PHYSICAL_BOUNDS, problem
     result.summary = summarize(result)
     return result
+
+
+def physical_bounds_problem(result: Result) -> str | None:
+    """Why the temperatures of a run cannot be physical, or None."""
+    series = result.timeseries
+    hottest_ball = float(series["theta_ball"].max())
+    limit = result.params.ball_temperature_limit
+    if hottest_ball > limit:
+        return (
+            f"The ball temperature reached {kelvin_to_celsius(hottest_ball):.4g} °C, above ball_temperature_limit "
+            f"({kelvin_to_celsius(limit):.4g} °C): the model does not hold there. Check omega, amplitude and the "
+            "units of the inputs (bare numbers are SI)."
+        )
+    coldest = min(float(series[name].min()) for name in ("theta_ball", "theta_vial", "theta_air"))
+    if coldest < 0.0:
+        return f"A temperature fell to {coldest:.4g} K, below absolute zero: the thermal network is not physical here."
+    return None
+
+
+def steady_state_bound_warning(result: Result) -> str | None:
+    """A line when the run stays in range but its steady state would not."""
+    steady = result.steady
+    limit = result.params.ball_temperature_limit
+    if steady is None or not steady.solved or steady.ball <= limit:
+        return None
+    return (
+        f"the ball's steady state ({kelvin_to_celsius(steady.ball):.4g} °C) is above ball_temperature_limit "
+        f"({kelvin_to_celsius(limit):.4g} °C): a longer run would leave the model's range"
+    )
 
 
 def no_impact_note(params: Parameters, impacts: int) -> str:
@@ -359,6 +413,22 @@ def kelvin_to_celsius(kelvin: float) -> float:
     return kelvin - 273.15
 
 
+def understood_inputs(params: Parameters) -> dict[str, float]:
+    """The inputs people most often give in other units, echoed in those units (guards against unit slips)."""
+    cycles_per_second = params.omega / (2.0 * math.pi)
+    return {
+        "omega_rad_s": params.omega,
+        "omega_hz": cycles_per_second,
+        "omega_rpm": 60.0 * cycles_per_second,
+        "amplitude_mm": params.amplitude * 1e3,
+        "ball_radius_mm": params.ball_radius * 1e3,
+        "vial_length_mm": params.vial_length * 1e3,
+        "vial_diameter_mm": params.vial_diameter * 1e3,
+        "ambient_temperature_C": kelvin_to_celsius(params.ambient_temperature),
+        "initial_temperature_C": kelvin_to_celsius(params.initial_temperature),
+    }
+
+
 def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]:
     """The flat summary printed by ``run --json`` and stored as ``summary.json``."""
     params = result.params
@@ -402,6 +472,9 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
             result.energy.projection_correction / result.energy.dissipated if result.energy.dissipated > 0 else 0.0
         ),
     }
+    summary.update(understood_inputs(params))
+    if result.steady is not None:
+        summary.update(result.steady.as_summary())
     if result.averages is not None:
         summary.update(result.averages.as_summary())
     summary["warnings"] = list(result.warnings)

@@ -1,0 +1,122 @@
+"""Steady state and time constants of the thermal network (MODEL.md section 11)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import shakermill as sm
+from shakermill.steady import SETTLED_TIME_CONSTANTS, run_length_warning, settled_means, steady_state
+
+
+def test_steady_state_of_a_ball_at_rest_matches_the_hand_solution():
+    # Re = 0 makes Nu = 2 whatever Sutherland's factor, so the network is linear and explicit:
+    # all heat leaves through h_o·A_o, and the ball's share crosses ball → air → vial.
+    params = sm.default_parameters()
+    heat = 0.5  # W
+    h_ball = 2.0 * params.air_conductivity / (2.0 * params.ball_radius)
+    vial = params.ambient_temperature + heat / (params.h_outer * params.outer_area)
+    air = vial + params.lam * heat / (params.h_inner * params.inner_area)
+    ball = air + params.lam * heat / (4 * math.pi * params.ball_radius**2 * params.beta * h_ball)
+    steady = steady_state(params, heat, 0.0)
+    assert steady.solved
+    assert (steady.ball, steady.vial, steady.air) == pytest.approx((ball, vial, air), abs=1e-9)
+
+
+def test_time_constants_are_those_of_the_hand_built_linear_network():
+    params = sm.default_parameters()
+    h_ball = 2.0 * params.air_conductivity / (2.0 * params.ball_radius)
+    g_ball = 4 * math.pi * params.ball_radius**2 * params.beta * h_ball
+    g_inner = params.h_inner * params.inner_area
+    g_outer = params.h_outer * params.outer_area
+    capacities = np.array(
+        [
+            params.ball_mass * params.ball_heat_capacity,
+            params.vial_mass * params.vial_heat_capacity,
+            params.air_mass * params.air_heat_capacity,
+        ]
+    )
+    conductances = np.array(
+        [
+            [-g_ball, 0.0, g_ball],
+            [0.0, -g_inner - g_outer, g_inner],
+            [g_ball, g_inner, -g_ball - g_inner],
+        ]
+    )
+    expected = sorted(-1.0 / np.linalg.eigvals(conductances / capacities[:, None]).real, reverse=True)
+    steady = steady_state(params, 0.5, 0.0)
+    assert steady.time_constants == pytest.approx(expected, rel=1e-6)
+
+
+def test_steady_state_with_moving_ball_is_a_root_of_the_nonlinear_network():
+    from shakermill import model
+
+    params = sm.default_parameters()
+    steady = steady_state(params, 1.2, 30.0)
+    rates = model.thermal_network(steady.ball, steady.vial, steady.air, 1.2, 30.0, model.constants_from(params))
+    assert np.max(np.abs(rates[:3])) < 1e-10
+    # Every watt leaves through the outer surface.
+    assert params.h_outer * params.outer_area * (steady.vial - params.ambient_temperature) == pytest.approx(1.2, rel=1e-9)
+
+
+def test_ball_only_model_has_vial_and_air_at_ambient():
+    params = sm.default_parameters(model="ball_only")
+    steady = steady_state(params, 0.5, 0.0)
+    h_ball = 2.0 * params.air_conductivity / (2.0 * params.ball_radius)
+    expected_ball = params.ambient_temperature + params.lam * 0.5 / (4 * math.pi * params.ball_radius**2 * params.beta * h_ball)
+    assert steady.vial == steady.air == params.ambient_temperature
+    assert steady.ball == pytest.approx(expected_ball, abs=1e-9)
+    assert len(steady.time_constants) == 1
+
+
+def test_no_outer_cooling_has_no_steady_state():
+    steady = steady_state(sm.default_parameters(h_outer=0.0), 1.0, 30.0)
+    assert not steady.solved
+    assert "h_outer = 0" in steady.message
+    assert math.isinf(steady.ball)
+
+
+def test_settled_means_use_the_second_half_of_the_run():
+    times = np.linspace(0.0, 10.0, 11)
+    heat = np.where(times < 3.0, 0.0, 2.0 * (times - 3.0))  # 2 W once settled after 3 s
+    term = 5.0 * times
+    assert settled_means(times, heat, term) == pytest.approx((2.0, 5.0))
+
+
+def test_steady_state_is_where_a_ten_hour_averaged_run_ends():
+    params = sm.default_parameters("spex8000m-calibrated", solver="averaged", duration=36000.0, record_windows=())
+    result = sm.simulate(params)
+    assert result.success, result.message
+    last = result.timeseries.isel(time=-1)
+    for node in ("ball", "vial", "air"):
+        assert float(last[f"theta_{node}"]) - 273.15 == pytest.approx(result.summary[f"{node}_steady_C"], abs=0.5)
+    # Ten hours are more than three slowest time constants, so no warning about the run's length.
+    assert not any("slowest time constants" in line for line in result.warnings)
+
+
+def test_steady_state_is_where_a_long_full_resolution_run_ends():
+    # The default preset's slowest time constant is ~20 min: three hours are nine of them.
+    result = sm.simulate(sm.default_parameters(duration=3 * 3600.0, record_windows=()))
+    assert result.success, result.message
+    last = result.timeseries.isel(time=-1)
+    for node in ("ball", "vial", "air"):
+        assert float(last[f"theta_{node}"]) - 273.15 == pytest.approx(result.summary[f"{node}_steady_C"], abs=0.5)
+
+
+def test_an_hour_of_the_calibrated_preset_warns_that_its_fit_is_not_the_steady_state():
+    result = sm.simulate(sm.default_parameters("spex8000m-calibrated", solver="averaged", record_windows=()))
+    slowest = result.summary["slowest_time_constant_min"]
+    assert 60.0 < SETTLED_TIME_CONSTANTS * slowest
+    lines = [line for line in result.warnings if "slowest time constants" in line]
+    assert len(lines) == 1
+    assert f"{result.summary['ball_steady_C']:.1f} °C" in lines[0]
+    assert result.summary["warnings"] == result.warnings
+
+
+def test_run_length_warning_only_for_short_runs():
+    steady = steady_state(sm.default_parameters(), 1.0, 30.0)
+    slowest = steady.slowest_time_constant
+    assert run_length_warning(2.9 * slowest, steady) is not None
+    assert run_length_warning(3.1 * slowest, steady) is None
