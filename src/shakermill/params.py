@@ -386,24 +386,26 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
 }
 
 
+def unit_slip(key: str, value: float) -> str | None:
+    """Why ``value`` (SI) of ``key`` looks like a unit slip, naming the unit likely meant; None if plausible."""
+    plausible = PLAUSIBLE_RANGES.get(key)
+    if plausible is None or plausible.low <= value <= plausible.high:
+        return None
+    unit = field_unit(key)
+    meant = next(
+        (alt for alt in plausible.likely_units if plausible.low <= to_si(f"{value:g} {alt}", unit, key=key) <= plausible.high),
+        None,
+    )
+    hint = f"; did you mean {value:g} {meant}? Write {key}='{value:g} {meant}'" if meant else ""
+    return (
+        f"{key} = {value:g} {unit} is outside what {plausible.users} use "
+        f"({plausible.low:g} to {plausible.high:g} {unit}); bare numbers are SI{hint}"
+    )
+
+
 def unit_slip_warnings(params: Parameters) -> list[str]:
-    """One line per value outside :data:`PLAUSIBLE_RANGES`, naming the unit that was likely meant."""
-    lines = []
-    for key, plausible in PLAUSIBLE_RANGES.items():
-        value = getattr(params, key)
-        if plausible.low <= value <= plausible.high:
-            continue
-        unit = field_unit(key)
-        meant = next(
-            (alt for alt in plausible.likely_units if plausible.low <= to_si(f"{value:g} {alt}", unit, key=key) <= plausible.high),
-            None,
-        )
-        hint = f"; did you mean {value:g} {meant}? Write {key}='{value:g} {meant}'" if meant else ""
-        lines.append(
-            f"{key} = {value:g} {unit} is outside what {plausible.users} use "
-            f"({plausible.low:g} to {plausible.high:g} {unit}); bare numbers are SI{hint}"
-        )
-    return lines
+    """One line per value outside :data:`PLAUSIBLE_RANGES` (see :func:`unit_slip`)."""
+    return [line for key in PLAUSIBLE_RANGES if (line := unit_slip(key, getattr(params, key))) is not None]
 
 
 def _is_bare_number(value: Any) -> bool:
@@ -487,7 +489,17 @@ def build_parameters(base: Mapping[str, Any], overrides: Mapping[str, Any] | Non
     try:
         return Parameters(**coerced)
     except ValidationError as exc:
-        raise ParameterError(_one_line(exc)) from None
+        raise ParameterError(_with_unit_hint(_one_line(exc), coerced)) from None
+
+
+def _with_unit_hint(message: str, values: Mapping[str, Any]) -> str:
+    """``message`` about a key, with the unit slip behind it when there is one.
+
+    A ball of 6.35 m does not fit the vial: the geometry error alone would hide the slip.
+    """
+    key = message.partition(":")[0]
+    slip = unit_slip(key, values[key]) if key in PLAUSIBLE_RANGES else None
+    return message if slip is None else f"{message} ({slip})"
 
 
 def default_parameters(preset: str = DEFAULT_PRESET, **overrides: Any) -> Parameters:
