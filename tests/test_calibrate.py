@@ -6,10 +6,18 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.calibrate import Curve, calibrate, parse_free, parse_targets, write_preset
+from shakermill.calibrate import (
+    DEFAULT_FREE,
+    DEFENSIBLE_RANGES,
+    calibrate,
+    free_set_study,
+    parse_free,
+    parse_targets,
+    write_preset,
+)
 from shakermill.config import load_config
 from shakermill.params import PRESETS, ParameterError
-from shakermill.validation import TABLE5
+from shakermill.validation import CURVE_TOLERANCE_K, TABLE5, Curve, experiment_curve
 
 TABLE5_TARGETS = {entry.key: entry.experiment for entry in TABLE5 if entry.key != "vial_ball_ratio"}
 
@@ -42,14 +50,48 @@ def test_table5_calibration_meets_the_targets_and_round_trips_as_a_preset(tmp_pa
     assert params.restitution == sm.default_parameters().restitution
 
 
-def test_shipped_calibrated_preset_reproduces_the_experiment_at_full_resolution() -> None:
+def test_shipped_calibrated_preset_follows_the_experiments_curve_at_full_resolution() -> None:
     preset = PRESETS["spex8000m-calibrated"]
-    assert preset.fitted == ("beta", "vial_mass")
-    assert preset.provenance["targets"] == TABLE5_TARGETS
-    result = sm.simulate(sm.default_parameters("spex8000m-calibrated", record_windows=()))
+    assert preset.fitted == DEFAULT_FREE
+    assert preset.provenance["curve"] == experiment_curve().source
+    params = sm.default_parameters("spex8000m-calibrated", record_windows=())
+    result = sm.simulate(params)
     assert result.solver == "full"
-    for key, target in TABLE5_TARGETS.items():
-        assert result.summary[key] == pytest.approx(target, rel=0.005), key
+    series = result.timeseries
+    assert experiment_curve().rms_K(series["time"].values, series["theta_ball"].values) <= CURVE_TOLERANCE_K
+    for key in preset.fitted:
+        assert DEFENSIBLE_RANGES[key].contains(getattr(params, key)), key
+
+
+def test_experiment_curve_is_the_papers_exponential() -> None:
+    curve = experiment_curve()
+    assert curve.times[0] == 0.0 and curve.times[-1] == 3600.0 and curve.times.size == 61
+    assert curve.ball_C[0] == pytest.approx(20.0)
+    # θ̇_0 = 28 K / 16.7 min, Table 5's 1.6766 °C/min.
+    assert (curve.ball_C[1] - curve.ball_C[0]) == pytest.approx(1.6766 * np.exp(-0.5 / 16.7), rel=1e-3)
+    assert curve.ball_C[-1] == pytest.approx(48.0 - 28.0 * np.exp(-60.0 / 16.7))
+
+
+def test_calibration_without_targets_fits_the_experiments_curve_and_reports_predictions() -> None:
+    fit = calibrate(sm.default_parameters(record_windows=()), ("beta", "vial_mass", "h_outer", "lam"))
+    assert fit.curve_source == experiment_curve().source
+    assert fit.curve_rms_K <= CURVE_TOLERANCE_K and fit.success, fit.message
+    assert set(fit.predictions) >= {"vial_ball_ratio", "ball_steady_C", "slowest_time_constant_min"}
+    assert all(np.isfinite(fit.parameter_stderr[key]) and fit.parameter_stderr[key] > 0 for key in fit.free)
+    assert set(fit.sensitivities) == {"ball_C at 30 min", "ball_C at 60 min"}
+    # A parameter that ends on the edge of its defensible range is said, not hidden.
+    for key in fit.at_bounds:
+        assert "on its edge" in fit.defensible[key]
+        assert key in fit.message
+
+
+def test_free_sets_that_cannot_follow_the_curve_say_why() -> None:
+    (paper_knobs,) = free_set_study(sm.default_parameters(record_windows=()), [("beta", "vial_mass")])
+    assert not paper_knobs.follows_curve
+    assert paper_knobs.calibration.curve_rms_K > CURVE_TOLERANCE_K
+    # With the paper's end-face area the vial's time constant is hours: the ball still rises at 60 min.
+    assert paper_knobs.calibration.predictions["slowest_time_constant_min"] > 60.0
+    assert "still rising at the hour" in paper_knobs.verdict
 
 
 def test_unreachable_targets_are_reported_not_hidden() -> None:
@@ -70,7 +112,7 @@ def test_bad_targets_get_one_clear_line(items, fragment) -> None:
 
 
 def test_free_keys_are_checked() -> None:
-    assert parse_free([]) == ("beta", "vial_mass")
+    assert parse_free([]) == DEFAULT_FREE
     assert parse_free(["eta, vial_mass"]) == ("eta", "vial_mass")
     with pytest.raises(ParameterError, match="did you mean 'beta'"):
         parse_free(["bta"])

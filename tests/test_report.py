@@ -113,7 +113,7 @@ def test_table5_of_a_calibrated_run_marks_the_calibration_targets_fitted(tmp_pat
         "rate0_C_per_min": "fitted",
         "vial_ball_ratio": "predicted",
     }
-    assert "beta, vial_mass were fitted" in document
+    assert "beta, vial_mass, h_outer, lam were fitted" in document
     # 30 s instead of the calibrated hour: the report says the fit need not hold for this run.
     assert "This run changes 1 of the preset&#x27;s values (duration)" in document
 

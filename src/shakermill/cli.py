@@ -26,7 +26,7 @@ from rich.table import Table
 from rich.text import Text
 
 from . import __version__
-from .calibrate import Curve, parse_free, parse_targets, write_preset
+from .calibrate import DEFAULT_FREE, free_set_study, parse_free, parse_targets, write_preset
 from .calibrate import calibrate as fit_parameters
 from .config import load_config
 from .params import (
@@ -59,7 +59,7 @@ from .sweep import (
 )
 from .sweep import sweep as run_sweep
 from .storage import RunData, StorageError, check_target, load_run, to_jsonable, write_run
-from .validation import EXPERIMENT, TABLE5, TARGET_KEYS
+from .validation import EXPERIMENT, TABLE5, TARGET_KEYS, Curve
 from .validation import validate as run_validation
 
 EXIT_FAILED_RUN = 1
@@ -618,33 +618,70 @@ def validate(
     solver: Annotated[
         str, typer.Option("--solver", help="'full' (default, as the paper) or 'averaged' (seconds instead of minutes).")
     ] = "full",
+    study: Annotated[
+        bool, typer.Option(help="Also fit several free sets to the experiment's curve and say which follow it (~15 s).")
+    ] = True,
     json_output: JsonOption = False,
 ) -> None:
-    """Paper Table 5 side by side: experiment, the paper's model, this model with published and calibrated parameters."""
+    """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
+    calibrated parameters, and which free sets of a calibration can follow the curve."""
     if solver not in ("full", "averaged"):
         _fail(f"solver: {solver!r} is not allowed; allowed: one of 'full', 'averaged'")
     runs = run_validation(solver)
+    outcomes = free_set_study(preset_parameters(DEFAULT_PRESET)) if study else []
     if json_output:
-        payload = {
-            "experiment_source": EXPERIMENT,
-            "solver": solver,
-            "quantities": {
-                entry.key: {"label": entry.label, "unit": entry.unit, "experiment": entry.experiment, "paper_model": entry.paper_model}
-                for entry in TABLE5
-            },
-            "runs": {
-                run.preset: {
-                    "fitted_parameters": list(run.fitted),
-                    "statement": run.statement,
-                    "values": {row.quantity.key: row.value for row in run.rows},
-                    "relative_error_vs_experiment": {row.quantity.key: row.error_vs_experiment for row in run.rows},
-                    "role": {row.quantity.key: row.role for row in run.rows},
-                }
-                for run in runs
-            },
-        }
-        typer.echo(json.dumps(to_jsonable(payload), sort_keys=True, allow_nan=False))
+        typer.echo(json.dumps(to_jsonable(validation_payload(runs, outcomes, solver)), sort_keys=True, allow_nan=False))
         return
+    console = _stdout_console()
+    console.print(validation_table(runs))
+    for run in runs:
+        console.print(Text(run.statement))
+    console.print(Text(f"The experiment's ratio is for five balls: {TABLE5[-1].experiment_note}."))
+    if outcomes:
+        console.print(free_set_table(outcomes))
+
+
+def preset_parameters(name: str) -> Parameters:
+    return load_config(preset=name, overrides=["record_windows="]).params
+
+
+def validation_payload(runs: Sequence[Any], outcomes: Sequence[Any], solver: str) -> dict[str, Any]:
+    return {
+        "experiment_source": EXPERIMENT,
+        "solver": solver,
+        "quantities": {
+            entry.key: {"label": entry.label, "unit": entry.unit, "experiment": entry.experiment, "paper_model": entry.paper_model}
+            for entry in TABLE5
+        },
+        "runs": {
+            run.preset: {
+                "fitted_parameters": list(run.fitted),
+                "statement": run.statement,
+                "values": {row.quantity.key: row.value for row in run.rows},
+                "relative_error_vs_experiment": {row.quantity.key: row.error_vs_experiment for row in run.rows},
+                "role": {row.quantity.key: row.role for row in run.rows},
+                "curve_rms_K": run.curve_rms_K,
+                "ball_steady_C": run.summary["ball_steady_C"],
+                "slowest_time_constant_min": run.summary["slowest_time_constant_min"],
+            }
+            for run in runs
+        },
+        "free_set_study": [
+            {
+                "free": list(outcome.free),
+                "fitted": outcome.calibration.fitted,
+                "curve_rms_K": outcome.calibration.curve_rms_K,
+                "follows_curve": outcome.follows_curve,
+                "at_edges": outcome.calibration.at_bounds,
+                "predictions": outcome.calibration.predictions,
+                "verdict": outcome.verdict,
+            }
+            for outcome in outcomes
+        ],
+    }
+
+
+def validation_table(runs: Sequence[Any]) -> Table:
     table = Table("quantity", "unit", "experiment", "paper's model", title=f"Table 5 ({EXPERIMENT})")
     for run in runs:
         table.add_column(f"{run.preset}", justify="right")
@@ -655,11 +692,30 @@ def validate(
             row = run.rows[index]
             cells += [f"{row.value:.4g} ({row.role})", f"{100 * row.error_vs_experiment:+.2f} %"]
         _add_plain_row(table, *cells)
-    console = _stdout_console()
-    console.print(table)
+    # The experiment's exponential plateau is its own estimate of the steady state; the paper gives none.
+    steady = ["ball steady state (MODEL.md §11)", "°C", f"{TABLE5[0].experiment:g}", "n/a"]
     for run in runs:
-        console.print(Text(run.statement))
-    console.print(Text(f"The experiment's ratio is for five balls: {TABLE5[-1].experiment_note}."))
+        value = run.summary["ball_steady_C"]
+        steady += [f"{value:.4g} (predicted)", f"{100 * (value - TABLE5[0].experiment) / TABLE5[0].experiment:+.2f} %"]
+    _add_plain_row(table, *steady)
+    deviation = ["RMS deviation from the experiment's curve, 0–60 min", "K", "0", "n/a"]
+    for run in runs:
+        deviation += [f"{run.curve_rms_K:.3g}", ""]
+    _add_plain_row(table, *deviation)
+    return table
+
+
+def free_set_table(outcomes: Sequence[Any]) -> Table:
+    table = Table(
+        "free keys", "fitted values", "RMS K", "vial/ball ratio (exp. 0.46)", "verdict",
+        title="Which free sets can follow the experiment's curve (fits within physically defensible ranges)",
+    )
+    for outcome in outcomes:
+        calibration = outcome.calibration
+        fitted = ", ".join(f"{key} {value:.3g}" for key, value in calibration.fitted.items())
+        ratio = calibration.predictions.get("vial_ball_ratio", math.nan)
+        _add_plain_row(table, ", ".join(outcome.free), fitted, _number(calibration.curve_rms_K, ".2f"), _number(ratio, ".3f"), outcome.verdict)
+    return table
 
 
 @app.command()
@@ -672,16 +728,22 @@ def calibrate(
         typer.Option("--target", "-t", metavar="NAME=VALUE", help=f"A target: {', '.join(TARGET_KEYS)}."),
     ] = None,
     curve: Annotated[
-        Path | None, typer.Option("--curve", help="CSV with time_s (or time_min) and ball_C columns to fit.")
+        Path | None,
+        typer.Option(
+            "--curve",
+            help="CSV with time_s (or time_min) and ball_C columns to fit (default, without --target: the "
+            "experiment's curve 48 - 28 exp(-t/16.7 min) over 0-60 min).",
+        ),
     ] = None,
     free: Annotated[
-        list[str] | None, typer.Option("--free", "-f", metavar="KEY[,KEY]", help="Keys to fit (default: beta,vial_mass).")
+        list[str] | None,
+        typer.Option("--free", "-f", metavar="KEY[,KEY]", help=f"Keys to fit (default: {','.join(DEFAULT_FREE)})."),
     ] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
 ) -> None:
-    """Fit free parameters to Table 5 targets and/or a measured curve by bounded least squares."""
+    """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])
         targets = parse_targets(target or [])
@@ -692,22 +754,27 @@ def calibrate(
         calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
     if out is not None:
         command = "shakermill calibrate " + " ".join(sys.argv[2:])
+        fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]
         description = (
-            f"{run_config.preset} with {', '.join(free_keys)} fitted to "
-            f"{', '.join([*targets, *(['curve ' + measured.source] if measured else [])])}"
+            f"{run_config.preset} with {', '.join(free_keys)} fitted to {', '.join(fitted_to)}; "
+            f"{', '.join(calibration.predictions)} are predictions"
         )
         write_preset(calibration, out, base_preset=run_config.preset, command=command, description=description)
     if json_output:
         typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False))
     else:
         console = _stdout_console()
-        table = Table("parameter", "start", "fitted", "std. error", title="calibration")
+        table = Table("parameter", "start", "fitted", "std. error", "physically defensible?", title="calibration")
         for key in free_keys:
             _add_plain_row(
                 table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}",
-                _number(calibration.parameter_stderr[key], ".3g"),
+                _number(calibration.parameter_stderr[key], ".3g"), calibration.defensible[key],
             )
         console.print(table)
+        predictions = Table("not fitted, predicted", "value", title="what the fitted model predicts")
+        for key, value in calibration.predictions.items():
+            _add_plain_row(predictions, key, _number(value, ".4g"))
+        console.print(predictions)
         if targets:
             residuals = Table("target", "wanted", "achieved", "residual", *[f"∂ln/∂ln {key}" for key in free_keys])
             for key, wanted in targets.items():
@@ -718,7 +785,10 @@ def calibrate(
                 )
             console.print(residuals)
         if calibration.curve_rms_K is not None:
-            console.print(Text(f"curve: rms residual {calibration.curve_rms_K:.3g} K"))
+            console.print(Text(f"curve ({calibration.curve_source}): RMS residual {calibration.curve_rms_K:.3g} K"))
+            for label, values in calibration.sensitivities.items():
+                if label not in targets:
+                    console.print(Text(f"d {label} / d ln(key), K: " + ", ".join(f"{key} {value:+.3g}" for key, value in values.items())))
         console.print(Text(f"{calibration.evaluations} model evaluations ({calibration.solver} solver): {calibration.message}"))
         if out is not None:
             console.print(Text(f"preset written to {out}; use it with `shakermill run {out}`"))

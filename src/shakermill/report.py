@@ -33,7 +33,7 @@ from .plotting import (
 )
 from .regime import classify_impacts, settled_run_impacts
 from .storage import CONFIG_FILE, RunData, load_run
-from .validation import EXPERIMENT, PAPER, ComparisonRow, compare
+from .validation import EXPERIMENT, PAPER, ComparisonRow, compare, fitted_quantities
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -98,9 +98,13 @@ ENERGY_TERMS = (
 RELATIVE_RESIDUAL_KEY = "relative_residual"
 
 RESULT_QUANTITIES = (
-    ("theta_inf_C", "ball θ∞ (exponential fit)", "°C", ".2f"),
-    ("tau_min", "time constant τ", "min", ".2f"),
-    ("rate0_C_per_min", "initial heating rate θ̇₀", "°C/min", ".3f"),
+    ("ball_steady_C", "ball steady state (root of the averaged network, MODEL.md §11)", "°C", ".2f"),
+    ("vial_steady_C", "vial steady state", "°C", ".2f"),
+    ("air_steady_C", "air steady state", "°C", ".2f"),
+    ("slowest_time_constant_min", "slowest time constant of the network", "min", ".1f"),
+    ("theta_inf_C", "ball θ∞ of the exponential fitted over the whole run (not the steady state)", "°C", ".2f"),
+    ("tau_min", "τ of that fit", "min", ".2f"),
+    ("rate0_C_per_min", "initial heating rate θ̇₀ of that fit", "°C/min", ".3f"),
     ("ball_C", "ball at the end", "°C", ".2f"),
     ("vial_C", "vial at the end", "°C", ".2f"),
     ("air_C", "air at the end", "°C", ".2f"),
@@ -328,11 +332,11 @@ def fitted_targets(preset: Preset | None) -> tuple[str, ...]:
     """The Table 5 quantities (summary keys) a preset's calibration was fitted to.
 
     ``Preset.fitted`` names the *parameters* the calibration set (beta, vial_mass); the quantities they
-    were fitted to are the keys of the provenance's ``targets``, as in :func:`shakermill.validation.validate`.
+    were fitted to come from its provenance, as in :func:`shakermill.validation.validate`.
     """
     if preset is None:
         return ()
-    return tuple(preset.provenance.get("targets", {}))
+    return fitted_quantities(preset.provenance)
 
 
 # ---------------------------------------------------------------- sections
