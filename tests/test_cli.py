@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
+from shakermill.calibrate import DEFAULT_FREE
 from shakermill.config import load_config
 from shakermill.params import FIELD_NAMES
 from shakermill.storage import RUN_FILES, load_run
@@ -302,11 +303,15 @@ def test_validate_prints_table5_with_fitted_and_predicted_roles():
     published, calibrated = payload["runs"]["spex8000m"], payload["runs"]["spex8000m-calibrated"]
     assert set(published["role"].values()) == {"predicted"}
     assert calibrated["role"]["vial_ball_ratio"] == "predicted"
-    assert calibrated["fitted_parameters"] == ["beta", "vial_mass"]
+    assert calibrated["fitted_parameters"] == list(DEFAULT_FREE)
     for key in ("theta_inf_C", "tau_min", "rate0_C_per_min"):
         assert calibrated["role"][key] == "fitted"
-        assert abs(calibrated["relative_error_vs_experiment"][key]) < 0.005
+        assert abs(calibrated["relative_error_vs_experiment"][key]) < 0.1
+    assert calibrated["curve_rms_K"] <= 1.0 < published["curve_rms_K"]
     assert payload["quantities"]["theta_inf_C"]["experiment"] == 48.0
+    study = {tuple(entry["free"]): entry for entry in payload["free_set_study"]}
+    assert study[DEFAULT_FREE]["follows_curve"] and not study[("beta", "vial_mass")]["follows_curve"]
+    assert "still rising at the hour" in study[("beta", "vial_mass")]["verdict"]
 
 
 def test_calibrate_writes_a_preset_that_run_accepts(tmp_path):
@@ -354,8 +359,8 @@ def test_plot_of_a_sweep_folder_draws_maps_with_the_contour(sweep_folder, tmp_pa
     assert outcome.exit_code == 0, outcome.stderr
     stems = {path.stem for path in (tmp_path / "maps").iterdir()}
     assert stems == {"sweep_theta_inf_C", "sweep_tau_min", "sweep_impact_rate_hz", "sweep_heat_power_W",
-                     "sweep_mean_impact_speed_m_s", "sweep_regime"}
-    assert "12 files written" in outcome.stdout
+                     "sweep_mean_impact_speed_m_s", "sweep_ball_steady_C", "sweep_regime"}
+    assert "14 files written" in outcome.stdout
     assert "not crossed" not in outcome.stderr
 
 

@@ -344,7 +344,7 @@ def test_sweep_maps_fill_the_grid_and_blank_the_failed_point():
     assert sorted(figures) == sorted([f"sweep_{column}" for column, _, _ in SWEEP_QUANTITIES] + ["sweep_regime"])
     axis, colourbar = figures["sweep_theta_inf_C"].axes
     assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "amplitude (mm)"
-    assert colourbar.get_ylabel() == "ball θ∞ (°C)"
+    assert colourbar.get_ylabel() == "ball θ∞ of the exponential fitted over the run (°C)"
     (mesh,) = axis.collections
     cells = mesh.get_array()
     # Rows are amplitudes, columns omegas; the failed point (omega 110, amplitude 28 mm) is masked.

@@ -81,7 +81,7 @@ def test_summary_json_is_strict_json_matching_the_result(run_folder, short_resul
     assert document["message"] == short_result.message
     assert document["counters"] == short_result.counters
     for key, value in short_result.summary.items():
-        if isinstance(value, str):
+        if isinstance(value, (str, list)):
             assert document["summary"][key] == value
         else:
             assert document["summary"][key] == pytest.approx(float(value), rel=1e-15), key

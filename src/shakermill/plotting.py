@@ -19,7 +19,7 @@ import io
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol, Sequence
+from typing import TYPE_CHECKING, Any, Protocol, Sequence
 
 import numpy as np
 import pandas as pd
@@ -62,6 +62,9 @@ class RunLike(Protocol):
 
     @property
     def ball_fit(self) -> ExponentialFit: ...
+
+    @property
+    def summary(self) -> dict[str, Any]: ...
 
 
 def plot_run(run: RunLike, out_dir: Path | str, *, impacts: bool = False, dpi: int = PNG_DPI) -> list[Path]:
@@ -128,11 +131,19 @@ def temperature_figure(run: RunLike) -> Figure:
     for name, label, colour in temperature_curves(run.params):
         axis.plot(minutes, to_celsius(series[name].values), color=colour, label=label)
     fit = run.ball_fit
+    window = f"0–{minutes[-1]:.3g} min"
     if math.isfinite(fit.theta_inf) and math.isfinite(fit.tau):
-        axis.plot(minutes, to_celsius(fit.evaluate(series["time"].values)), "k--", lw=1, label="ball, exponential fit")
+        axis.plot(
+            minutes, to_celsius(fit.evaluate(series["time"].values)), "k--", lw=1,
+            label=f"ball, exponential fitted over {window}",
+        )
+    steady = run.summary.get("ball_steady_C")
+    if steady is not None and math.isfinite(steady):
+        # The fit's θ∞ is a property of the window; the steady state is where the ball really settles.
+        axis.axhline(steady, color="tab:red", ls=":", lw=1, label=f"ball steady state {steady:.1f} °C (MODEL.md §11)")
     axis.text(
-        0.98, 0.04, _fit_text(fit), transform=axis.transAxes, ha="right", va="bottom",
-        bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
+        0.98, 0.04, f"exponential fitted over {window}:\n{_fit_text(fit)}", transform=axis.transAxes, ha="right",
+        va="bottom", bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
     )
     axis.set_xlabel("time (min)")
     axis.set_ylabel("temperature (°C)")
@@ -396,11 +407,12 @@ def png_bytes(figure: Figure, dpi: int = PNG_DPI) -> bytes:
 
 # (column of the sweep table, quantity, unit) drawn by `shakermill plot SWEEP_DIR`.
 SWEEP_QUANTITIES = (
-    ("theta_inf_C", "ball θ∞", "°C"),
+    ("theta_inf_C", "ball θ∞ of the exponential fitted over the run", "°C"),
     ("tau_min", "time constant τ", "min"),
     ("impact_rate_hz", "impact rate", "1/s"),
     ("heat_power_W", "heat generated", "W"),
     ("mean_impact_speed_m_s", "mean impact speed", "m/s"),
+    ("ball_steady_C", "ball steady state", "°C"),
 )
 # Lengths read better in mm: a vial is a few centimetres long.
 DISPLAY_UNITS = {"m": (1e3, "mm")}
