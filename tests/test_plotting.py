@@ -97,8 +97,13 @@ def test_temperature_figure_shows_celsius_minutes_and_the_fit(result):
     minutes = result.timeseries["time"].values / 60.0
     np.testing.assert_allclose(lines["ball"].get_xdata(), minutes)
     np.testing.assert_allclose(lines["vial"].get_ydata(), result.timeseries["theta_vial"].values - 273.15)
-    fit_line = lines["ball, exponential fit"]
+    window = f"0–{minutes[-1]:.3g} min"
+    fit_line = lines[f"ball, exponential fitted over {window}"]
     assert fit_line.get_linestyle() == "--"
+    steady = result.summary["ball_steady_C"]
+    (steady_line,) = [line for label, line in lines.items() if label.startswith("ball steady state")]
+    np.testing.assert_allclose(steady_line.get_ydata(), [steady, steady])
+    assert f"{steady:.1f} °C" in steady_line.get_label()
     np.testing.assert_allclose(
         fit_line.get_ydata(), result.ball_fit.evaluate(result.timeseries["time"].values) - 273.15
     )
@@ -232,7 +237,8 @@ def test_ball_only_temperature_figure_draws_vial_and_air_as_one_ambient_line(res
     run = dataclasses.replace(result, params=result.params.replace(model="ball_only"))
     (axis,) = temperature_figure(run).axes
     labels = [line.get_label() for line in axis.get_lines()]
-    assert labels == ["ball", "vial and air (held at ambient: ball_only model)", "ball, exponential fit"]
+    assert labels[:2] == ["ball", "vial and air (held at ambient: ball_only model)"]
+    assert labels[2].startswith("ball, exponential fitted over 0–")
 
 
 def test_png_bytes_is_a_png(result):
@@ -400,7 +406,7 @@ def test_one_key_sweep_is_a_line_with_the_contour_crossing_marked():
     np.testing.assert_allclose(curve.get_ydata(), [50.0, 70.0, 90.0])
     assert crossing.get_xdata()[0] == pytest.approx(100.0)  # linear between (90, 50) and (110, 70)
     assert level.get_ydata()[0] == pytest.approx(60.0)
-    assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "ball θ∞ (°C)"
+    assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "ball θ∞ of the exponential fitted over the run (°C)"
 
 
 def test_regime_map_counts_each_regime_and_the_failed_points():
