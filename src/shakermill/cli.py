@@ -290,9 +290,11 @@ def summary_table(result: Result, target: Path) -> Table:
 
 
 COMPARED_QUANTITIES = (
-    ("theta_inf_C", "ball θ∞", "°C"),
-    ("tau_min", "time constant τ", "min"),
-    ("rate0_C_per_min", "initial heating rate θ̇₀", "°C/min"),
+    ("ball_steady_C", "ball steady state", "°C"),
+    ("slowest_time_constant_min", "slowest time constant", "min"),
+    ("theta_inf_C", "ball θ∞ of the exponential fitted over the run", "°C"),
+    ("tau_min", "τ of that fit", "min"),
+    ("rate0_C_per_min", "initial heating rate θ̇₀ of that fit", "°C/min"),
     ("ball_C", "ball at the end", "°C"),
     ("vial_C", "vial at the end", "°C"),
     ("air_C", "air at the end", "°C"),
@@ -451,8 +453,9 @@ def report(
 SWEEP_PREVIEW_ROWS = 20
 SWEEP_PREVIEW_COLUMNS = (
     ("regime", "regime", ""),
-    ("theta_inf_C", "θ∞", "°C"),
-    ("tau_min", "τ", "min"),
+    ("ball_steady_C", "steady", "°C"),
+    ("theta_inf_C", "θ∞ (fit)", "°C"),
+    ("tau_min", "τ (fit)", "min"),
     ("impact_rate_hz", "impact rate", "Hz"),
     ("heat_power_W", "heat", "W"),
     ("mean_impact_speed_m_s", "mean speed", "m/s"),
