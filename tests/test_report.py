@@ -280,3 +280,13 @@ def test_report_renders_in_headless_chromium(run_folder, tmp_path):
     images = re.findall(r"<img[^>]*>", dom.stdout)
     assert len(images) >= 4
     assert all('src="data:image/png;base64,' in image for image in images)
+
+
+def test_report_shows_the_runs_warnings_and_its_steady_state(run_folder, report_html):
+    summary = load_run(run_folder).summary
+    # 30 s is far shorter than three slowest time constants: the run says so, and so does its report.
+    assert any("slowest time constants" in line for line in summary["warnings"])
+    for line in summary["warnings"]:
+        assert html.escape("Warning: " + line) in report_html
+    results = "".join(rows_of_table_after(report_html, "Results"))
+    assert "ball steady state" in results and number(summary["ball_steady_C"], ".2f") in results

@@ -361,9 +361,10 @@ def header_section(run: RunData) -> str:
         ("command", str(provenance.get("command", "n/a"))),
         ("overrides (--set)", ", ".join(provenance.get("overrides", [])) or "none"),
     ]
+    warnings = "".join(f"<p class=\"status failed\">{esc('Warning: ' + line)}</p>\n" for line in run.summary.get("warnings", []))
     return (
         f"<header>\n<h1>{esc('shakermill run report: ' + run_name(run))}</h1>\n"
-        f"<p class=\"status {status_class}\">{esc(status)}</p>\n"
+        f"<p class=\"status {status_class}\">{esc(status)}</p>\n{warnings}"
         + table(None, facts)
         + "\n</header>"
     )
@@ -435,8 +436,14 @@ def fitted_statement(run: RunData, preset: Preset | None, rows: Sequence[Compari
             f"name the quantities they were fitted to, so every quantity is listed as predicted."
         )
     else:
+        through = (
+            f"the experiment's curve ({preset.provenance['curve']}; RMS deviation "
+            f"{preset.provenance.get('curve_rms_K', math.nan):.2f} K), which carries {fitted},"
+            if "curve" in preset.provenance
+            else f"make {fitted} match the experiment,"
+        )
         statement = (
-            f"{', '.join(preset.fitted)} were fitted (preset {preset.name}) to make {fitted} match the experiment, "
+            f"{', '.join(preset.fitted)} were fitted (preset {preset.name}) to {through} "
             f"so agreement on these is by construction; predicted, not fitted: {predicted or 'nothing'}."
         )
     changed = [key for key in keys_differing_from_preset(run, preset) if key not in OUTPUT_ONLY_KEYS]
