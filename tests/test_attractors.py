@@ -53,6 +53,7 @@ def test_a_periodic_attractor_hits_a_whole_number_of_times_per_cycle(coexisting)
     params, scan = coexisting
     drive_period = 2 * math.pi / params.omega
     for attractor in scan.attractors:
+        assert attractor.period is not None
         per_cycle = attractor.impact_rate_hz * attractor.period * drive_period
         assert per_cycle == pytest.approx(round(per_cycle), abs=1e-9) and per_cycle >= 1
 
