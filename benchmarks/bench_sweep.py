@@ -69,7 +69,7 @@ def main() -> None:
             f"{medians[workers] / len(plan.points):7.3f} | {table['wall_time_s'].sum():9.2f} | {verdict}"
         )
     print("Σ point s: the points' own run times (last repeat), summed over workers; the rest is the sweep's own")
-    print("work (regime classification, point files, table) and, with workers > 1, the pool's start-up.")
+    print("work (regime classification, attractor probes, point files, table) and, with workers > 1, the pool's start-up.")
     print()
 
     if 1 in medians:

@@ -416,6 +416,15 @@ def test_regime_map_counts_each_regime_and_the_failed_points():
     assert labels == ["period-1 (1)", "period-2 (3)", "irregular (1)", "failed (1)"]
 
 
+def test_regime_map_frames_the_points_with_more_than_one_attractor():
+    table = synthetic_sweep(failed_index=0)
+    table["n_attractors"] = pd.array([None, 1, 2, 1, 3, 1], dtype="Int64")
+    (axis,) = sweep_figures(table, ("omega", "amplitude"))["sweep_regime"].axes
+    assert [text.get_text() for text in axis.get_legend().get_texts()][-1] == "more than one attractor (2)"
+    framed = axis.collections[-1].get_offsets()
+    np.testing.assert_allclose(framed, [[110.0, 24.0], [130.0, 24.0]])
+
+
 def test_sweeps_over_three_keys_are_refused_with_one_line():
     with pytest.raises(sm.ParameterError, match="3 keys"):
         sweep_figures(synthetic_sweep(), ("omega", "amplitude", "restitution"))
@@ -431,19 +440,42 @@ def test_bad_contours_name_the_problem(spec, message):
     assert parse_contour(" theta_inf_C = 60 ", ["theta_inf_C"]) == ("theta_inf_C", 60.0)
 
 
-def test_bifurcation_figure_plots_every_phase_and_the_periods():
+def test_bifurcation_figure_plots_every_phase_and_the_periods_of_every_attractor():
     phases = pd.DataFrame(
-        {"omega": [100.0, 100.0, 100.0, 110.0, 110.0], "phase": [0.5, 4.0, 5.9, 1.0, 3.0], "wall": ["left", "right", "left", "left", "right"]}
+        {
+            "omega": [100.0, 100.0, 100.0, 110.0, 110.0],
+            "start": [0, 0, 1, 0, 0],
+            "attractor": [0, 0, 1, 0, 0],
+            "phase": [0.5, 4.0, 5.9, 1.0, 3.0],
+            "wall": ["left", "right", "left", "left", "right"],
+        }
     )
-    regimes = pd.DataFrame({"omega": [100.0, 110.0], "regime": ["period-1", "irregular"], "period": pd.array([1, None], dtype="Int64")})
-    figure = bifurcation_figure(phases, regimes, "omega")
+    attractors = pd.DataFrame(
+        {
+            "omega": [100.0, 100.0, 110.0],
+            "attractor": [0, 1, 0],
+            "regime": ["period-1", "period-2", "irregular"],
+            "period": pd.array([1, 2, None], dtype="Int64"),
+            "basin_fraction": [0.75, 0.25, 1.0],
+        }
+    )
+    figure = bifurcation_figure(phases, attractors, "omega")
     phase_axis, period_axis = figure.axes
-    left, right = phase_axis.collections
-    np.testing.assert_allclose(left.get_offsets()[:, 1], [0.5, 5.9, 1.0])
-    np.testing.assert_allclose(right.get_offsets()[:, 1], [4.0, 3.0])
+    # One scatter per attractor and end face: attractor 0 left, right; attractor 1 left, right.
+    first_left, first_right, second_left, second_right = phase_axis.collections
+    np.testing.assert_allclose(first_left.get_offsets()[:, 1], [0.5, 1.0])
+    np.testing.assert_allclose(first_right.get_offsets()[:, 1], [4.0, 3.0])
+    np.testing.assert_allclose(second_left.get_offsets()[:, 1], [5.9])
+    assert len(second_right.get_offsets()) == 0
+    assert not np.allclose(first_left.get_edgecolor()[0], second_left.get_edgecolor()[0])
+    legend = [text.get_text() for text in phase_axis.get_legend().get_texts()]
+    assert legend == ["attractor 0 (configured start)", "attractor 1", "left end face", "right end face"]
     assert phase_axis.get_ylim() == pytest.approx((0.0, 2 * np.pi))
-    periodic, irregular = period_axis.get_lines()
-    np.testing.assert_allclose(periodic.get_ydata(), [1.0, np.nan])
-    np.testing.assert_allclose(irregular.get_xdata(), [110.0])
+    (periods,) = period_axis.collections
+    # Irregular motion is drawn one above the largest period; marker area follows the basin fraction.
+    np.testing.assert_allclose(periods.get_offsets(), [[100.0, 1.0], [100.0, 2.0], [110.0, 3.0]])
+    sizes = periods.get_sizes()
+    assert sizes[0] == pytest.approx(3 * sizes[1]) and sizes[2] == pytest.approx(4 * sizes[1])
     assert period_axis.get_xlabel() == "omega (rad/s)"
+    assert period_axis.get_ylabel().startswith("period n (drive periods)")
     assert phase_axis.get_ylabel() == "impact phase ωt + φ mod 2π (rad)"

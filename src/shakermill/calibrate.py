@@ -238,7 +238,8 @@ def calibrate(
     def evaluate(x: np.ndarray) -> tuple[np.ndarray, Result]:
         key = tuple(np.round(x, 14))
         if key not in cache:
-            params = base.replace(solver=solver, **{name: float(math.exp(v)) for name, v in zip(free, x)})
+            # The fit needs the configured motion only: probing other attractors would cost every evaluation.
+            params = base.replace(solver=solver, attractor_starts=1, **{name: float(math.exp(v)) for name, v in zip(free, x)})
             result = simulate(params)
             cache[key] = (_residuals(result, targets, curve), result)
         return cache[key]
@@ -273,7 +274,7 @@ def calibrate(
             "range: the data pull beyond what physics allows"
         )
     return Calibration(
-        params=result.params.replace(solver=base.solver),
+        params=result.params.replace(solver=base.solver, attractor_starts=base.attractor_starts),
         free=free,
         fitted=fitted,
         start=start,

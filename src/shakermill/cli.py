@@ -590,7 +590,7 @@ def bifurcation(
             _fail("interrupted; nothing was written (a scan is quick to repeat)", EXIT_INTERRUPTED)
     try:
         paths = write_bifurcation(scan, target)
-        paths += plot_figures({"bifurcation": bifurcation_figure(scan.phases, scan.regimes, key)}, target, dpi=dpi)
+        paths += plot_figures({"bifurcation": bifurcation_figure(scan.phases, scan.attractors, key)}, target, dpi=dpi)
     except OSError as exc:
         _fail(f"{target}: cannot write the results ({exc.strerror or exc})")
     counts = scan.regimes["regime"].value_counts()
@@ -600,7 +600,31 @@ def bifurcation(
         _add_plain_row(table, str(label), str(count), f"{inside.min():.5g} – {inside.max():.5g}")
     console = _stdout_console()
     console.print(table)
+    console.print(coexisting_attractors_table(scan.attractors, key, run_config.params.attractor_starts))
     console.print(Text(f"{len(paths)} files written to {target}"))
+
+
+COEXISTING_PREVIEW_ROWS = 20
+
+
+def coexisting_attractors_table(attractors: pd.DataFrame, key: str, starts: int) -> Table:
+    """The values with more than one attractor: each attractor's regime, basin fraction and heat power."""
+    counts = attractors.groupby(key, sort=False)["attractor"].transform("size")
+    several = attractors[counts > 1]
+    values = several[key].unique()
+    unit = field_unit(key)
+    table = Table(
+        f"{key} ({unit})" if unit else key, "attractor", "regime", "basin fraction", "heat power (W)", "impact rate (Hz)",
+        title=f"coexisting attractors ({starts} starts per value): at {len(values)} of {attractors[key].nunique()} values",
+    )
+    for _, row in several[several[key].isin(values[:COEXISTING_PREVIEW_ROWS])].iterrows():
+        _add_plain_row(
+            table, f"{row[key]:.5g}", str(row["attractor"]), str(row["regime"]), f"{row['basin_fraction']:.2f}",
+            f"{row['heat_power_W']:.4g}", f"{row['impact_rate_hz']:.4g}",
+        )
+    more = len(values) - COEXISTING_PREVIEW_ROWS
+    table.caption = (f"{more} more values; " if more > 0 else "") + "all attractors: bifurcation_attractors.csv"
+    return table
 
 
 def format_value(key: str, value: Any) -> str:

@@ -110,6 +110,13 @@ class Parameters(BaseModel):
     averaging_fallback: Literal["full", "fail"] = Field(
         json_schema_extra={"description": "averaged solver: what to do when averaging is not valid"}
     )
+    attractor_starts: int = Field(
+        ge=1,
+        json_schema_extra={
+            "unit": "",
+            "description": "initial states settled to find coexisting attractors (bifurcation, sweeps, averaged solver); 1: only the configured start",
+        },
+    )
     # Model options (MODEL.md sections 2-4: the alternatives the spec allows)
     model: Literal["three_node", "ball_only"] = Field(
         json_schema_extra={
@@ -299,6 +306,11 @@ SPEX_8000M = Preset(
         "averaging_min_batches": Cited(10, "numerical choice: the usual minimum for batch means"),
         "averaging_max_time": Cited(120.0, "numerical choice: 2 simulated minutes of mechanics at most"),
         "averaging_fallback": Cited("full", "numerical choice: fall back to full resolution and say so"),
+        "attractor_starts": Cited(
+            8,
+            "numerical choice: the configured start and 7 spread over the free gap, at rest or at the vial's peak "
+            "speed; ~0.02 s of mechanics each",
+        ),
         "energy_projection": Cited(True, "numerical choice: projection method (Hairer, Lubich & Wanner 2006, §IV.4)"),
         "model": Cited("three_node", f"{PAPER}: ball, vial and inner air as three lumped reservoirs"),
         "no_tension": Cited(False, "MODEL.md section 2: the total force is not clipped by default"),

@@ -613,7 +613,10 @@ def sweep_map_figure(
 
 
 def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
-    """The regime of each point (period-n, irregular, no impacts; failed points open) over the swept keys."""
+    """The regime of each point (period-n, irregular, no impacts; failed points open) over the swept keys.
+
+    The regime is the configured start's; points where other starts settle elsewhere are framed.
+    """
     figure, (axis,) = _new_figure(height=4.0 if len(keys) == 1 else 5.0)
     x = display_values(keys[0], table[keys[0]].to_numpy())
     y = display_values(keys[1], table[keys[1]].to_numpy()) if len(keys) == 2 else np.zeros(len(table))
@@ -628,6 +631,12 @@ def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
         # Colours by rank among the periods present, so that period-4 and period-12 never share one.
         colour = PERIOD_COLOURS[periods.index(label) % len(PERIOD_COLOURS)] if label in periods else REGIME_COLOURS[label]
         axis.scatter(x[inside], y[inside], marker="s", s=70, color=colour, label=f"{label} ({inside.sum()})")
+    if "n_attractors" in table:  # sweeps before attractors were probed have no such column
+        several = _numeric(table, "n_attractors") > 1
+        axis.scatter(
+            x[several], y[several], marker="s", s=150, facecolors="none", edgecolors="black", lw=1.2,
+            label=f"more than one attractor ({several.sum()})",
+        )
     axis.set_xlabel(axis_label(keys[0]))
     if len(keys) == 2:
         axis.set_ylabel(axis_label(keys[1]))
@@ -646,35 +655,72 @@ def _regime_order(label: str) -> tuple[int, int]:
     return 1, ("irregular", "no impacts", "failed").index(label)
 
 
-def bifurcation_figure(phases: pd.DataFrame, regimes: pd.DataFrame, key: str) -> Figure:
-    """Bifurcation diagram: the drive phase of every settled impact against ``key``, by end face, with the regimes."""
-    from matplotlib.ticker import MaxNLocator
+# End faces in the bifurcation diagram, where the colour tells the attractors apart.
+WALL_MARKERS = (("left", "left end face", "o"), ("right", "right end face", "x"))
+# Marker area in the period panel of an attractor reached from every start (pt²).
+FULL_BASIN_AREA = 60.0
 
-    figure, (phase_axis, period_axis) = _new_figure(rows=2, height=6.5)
-    for wall, label, colour in WALLS:
-        inside = phases["wall"] == wall
-        x = display_values(key, phases.loc[inside, key].to_numpy())
-        phase_axis.scatter(x, phases.loc[inside, "phase"], s=1.5, color=colour, alpha=0.6, lw=0, label=label)
+
+def bifurcation_figure(phases: pd.DataFrame, attractors: pd.DataFrame, key: str) -> Figure:
+    """Bifurcation diagram: the drive phase of every settled impact against ``key`` (top) and the period of
+    each attractor (bottom), coloured by attractor; attractor 0 is the configured start's at every value."""
+    figure, (phase_axis, period_axis) = _new_figure(rows=2, height=7.0)
+    labels = sorted(set(attractors["attractor"]) | set(phases["attractor"]))
+    for label in labels:
+        colour = PERIOD_COLOURS[label % len(PERIOD_COLOURS)]
+        for wall, _, marker in WALL_MARKERS:
+            inside = (phases["attractor"] == label) & (phases["wall"] == wall)
+            x = display_values(key, phases.loc[inside, key].to_numpy())
+            phase_axis.scatter(x, phases.loc[inside, "phase"], s=4, marker=marker, color=colour, alpha=0.6, lw=0.6)
     _radian_ticks(phase_axis.yaxis)
     phase_axis.set_ylim(0.0, 2 * math.pi)
     phase_axis.set_ylabel("impact phase ωt + φ mod 2π (rad)")
     # Above the axes: inside, the legend would hide branches near 0 or 2π.
-    phase_axis.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=2, markerscale=6, fontsize="small", frameon=False)
-    figure.suptitle(f"Bifurcation diagram over {key}: impact phases of the settled motion")
-    x = display_values(key, regimes[key].to_numpy())
-    periods = pd.to_numeric(regimes["period"], errors="coerce").to_numpy(dtype=float)
-    period_axis.plot(x, periods, "o", ms=3, color="tab:blue", label="period-n")
-    irregular = (regimes["regime"] == "irregular").to_numpy()
-    if irregular.any():
-        top = np.nanmax(periods, initial=1.0) + 1
-        period_axis.plot(x[irregular], np.full(irregular.sum(), top), "x", ms=4, color="0.25", label=f"irregular (at {top:g})")
-        period_axis.legend(loc="best", fontsize="small")
-    period_axis.yaxis.set_major_locator(MaxNLocator(integer=True))
-    period_axis.set_ylabel("period n (drive periods)")
+    phase_axis.legend(
+        handles=_attractor_handles(labels) + _wall_handles(),
+        loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=4, fontsize="small", frameon=False,
+    )
+    figure.suptitle(f"Bifurcation diagram over {key}: impact phases of every attractor")
+    _attractor_periods(period_axis, attractors, key)
     period_axis.set_xlabel(axis_label(key))
     for axis in (phase_axis, period_axis):
         axis.grid(alpha=0.3)
     return figure
+
+
+def _attractor_periods(axis: object, attractors: pd.DataFrame, key: str) -> None:
+    """Period of each attractor, irregular ones above the largest period; marker area ∝ basin fraction."""
+    from matplotlib.ticker import MaxNLocator
+
+    periods = pd.to_numeric(attractors["period"], errors="coerce").to_numpy(dtype=float)
+    top = np.nanmax(periods, initial=1.0) + 1
+    irregular = (attractors["regime"] == "irregular").to_numpy()
+    shown = np.where(irregular, top, periods)
+    x = display_values(key, attractors[key].to_numpy())
+    colours = [PERIOD_COLOURS[label % len(PERIOD_COLOURS)] for label in attractors["attractor"]]
+    # Open markers: two attractors of the same period at one value show as concentric rings.
+    axis.scatter(x, shown, s=FULL_BASIN_AREA * attractors["basin_fraction"].to_numpy(), facecolors="none", edgecolors=colours)  # type: ignore[attr-defined]
+    if irregular.any():
+        axis.axhline(top, color="0.6", lw=0.8, ls=":")  # type: ignore[attr-defined]
+        axis.text(0.01, top, f" irregular (drawn at {top:g})", transform=axis.get_yaxis_transform(), va="bottom", fontsize="small")  # type: ignore[attr-defined]
+    axis.yaxis.set_major_locator(MaxNLocator(integer=True))  # type: ignore[attr-defined]
+    axis.set_ylabel("period n (drive periods)\nmarker area ∝ basin fraction")  # type: ignore[attr-defined]
+
+
+def _attractor_handles(labels: Sequence[int]) -> list:
+    from matplotlib.lines import Line2D
+
+    return [
+        Line2D([], [], ls="", marker="s", color=PERIOD_COLOURS[label % len(PERIOD_COLOURS)],
+               label="attractor 0 (configured start)" if label == 0 else f"attractor {label}")
+        for label in labels
+    ]
+
+
+def _wall_handles() -> list:
+    from matplotlib.lines import Line2D
+
+    return [Line2D([], [], ls="", marker=marker, color="0.3", label=name) for _, name, marker in WALL_MARKERS]
 
 
 def plot_figures(figures: dict[str, Figure], out_dir: Path | str, *, dpi: int = PNG_DPI) -> list[Path]:

@@ -62,7 +62,11 @@ def impact_phases(impacts: pd.DataFrame, omega: float, phase: float) -> ImpactPh
     )
 
 
-def _signatures(phases: ImpactPhases) -> list[tuple[tuple[str, ...], np.ndarray]]:
+# The walls and the drive phases of the impacts of one drive period.
+Signature = tuple[tuple[str, ...], np.ndarray]
+
+
+def period_signatures(phases: ImpactPhases) -> list[Signature]:
     """(walls, phases) of each complete drive period, first to last (the partial ends are dropped).
 
     The impacts are in time order, so each period is one slice: linear in the number of impacts,
@@ -76,11 +80,12 @@ def _signatures(phases: ImpactPhases) -> list[tuple[tuple[str, ...], np.ndarray]
     ]
 
 
-def _matches(a: tuple[tuple[str, ...], np.ndarray], b: tuple[tuple[str, ...], np.ndarray]) -> bool:
+def signatures_match(a: Signature, b: Signature, tolerance: float = PHASE_TOLERANCE) -> bool:
+    """Same walls in the same order, each phase within ``tolerance`` (rad, on the circle)."""
     if a[0] != b[0]:
         return False
     difference = np.abs(a[1] - b[1])
-    return bool(np.all(np.minimum(difference, 2 * math.pi - difference) <= PHASE_TOLERANCE))
+    return bool(np.all(np.minimum(difference, 2 * math.pi - difference) <= tolerance))
 
 
 def classify(result: Result) -> tuple[str, int | None]:
@@ -93,22 +98,23 @@ def classify_impacts(settled: pd.DataFrame, omega: float, phase: float) -> tuple
     """The regime of a settled motion from its impacts (columns ``time`` and ``wall``), drive ω and φ."""
     if settled.empty:
         return NO_IMPACTS, None
-    signatures = _signatures(impact_phases(settled, omega, phase))
+    signatures = period_signatures(impact_phases(settled, omega, phase))
     for period in range(1, MAX_PERIOD + 1):
         if len(signatures) < (MIN_REPEATS + 1) * period:
             break
-        if all(_matches(signatures[k], signatures[k + period]) for k in range(len(signatures) - period)):
+        if all(signatures_match(signatures[k], signatures[k + period]) for k in range(len(signatures) - period)):
             return f"period-{period}", period
     return IRREGULAR, None
 
 
 @dataclass(frozen=True)
 class Bifurcation:
-    """Per value of the scanned key: the regime, and the phases of the settled impacts (long format)."""
+    """Per value of the scanned key: the configured start's regime, every attractor, and their impact phases."""
 
     key: str
-    regimes: pd.DataFrame  # <key>, regime, period, solver, message
-    phases: pd.DataFrame  # <key>, phase, wall
+    regimes: pd.DataFrame  # <key>, regime, period, solver, message (the configured start's run), n_attractors
+    attractors: pd.DataFrame  # <key>, attractor, regime, period, basin_fraction, impact_rate_hz, heat_power_W, starts
+    phases: pd.DataFrame  # <key>, start, attractor, phase, wall: the settled impacts of every start
 
 
 def bifurcation(
@@ -117,36 +123,51 @@ def bifurcation(
     key: str = "omega",
     progress: Callable[[int, int], None] | None = None,
 ) -> Bifurcation:
-    """Settle the motion at each value of ``key`` and record its impact phases and regime.
+    """Settle the motion at each value of ``key`` from every start; record the attractors and their impact phases.
 
-    The impacts are those of the settled motion: the averaged solver's mechanics phase (transient
-    cut by MSER) when ``base`` uses it, the second half of a full run otherwise. The phase of an
-    impact is ωt + φ (mod 2π) with the ω of that run. Ctrl-C during a run raises
-    ``KeyboardInterrupt``.
+    The regime in ``regimes`` is that of a run from the configured start with ``base``'s solver (the
+    averaged solver's mechanics phase, transient cut by MSER, or the second half of a full run).
+    ``attractors`` and ``phases`` come from ``base.attractor_starts`` starts settled at full
+    resolution (:mod:`shakermill.attractors`); the phase of an impact is ωt + φ (mod 2π) with the ω
+    of that run. Ctrl-C during a run raises ``KeyboardInterrupt``.
     """
+    from .attractors import probed
     from .simulate import INTERRUPTED, simulate
 
-    regimes, phases = [], []
+    regimes, attractors, phases = [], [], []
     for index, value in enumerate(values):
         result = simulate(base.replace(**{key: float(value)}))
         if result.status == INTERRUPTED:
             # simulate() turns Ctrl-C into a status; the scan must stop, not go on to the next value.
             raise KeyboardInterrupt
-        settled = settled_impacts(result.impacts, result.solver, result.t_end)
-        label, period = classify_impacts(settled, result.params.omega, result.params.phase)
-        angles = impact_phases(settled, result.params.omega, result.params.phase)
-        regimes.append({key: float(value), "regime": label, "period": period, "solver": result.solver, "message": result.message})
-        phases.append(pd.DataFrame({key: float(value), "phase": angles.phase, "wall": angles.wall}))
+        scan = probed(result)
+        label, period = classify(result)
+        regimes.append(
+            {key: float(value), "regime": label, "period": period, "solver": result.solver, "message": result.message,
+             "n_attractors": len(scan.attractors)}
+        )
+        attractors.append(_keyed(scan.table(), key, value))
+        phases.append(_keyed(scan.phases(result.params.omega, result.params.phase), key, value))
         if progress is not None:
             progress(index + 1, len(values))
     table = pd.DataFrame(regimes)
     table["period"] = table["period"].astype("Int64")
-    return Bifurcation(key, table, pd.concat(phases, ignore_index=True))
+    return Bifurcation(key, table, pd.concat(attractors, ignore_index=True), pd.concat(phases, ignore_index=True))
+
+
+def _keyed(table: pd.DataFrame, key: str, value: float) -> pd.DataFrame:
+    """``table`` with the scanned value as its first column."""
+    table.insert(0, key, float(value))
+    return table
 
 
 def write_bifurcation(scan: Bifurcation, folder: Path) -> list[Path]:
-    """``bifurcation_regimes`` and ``bifurcation_phases`` tables (Parquet and CSV) in ``folder``."""
+    """``bifurcation_regimes``, ``bifurcation_attractors`` and ``bifurcation_phases`` tables (Parquet and CSV) in ``folder``."""
     from .sweep import write_table
 
     folder.mkdir(parents=True, exist_ok=True)
-    return [*write_table(scan.regimes, folder, "bifurcation_regimes"), *write_table(scan.phases, folder, "bifurcation_phases")]
+    return [
+        *write_table(scan.regimes, folder, "bifurcation_regimes"),
+        *write_table(scan.attractors, folder, "bifurcation_attractors"),
+        *write_table(scan.phases, folder, "bifurcation_phases"),
+    ]

@@ -41,8 +41,8 @@ if TYPE_CHECKING:
 REPORT_FILE = "report.html"
 # Screen resolution: sharp enough in a browser, and keeps a report of six figures well under a megabyte.
 EMBED_DPI = 100
-# Keys that change what is stored, not what is simulated: a calibration still holds when they differ.
-OUTPUT_ONLY_KEYS = frozenset({"record_windows", "output_interval"})
+# Keys that change what is stored or reported, not what is simulated: a calibration still holds when they differ.
+OUTPUT_ONLY_KEYS = frozenset({"record_windows", "output_interval", "attractor_starts"})
 
 FIGURE_CAPTIONS = {
     "ball_motion": (

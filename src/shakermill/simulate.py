@@ -25,6 +25,7 @@ from .params import Parameters, unit_slip_warnings
 from .steady import SteadyState, run_length_warning, settled_means, steady_state
 
 if TYPE_CHECKING:
+    from .attractors import AttractorScan
     from .averaged import MechanicsAverages
 
 # The step inside a contact stays below this fraction of the Rayleigh time (MODEL.md §7).
@@ -119,6 +120,7 @@ class Result:
     impact_window: float | None = None  # s covered by ``impacts``; None means the whole run
     averages: MechanicsAverages | None = None
     steady: SteadyState | None = None
+    attractors: AttractorScan | None = None  # the settled motions of other starts, where they were probed
     # One line each, for things a user should know that do not stop the run (stderr and summary.json).
     warnings: list[str] = field(default_factory=list)
     summary: dict[str, float | int | str | bool | list[str]] = field(default_factory=dict)
@@ -477,5 +479,7 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         summary.update(result.steady.as_summary())
     if result.averages is not None:
         summary.update(result.averages.as_summary())
+    if result.attractors is not None:
+        summary.update(result.attractors.as_summary())
     summary["warnings"] = list(result.warnings)
     return summary

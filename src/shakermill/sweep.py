@@ -286,7 +286,9 @@ class PointInterrupted(Exception):
 
 def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = False) -> PointOutcome:
     """Run one point and build its table row; a point that cannot run records why instead of raising."""
-    from .regime import classify  # regime builds on simulate; imported where it is used
+    # Both build on simulate; imported where they are used.
+    from .attractors import probed
+    from .regime import classify
 
     swept = dict(values)
     try:
@@ -296,13 +298,16 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
     try:
         result = simulate(params)
         regime, period = classify(result)
+        if result.status != INTERRUPTED:
+            # The averaged solver probed the other starts already; a full run has them probed here.
+            probed(result)
     except Exception as exc:  # noqa: BLE001 - one point's crash must not stop the sweep; its row says why
         return PointOutcome(failed_row(swept, f"{type(exc).__name__}: {exc}"))
     if result.status == INTERRUPTED:
         raise PointInterrupted(result.message)
     summary = {(f"{key}{USED_SUFFIX}" if key in swept else key): value for key, value in result.summary.items()}
-    # A table cell holds one value: the warnings become one string.
-    summary["warnings"] = "; ".join(result.warnings)
+    # A table cell holds one value: the warnings become one string, or none (CSV cannot tell "" from missing).
+    summary["warnings"] = "; ".join(result.warnings) or None
     row = {
         **swept,
         "regime": regime,
