@@ -371,7 +371,7 @@ def test_plot_says_when_a_contour_level_is_never_reached(sweep_folder, tmp_path)
     assert outcome.exit_code == 0, outcome.stderr
     (line,) = outcome.stderr.strip().splitlines()
     assert line.startswith(f"note: theta_inf_C = {level:g} not crossed") and "below it at every point" in line
-    assert "12 files written" in outcome.stdout
+    assert "14 files written" in outcome.stdout
 
 
 @pytest.mark.parametrize(
