@@ -95,12 +95,12 @@ def steady_state(params: Parameters, heat_power: float, velocity_term: float) ->
     size = 1 if params.model == "ball_only" else 3
     ambient = params.ambient_temperature
     if params.model != "ball_only" and params.h_outer * params.outer_area <= 0.0 and heat_power > 0.0:
-        return _unsolved(params, heat_power, velocity_term, "no heat leaves the vial (h_outer = 0): the temperatures rise without bound")
+        return _unsolved(heat_power, velocity_term, "no heat leaves the vial (h_outer = 0): the temperatures rise without bound")
     rates = _rates(params, heat_power, velocity_term)
     solution = root(rates, _first_guess(params, heat_power, size), method="hybr", tol=1e-12)
     residual = float(np.max(np.abs(rates(solution.x))))
     if not np.all(np.isfinite(solution.x)) or residual > ROOT_TOLERANCE:
-        return _unsolved(params, heat_power, velocity_term, f"the root of the thermal network was not found ({solution.message})")
+        return _unsolved(heat_power, velocity_term, f"the root of the thermal network was not found ({solution.message})")
     theta = solution.x
     derivative = jacobian(_vectorised(rates), theta, initial_step=1.0).df
     eigenvalues = np.linalg.eigvals(np.atleast_2d(derivative))
@@ -118,7 +118,7 @@ def steady_state(params: Parameters, heat_power: float, velocity_term: float) ->
     )
 
 
-def _unsolved(params: Parameters, heat_power: float, velocity_term: float, message: str) -> SteadyState:
+def _unsolved(heat_power: float, velocity_term: float, message: str) -> SteadyState:
     return SteadyState(math.inf, math.inf, math.inf, (math.inf,), heat_power, velocity_term, False, message)
 
 
