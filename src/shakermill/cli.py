@@ -607,11 +607,13 @@ def bifurcation(
 COEXISTING_PREVIEW_ROWS = 20
 
 
-def coexisting_attractors_table(attractors: pd.DataFrame, key: str, starts: int) -> Table:
+def coexisting_attractors_table(attractors: pd.DataFrame, key: str, starts: int) -> Table | Text:
     """The values with more than one attractor: each attractor's regime, basin fraction and heat power."""
     counts = attractors.groupby(key, sort=False)["attractor"].transform("size")
     several = attractors[counts > 1]
     values = several[key].unique()
+    if not len(values):
+        return Text(f"coexisting attractors: none; all {starts} starts reach one attractor at each of {attractors[key].nunique()} values")
     unit = field_unit(key)
     table = Table(
         f"{key} ({unit})" if unit else key, "attractor", "regime", "basin fraction", "heat power (W)", "impact rate (Hz)",

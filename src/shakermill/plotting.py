@@ -141,14 +141,16 @@ def temperature_figure(run: RunLike) -> Figure:
     if steady is not None and math.isfinite(steady):
         # The fit's θ∞ is a property of the window; the steady state is where the ball really settles.
         axis.axhline(steady, color="tab:red", ls=":", lw=1, label=f"ball steady state {steady:.1f} °C (MODEL.md §11)")
+        low, high = axis.get_ylim()
+        axis.set_ylim(low, max(high, steady + 0.05 * (steady - low)))
     axis.text(
-        0.98, 0.04, f"exponential fitted over {window}:\n{_fit_text(fit)}", transform=axis.transAxes, ha="right",
+        0.98, 0.55, f"exponential fitted over {window}:\n{_fit_text(fit)}", transform=axis.transAxes, ha="right",
         va="bottom", bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
     )
     axis.set_xlabel("time (min)")
     axis.set_ylabel("temperature (°C)")
     axis.set_title("Temperatures of ball, vial and inner air (cf. paper Fig. 5a)")
-    axis.legend(loc="upper left")
+    axis.legend(loc="lower right")
     axis.grid(alpha=0.3)
     return figure
 
@@ -703,7 +705,9 @@ def _attractor_periods(axis: object, attractors: pd.DataFrame, key: str) -> None
     if irregular.any():
         axis.axhline(top, color="0.6", lw=0.8, ls=":")  # type: ignore[attr-defined]
         axis.text(0.01, top, f" irregular (drawn at {top:g})", transform=axis.get_yaxis_transform(), va="bottom", fontsize="small")  # type: ignore[attr-defined]
-    axis.yaxis.set_major_locator(MaxNLocator(integer=True))  # type: ignore[attr-defined]
+    # Periods are whole numbers: half a period of room either way keeps the ticks on them.
+    axis.set_ylim(0.5, np.nanmax(shown, initial=1.0) + 0.5)  # type: ignore[attr-defined]
+    axis.yaxis.set_major_locator(MaxNLocator(integer=True, min_n_ticks=1))  # type: ignore[attr-defined]
     axis.set_ylabel("period n (drive periods)\nmarker area ∝ basin fraction")  # type: ignore[attr-defined]
 
 
