@@ -257,22 +257,7 @@ def calibrate(
     missed = {key: error for key, error in missed.items() if abs(error) > TARGET_TOLERANCE}
     curve_rms = _curve_rms(result, curve)
     off_curve = curve_rms is not None and curve_rms > CURVE_TOLERANCE_K
-    edges = [key for key in at_bounds if key in DEFENSIBLE_RANGES]
     stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
-    message = str(solution.message).rstrip(".")
-    if missed or stuck or off_curve:
-        reasons = [f"{key} is off by {100 * error:+.2f} %" for key, error in missed.items()]
-        reasons += [f"{key} ended on a bound" for key in stuck]
-        reasons += [f"the curve is missed by {curve_rms:.2f} K RMS (more than {CURVE_TOLERANCE_K:g} K)"] if off_curve else []
-        message = (
-            f"the targets cannot be met by moving {', '.join(free)} alone ({'; '.join(reasons)}); "
-            "free another parameter or check the targets"
-        )
-    if edges:
-        message += (
-            f"; {', '.join(edges)} ended on the edge of {'its' if len(edges) == 1 else 'their'} physically defensible "
-            "range: the data pull beyond what physics allows"
-        )
     return Calibration(
         params=result.params.replace(solver=base.solver, attractor_starts=base.attractor_starts),
         free=free,
@@ -286,12 +271,37 @@ def calibrate(
         predictions={key: float(result.summary[key]) for key in PREDICTED_KEYS if key not in targets},
         at_bounds=at_bounds,
         success=bool(solution.success) and not stuck and not missed and not off_curve and result.success,
-        message=message,
+        message=_outcome(str(solution.message), free, missed, at_bounds, curve_rms if off_curve else None),
         evaluations=len(cache),
         solver=solver,
         curve_source=curve.source if curve is not None else "",
         result=result,
     )
+
+
+def _outcome(
+    solver_message: str, free: Sequence[str], missed: Mapping[str, float], at_bounds: Sequence[str], curve_missed_by: float | None
+) -> str:
+    """What the fit achieved, in words: the optimiser's message, or why the targets were not met, and the
+    keys that ended on the edge of their physically defensible range."""
+    edges = [key for key in at_bounds if key in DEFENSIBLE_RANGES]
+    stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
+    message = solver_message.rstrip(".")
+    if missed or stuck or curve_missed_by is not None:
+        reasons = [f"{key} is off by {100 * error:+.2f} %" for key, error in missed.items()]
+        reasons += [f"{key} ended on a bound" for key in stuck]
+        if curve_missed_by is not None:
+            reasons.append(f"the curve is missed by {curve_missed_by:.2f} K RMS (more than {CURVE_TOLERANCE_K:g} K)")
+        message = (
+            f"the targets cannot be met by moving {', '.join(free)} alone ({'; '.join(reasons)}); "
+            "free another parameter or check the targets"
+        )
+    if edges:
+        message += (
+            f"; {', '.join(edges)} ended on the edge of {'its' if len(edges) == 1 else 'their'} physically defensible "
+            "range: the data pull beyond what physics allows"
+        )
+    return message
 
 
 def _ball_history(result: Result) -> tuple[np.ndarray, np.ndarray]:
