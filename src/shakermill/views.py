@@ -117,8 +117,8 @@ def experiment_comparison(summary: Mapping[str, Any], preset: str) -> str:
         return ""
     return (
         f"With preset {preset}, which uses the published parameters and fits nothing, this is far above the "
-        f"experiment: the ball rises {ratio:.1f} times as much as the {EXPERIMENT_BALL_C:g} °C the experiment "
-        f"reached after an hour (Takacs & McHenry 2006). Preset {CALIBRATED_PRESET} is fitted to that "
+        f"experiment: the ball's temperature rise is {ratio:.1f} times the experiment's, which approached "
+        f"{EXPERIMENT_BALL_C:g} °C within the hour (Takacs & McHenry 2006). Preset {CALIBRATED_PRESET} is fitted to that "
         "experiment; use it for predictions near it."
     )
 
