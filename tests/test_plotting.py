@@ -488,7 +488,7 @@ def test_bifurcation_figure_plots_every_phase_and_the_periods_of_every_attractor
     assert [label.get_text() for label in period_axis.get_yticklabels()] == ["1", "2", "irregular"]
     (rule,) = period_axis.get_lines()
     assert rule.get_ydata()[0] == pytest.approx(2.5)
-    assert [child.get_xlabel() for child in phase_axis.child_axes] == ["drive frequency (rpm)"]
+    assert [child.get_xlabel() for child in period_axis.child_axes] == ["drive frequency (rpm)"]
     titled = bifurcation_figure(phases, attractors, "omega", context="spex8000m, 60 min, averaged solver")
     assert titled.get_suptitle().endswith("\nspex8000m, 60 min, averaged solver")
     assert phase_axis.get_ylabel() == "impact phase ωt + φ mod 2π (rad)"

@@ -811,7 +811,8 @@ def bifurcation_figure(phases: pd.DataFrame, attractors: pd.DataFrame, key: str,
     figure.suptitle(f"Bifurcation diagram over {key}: impact phases of every attractor")
     _attractor_periods(period_axis, attractors, key)
     period_axis.set_xlabel(axis_label(key))
-    rpm_axis(phase_axis, key)
+    # Between the panels: above the phases it would run into their legend.
+    rpm_axis(period_axis, key)
     add_context(figure, context)
     for axis in (phase_axis, period_axis):
         axis.grid(alpha=0.3)
