@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import base64
 import errno
-import html
 import itertools
 import math
 import tomllib
@@ -43,7 +42,7 @@ from .validation import (
     fitted_quantities,
     operating_point_mismatches,
 )
-from .views import answer_sentences
+from .views import answer_sentences, esc, number
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -204,21 +203,6 @@ def render_report(run: RunData, other: RunData | None = None) -> str:
 
 
 # ---------------------------------------------------------------- HTML and number helpers
-
-
-def esc(value: Any) -> str:
-    return html.escape(str(value), quote=True)
-
-
-def number(value: Any, spec: str = ".4g") -> str:
-    """``value`` formatted with ``spec``; "n/a" for missing or non-finite numbers (stored as null in JSON)."""
-    if value is None:
-        return "n/a"
-    if isinstance(value, bool):
-        return str(value).lower()
-    if isinstance(value, (int, float)):
-        return format(value, spec) if math.isfinite(value) else "n/a"
-    return str(value)
 
 
 def percent(fraction: float) -> str:

@@ -58,11 +58,15 @@ def esc(value: Any) -> str:
     return html.escape(str(value), quote=True)
 
 
-def value_text(value: Any, spec: str) -> str:
-    """``value`` formatted with ``spec``, "n/a" when missing or not finite (summary.json stores NaN as null)."""
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
+def number(value: Any, spec: str = ".4g") -> str:
+    """``value`` formatted with ``spec``; "n/a" for missing or non-finite numbers (stored as null in JSON)."""
+    if value is None:
+        return "n/a"
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, (int, float)):
         return format(value, spec) if math.isfinite(value) else "n/a"
-    return "n/a" if value is None else str(value)
+    return str(value)
 
 
 def rpm(omega: float) -> float:
@@ -76,8 +80,8 @@ def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitt
     For a preset that nothing was fitted to (``fitted`` False), one more sentence compares the
     steady state with the experiment and points to the calibrated preset.
     """
-    v = {key: value_text(summary.get(key), spec) for key, _, _, spec in ANSWER_KEYS}
-    minutes = value_text(_number(summary.get("simulated_s")) / 60.0, ".3g")
+    v = {key: number(summary.get(key), spec) for key, _, _, spec in ANSWER_KEYS}
+    minutes = number(_number(summary.get("simulated_s")) / 60.0, ".3g")
     sentences = [
         f"After {minutes} min the ball is at {v['ball_C']} °C, the vial at {v['vial_C']} °C and the air at "
         f"{v['air_C']} °C.",
@@ -102,7 +106,7 @@ def _number(value: Any) -> float:
 def _averaging_note(summary: Mapping[str, Any]) -> str:
     if summary.get("solver") != "averaged":
         return ""
-    window = value_text(summary.get("averaging_window_s"), ".3g")
+    window = number(summary.get("averaging_window_s"), ".3g")
     return f" (impacts resolved over the {window} s averaging window, the rate holding for the whole run)"
 
 
@@ -136,10 +140,10 @@ def _input_rows(params: Parameters) -> list[tuple[str, str, str]]:
     for key, label, scale, unit, spec in KEY_INPUTS:
         if key not in values:
             continue
-        shown = value_text(values[key] * scale, spec) if scale is not None else str(values[key])
+        shown = number(values[key] * scale, spec) if scale is not None else str(values[key])
         rows.append((label, shown, unit))
     # Researchers quote the mill in cycles per minute (1060 for the SPEX 8000M on 60 Hz mains).
-    rows.insert(1, ("drive frequency", value_text(rpm(params.omega), ".4g"), "rpm"))
+    rows.insert(1, ("drive frequency", number(rpm(params.omega), ".4g"), "rpm"))
     return rows
 
 
@@ -159,7 +163,7 @@ def result_html(result: Result) -> str:
     summary = result.summary
     status = "completed" if result.success else f"stopped early (status {result.status})"
     answer = [
-        (label, value_text(summary.get(key), spec), unit) for key, label, unit, spec in ANSWER_KEYS
+        (label, number(summary.get(key), spec), unit) for key, label, unit, spec in ANSWER_KEYS
     ]
     warnings = "".join(f"<li>{esc(line)}</li>" for line in result.warnings)
     return (
