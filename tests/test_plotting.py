@@ -33,6 +33,7 @@ from shakermill.plotting import (
     png_bytes,
     rate_bin_edges,
     run_figures,
+    sweep_context,
     sweep_figures,
     temperature_figure,
     window_data,
@@ -351,12 +352,15 @@ def test_sweep_maps_fill_the_grid_and_blank_the_failed_point():
     axis, colourbar = figures["sweep_theta_inf_C"].axes
     assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "amplitude (mm)"
     assert colourbar.get_ylabel() == "ball θ∞ of the exponential fitted over the run (°C)"
-    (mesh,) = axis.collections
+    mesh, missing = axis.collections
     cells = mesh.get_array()
     # Rows are amplitudes, columns omegas; the failed point (omega 110, amplitude 28 mm) is masked.
     expected = np.array([[50.0, 70.0, 90.0], [54.0, np.nan, 94.0]])
     np.testing.assert_allclose(np.ma.filled(cells, np.nan).reshape(2, 3), expected)
     assert cells.mask.reshape(2, 3)[1, 1] and cells.mask.sum() == 1
+    # And marked, so that the blank cell reads as a missing point, not as a colour of the map.
+    np.testing.assert_allclose(missing.get_offsets(), [[110.0, 28.0]])
+    assert axis.get_legend().get_texts()[0].get_text() == "failed or no value (1)"
     # Cell edges half-way between the grid values, in mm on the amplitude axis.
     assert axis.get_ylim() == pytest.approx((22.0, 30.0))
 
@@ -391,14 +395,15 @@ def test_a_contour_level_outside_the_values_is_said_on_every_figure_not_drawn():
     # Every level crossed: no note.
     assert contour_notes(table, [("theta_inf_C", 60.0)]) == []
     crossed = sweep_figures(table, ("omega", "amplitude"), [("theta_inf_C", 60.0)])["sweep_tau_min"].axes[0]
-    assert [text.get_text() for text in crossed.texts] == ["theta_inf_C = 60"]  # the contour's own label
+    # The contour's own label: the quantity's name and unit, not the column's name.
+    assert [text.get_text() for text in crossed.texts] == ["ball θ∞ = 60 °C"]
     assert contour_notes(synthetic_sweep().assign(error="failed"), [("tau_min", 1.0)]) == [
         "tau_min = 1: no finished point has a value"
     ]
 
 
 def test_one_key_sweep_is_a_line_with_the_contour_crossing_marked():
-    table = synthetic_sweep().iloc[[4, 0, 2]]  # amplitude 24 mm only, out of order
+    table = synthetic_sweep().iloc[[4, 0, 2]].assign(regime="period-1")  # amplitude 24 mm only, out of order
     figures = sweep_figures(table.drop(columns="amplitude"), ("omega",), [("theta_inf_C", 60.0)])
     (axis,) = figures["sweep_theta_inf_C"].axes
     curve, crossing, level = axis.get_lines()[:3]
@@ -406,6 +411,7 @@ def test_one_key_sweep_is_a_line_with_the_contour_crossing_marked():
     np.testing.assert_allclose(curve.get_ydata(), [50.0, 70.0, 90.0])
     assert crossing.get_xdata()[0] == pytest.approx(100.0)  # linear between (90, 50) and (110, 70)
     assert level.get_ydata()[0] == pytest.approx(60.0)
+    assert axis.get_legend().get_texts()[0].get_text() == "ball θ∞ = 60 °C"
     assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "ball θ∞ of the exponential fitted over the run (°C)"
 
 
@@ -478,4 +484,63 @@ def test_bifurcation_figure_plots_every_phase_and_the_periods_of_every_attractor
     assert sizes[0] == pytest.approx(3 * sizes[1]) and sizes[2] == pytest.approx(4 * sizes[1])
     assert period_axis.get_xlabel() == "omega (rad/s)"
     assert period_axis.get_ylabel().startswith("period n (drive periods)")
+    # The irregular row is named, not numbered "3", and ruled off from the periods.
+    assert [label.get_text() for label in period_axis.get_yticklabels()] == ["1", "2", "irregular"]
+    (rule,) = period_axis.get_lines()
+    assert rule.get_ydata()[0] == pytest.approx(2.5)
+    assert [child.get_xlabel() for child in period_axis.child_axes] == ["drive frequency (rpm)"]
+    titled = bifurcation_figure(phases, attractors, "omega", context="spex8000m, 60 min, averaged solver")
+    assert titled.get_suptitle().endswith("\nspex8000m, 60 min, averaged solver")
     assert phase_axis.get_ylabel() == "impact phase ωt + φ mod 2π (rad)"
+
+
+def test_one_key_sweep_lines_break_where_the_regime_changes_and_mark_the_missing_points():
+    table = synthetic_sweep(failed_index=4).iloc[[0, 2, 4]].drop(columns="amplitude")  # amplitude 24 mm
+    table["regime"] = ["period-1", "period-2", "period-2"]
+    table.loc[2, "tau_min"] = np.nan  # finished, but without a value
+    figures = sweep_figures(table, ("omega",))
+    (axis,) = figures["sweep_theta_inf_C"].axes
+    curve = axis.get_lines()[0]
+    # A NaN between omega 90 (period-1) and 110 (period-2), and before the failed point: no line joins regimes.
+    np.testing.assert_allclose(curve.get_xdata(), [90.0, np.nan, 110.0, np.nan, 130.0])
+    np.testing.assert_allclose(curve.get_ydata(), [50.0, np.nan, 70.0, np.nan, np.nan])
+    (missing,) = axis.collections
+    assert missing.get_offsets()[:, 0].tolist() == [130.0]  # the failed point
+    (axis,) = figures["sweep_tau_min"].axes
+    assert axis.collections[0].get_offsets()[:, 0].tolist() == [110.0, 130.0]
+    assert axis.get_legend().get_texts()[0].get_text() == "failed or no value (2)"
+
+
+def test_omega_axes_also_read_in_rpm():
+    figures = sweep_figures(synthetic_sweep(), ("amplitude", "omega"))
+    axis = figures["sweep_theta_inf_C"].axes[0]
+    (secondary,) = axis.child_axes
+    assert secondary.get_ylabel() == "drive frequency (rpm)"
+    # 111 rad/s is the SPEX 8000M's 1060 rpm.
+    assert secondary.yaxis.get_transform().inverted().transform(111.0) == pytest.approx(111.0 * 60 / (2 * np.pi))
+    line = sweep_figures(synthetic_sweep().iloc[[0, 2, 4]].drop(columns="amplitude"), ("omega",))
+    assert [child.get_xlabel() for child in line["sweep_regime"].axes[0].child_axes] == ["drive frequency (rpm)"]
+    assert sweep_figures(synthetic_sweep(), ("omega", "amplitude"))["sweep_tau_min"].axes[0].child_axes[0].get_xlabel() == (
+        "drive frequency (rpm)"
+    )
+
+
+def test_sweep_titles_carry_the_preset_and_duration():
+    manifest = {"preset": "spex8000m-calibrated", "base": {"duration": 3600.0, "solver": "averaged"}}
+    context = sweep_context(manifest, ("omega", "amplitude"))
+    assert context == "spex8000m-calibrated, 60 min, averaged solver"
+    assert sweep_context(manifest, ("duration",)) == "spex8000m-calibrated, averaged solver"
+    figures = sweep_figures(synthetic_sweep(), ("omega", "amplitude"), context=context)
+    for name, figure in figures.items():
+        assert figure.axes[0].get_title().endswith("\n" + context), name
+
+
+def test_run_figures_name_the_run_and_averaged_impact_figures_their_window(tmp_path):
+    params = sm.default_parameters(solver="averaged", duration=600.0)
+    run = load_run(write_run(sm.simulate(params), tmp_path / "run", preset="spex8000m"))
+    figures = run_figures(run, impacts=True)
+    window = f"impacts of the {run.summary['averaging_window_s']:.3g} s averaging window only"
+    for name, figure in figures.items():
+        title = figure.get_suptitle() or figure.axes[0].get_title()
+        assert "spex8000m, 10 min, averaged solver" in title, name
+        assert (window in title) == (name in IMPACT_FIGURES), name

@@ -21,6 +21,7 @@ from shakermill.params import DEFAULT_PRESET, FIELD_NAMES, PRESETS
 from shakermill.regime import classify_impacts, settled_run_impacts
 from shakermill.report import REPORT_FILE, fitted_targets, number, render_report, write_report
 from shakermill.storage import load_run, write_run
+from shakermill.storage import RunData
 from shakermill.validation import TABLE5
 
 CALIBRATED_PRESET = "spex8000m-calibrated"
@@ -93,7 +94,14 @@ def test_report_names_the_assumptions_and_the_deliberate_differences(report_html
     assert "MODEL.md §9" in assumptions
 
 
-def test_table5_of_the_published_preset_is_all_predicted(report_html):
+def at_the_experiments_operating_point(run: RunData, **changes) -> RunData:
+    """``run`` as if it had lasted the experiment's hour (with ``changes``): Table 5 compares only such runs."""
+    params = run.params.replace(duration=3600.0, **changes)
+    return dataclasses.replace(run, params=params, summary={**run.summary, "simulated_s": 3600.0})
+
+
+def test_table5_of_the_published_preset_is_all_predicted(run_folder):
+    report_html = render_report(at_the_experiments_operating_point(load_run(run_folder)))
     rows = rows_of_table_after(report_html, "Table 5")
     assert len(rows) == 1 + len(TABLE5)
     for quantity, row in zip(TABLE5, rows[1:]):
@@ -104,7 +112,8 @@ def test_table5_of_the_published_preset_is_all_predicted(report_html):
 
 def test_table5_of_a_calibrated_run_marks_the_calibration_targets_fitted(tmp_path):
     folder = short_run(tmp_path / "calibrated", preset=CALIBRATED_PRESET)
-    document = render_report(load_run(folder))
+    # 1 % off the experiment's ω: inside the operating point's tolerance, so Table 5 is shown.
+    document = render_report(at_the_experiments_operating_point(load_run(folder), omega=112.1))
     rows = rows_of_table_after(document, "Table 5")[1:]
     roles = {quantity.key: re.findall(r"<td>(fitted|predicted)</td>", row)[0] for quantity, row in zip(TABLE5, rows)}
     assert roles == {
@@ -114,8 +123,9 @@ def test_table5_of_a_calibrated_run_marks_the_calibration_targets_fitted(tmp_pat
         "vial_ball_ratio": "predicted",
     }
     assert "beta, vial_mass, h_outer, lam were fitted" in document
-    # 30 s instead of the calibrated hour: the report says the fit need not hold for this run.
-    assert "This run changes 1 of the preset&#x27;s values (duration)" in document
+    # Any change of a calibrated value, however small: the report says the fit need not hold for this run.
+    assert "This run changes 1 of the preset&#x27;s values (omega)" in document
+    assert "far above the experiment" not in document
 
 
 def test_fitted_targets_are_the_calibration_quantities_not_the_fitted_parameters():
@@ -171,7 +181,7 @@ def test_text_from_the_run_is_escaped(run_folder):
 
 
 def test_unknown_preset_and_missing_numbers_still_render(run_folder):
-    run = load_run(run_folder)
+    run = at_the_experiments_operating_point(load_run(run_folder))
     summary = {**run.summary, "theta_inf_C": None, "tau_min": None}
     document = render_report(dataclasses.replace(run, preset="no-such-preset", summary=summary))
     assert "is not known to this version of shakermill" in document
@@ -290,3 +300,38 @@ def test_report_shows_the_runs_warnings_and_its_steady_state(run_folder, report_
         assert html.escape("Warning: " + line) in report_html
     results = "".join(rows_of_table_after(report_html, "Results"))
     assert "ball steady state" in results and number(summary["ball_steady_C"], ".2f") in results
+
+
+def test_table5_is_left_out_off_the_experiments_operating_point_and_the_report_says_why(run_folder, report_html):
+    table5 = report_html[report_html.index("<h2>Table 5") :].split("</section>")[0]
+    assert "<table>" not in table5
+    assert "Left out" in table5 and "duration = 30 s (experiment: 3600 s)" in table5
+    faster = render_report(at_the_experiments_operating_point(load_run(run_folder), omega=115.0))
+    table5 = faster[faster.index("<h2>Table 5") :].split("</section>")[0]
+    assert "<table>" not in table5 and "omega = 115 rad/s (experiment: 111 rad/s)" in table5
+    assert "duration" not in table5
+
+
+def test_report_opens_with_the_answer_and_points_the_default_preset_to_the_calibrated_one(run_folder, report_html):
+    summary = load_run(run_folder).summary
+    answer = re.search(r'<p class="statement answer">(.*?)</p>', report_html).group(1)
+    # Before every table: the answer is the first thing read.
+    assert report_html.index(answer) < report_html.index("<table>")
+    assert f"the ball would settle at {summary['ball_steady_C']:.1f} °C" in answer
+    assert f"slowest time constant of the thermal network is {summary['slowest_time_constant_min']:.1f} min" in answer
+    assert f"{summary['heat_power_W']:.3g} W of heat at {summary['impact_rate_hz']:.3g} impacts per second" in answer
+    assert "far above the experiment" in answer and CALIBRATED_PRESET in answer
+
+
+def test_report_numbers_its_figures_in_order(report_html, run_folder, ball_only_folder):
+    numbers = [int(n) for n in re.findall(r"<figcaption>Figure (\d+): ", report_html)]
+    assert numbers == list(range(1, report_html.count("<figure>") + 1)) and len(numbers) >= 4
+    compared = render_report(load_run(run_folder), load_run(ball_only_folder))
+    assert f"<figcaption>Figure {len(numbers) + 1}: Ball (solid)" in compared
+
+
+def test_report_ends_with_what_to_cite(report_html):
+    last = report_html[report_html.rindex("<section>") :]
+    assert "<h2>What to cite</h2>" in last
+    for source in ("shakermill ", "Son 2025, Mathematics 13, 446", "Takacs &amp; McHenry 2006, J. Mater. Sci. 41, 5246"):
+        assert source in last, source

@@ -41,7 +41,7 @@ from .params import (
     preset_values,
     unit_slip_warnings,
 )
-from .plotting import PNG_DPI, bifurcation_figure, contour_notes, impact_figures, parse_contour, plot_figures, plot_run, run_figures, sweep_figures
+from .plotting import PNG_DPI, bifurcation_figure, contour_notes, impact_figures, parse_contour, plot_figures, plot_run, run_figures, sweep_context, sweep_figures
 from .regime import bifurcation as regime_scan
 from .regime import write_bifurcation
 from .report import REPORT_FILE, save_report
@@ -412,7 +412,7 @@ def plot(
             data = load_sweep(folder)
             numeric = list(data.table.select_dtypes("number").columns)
             levels = [parse_contour(spec, numeric) for spec in contour or []]
-            figures = sweep_figures(data.table, data.keys, levels)
+            figures = sweep_figures(data.table, data.keys, levels, context=sweep_context(data.manifest, data.keys))
         for note in contour_notes(data.table, levels):
             typer.echo(f"note: {note}; no contour drawn", err=True)
     else:
@@ -590,7 +590,9 @@ def bifurcation(
             _fail("interrupted; nothing was written (a scan is quick to repeat)", EXIT_INTERRUPTED)
     try:
         paths = write_bifurcation(scan, target)
-        paths += plot_figures({"bifurcation": bifurcation_figure(scan.phases, scan.attractors, key)}, target, dpi=dpi)
+        context = sweep_context({"preset": run_config.preset, "base": run_config.params.model_dump()}, (key,))
+        figure = bifurcation_figure(scan.phases, scan.attractors, key, context=context)
+        paths += plot_figures({"bifurcation": figure}, target, dpi=dpi)
     except OSError as exc:
         _fail(f"{target}: cannot write the results ({exc.strerror or exc})")
     counts = scan.regimes["regime"].value_counts()

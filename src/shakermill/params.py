@@ -178,6 +178,11 @@ class Parameters(BaseModel):
         """c_a = c_p,a/γ: the trapped air is heated at constant volume (J/(kg·K))."""
         return self.air_cp / self.air_heat_capacity_ratio
 
+    def _repr_html_(self) -> str:
+        from .views import parameters_html  # views reads Parameters: imported when a notebook asks
+
+        return parameters_html(self)
+
     def replace(self, **changes: Any) -> "Parameters":
         """A new validated ``Parameters`` with ``changes`` applied (values may carry units)."""
         return build_parameters(self.model_dump(), changes)

@@ -19,7 +19,7 @@ import io
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol, Sequence
+from typing import TYPE_CHECKING, Any, Mapping, Protocol, Sequence
 
 import numpy as np
 import pandas as pd
@@ -80,8 +80,45 @@ def run_figures(run: RunLike, *, impacts: bool = False) -> dict[str, Figure]:
     return figures
 
 
+def run_context(run: RunLike) -> str:
+    """"spex8000m, 60 min, averaged solver": what a figure of ``run`` shows, for its title.
+
+    The preset is known for a stored run (:class:`shakermill.storage.RunData`), not for a bare Result.
+    """
+    minutes = run.summary.get("simulated_s", run.params.duration) / 60.0
+    parts = [getattr(run, "preset", None), f"{minutes:.3g} min", f"{run.params.solver} solver"]
+    return ", ".join(part for part in parts if part)
+
+
+def averaging_window_note(run: RunLike) -> str:
+    """For the averaged solver, which keeps the impacts of its averaging window only: that window; else empty."""
+    window = run.summary.get("averaging_window_s")
+    if run.params.solver != "averaged" or window is None:
+        return ""
+    return f"impacts of the {window:.3g} s averaging window only"
+
+
+def add_context(figure: Figure, *lines: str) -> Figure:
+    """``lines`` (the empty ones skipped) under the figure's title: its suptitle, else its first axes' title."""
+    text = "\n".join(line for line in lines if line)
+    if not text:
+        return figure
+    if figure.get_suptitle():
+        figure.suptitle(f"{figure.get_suptitle()}\n{text}")
+    else:
+        axis = figure.axes[0]
+        axis.set_title(f"{axis.get_title()}\n{text}")
+    return figure
+
+
 def paper_figures(run: RunLike) -> dict[str, Figure]:
     """Fig. 5a always; Fig. 4 and Fig. 5b only when their record windows hold enough points."""
+    figures = _paper_figures(run)
+    context = run_context(run)
+    return {name: add_context(figure, context) for name, figure in figures.items()}
+
+
+def _paper_figures(run: RunLike) -> dict[str, Figure]:
     figures = {"temperatures": temperature_figure(run)}
     first_window = window_data(run, 0)
     if first_window is not None:
@@ -265,7 +302,7 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
     impacts = run.impacts
     if impacts.empty:
         return {}
-    return {
+    figures = {
         "impact_speed_histogram": impact_histogram_figure(
             impacts, "impact_speed", 1.0, "impact speed relative to the end face", "m/s"
         ),
@@ -275,6 +312,8 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
         "impacts_per_second": impact_rate_figure(impacts),
         "impact_phase_histogram": impact_phase_figure(run),
     }
+    context, window = run_context(run), averaging_window_note(run)
+    return {name: add_context(figure, context, window) for name, figure in figures.items()}
 
 
 def impact_histogram_figure(impacts: pd.DataFrame, column: str, scale: float, quantity: str, unit: str) -> Figure:
@@ -425,6 +464,54 @@ REGIME_COLOURS = {"no impacts": "0.85", "irregular": "0.25"}
 PERIOD_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
 
 
+# Short names of the sweep columns for contour labels ("ball θ∞ = 60 °C"); other columns go by their own name.
+SHORT_NAMES = {
+    "theta_inf_C": "ball θ∞",
+    "tau_min": "τ",
+    "impact_rate_hz": "impact rate",
+    "heat_power_W": "heat power",
+    "mean_impact_speed_m_s": "mean impact speed",
+    "ball_steady_C": "ball steady state",
+}
+# Units of the summary columns by the suffix of their names (theta_inf_C, tau_min, impact_rate_hz, ...).
+SUFFIX_UNITS = (("_C", "°C"), ("_K", "K"), ("_min", "min"), ("_hz", "1/s"), ("_W", "W"), ("_m_s", "m/s"), ("_J", "J"), ("_s", "s"))
+MISSING_STYLE = {"marker": "x", "color": "tab:red", "s": 40, "zorder": 3}
+
+
+def contour_label(column: str, level: float) -> str:
+    """``("theta_inf_C", 60)`` -> ``"ball θ∞ = 60 °C"``: the quantity's name and unit, not the column's."""
+    unit = next((unit for suffix, unit in SUFFIX_UNITS if column.endswith(suffix)), "")
+    return f"{SHORT_NAMES.get(column, column)} = {level:g} {unit}".rstrip()
+
+
+def rpm_axis(axis: object, key: str, which: str = "x") -> None:
+    """A second ω axis in rpm (drive cycles per minute, as mills are specified) when ``key`` is omega."""
+    if key != "omega":
+        return
+    to_rpm = 60.0 / (2.0 * math.pi)
+    functions = (lambda omega: omega * to_rpm, lambda rpm: rpm / to_rpm)
+    if which == "x":
+        secondary = axis.secondary_xaxis("top", functions=functions)  # type: ignore[attr-defined]
+        secondary.set_xlabel("drive frequency (rpm)")
+    else:
+        secondary = axis.secondary_yaxis("left", functions=functions)  # type: ignore[attr-defined]
+        secondary.set_ylabel("drive frequency (rpm)")
+        # Outside the rad/s ticks of the same side, so that the two scales do not overlap.
+        secondary.spines["left"].set_position(("outward", 45))
+
+
+def sweep_context(manifest: Mapping[str, Any], keys: Sequence[str]) -> str:
+    """"spex8000m, 60 min, averaged solver" from a sweep's ``sweep.json``; the duration only when it is not swept."""
+    base = manifest.get("base", {})
+    duration = base.get("duration")
+    parts = [
+        manifest.get("preset"),
+        f"{duration / 60.0:.3g} min" if duration is not None and "duration" not in keys else None,
+        f"{base['solver']} solver" if "solver" in base and "solver" not in keys else None,
+    ]
+    return ", ".join(part for part in parts if part)
+
+
 def axis_label(key: str) -> str:
     """``"amplitude (mm)"``: the key with the unit its values are drawn in."""
     from .params import field_unit
@@ -459,12 +546,15 @@ def parse_contour(spec: str, columns: Sequence[str]) -> tuple[str, float]:
     return column, value
 
 
-def sweep_figures(table: pd.DataFrame, keys: Sequence[str], contours: Sequence[tuple[str, float]] = ()) -> dict[str, Figure]:
+def sweep_figures(
+    table: pd.DataFrame, keys: Sequence[str], contours: Sequence[tuple[str, float]] = (), *, context: str = ""
+) -> dict[str, Figure]:
     """Lines (one swept key) or maps (two) of :data:`SWEEP_QUANTITIES` and of the regime, by figure name.
 
     ``contours`` are (column, level) pairs drawn on every map (on lines: where the column crosses
     the level), so the 60 °C line of θ∞ can be read off the impact-rate map too. Failed points are
-    gaps. Sweeps over more keys are not drawn: their table is the result.
+    marked with a red x. ``context`` (preset, duration: :func:`sweep_context`) goes under every title.
+    Sweeps over more keys are not drawn: their table is the result.
     """
     from .params import ParameterError
 
@@ -489,7 +579,7 @@ def sweep_figures(table: pd.DataFrame, keys: Sequence[str], contours: Sequence[t
             figure.axes[0].text(0.01, 0.01, "\n".join(notes), transform=figure.axes[0].transAxes, **NOTE_STYLE)
         figures[f"sweep_{column}"] = figure
     figures["sweep_regime"] = regime_figure(table, keys)
-    return figures
+    return {name: add_context(figure, context) for name, figure in figures.items()}
 
 
 def contour_notes(table: pd.DataFrame, contours: Sequence[tuple[str, float]]) -> list[str]:
@@ -529,7 +619,13 @@ def sweep_line_figure(
     figure, (axis,) = _new_figure(height=4.0)
     ordered = table.sort_values(key)
     x = display_values(key, ordered[key].to_numpy())
-    axis.plot(x, _numeric(ordered, column), "o-", color="tab:red", ms=4)
+    y = _numeric(ordered, column)
+    axis.plot(*_broken_at_regime_changes(x, y, _regimes(ordered)), "o-", color="tab:blue", ms=4)
+    missing = ~np.isfinite(y)
+    if missing.any():
+        # At the foot of the axis: a failed point has no value to place it at, but it must not vanish.
+        axis.scatter(x[missing], np.zeros(missing.sum()), transform=axis.get_xaxis_transform(), clip_on=False,
+                     label=f"failed or no value ({missing.sum()})", **MISSING_STYLE)
     for contour_column, level in contours:
         values = _numeric(ordered, contour_column)
         for crossing in _crossings(x, values, level):
@@ -537,14 +633,30 @@ def sweep_line_figure(
         if contour_column == column:
             axis.axhline(level, color="0.3", ls=":", lw=1)
         if len(_crossings(x, values, level)):
-            axis.plot([], [], color="0.3", ls="--", lw=1, label=f"{contour_column} = {level:g}")
+            axis.plot([], [], color="0.3", ls="--", lw=1, label=contour_label(contour_column, level))
     if axis.get_legend_handles_labels()[0]:
         axis.legend(loc="best")
     axis.set_xlabel(axis_label(key))
+    rpm_axis(axis, key)
     axis.set_ylabel(f"{quantity} ({unit})")
-    axis.set_title(f"{quantity} against {key} ({len(ordered)} points)")
+    axis.set_title(f"{quantity} against {key} ({len(ordered)} points; lines break where the regime changes)")
     axis.grid(alpha=0.3)
     return figure
+
+
+def _regimes(table: pd.DataFrame) -> np.ndarray:
+    """The regime of each point ("failed" where it failed); one regime for all in tables without the column."""
+    regimes = table["regime"].astype(object) if "regime" in table else pd.Series("", index=table.index, dtype=object)
+    return regimes.where(table["error"].isna(), "failed").to_numpy()
+
+
+def _broken_at_regime_changes(x: np.ndarray, y: np.ndarray, regimes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y) with a NaN point between neighbours of different regimes: matplotlib does not join across it.
+
+    A line between a period-1 and a period-2 point would suggest values between them that no motion has.
+    """
+    changes = np.flatnonzero(regimes[1:] != regimes[:-1]) + 1
+    return np.insert(x, changes, np.nan), np.insert(y, changes, np.nan)
 
 
 def _crossings(x: np.ndarray, values: np.ndarray, level: float) -> np.ndarray:
@@ -597,7 +709,7 @@ def sweep_map_figure(
             _, _, levels = _grid_of(table, keys, contour_column)  # type: ignore[misc]
             if _straddled(levels, level):
                 lines = axis.contour(x, y, levels, levels=[level], **CONTOUR_STYLE)
-                axis.clabel(lines, fmt=f"{contour_column} = {level:g}", fontsize="small")
+                axis.clabel(lines, fmt=contour_label(contour_column, level), fontsize="small")
     else:
         # A points file: no cells to fill.
         x, y = display_values(x_key, table[x_key].to_numpy()), display_values(y_key, table[y_key].to_numpy())
@@ -606,12 +718,24 @@ def sweep_map_figure(
             levels = _numeric(table, contour_column)
             if len(x) >= 3 and _straddled(levels, level):
                 lines = axis.tricontour(x, y, levels, levels=[level], colors="0.3", linestyles="--")
-                axis.clabel(lines, fmt=f"{contour_column} = {level:g}", fontsize="small")
+                axis.clabel(lines, fmt=contour_label(contour_column, level), fontsize="small")
+    _mark_missing(axis, table, keys, column)
     figure.colorbar(mesh, ax=axis, label=f"{quantity} ({unit})")
     axis.set_xlabel(axis_label(x_key))
     axis.set_ylabel(axis_label(y_key))
+    rpm_axis(axis, x_key)
+    rpm_axis(axis, y_key, which="y")
     axis.set_title(f"{quantity} over {x_key} and {y_key} ({len(table)} points)")
     return figure
+
+
+def _mark_missing(axis: object, table: pd.DataFrame, keys: Sequence[str], column: str) -> None:
+    """A red x on each point without a value (failed, or NaN), so that a blank cell reads as a missing point."""
+    missing = ~np.isfinite(_numeric(table, column))
+    if missing.any():
+        x, y = (display_values(key, table.loc[missing, key].to_numpy()) for key in keys)
+        axis.scatter(x, y, label=f"failed or no value ({missing.sum()})", **MISSING_STYLE)  # type: ignore[attr-defined]
+        axis.legend(loc="upper left", bbox_to_anchor=(0.0, -0.12), fontsize="small", frameon=False)  # type: ignore[attr-defined]
 
 
 def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
@@ -640,8 +764,10 @@ def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
             label=f"more than one attractor ({several.sum()})",
         )
     axis.set_xlabel(axis_label(keys[0]))
+    rpm_axis(axis, keys[0])
     if len(keys) == 2:
         axis.set_ylabel(axis_label(keys[1]))
+        rpm_axis(axis, keys[1], which="y")
     else:
         axis.set_yticks([])
         axis.set_ylabel("regime (–)")
@@ -663,7 +789,7 @@ WALL_MARKERS = (("left", "left end face", "o"), ("right", "right end face", "x")
 FULL_BASIN_AREA = 60.0
 
 
-def bifurcation_figure(phases: pd.DataFrame, attractors: pd.DataFrame, key: str) -> Figure:
+def bifurcation_figure(phases: pd.DataFrame, attractors: pd.DataFrame, key: str, *, context: str = "") -> Figure:
     """Bifurcation diagram: the drive phase of every settled impact against ``key`` (top) and the period of
     each attractor (bottom), coloured by attractor; attractor 0 is the configured start's at every value."""
     figure, (phase_axis, period_axis) = _new_figure(rows=2, height=7.0)
@@ -685,6 +811,9 @@ def bifurcation_figure(phases: pd.DataFrame, attractors: pd.DataFrame, key: str)
     figure.suptitle(f"Bifurcation diagram over {key}: impact phases of every attractor")
     _attractor_periods(period_axis, attractors, key)
     period_axis.set_xlabel(axis_label(key))
+    # Between the panels: above the phases it would run into their legend.
+    rpm_axis(period_axis, key)
+    add_context(figure, context)
     for axis in (phase_axis, period_axis):
         axis.grid(alpha=0.3)
     return figure
@@ -702,12 +831,15 @@ def _attractor_periods(axis: object, attractors: pd.DataFrame, key: str) -> None
     colours = [PERIOD_COLOURS[label % len(PERIOD_COLOURS)] for label in attractors["attractor"]]
     # Open markers: two attractors of the same period at one value show as concentric rings.
     axis.scatter(x, shown, s=FULL_BASIN_AREA * attractors["basin_fraction"].to_numpy(), facecolors="none", edgecolors=colours)  # type: ignore[attr-defined]
-    if irregular.any():
-        axis.axhline(top, color="0.6", lw=0.8, ls=":")  # type: ignore[attr-defined]
-        axis.text(0.01, top, f" irregular (drawn at {top:g})", transform=axis.get_yaxis_transform(), va="bottom", fontsize="small")  # type: ignore[attr-defined]
     # Periods are whole numbers: half a period of room either way keeps the ticks on them.
     axis.set_ylim(0.5, np.nanmax(shown, initial=1.0) + 0.5)  # type: ignore[attr-defined]
-    axis.yaxis.set_major_locator(MaxNLocator(integer=True, min_n_ticks=1))  # type: ignore[attr-defined]
+    ticks = [tick for tick in MaxNLocator(integer=True, min_n_ticks=1).tick_values(1, top - 1) if 1 <= tick < top]
+    labels = [f"{tick:g}" for tick in ticks]
+    if irregular.any():
+        # Irregular motion has no period: its row is named, not numbered, and ruled off from the periods.
+        axis.axhline(top - 0.5, color="0.3", lw=1.0, ls="--")  # type: ignore[attr-defined]
+        ticks, labels = [*ticks, top], [*labels, "irregular"]
+    axis.set_yticks(ticks, labels)  # type: ignore[attr-defined]
     axis.set_ylabel("period n (drive periods)\nmarker area ∝ basin fraction")  # type: ignore[attr-defined]
 
 

@@ -14,15 +14,15 @@ from __future__ import annotations
 
 import base64
 import errno
-import html
+import itertools
 import math
 import tomllib
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping, Sequence
 
 from . import __version__
 from .atomic import write_text_atomically
-from .params import PRESETS, Preset, field_description, field_unit
+from .params import DEFAULT_PRESET, PRESETS, Preset, field_description, field_unit
 from .plotting import (
     PAPER_FIGURES,
     comparison_temperature_figure,
@@ -33,7 +33,16 @@ from .plotting import (
 )
 from .regime import classify_impacts, settled_run_impacts
 from .storage import CONFIG_FILE, RunData, load_run
-from .validation import EXPERIMENT, PAPER, ComparisonRow, compare, fitted_quantities
+from .validation import (
+    EXPERIMENT,
+    OPERATING_POINT_TOLERANCE,
+    PAPER,
+    ComparisonRow,
+    compare,
+    fitted_quantities,
+    operating_point_mismatches,
+)
+from .views import answer_sentences, esc, number
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -167,21 +176,23 @@ def save_report(run: RunData, target: Path, other: RunData | None = None) -> Pat
 
 
 def render_report(run: RunData, other: RunData | None = None) -> str:
-    """The report as one HTML document."""
+    """The report as one HTML document: the answer first, then how it was obtained, then what to cite."""
     preset = PRESETS.get(run.preset)
+    figure_numbers = itertools.count(1)
     sections = [
-        header_section(run),
+        header_section(run, preset),
         results_section(run),
         table5_section(run, preset),
-        paper_figures_section(run),
+        paper_figures_section(run, figure_numbers),
         configuration_section(run, preset),
         assumptions_section(run, preset),
         energy_section(run),
-        impacts_section(run),
+        impacts_section(run, figure_numbers),
         numerics_section(run),
     ]
     if other is not None:
-        sections.append(comparison_section(run, other))
+        sections.append(comparison_section(run, other, figure_numbers))
+    sections.append(citation_section())
     title = f"shakermill run report: {run_name(run)}"
     return (
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
@@ -192,21 +203,6 @@ def render_report(run: RunData, other: RunData | None = None) -> str:
 
 
 # ---------------------------------------------------------------- HTML and number helpers
-
-
-def esc(value: Any) -> str:
-    return html.escape(str(value), quote=True)
-
-
-def number(value: Any, spec: str = ".4g") -> str:
-    """``value`` formatted with ``spec``; "n/a" for missing or non-finite numbers (stored as null in JSON)."""
-    if value is None:
-        return "n/a"
-    if isinstance(value, bool):
-        return str(value).lower()
-    if isinstance(value, (int, float)):
-        return format(value, spec) if math.isfinite(value) else "n/a"
-    return str(value)
 
 
 def percent(fraction: float) -> str:
@@ -261,17 +257,21 @@ def bullet_list(items: Iterable[str], ordered: bool = False) -> str:
     return f"<{tag}>" + "".join(f"<li>{esc(item)}</li>" for item in items) + f"</{tag}>"
 
 
-def figure_html(figure: Figure, caption: str) -> str:
-    """``figure`` as an inline PNG (data URI) with its caption."""
+def figure_html(figure: Figure, caption: str, number: int) -> str:
+    """``figure`` as an inline PNG (data URI) with its caption, numbered "Figure ``number``"."""
     encoded = base64.b64encode(png_bytes(figure, EMBED_DPI)).decode("ascii")
+    caption = f"Figure {number}: {caption}"
     return (
         f"<figure><img src=\"data:image/png;base64,{encoded}\" alt=\"{esc(caption)}\">"
         f"<figcaption>{esc(caption)}</figcaption></figure>"
     )
 
 
-def figures_html(figures: Mapping[str, Figure]) -> str:
-    return "\n".join(figure_html(figure, FIGURE_CAPTIONS.get(name, name)) for name, figure in figures.items())
+def figures_html(figures: Mapping[str, Figure], numbers: Iterator[int]) -> str:
+    """The figures in order, numbered on from ``numbers`` (one count for the whole report)."""
+    return "\n".join(
+        figure_html(figure, FIGURE_CAPTIONS.get(name, name), next(numbers)) for name, figure in figures.items()
+    )
 
 
 # ---------------------------------------------------------------- run facts
@@ -342,14 +342,13 @@ def fitted_targets(preset: Preset | None) -> tuple[str, ...]:
 # ---------------------------------------------------------------- sections
 
 
-def header_section(run: RunData) -> str:
+def header_section(run: RunData, preset: Preset | None) -> str:
     provenance = run_provenance(run)
     status_class = "ok" if run.success else "failed"
     if run.success:
         status = f"Run completed: {run.message}"
     else:
         status = f"Run stopped early (status {run.status}): {run.message}"
-    preset = PRESETS.get(run.preset)
     facts = [
         ("run folder", str(run.path.resolve())),
         ("preset", f"{run.preset}: {preset.description}" if preset else f"{run.preset} (not known to this version)"),
@@ -365,9 +364,17 @@ def header_section(run: RunData) -> str:
     return (
         f"<header>\n<h1>{esc('shakermill run report: ' + run_name(run))}</h1>\n"
         f"<p class=\"status {status_class}\">{esc(status)}</p>\n{warnings}"
+        + answer_html(run, preset)
         + table(None, facts)
         + "\n</header>"
     )
+
+
+def answer_html(run: RunData, preset: Preset | None) -> str:
+    """The run's answer in sentences, the first thing the report says."""
+    fitted = preset is None or bool(preset.fitted)
+    sentences = answer_sentences(run.summary, run.preset, fitted=fitted)
+    return paragraph(" ".join(sentences), "statement answer") + "\n"
 
 
 def results_section(run: RunData) -> str:
@@ -381,7 +388,21 @@ def results_section(run: RunData) -> str:
     return section("Results", table(("quantity", "value", "unit"), rows, numeric=(1,)), paragraph(uncertainty, "note"))
 
 
+TABLE5_TITLE = "Table 5: experiment, the paper's model and this run"
+
+
 def table5_section(run: RunData, preset: Preset | None) -> str:
+    vial = (preset or PRESETS[DEFAULT_PRESET]).values
+    values = {**run.params.model_dump(), "duration": float(run.summary.get("simulated_s") or 0.0)}
+    mismatches = operating_point_mismatches(values, {key: cited.value for key, cited in vial.items()})
+    if mismatches:
+        reason = (
+            "Left out: the experiment of Table 5 ran at ω = 111 rad/s (about 1060 rpm), 25 mm amplitude, one "
+            "12.7 mm steel ball in the preset's vial, for 60 min; this run differs by more than "
+            f"{OPERATING_POINT_TOLERANCE:.0%} in {'; '.join(mismatches)}. Its fitted exponential and temperatures "
+            "are not comparable with the experiment's."
+        )
+        return section(TABLE5_TITLE, paragraph(reason, "statement"))
     rows = compare(finite_summary(run.summary), fitted_targets(preset))
     cells = []
     notes = []
@@ -408,7 +429,7 @@ def table5_section(run: RunData, preset: Preset | None) -> str:
     footnotes = [f"{'*' * (index + 1)} {note}" for index, note in enumerate(notes)]
     sources = f"Experiment: {EXPERIMENT}. Paper's model: {PAPER}, Table 5."
     return section(
-        "Table 5: experiment, the paper's model and this run",
+        TABLE5_TITLE,
         paragraph(fitted_statement(run, preset, rows), "statement"),
         table(headers, cells, numeric=(2, 3, 4, 5), row_classes=fitted_rows),
         *(paragraph(note, "note") for note in footnotes),
@@ -455,10 +476,10 @@ def fitted_statement(run: RunData, preset: Preset | None, rows: Sequence[Compari
     return statement
 
 
-def paper_figures_section(run: RunData) -> str:
+def paper_figures_section(run: RunData, numbers: Iterator[int]) -> str:
     figures = paper_figures(run)
     missing = [name for name in PAPER_FIGURES if name not in figures]
-    parts = [figures_html(figures)]
+    parts = [figures_html(figures, numbers)]
     if missing:
         parts.append(paragraph(f"Not drawn, no record window with enough points: {', '.join(missing)}.", "note"))
     return section("Figures of the paper (Son 2025, section 4)", *parts)
@@ -571,7 +592,7 @@ def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
     return rows
 
 
-def impacts_section(run: RunData) -> str:
+def impacts_section(run: RunData, numbers: Iterator[int]) -> str:
     parts = [table(("quantity", "value", "unit"), impact_statistics(run), numeric=(1,))]
     if run.impacts.empty:
         parts.append(paragraph("No impacts were recorded.", "note"))
@@ -584,7 +605,7 @@ def impacts_section(run: RunData) -> str:
                 "note",
             )
         )
-    parts.append(figures_html(impact_figures(run)))
+    parts.append(figures_html(impact_figures(run), numbers))
     return section("Impacts", *parts)
 
 
@@ -607,7 +628,7 @@ def numerics_section(run: RunData) -> str:
     return section("Numerics", table(("quantity", "value", "unit"), rows, numeric=(1,)))
 
 
-def comparison_section(run: RunData, other: RunData) -> str:
+def comparison_section(run: RunData, other: RunData, numbers: Iterator[int]) -> str:
     first, second = run_label(run), run_label(other)
     rows = [
         ("model", "", model_name(run), model_name(other), ""),
@@ -638,5 +659,16 @@ def comparison_section(run: RunData, other: RunData) -> str:
         table(("quantity", "unit", first, second, "second − first"), rows, numeric=(2, 3, 4)),
         paragraph("Parameters that differ between the two runs:"),
         parameters,
-        figure_html(figure, caption),
+        figure_html(figure, caption, next(numbers)),
     )
+
+
+CITATIONS = (
+    f"shakermill {__version__}: the simulator that produced this report (see CITATION.cff in its sources).",
+    f"{PAPER}: the model, its parameters and the comparison of Table 5.",
+    "Takacs & McHenry 2006, J. Mater. Sci. 41, 5246: the measured temperatures of Table 5.",
+)
+
+
+def citation_section() -> str:
+    return section("What to cite", paragraph("Work that uses these results should cite:"), bullet_list(CITATIONS))

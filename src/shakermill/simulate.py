@@ -27,6 +27,7 @@ from .steady import SteadyState, run_length_warning, settled_means, steady_state
 if TYPE_CHECKING:
     from .attractors import AttractorScan
     from .averaged import MechanicsAverages
+    from .views import FigureSet
 
 # The step inside a contact stays below this fraction of the Rayleigh time (MODEL.md §7).
 RAYLEIGH_FRACTION = 0.9
@@ -128,6 +129,18 @@ class Result:
     @property
     def success(self) -> bool:
         return self.status == REACHED_STOP
+
+    def plot(self, *, impacts: bool = False) -> FigureSet:
+        """The paper's figures of this run (and the impact figures if asked), by name; a notebook shows them."""
+        from .plotting import run_figures
+        from .views import FigureSet
+
+        return FigureSet(run_figures(self, impacts=impacts))
+
+    def _repr_html_(self) -> str:
+        from .views import result_html
+
+        return result_html(self)
 
 
 def tolerances_for(params: Parameters, constants: model.Constants) -> Tolerances:
@@ -336,12 +349,21 @@ _VARIABLES = {
 }
 
 
+# Temperatures (K) that the datasets also carry in °C, as ``<name>_C``.
+CELSIUS_VARIABLES = ("theta_ball", "theta_vial", "theta_air")
+
+
 def state_dataset(times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters) -> xr.Dataset:
     """The state history as an xarray Dataset with units in the attributes."""
     data_vars = {
         name: ("time", states[:, index], {"units": units, "long_name": long_name})
         for name, (index, units, long_name) in _VARIABLES.items()
     }
+    # The same temperatures in °C beside the kelvin ones: ``ds.theta_ball_C.plot()`` is then labelled with the
+    # unit of its values, which converting ``theta_ball`` by hand would not change from [K].
+    for name in CELSIUS_VARIABLES:
+        kelvin = data_vars[name]
+        data_vars[f"{name}_C"] = ("time", kelvin_to_celsius(kelvin[1]), {"units": "degC", "long_name": kelvin[2]["long_name"]})
     data_vars["velocity"] = ("time", states[:, model.P] / constants.ball_mass, {"units": "m s-1", "long_name": "ball velocity"})
     data_vars["vial_position"] = (
         "time",

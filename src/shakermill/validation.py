@@ -10,7 +10,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .params import ParameterError
+from .params import ParameterError, field_unit
 
 PAPER = "Son 2025, Mathematics 13, 446"
 EXPERIMENT = "Takacs & McHenry 2006 (J. Mater. Sci. 41, 5246), one ball, SPEX 8000"
@@ -41,6 +41,14 @@ TABLE5: tuple[Quantity, ...] = (
         experiment_note="five balls (vial +21 °C, ball +46 °C); the paper compares its one-ball model with it",
     ),
 )
+
+# The experiment's operating point (one 12.7 mm steel ball, SPEX 8000M at about 1060 rpm, 25 mm amplitude, one hour):
+# Table 5 compares only runs at this point, each key within OPERATING_POINT_TOLERANCE of it. The vial's
+# length and diameter are the preset's (see :func:`operating_point_mismatches`).
+EXPERIMENT_OPERATING_POINT = {"omega": 111.0, "amplitude": 25e-3, "ball_radius": 6.35e-3, "duration": 3600.0}
+VIAL_KEYS = ("vial_length", "vial_diameter")
+# 2 %: ω = 111 ± 2.2 rad/s spans 1039–1081 rpm, the SPEX 8000M's speed on 50 and 60 Hz mains within its slip.
+OPERATING_POINT_TOLERANCE = 0.02
 
 TARGET_KEYS: tuple[str, ...] = tuple(quantity.key for quantity in TABLE5)
 # The experiment's curve is an exponential with these three numbers: a calibration to the curve fits them.
@@ -197,3 +205,17 @@ def validate(solver: str = "full") -> list[ValidationRun]:
             )
         )
     return runs
+
+
+def operating_point_mismatches(values: Mapping[str, float], vial: Mapping[str, float]) -> list[str]:
+    """The keys of ``values`` (parameters, with the simulated time as ``duration``) off the experiment's operating
+    point by more than :data:`OPERATING_POINT_TOLERANCE`, as "omega = 100 rad/s (experiment: 111 rad/s)".
+
+    ``vial`` holds the preset's vial length and diameter: the experiment's vial.
+    """
+    wanted = {**EXPERIMENT_OPERATING_POINT, **{key: vial[key] for key in VIAL_KEYS}}
+    return [
+        f"{key} = {values[key]:.4g} {field_unit(key)} (experiment: {target:.4g} {field_unit(key)})"
+        for key, target in wanted.items()
+        if not math.isclose(values[key], target, rel_tol=OPERATING_POINT_TOLERANCE)
+    ]
