@@ -19,8 +19,10 @@ $(STAMP): pyproject.toml
 run: install
 	$(BIN)/shakermill run --out $(OUT)
 
+# scripts/ensure-browser installs Chromium for the report's browser test, or prints why it cannot
+# (the test then skips with that reason).
 test: install
-	$(BIN)/python -m pytest
+	@reason="$$(scripts/ensure-browser)"; SHAKERMILL_BROWSER_UNAVAILABLE="$$reason" $(BIN)/python -m pytest
 
 bench: install
 	$(BIN)/python benchmarks/bench_full_run.py
