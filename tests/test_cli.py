@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import io
 import json
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +21,7 @@ from shakermill import cli
 from shakermill.calibrate import DEFAULT_FREE
 from shakermill.config import load_config
 from shakermill.params import FIELD_NAMES
+from shakermill.simulate import INTERRUPTED
 from shakermill.storage import RUN_FILES, load_run
 from shakermill.sweep import load_sweep
 
@@ -432,3 +435,26 @@ def test_bifurcation_bad_grid_exits_2_with_one_line(tmp_path, grid, fragments):
     assert outcome.exit_code == 2
     assert_one_error_line(outcome.stderr, *fragments)
     assert not (tmp_path / "scan").exists()
+
+
+def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path):
+    # A short run first: Numba's cache is warm, and its wall time says how long start-up takes on this machine.
+    started = time.monotonic()
+    warm = subprocess.run([str(SHAKERMILL), "run", *SHORT, "--no-plots", "--out", str(tmp_path / "warm")], capture_output=True, text=True, timeout=300)
+    assert warm.returncode == 0, warm.stderr
+    start_up = time.monotonic() - started
+    out = tmp_path / "run"
+    command = [str(SHAKERMILL), "run", "--set", "solver=full", "--set", "duration=600 min", "--no-plots", "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(start_up + 2.0)
+    assert process.poll() is None, "the ten hours at full resolution ended before they could be interrupted"
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("interrupted:") and str(out) in lines[0], stderr
+    assert "Traceback" not in stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == INTERRUPTED
+    assert summary["message"].startswith("Interrupted by the user")
+    assert 0 < summary["summary"]["simulated_s"] < 36000

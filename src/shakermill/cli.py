@@ -165,7 +165,9 @@ def run(
     said_first = unit_slip_warnings(run_config.params)
     echo_warnings(said_first)
     result = simulate_with_progress(run_config.params)
-    echo_warnings([line for line in result.warnings if line not in said_first])
+    if result.status != INTERRUPTED:
+        # An interrupted run is short by choice: its warnings (run length, steady state) stay in summary.json.
+        echo_warnings([line for line in result.warnings if line not in said_first])
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
     target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots)
     if json_output:
