@@ -437,24 +437,49 @@ def test_bifurcation_bad_grid_exits_2_with_one_line(tmp_path, grid, fragments):
     assert not (tmp_path / "scan").exists()
 
 
-def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path):
-    # A short run first: Numba's cache is warm, and its wall time says how long start-up takes on this machine.
+@pytest.fixture(scope="module")
+def start_up_s(tmp_path_factory) -> float:
+    """Seconds a short run takes as a process here, with Numba's cache warm: how long to wait before a Ctrl-C."""
+    out = tmp_path_factory.mktemp("warm") / "run"
     started = time.monotonic()
-    warm = subprocess.run([str(SHAKERMILL), "run", *SHORT, "--no-plots", "--out", str(tmp_path / "warm")], capture_output=True, text=True, timeout=300)
+    warm = subprocess.run([str(SHAKERMILL), "run", *SHORT, "--no-plots", "--out", str(out)], capture_output=True, text=True, timeout=300)
     assert warm.returncode == 0, warm.stderr
-    start_up = time.monotonic() - started
-    out = tmp_path / "run"
-    command = [str(SHAKERMILL), "run", "--set", "solver=full", "--set", "duration=600 min", "--no-plots", "--out", str(out)]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(start_up + 2.0)
-    assert process.poll() is None, "the ten hours at full resolution ended before they could be interrupted"
+    return time.monotonic() - started
+
+
+def press_ctrl_c(command: list[str], after_s: float) -> str:
+    """Run ``command``, send it SIGINT after ``after_s`` seconds, and return its stderr once it exited with 130."""
+    process = subprocess.Popen([str(SHAKERMILL), *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(after_s)
+    assert process.poll() is None, f"{command[0]} ended before it could be interrupted"
     process.send_signal(signal.SIGINT)
     _, stderr = process.communicate(timeout=120)
     assert process.returncode == 130, stderr
-    lines = stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("interrupted:") and str(out) in lines[0], stderr
-    assert "Traceback" not in stderr
+    assert len(stderr.strip().splitlines()) == 1 and "Traceback" not in stderr, stderr
+    return stderr
+
+
+def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path, start_up_s):
+    out = tmp_path / "run"
+    command = ["run", "--set", "solver=full", "--set", "duration=600 min", "--no-plots", "--out", str(out)]
+    stderr = press_ctrl_c(command, start_up_s + 2.0)
+    assert stderr.startswith("interrupted:") and str(out) in stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == INTERRUPTED
     assert summary["message"].startswith("Interrupted by the user")
     assert 0 < summary["summary"]["simulated_s"] < 36000
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["bifurcation", "--full-resolution", "--set", "duration=600", "--grid", "omega=90:130:50"],
+        ["calibrate", "--full-resolution"],
+    ],
+    ids=["bifurcation", "calibrate"],
+)
+def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up_s, command):
+    out = tmp_path / "out"
+    stderr = press_ctrl_c([*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0)
+    assert stderr.startswith("error: interrupted; nothing was written")
+    assert list(tmp_path.iterdir()) == []

@@ -125,6 +125,15 @@ def _user_errors() -> Iterator[None]:
         _fail(str(exc))
 
 
+@contextmanager
+def _nothing_written_when_interrupted(what: str) -> Iterator[None]:
+    """Ctrl-C before anything was written: one line and exit code 130."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        _fail(f"interrupted; nothing was written ({what})", EXIT_INTERRUPTED)
+
+
 # Options shared by several commands, declared once.
 ConfigArgument = Annotated[
     Path | None,
@@ -585,11 +594,10 @@ def bifurcation(
         for value in (values[0], values[-1]):
             run_config.params.replace(**{key: float(value)})
     target = out if out is not None else timestamped_folder("bifurcation")
-    with _progress_bar("scanning", "{task.completed}/{task.total} runs", len(values)) as update:
-        try:
-            scan = regime_scan(run_config.params, values, key, progress=None if update is None else lambda done, _total: update(done))
-        except KeyboardInterrupt:
-            _fail("interrupted; nothing was written (a scan is quick to repeat)", EXIT_INTERRUPTED)
+    with _nothing_written_when_interrupted("a scan is quick to repeat"), _progress_bar(
+        "scanning", "{task.completed}/{task.total} runs", len(values)
+    ) as update:
+        scan = regime_scan(run_config.params, values, key, progress=None if update is None else lambda done, _total: update(done))
     try:
         paths = write_bifurcation(scan, target)
         paths += plot_figures({"bifurcation": bifurcation_figure(scan.phases, scan.attractors, key)}, target, dpi=dpi)
@@ -782,7 +790,8 @@ def calibrate(
         measured = Curve.from_csv(curve) if curve is not None else None
         if out is not None and out.exists() and out.is_dir():
             raise ParameterError(f"out: {out} is a folder; give a .toml file name")
-        calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
+        with _nothing_written_when_interrupted("the fit starts again from the beginning"):
+            calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
     if out is not None:
         command = "shakermill calibrate " + " ".join(sys.argv[2:])
         fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]
