@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: install
-	$(BIN)/shakermill run --out $(OUT)
+	$(BIN)/shakermill run --overwrite --out $(OUT)
 
 # scripts/ensure-browser installs Chromium for the report's browser test, or prints why it cannot
 # (the test then skips with that reason).

@@ -483,3 +483,52 @@ def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up
     stderr = press_ctrl_c([*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0)
     assert stderr.startswith("error: interrupted; nothing was written")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_run_onto_a_run_folder_is_refused_unless_overwrite(tmp_path):
+    out = tmp_path / "run"
+    assert invoke("run", *SHORT, "--no-plots", "--out", str(out)).exit_code == 0
+    before = (out / "summary.json").read_text()
+    refused = invoke("run", *SHORT, "--set", "duration=1", "--no-plots", "--out", str(out))
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(out), "holds a run already", "--overwrite")
+    assert (out / "summary.json").read_text() == before
+    replaced = invoke("run", *SHORT, "--set", "duration=1", "--no-plots", "--out", str(out), "--overwrite")
+    assert replaced.exit_code == 0, replaced.stderr
+    assert load_run(out).summary["simulated_s"] == 1.0
+
+
+def test_overwrite_never_replaces_a_folder_shakermill_did_not_write(tmp_path):
+    (tmp_path / "thesis.tex").write_text("precious")
+    refused = invoke("run", *SHORT, "--no-plots", "--out", str(tmp_path), "--overwrite")
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, "not a shakermill run")
+    assert [entry.name for entry in tmp_path.iterdir()] == ["thesis.tex"]
+
+
+def test_bifurcation_onto_a_non_empty_folder_is_refused_unless_overwrite(tmp_path):
+    folder = tmp_path / "scan"
+    folder.mkdir()
+    (folder / "bifurcation_regimes.csv").write_text("earlier scan")
+    arguments = ["bifurcation", *QUICK_BASE, "--grid", "omega=100:120:2", "--out", str(folder)]
+    refused = invoke(*arguments)
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(folder), "not empty", "--overwrite")
+    assert (folder / "bifurcation_regimes.csv").read_text() == "earlier scan"
+    replaced = invoke(*arguments, "--overwrite")
+    assert replaced.exit_code == 0, replaced.stderr
+    assert pd.read_csv(folder / "bifurcation_regimes.csv")["omega"].tolist() == [100.0, 120.0]
+
+
+def test_report_onto_an_existing_file_is_refused_unless_overwrite(tmp_path):
+    run_folder = tmp_path / "run"
+    assert invoke("run", *SHORT, "--no-plots", "--out", str(run_folder)).exit_code == 0
+    report = tmp_path / "report.html"
+    report.write_text("an earlier report")
+    refused = invoke("report", str(run_folder), "--out", str(report))
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(report), "exists", "--overwrite")
+    assert report.read_text() == "an earlier report"
+    replaced = invoke("report", str(run_folder), "--out", str(report), "--overwrite")
+    assert replaced.exit_code == 0, replaced.stderr
+    assert report.read_text().lstrip().lower().startswith("<!doctype html")

@@ -137,7 +137,7 @@ def test_writing_again_replaces_the_old_run_completely(run_folder, short_result)
     def add_extra(folder: Path) -> None:
         (folder / "extra.txt").write_text("new")
 
-    write_run(short_result, run_folder, preset=DEFAULT_PRESET, add_files=add_extra)
+    write_run(short_result, run_folder, preset=DEFAULT_PRESET, add_files=add_extra, overwrite=True)
     assert not (run_folder / "stale.txt").exists()
     assert (run_folder / "extra.txt").read_text() == "new"
     assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]
@@ -156,6 +156,13 @@ def test_refuses_to_replace_what_is_not_a_run_folder(short_result, tmp_path, exi
     with pytest.raises(StorageError, match="choose another --out"):
         write_run(short_result, target, preset=DEFAULT_PRESET)
     assert precious.read_text() == "precious"
+
+
+def test_refuses_to_replace_a_run_unless_told_to(run_folder, short_result):
+    before = (run_folder / "summary.json").read_text(encoding="utf-8")
+    with pytest.raises(StorageError, match="holds a run already.*--overwrite"):
+        write_run(short_result, run_folder, preset=DEFAULT_PRESET)
+    assert (run_folder / "summary.json").read_text(encoding="utf-8") == before
 
 
 def fail_midway(*_args, **_kwargs):
@@ -183,6 +190,6 @@ def test_interrupted_replacement_keeps_the_previous_run(run_folder, short_result
     before = (run_folder / "summary.json").read_text(encoding="utf-8")
     monkeypatch.setattr(storage, "write_impacts", fail_midway)
     with pytest.raises(KeyboardInterrupt):
-        write_run(short_result, run_folder, preset=DEFAULT_PRESET)
+        write_run(short_result, run_folder, preset=DEFAULT_PRESET, overwrite=True)
     assert (run_folder / "summary.json").read_text(encoding="utf-8") == before
     assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]

@@ -147,6 +147,9 @@ SettingsOption = Annotated[
     typer.Option("--set", "-s", metavar="KEY=VALUE", help="Override one key, units allowed: --set ball_radius='5 mm'."),
 ]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")]
+OverwriteOption = Annotated[
+    bool, typer.Option("--overwrite", help="Replace what --out holds (never a folder that shakermill did not write).")
+]
 FullResolutionOption = Annotated[
     bool, typer.Option("--full-resolution", help="Use the full-resolution solver (default: averaged).")
 ]
@@ -163,13 +166,14 @@ def run(
     ] = None,
     json_output: JsonOption = False,
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
+    overwrite: OverwriteOption = False,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
     overrides = settings or []
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=overrides)
         target = out if out is not None else timestamped_folder("run")
-        check_target(target)
+        check_target(target, overwrite=overwrite)
     # Unit slips are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)
     echo_warnings(said_first)
@@ -178,7 +182,7 @@ def run(
         # An interrupted run is short by choice: its warnings (run length, steady state) stay in summary.json.
         echo_warnings([line for line in result.warnings if line not in said_first])
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
-    target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots)
+    target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots, overwrite=overwrite)
     if json_output:
         summary = to_jsonable({**result.summary, "output_dir": str(target)})
         typer.echo(json.dumps(summary, sort_keys=True, allow_nan=False))
@@ -228,7 +232,9 @@ def _progress_bar(verb: str, counter: str, total: float, **fields: Any) -> Itera
         yield lambda completed, **updates: bar.update(task, completed=completed, **updates)
 
 
-def _write(result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool) -> Path:
+def _write(
+    result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool, overwrite: bool
+) -> Path:
     """Write the run folder (with figures unless told not to); return its absolute path."""
 
     def add_figures(folder: Path) -> None:
@@ -236,7 +242,8 @@ def _write(result: Result, target: Path, preset: str, provenance: dict[str, Any]
 
     try:
         return write_run(
-            result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None
+            result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None,
+            overwrite=overwrite,
         )
     except StorageError as exc:
         _fail(str(exc))
@@ -386,6 +393,14 @@ def keys() -> None:
     _stdout_console().print(table)
 
 
+def _check_free_folder(target: Path, overwrite: bool) -> None:
+    """Before any work: ``target`` is absent or an empty folder, or ``overwrite`` lets files there be replaced."""
+    if target.exists() and not target.is_dir():
+        _fail(f"{target}: exists and is not a folder; choose another --out")
+    if target.is_dir() and any(target.iterdir()) and not overwrite:
+        _fail(f"{target}: not empty; choose another --out, or add --overwrite to replace the files of the same names")
+
+
 def _load_run_or_fail(folder: Path) -> RunData:
     """The run folder at ``folder``, or one ``error:`` line and exit code 2."""
     try:
@@ -449,11 +464,14 @@ def report(
         Path | None,
         typer.Option("--compare", metavar="OTHER_RUN_DIR", help="Add a side-by-side comparison with this run folder."),
     ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the report file if it exists.")] = False,
 ) -> None:
     """Write one self-contained HTML report of a run folder (figures embedded, no external resources)."""
     run_data = _load_run_or_fail(run_dir)
     other = _load_run_or_fail(compare) if compare is not None else None
     target = out if out is not None else run_dir / REPORT_FILE
+    if target.is_file() and not overwrite:
+        _fail(f"{target}: exists; choose another --out, or add --overwrite to replace it")
     try:
         save_report(run_data, target, other)
     except OSError as exc:
@@ -585,6 +603,7 @@ def bifurcation(
         bool, typer.Option("--full-resolution", help="Settle with the full-resolution solver (default: averaged).")
     ] = False,
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG file.")] = PNG_DPI,
+    overwrite: OverwriteOption = False,
 ) -> None:
     """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
     with _user_errors():
@@ -594,6 +613,7 @@ def bifurcation(
         for value in (values[0], values[-1]):
             run_config.params.replace(**{key: float(value)})
     target = out if out is not None else timestamped_folder("bifurcation")
+    _check_free_folder(target, overwrite)
     with _nothing_written_when_interrupted("a scan is quick to repeat"), _progress_bar(
         "scanning", "{task.completed}/{task.total} runs", len(values)
     ) as update:

@@ -91,18 +91,22 @@ def to_jsonable(value: Any) -> Any:
     return value
 
 
-def check_target(path: Path) -> None:
-    """Raise :class:`StorageError` unless ``path`` is free, an empty folder or a run folder to replace.
+def check_target(path: Path, *, overwrite: bool = False) -> None:
+    """Raise :class:`StorageError` unless ``path`` is free, an empty folder, or a run folder and ``overwrite``.
 
-    Replacing deletes the old folder, so anything else (a file, a folder of the
-    user's own) is refused rather than destroyed.
+    Replacing deletes the old folder: a run only when asked to, anything else (a file, a folder of
+    the user's own) never.
     """
     if not path.exists() and not path.is_symlink():
         return
     if path.is_symlink() or not path.is_dir():
         raise StorageError(f"{path}: exists and is not a folder; choose another --out")
-    if any(path.iterdir()) and not (path / SUMMARY_FILE).is_file():
+    if not any(path.iterdir()):
+        return
+    if not (path / SUMMARY_FILE).is_file():
         raise StorageError(f"{path}: a non-empty folder that is not a shakermill run; choose another --out")
+    if not overwrite:
+        raise StorageError(f"{path}: holds a run already; choose another --out, or add --overwrite to replace it")
 
 
 def write_run(
@@ -112,15 +116,16 @@ def write_run(
     preset: str,
     extra_provenance: Mapping[str, Any] | None = None,
     add_files: Callable[[Path], object] | None = None,
+    overwrite: bool = False,
 ) -> Path:
-    """Write ``result`` as a run folder at ``path``, replacing a previous run folder there.
+    """Write ``result`` as a run folder at ``path``; a previous run folder there is replaced only with ``overwrite``.
 
     ``add_files(folder)`` may add more files (figures) before the folder is
     moved into place. Returns the folder's absolute path.
     """
     # Absolute, so that "." has a name to derive the sibling folders from.
     target = Path(path).absolute()
-    check_target(target)
+    check_target(target, overwrite=overwrite)
     target.parent.mkdir(parents=True, exist_ok=True)
     partial = partial_path(target)
     partial.mkdir()

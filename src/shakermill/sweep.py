@@ -481,7 +481,8 @@ def _store_point(folder: Path, identifier: str, outcome: PointOutcome, preset: s
 
         target = folder / RUNS_FOLDER / identifier
         provenance = {"command": "shakermill sweep", "sweep": str(folder.absolute()), "point_id": identifier}
-        row["output_dir"] = str(write_run(outcome.result, target, preset=preset, extra_provenance=provenance))
+        # A run folder without its point file was left by a killed sweep: this point's, so it is replaced.
+        row["output_dir"] = str(write_run(outcome.result, target, preset=preset, extra_provenance=provenance, overwrite=True))
     document = {"point_id": identifier, "shakermill_version": __version__, "row": row}
     write_text_atomically(_point_path(folder, identifier), json.dumps(document, indent=1, allow_nan=False) + "\n")
     return row
