@@ -49,6 +49,7 @@ from .simulate import INTERRUPTED, Result, simulate
 from .sweep import (
     DEFAULT_SCHEDULER_TIMEOUT_S,
     TABLE_CSV,
+    SweepFailed,
     TABLE_PARQUET,
     failed_points,
     is_sweep_folder,
@@ -536,6 +537,9 @@ def sweep(
                 run_config.params, plan, target, workers=workers, scheduler=scheduler,
                 keep_runs=keep_runs, progress=progress, preset=run_config.preset, scheduler_timeout=scheduler_timeout,
             )
+    except SweepFailed as exc:
+        # Said below like any failed point, after the table's preview.
+        table = exc.table
     except KeyboardInterrupt:
         _fail(f"interrupted; the finished points are stored in {target}; re-run with --out {target} to finish", EXIT_INTERRUPTED)
     except OSError as exc:
