@@ -193,3 +193,29 @@ def test_interrupted_replacement_keeps_the_previous_run(run_folder, short_result
         write_run(short_result, run_folder, preset=DEFAULT_PRESET, overwrite=True)
     assert (run_folder / "summary.json").read_text(encoding="utf-8") == before
     assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]
+
+
+def test_averaged_run_files_say_what_covers_only_the_averaging_window(tmp_path):
+    result = sm.simulate(sm.default_parameters(solver="averaged", duration=600.0, attractor_starts=1))
+    assert result.solver == "averaged" and result.impact_window is not None
+    folder = write_run(result, tmp_path / "averaged", preset=DEFAULT_PRESET)
+    end = result.averages.transient + result.averages.window
+    with xr.open_dataset(folder / "timeseries.nc", engine="h5netcdf") as series:
+        assert "x, p, velocity are NaN" in series.attrs["coverage"]
+        for name in ("x", "p", "velocity"):
+            assert np.isnan(series[name].values).all()
+            assert "not computed by the averaged solver" in series[name].attrs["coverage"]
+        assert "mean rate times time" in series["heat_generated"].attrs["coverage"]
+        assert "coverage" not in series["theta_ball"].attrs
+    with xr.open_dataset(folder / "windows.nc", engine="h5netcdf") as windows:
+        assert f"up to t = {end:.6g} s" in windows.attrs["coverage"]
+    coverage = pq.read_schema(folder / "impacts.parquet").metadata[b"coverage"].decode()
+    assert f"to {end:.6g} s" in coverage and "impact_rate_hz" in coverage
+    assert load_run(folder).impacts["time"].max() <= end
+
+
+def test_full_run_files_cover_the_whole_run(tmp_path):
+    folder = write_run(sm.simulate(sm.default_parameters(solver="full", duration=2.0)), tmp_path / "full", preset=DEFAULT_PRESET)
+    with xr.open_dataset(folder / "timeseries.nc", engine="h5netcdf") as series:
+        assert "coverage" not in series.attrs and "coverage" not in series["x"].attrs
+    assert b"coverage" not in pq.read_schema(folder / "impacts.parquet").metadata
