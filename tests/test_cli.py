@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import io
 import json
 import signal
@@ -48,6 +49,8 @@ REQUIRED_SUMMARY_KEYS = {
     "output_dir",
 }
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
+# The module, not the function that shadows it as ``shakermill.simulate``; the command line calls it there.
+SIMULATE_MODULE = importlib.import_module("shakermill.simulate")
 
 runner = CliRunner()
 
@@ -158,7 +161,7 @@ def test_unknown_preset_exits_2():
 
 def test_output_over_a_foreign_folder_is_refused_before_running(tmp_path, monkeypatch):
     (tmp_path / "notes.txt").write_text("mine")
-    monkeypatch.setattr(cli, "simulate", lambda *_args, **_kwargs: pytest.fail("must not run"))
+    monkeypatch.setattr(SIMULATE_MODULE, "simulate", lambda *_args, **_kwargs: pytest.fail("must not run"))
     result = invoke("run", *SHORT, "--out", str(tmp_path))
     assert result.exit_code == 2
     assert_one_error_line(result.stderr, str(tmp_path), "not a shakermill run")
@@ -192,7 +195,7 @@ def test_interruption_writes_partial_results_and_exits_130(tmp_path, monkeypatch
         raise KeyboardInterrupt
 
     # The interruption arrives after the first chunk, inside the library, as a real Ctrl-C would.
-    monkeypatch.setattr(cli, "simulate", lambda params, progress=None: real_simulate(params, progress=press_ctrl_c))
+    monkeypatch.setattr(SIMULATE_MODULE, "simulate", lambda params, progress=None: real_simulate(params, progress=press_ctrl_c))
     out = tmp_path / "run"
     result = invoke("run", "--set", "duration=30", "--set", "record_windows=0:0.2", "--out", str(out), "--no-plots")
     assert result.exit_code == 130
@@ -447,7 +450,7 @@ def start_up_s(tmp_path_factory) -> float:
     return time.monotonic() - started
 
 
-def press_ctrl_c(command: list[str], after_s: float) -> str:
+def interrupt_after(command: list[str], after_s: float) -> str:
     """Run ``command``, send it SIGINT after ``after_s`` seconds, and return its stderr once it exited with 130."""
     process = subprocess.Popen([str(SHAKERMILL), *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(after_s)
@@ -462,7 +465,7 @@ def press_ctrl_c(command: list[str], after_s: float) -> str:
 def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path, start_up_s):
     out = tmp_path / "run"
     command = ["run", "--set", "solver=full", "--set", "duration=600 min", "--no-plots", "--out", str(out)]
-    stderr = press_ctrl_c(command, start_up_s + 2.0)
+    stderr = interrupt_after(command, start_up_s + 2.0)
     assert stderr.startswith("interrupted:") and str(out) in stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == INTERRUPTED
@@ -480,7 +483,7 @@ def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path, sta
 )
 def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up_s, command):
     out = tmp_path / "out"
-    stderr = press_ctrl_c([*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0)
+    stderr = interrupt_after([*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0)
     assert stderr.startswith("error: interrupted; nothing was written")
     assert list(tmp_path.iterdir()) == []
 

@@ -16,52 +16,40 @@ import sys
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
-from typing import Annotated, Any, Callable, Iterator, NoReturn, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, NoReturn, Sequence
 
-import pandas as pd
 import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
+# Only light modules here: `shakermill --help` and the listing commands must not wait for NumPy, Numba,
+# pandas, xarray, SciPy or Matplotlib. Each command imports what it uses.
 from . import __version__
-from .calibrate import DEFAULT_FREE, free_set_study, parse_free, parse_targets, write_preset
-from .calibrate import calibrate as fit_parameters
+from .atomic import StorageError
 from .config import load_config
+from .defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
 from .params import (
     DEFAULT_PRESET,
     FIELD_NAMES,
     PRESETS,
     ParameterError,
-    Parameters,
     allowed_range,
     field_description,
     field_unit,
     preset_values,
     unit_slip_warnings,
 )
-from .plotting import PNG_DPI, bifurcation_figure, contour_notes, impact_figures, parse_contour, plot_figures, plot_run, run_figures, sweep_figures
-from .regime import bifurcation as regime_scan
-from .regime import write_bifurcation
-from .report import REPORT_FILE, save_report
-from .simulate import INTERRUPTED, Result, simulate
-from .sweep import (
-    DEFAULT_SCHEDULER_TIMEOUT_S,
-    TABLE_CSV,
-    SweepFailed,
-    TABLE_PARQUET,
-    failed_points,
-    is_sweep_folder,
-    load_sweep,
-    parse_grid,
-    plan_sweep,
-    sweep_parameters,
-)
-from .sweep import sweep as run_sweep
-from .storage import RunData, StorageError, check_target, load_run, to_jsonable, write_run
 from .validation import EXPERIMENT, TABLE5, TARGET_KEYS, Curve
 from .validation import validate as run_validation
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from .params import Parameters
+    from .simulate import Result
+    from .storage import RunData
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
@@ -170,6 +158,9 @@ def run(
     overwrite: OverwriteOption = False,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
+    from .simulate import INTERRUPTED
+    from .storage import check_target, to_jsonable
+
     overrides = settings or []
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=overrides)
@@ -211,6 +202,8 @@ def timestamped_folder(kind: str) -> Path:
 
 def simulate_with_progress(params: Parameters) -> Result:
     """``simulate``, with a transient progress bar on stderr for long runs when stderr is a terminal."""
+    from .simulate import simulate
+
     if params.duration < PROGRESS_MIN_DURATION_S:
         return simulate(params)
     with _progress_bar("simulating", "{task.completed:.0f}/{task.total:.0f} s simulated", params.duration) as update:
@@ -237,6 +230,9 @@ def _write(
     result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool, overwrite: bool
 ) -> Path:
     """Write the run folder (with figures unless told not to); return its absolute path."""
+    from .plotting import plot_run
+    from .storage import write_run
+
 
     def add_figures(folder: Path) -> None:
         plot_run(result, folder / FIGURES_FOLDER)
@@ -255,6 +251,8 @@ def _write(
 
 
 def _exit_for_status(result: Result, target: Path) -> None:
+    from .simulate import INTERRUPTED
+
     if result.status == INTERRUPTED:
         typer.echo(f"interrupted: {result.message} Partial results in {target}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
@@ -333,6 +331,9 @@ def compare_solvers(
     json_output: JsonOption = False,
 ) -> None:
     """Run the same configuration with the full and the averaged solver; print both, the differences and the speed ratio."""
+    from .simulate import simulate
+    from .storage import to_jsonable
+
     with _user_errors():
         params = load_config(config, preset=preset, overrides=settings or []).params
     full = simulate_with_progress(params.replace(solver="full"))
@@ -404,6 +405,8 @@ def _check_free_folder(target: Path, overwrite: bool) -> None:
 
 def _load_run_or_fail(folder: Path) -> RunData:
     """The run folder at ``folder``, or one ``error:`` line and exit code 2."""
+    from .storage import load_run
+
     try:
         return load_run(folder)
     except StorageError as exc:
@@ -431,6 +434,9 @@ def plot(
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG files.")] = PNG_DPI,
 ) -> None:
     """Draw the figures of a run folder (paper Figs. 4, 5a, 5b, impact statistics) or of a sweep folder (maps or lines)."""
+    from .plotting import contour_notes, impact_figures, parse_contour, plot_figures, run_figures, sweep_figures
+    from .sweep import is_sweep_folder, load_sweep
+
     target = out if out is not None else folder / FIGURES_FOLDER
     if is_sweep_folder(folder):
         if impacts:
@@ -468,6 +474,8 @@ def report(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the report file if it exists.")] = False,
 ) -> None:
     """Write one self-contained HTML report of a run folder (figures embedded, no external resources)."""
+    from .report import save_report
+
     run_data = _load_run_or_fail(run_dir)
     other = _load_run_or_fail(compare) if compare is not None else None
     target = out if out is not None else run_dir / REPORT_FILE
@@ -525,6 +533,9 @@ def sweep(
     json_output: JsonOption = False,
 ) -> None:
     """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
+    from .sweep import TABLE_CSV, TABLE_PARQUET, SweepFailed, failed_points, plan_sweep, sweep_parameters
+    from .sweep import sweep as run_sweep
+
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
         plan = plan_sweep(grid or [], points)
@@ -569,6 +580,10 @@ def sweep(
 
 def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path) -> Table:
     """The first rows of a sweep table: swept values, regime and the main results."""
+    import pandas as pd
+
+    from .sweep import TABLE_CSV, TABLE_PARQUET, failed_points
+
     preview = Table(title=f"shakermill sweep: {len(table)} points, {len(failed_points(table))} failed")
     for key in keys:
         preview.add_column(f"{key} ({field_unit(key)})" if field_unit(key) else key, justify="right")
@@ -587,6 +602,8 @@ def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path) -> Tab
 
 
 def _cell(value: Any, spec: str) -> str:
+    import pandas as pd
+
     if value is None or (not isinstance(value, str) and pd.isna(value)):
         return "n/a"
     return value if isinstance(value, str) else _number(value, spec)
@@ -610,6 +627,11 @@ def bifurcation(
     overwrite: OverwriteOption = False,
 ) -> None:
     """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
+    from .plotting import bifurcation_figure, plot_figures
+    from .regime import bifurcation as regime_scan
+    from .regime import write_bifurcation
+    from .sweep import parse_grid, sweep_parameters
+
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
         key, values = parse_grid(grid)
@@ -688,6 +710,9 @@ def validate(
 ) -> None:
     """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
     calibrated parameters, and which free sets of a calibration can follow the curve."""
+    from .calibrate import free_set_study
+    from .storage import to_jsonable
+
     if solver not in ("full", "averaged"):
         _fail(f"solver: {solver!r} is not allowed; allowed: one of 'full', 'averaged'")
     runs = run_validation(solver)
@@ -807,6 +832,10 @@ def calibrate(
     json_output: JsonOption = False,
 ) -> None:
     """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
+    from .calibrate import calibrate as fit_parameters
+    from .calibrate import parse_free, parse_targets, write_preset
+    from .storage import to_jsonable
+
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])
         targets = parse_targets(target or [])

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
 from . import __version__
 from .atomic import write_text_atomically
+from .defaults import REPORT_FILE
 from .params import PRESETS, Preset, field_description, field_unit
 from .plotting import (
     PAPER_FIGURES,
@@ -38,7 +39,6 @@ from .validation import EXPERIMENT, PAPER, ComparisonRow, compare, fitted_quanti
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-REPORT_FILE = "report.html"
 # Screen resolution: sharp enough in a browser, and keeps a report of six figures well under a megabyte.
 EMBED_DPI = 100
 # Keys that change what is stored or reported, not what is simulated: a calibration still holds when they differ.

@@ -33,7 +33,7 @@ import pyarrow.parquet as pq
 import xarray as xr
 
 from . import __version__
-from .atomic import partial_path
+from .atomic import StorageError, partial_path
 from .config import load_config, write_config_toml
 from .fit import ExponentialFit
 from .integrate import REACHED_STOP
@@ -54,10 +54,6 @@ COVERAGE_KEY = "coverage"
 AVERAGED_MOTION_VARIABLES = ("x", "p", "velocity")
 AVERAGED_FLOW_VARIABLES = ("work_vial", "dissipated", "heat_generated", "velocity_term_integral")
 NETCDF_ENGINE = "h5netcdf"
-
-
-class StorageError(Exception):
-    """A run folder cannot be written to, or read from, the given path."""
 
 
 @dataclass(frozen=True)

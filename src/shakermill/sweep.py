@@ -43,6 +43,7 @@ import pandas as pd
 
 from . import __version__
 from .atomic import partial_path, write_text_atomically
+from .defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from .config import RunConfig, load_config, parse_overrides, read_config_file
 from .params import DEFAULT_PRESET, ParameterError, Parameters, check_known_keys, field_unit
 from .simulate import INTERRUPTED, Result, simulate
@@ -61,7 +62,6 @@ TABLE_CSV = f"{TABLE_STEM}.csv"
 MANIFEST_FORMAT = "shakermill-sweep/1"
 # 64 bits of SHA-256: collisions are out of reach for any sweep that fits on a disk.
 POINT_ID_LENGTH = 16
-DEFAULT_SCHEDULER_TIMEOUT_S = 10.0
 # Columns that measure the machine, not the model: they differ between two runs of the same point.
 TIMING_COLUMNS = ("wall_time_s",)
 # A summary key that is also a swept key (only ``solver``: the averaged solver may fall back to
