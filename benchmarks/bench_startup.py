@@ -23,15 +23,17 @@ import time
 from pathlib import Path
 
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
-RUN = ["run", "--set", "solver=averaged", "--no-plots", "--overwrite"]  # the preset runs 60 min
+RUN = ["run", "--set", "solver=averaged", "--no-plots"]  # the preset runs 60 min
 
 
-def timed(arguments: list[str], repeats: int) -> list[float]:
-    """Wall times of ``shakermill ARGUMENTS`` as a process, each checked to succeed."""
+def timed(arguments: list[str], repeats: int, out: Path | None = None) -> list[float]:
+    """Wall times of ``shakermill ARGUMENTS`` as a process, each checked to succeed; with ``out``, each
+    repetition writes a fresh folder inside it (--out onto an earlier run is refused)."""
     times = []
-    for _ in range(repeats):
+    for repetition in range(repeats):
+        target = [] if out is None else ["--out", str(out / f"{repetition}")]
         started = time.perf_counter()
-        subprocess.run([str(SHAKERMILL), *arguments], check=True, capture_output=True)
+        subprocess.run([str(SHAKERMILL), *arguments, *target], check=True, capture_output=True)
         times.append(time.perf_counter() - started)
     return times
 
@@ -47,13 +49,12 @@ def main() -> None:
     repeats = max(args.repeats, 5)
     folder = Path(tempfile.mkdtemp(prefix="bench-startup-"))
     try:
-        run_dir = folder / "run"
-        timed([*RUN, "--out", str(run_dir)], 1)  # Numba's cache and the OS's file cache warm
+        timed(RUN, 1, folder / "warm")  # Numba's cache and the OS's file cache warm
         report("shakermill --help", timed(["--help"], repeats))
-        report("run, averaged, 60 min, --no-plots", timed([*RUN, "--out", str(run_dir)], repeats))
-        single = [*RUN, "--set", "attractor_starts=1", "--out", str(folder / "single")]
-        report("run, averaged, 60 min, --no-plots, attractor_starts=1", timed(single, repeats))
-        report("plot RUN_DIR", timed(["plot", str(run_dir)], repeats))
+        report("run, averaged, 60 min, --no-plots", timed(RUN, repeats, folder / "probed"))
+        single = [*RUN, "--set", "attractor_starts=1"]
+        report("run, averaged, 60 min, --no-plots, attractor_starts=1", timed(single, repeats, folder / "single"))
+        report("plot RUN_DIR", timed(["plot", str(folder / "warm" / "0")], repeats))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
