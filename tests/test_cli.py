@@ -535,3 +535,19 @@ def test_report_onto_an_existing_file_is_refused_unless_overwrite(tmp_path):
     replaced = invoke("report", str(run_folder), "--out", str(report), "--overwrite")
     assert replaced.exit_code == 0, replaced.stderr
     assert report.read_text().lstrip().lower().startswith("<!doctype html")
+
+
+def test_calibrate_onto_an_existing_preset_file_is_refused_unless_overwrite(tmp_path, monkeypatch):
+    preset_file = tmp_path / "fitted.toml"
+    preset_file.write_text("# an earlier fit\n")
+    calibrate_module = importlib.import_module("shakermill.calibrate")
+    monkeypatch.setattr(calibrate_module, "calibrate", lambda *_args, **_kwargs: pytest.fail("must not fit"))
+    arguments = ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", str(preset_file)]
+    refused = invoke(*arguments)
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(preset_file), "exists", "--overwrite")
+    assert preset_file.read_text() == "# an earlier fit\n"
+    monkeypatch.undo()
+    replaced = invoke(*arguments, "--overwrite", "--json")
+    assert replaced.exit_code == 0, replaced.stderr
+    assert load_config(preset_file).params.beta == pytest.approx(json.loads(replaced.stdout)["fitted"]["beta"])

@@ -830,6 +830,7 @@ def calibrate(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
 ) -> None:
     """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
     from .calibrate import calibrate as fit_parameters
@@ -843,6 +844,9 @@ def calibrate(
         measured = Curve.from_csv(curve) if curve is not None else None
         if out is not None and out.exists() and out.is_dir():
             raise ParameterError(f"out: {out} is a folder; give a .toml file name")
+        if out is not None and out.exists() and not overwrite:
+            # Checked before the fit, which takes a while.
+            raise ParameterError(f"out: {out} exists; choose another --out, or add --overwrite to replace it")
         with _nothing_written_when_interrupted("the fit starts again from the beginning"):
             calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
     if out is not None:
