@@ -551,3 +551,14 @@ def test_calibrate_onto_an_existing_preset_file_is_refused_unless_overwrite(tmp_
     replaced = invoke(*arguments, "--overwrite", "--json")
     assert replaced.exit_code == 0, replaced.stderr
     assert load_config(preset_file).params.beta == pytest.approx(json.loads(replaced.stdout)["fitted"]["beta"])
+
+
+def test_ctrl_c_in_the_averaged_solver_says_so_in_one_line_and_writes_nothing(tmp_path, monkeypatch):
+    def interrupted(*_args, **_kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(SIMULATE_MODULE, "simulate", interrupted)
+    result = invoke("run", "--set", "solver=averaged", "--out", str(tmp_path / "run"))
+    assert result.exit_code == 130
+    assert_one_error_line(result.stderr, "interrupted; nothing was written")
+    assert list(tmp_path.iterdir()) == []

@@ -169,7 +169,9 @@ def run(
     # Unit slips are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)
     echo_warnings(said_first)
-    result = simulate_with_progress(run_config.params)
+    # A full-resolution run keeps what it computed when interrupted; the averaged solver has nothing to keep.
+    with _nothing_written_when_interrupted("the averaged solver keeps no part of a run"):
+        result = simulate_with_progress(run_config.params)
     if result.status != INTERRUPTED:
         # An interrupted run is short by choice: its warnings (run length, steady state) stay in summary.json.
         echo_warnings([line for line in result.warnings if line not in said_first])
