@@ -17,15 +17,18 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: install
-	$(BIN)/shakermill run --out $(OUT)
+	$(BIN)/shakermill run --overwrite --out $(OUT)
 
+# scripts/ensure-browser installs Chromium for the report's browser test, or prints why it cannot
+# (the test then skips with that reason).
 test: install
-	$(BIN)/python -m pytest
+	@reason="$$(scripts/ensure-browser)"; SHAKERMILL_BROWSER_UNAVAILABLE="$$reason" $(BIN)/python -m pytest
 
 bench: install
 	$(BIN)/python benchmarks/bench_full_run.py
 	$(BIN)/python benchmarks/bench_averaged.py
 	$(BIN)/python benchmarks/bench_sweep.py
+	$(BIN)/python benchmarks/bench_startup.py
 
 clean:
 	rm -rf $(VENV) results

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import importlib
 import io
 import json
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +22,7 @@ from shakermill import cli
 from shakermill.calibrate import DEFAULT_FREE
 from shakermill.config import load_config
 from shakermill.params import FIELD_NAMES
+from shakermill.simulate import INTERRUPTED
 from shakermill.storage import RUN_FILES, load_run
 from shakermill.sweep import load_sweep
 
@@ -45,6 +49,8 @@ REQUIRED_SUMMARY_KEYS = {
     "output_dir",
 }
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
+# The module, not the function that shadows it as ``shakermill.simulate``; the command line calls it there.
+SIMULATE_MODULE = importlib.import_module("shakermill.simulate")
 
 runner = CliRunner()
 
@@ -155,7 +161,7 @@ def test_unknown_preset_exits_2():
 
 def test_output_over_a_foreign_folder_is_refused_before_running(tmp_path, monkeypatch):
     (tmp_path / "notes.txt").write_text("mine")
-    monkeypatch.setattr(cli, "simulate", lambda *_args, **_kwargs: pytest.fail("must not run"))
+    monkeypatch.setattr(SIMULATE_MODULE, "simulate", lambda *_args, **_kwargs: pytest.fail("must not run"))
     result = invoke("run", *SHORT, "--out", str(tmp_path))
     assert result.exit_code == 2
     assert_one_error_line(result.stderr, str(tmp_path), "not a shakermill run")
@@ -189,7 +195,7 @@ def test_interruption_writes_partial_results_and_exits_130(tmp_path, monkeypatch
         raise KeyboardInterrupt
 
     # The interruption arrives after the first chunk, inside the library, as a real Ctrl-C would.
-    monkeypatch.setattr(cli, "simulate", lambda params, progress=None: real_simulate(params, progress=press_ctrl_c))
+    monkeypatch.setattr(SIMULATE_MODULE, "simulate", lambda params, progress=None: real_simulate(params, progress=press_ctrl_c))
     out = tmp_path / "run"
     result = invoke("run", "--set", "duration=30", "--set", "record_windows=0:0.2", "--out", str(out), "--no-plots")
     assert result.exit_code == 130
@@ -432,3 +438,127 @@ def test_bifurcation_bad_grid_exits_2_with_one_line(tmp_path, grid, fragments):
     assert outcome.exit_code == 2
     assert_one_error_line(outcome.stderr, *fragments)
     assert not (tmp_path / "scan").exists()
+
+
+@pytest.fixture(scope="module")
+def start_up_s(tmp_path_factory) -> float:
+    """Seconds a short run takes as a process here, with Numba's cache warm: how long to wait before a Ctrl-C."""
+    out = tmp_path_factory.mktemp("warm") / "run"
+    started = time.monotonic()
+    warm = subprocess.run([str(SHAKERMILL), "run", *SHORT, "--no-plots", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    assert warm.returncode == 0, warm.stderr
+    return time.monotonic() - started
+
+
+def interrupt_after(command: list[str], after_s: float) -> str:
+    """Run ``command``, send it SIGINT after ``after_s`` seconds, and return its stderr once it exited with 130."""
+    process = subprocess.Popen([str(SHAKERMILL), *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(after_s)
+    assert process.poll() is None, f"{command[0]} ended before it could be interrupted"
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr
+    assert len(stderr.strip().splitlines()) == 1 and "Traceback" not in stderr, stderr
+    return stderr
+
+
+def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path, start_up_s):
+    out = tmp_path / "run"
+    command = ["run", "--set", "solver=full", "--set", "duration=600 min", "--no-plots", "--out", str(out)]
+    stderr = interrupt_after(command, start_up_s + 2.0)
+    assert stderr.startswith("interrupted:") and str(out) in stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == INTERRUPTED
+    assert summary["message"].startswith("Interrupted by the user")
+    assert 0 < summary["summary"]["simulated_s"] < 36000
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["bifurcation", "--full-resolution", "--set", "duration=600", "--grid", "omega=90:130:50"],
+        ["calibrate", "--full-resolution"],
+    ],
+    ids=["bifurcation", "calibrate"],
+)
+def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up_s, command):
+    out = tmp_path / "out"
+    stderr = interrupt_after([*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0)
+    assert stderr.startswith("error: interrupted; nothing was written")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_run_onto_a_run_folder_is_refused_unless_overwrite(tmp_path):
+    out = tmp_path / "run"
+    assert invoke("run", *SHORT, "--no-plots", "--out", str(out)).exit_code == 0
+    before = (out / "summary.json").read_text()
+    refused = invoke("run", *SHORT, "--set", "duration=1", "--no-plots", "--out", str(out))
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(out), "holds a run already", "--overwrite")
+    assert (out / "summary.json").read_text() == before
+    replaced = invoke("run", *SHORT, "--set", "duration=1", "--no-plots", "--out", str(out), "--overwrite")
+    assert replaced.exit_code == 0, replaced.stderr
+    assert load_run(out).summary["simulated_s"] == 1.0
+
+
+def test_overwrite_never_replaces_a_folder_shakermill_did_not_write(tmp_path):
+    (tmp_path / "thesis.tex").write_text("precious")
+    refused = invoke("run", *SHORT, "--no-plots", "--out", str(tmp_path), "--overwrite")
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, "not a shakermill run")
+    assert [entry.name for entry in tmp_path.iterdir()] == ["thesis.tex"]
+
+
+def test_bifurcation_onto_a_non_empty_folder_is_refused_unless_overwrite(tmp_path):
+    folder = tmp_path / "scan"
+    folder.mkdir()
+    (folder / "bifurcation_regimes.csv").write_text("earlier scan")
+    arguments = ["bifurcation", *QUICK_BASE, "--grid", "omega=100:120:2", "--out", str(folder)]
+    refused = invoke(*arguments)
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(folder), "not empty", "--overwrite")
+    assert (folder / "bifurcation_regimes.csv").read_text() == "earlier scan"
+    replaced = invoke(*arguments, "--overwrite")
+    assert replaced.exit_code == 0, replaced.stderr
+    assert pd.read_csv(folder / "bifurcation_regimes.csv")["omega"].tolist() == [100.0, 120.0]
+
+
+def test_report_onto_an_existing_file_is_refused_unless_overwrite(tmp_path):
+    run_folder = tmp_path / "run"
+    assert invoke("run", *SHORT, "--no-plots", "--out", str(run_folder)).exit_code == 0
+    report = tmp_path / "report.html"
+    report.write_text("an earlier report")
+    refused = invoke("report", str(run_folder), "--out", str(report))
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(report), "exists", "--overwrite")
+    assert report.read_text() == "an earlier report"
+    replaced = invoke("report", str(run_folder), "--out", str(report), "--overwrite")
+    assert replaced.exit_code == 0, replaced.stderr
+    assert report.read_text().lstrip().lower().startswith("<!doctype html")
+
+
+def test_calibrate_onto_an_existing_preset_file_is_refused_unless_overwrite(tmp_path, monkeypatch):
+    preset_file = tmp_path / "fitted.toml"
+    preset_file.write_text("# an earlier fit\n")
+    calibrate_module = importlib.import_module("shakermill.calibrate")
+    monkeypatch.setattr(calibrate_module, "calibrate", lambda *_args, **_kwargs: pytest.fail("must not fit"))
+    arguments = ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", str(preset_file)]
+    refused = invoke(*arguments)
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(preset_file), "exists", "--overwrite")
+    assert preset_file.read_text() == "# an earlier fit\n"
+    monkeypatch.undo()
+    replaced = invoke(*arguments, "--overwrite", "--json")
+    assert replaced.exit_code == 0, replaced.stderr
+    assert load_config(preset_file).params.beta == pytest.approx(json.loads(replaced.stdout)["fitted"]["beta"])
+
+
+def test_ctrl_c_in_the_averaged_solver_says_so_in_one_line_and_writes_nothing(tmp_path, monkeypatch):
+    def interrupted(*_args, **_kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(SIMULATE_MODULE, "simulate", interrupted)
+    result = invoke("run", "--set", "solver=averaged", "--out", str(tmp_path / "run"))
+    assert result.exit_code == 130
+    assert_one_error_line(result.stderr, "interrupted; nothing was written")
+    assert list(tmp_path.iterdir()) == []

@@ -137,7 +137,7 @@ def test_writing_again_replaces_the_old_run_completely(run_folder, short_result)
     def add_extra(folder: Path) -> None:
         (folder / "extra.txt").write_text("new")
 
-    write_run(short_result, run_folder, preset=DEFAULT_PRESET, add_files=add_extra)
+    write_run(short_result, run_folder, preset=DEFAULT_PRESET, add_files=add_extra, overwrite=True)
     assert not (run_folder / "stale.txt").exists()
     assert (run_folder / "extra.txt").read_text() == "new"
     assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]
@@ -156,6 +156,13 @@ def test_refuses_to_replace_what_is_not_a_run_folder(short_result, tmp_path, exi
     with pytest.raises(StorageError, match="choose another --out"):
         write_run(short_result, target, preset=DEFAULT_PRESET)
     assert precious.read_text() == "precious"
+
+
+def test_refuses_to_replace_a_run_unless_told_to(run_folder, short_result):
+    before = (run_folder / "summary.json").read_text(encoding="utf-8")
+    with pytest.raises(StorageError, match="holds a run already.*--overwrite"):
+        write_run(short_result, run_folder, preset=DEFAULT_PRESET)
+    assert (run_folder / "summary.json").read_text(encoding="utf-8") == before
 
 
 def fail_midway(*_args, **_kwargs):
@@ -183,6 +190,32 @@ def test_interrupted_replacement_keeps_the_previous_run(run_folder, short_result
     before = (run_folder / "summary.json").read_text(encoding="utf-8")
     monkeypatch.setattr(storage, "write_impacts", fail_midway)
     with pytest.raises(KeyboardInterrupt):
-        write_run(short_result, run_folder, preset=DEFAULT_PRESET)
+        write_run(short_result, run_folder, preset=DEFAULT_PRESET, overwrite=True)
     assert (run_folder / "summary.json").read_text(encoding="utf-8") == before
     assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]
+
+
+def test_averaged_run_files_say_what_covers_only_the_averaging_window(tmp_path):
+    result = sm.simulate(sm.default_parameters(solver="averaged", duration=600.0, attractor_starts=1))
+    assert result.solver == "averaged" and result.impact_window is not None
+    folder = write_run(result, tmp_path / "averaged", preset=DEFAULT_PRESET)
+    end = result.averages.transient + result.averages.window
+    with xr.open_dataset(folder / "timeseries.nc", engine="h5netcdf") as series:
+        assert "x, p, velocity are NaN" in series.attrs["coverage"]
+        for name in ("x", "p", "velocity"):
+            assert np.isnan(series[name].values).all()
+            assert "not computed by the averaged solver" in series[name].attrs["coverage"]
+        assert "mean rate times time" in series["heat_generated"].attrs["coverage"]
+        assert "coverage" not in series["theta_ball"].attrs
+    with xr.open_dataset(folder / "windows.nc", engine="h5netcdf") as windows:
+        assert f"up to t = {end:.6g} s" in windows.attrs["coverage"]
+    coverage = pq.read_schema(folder / "impacts.parquet").metadata[b"coverage"].decode()
+    assert f"to {end:.6g} s" in coverage and "impact_rate_hz" in coverage
+    assert load_run(folder).impacts["time"].max() <= end
+
+
+def test_full_run_files_cover_the_whole_run(tmp_path):
+    folder = write_run(sm.simulate(sm.default_parameters(solver="full", duration=2.0)), tmp_path / "full", preset=DEFAULT_PRESET)
+    with xr.open_dataset(folder / "timeseries.nc", engine="h5netcdf") as series:
+        assert "coverage" not in series.attrs and "coverage" not in series["x"].attrs
+    assert b"coverage" not in pq.read_schema(folder / "impacts.parquet").metadata

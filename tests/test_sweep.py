@@ -26,6 +26,7 @@ from shakermill.sweep import (
     POINTS_FOLDER,
     TABLE_CSV,
     TABLE_PARQUET,
+    SweepFailed,
     SweepPlan,
     comparable_columns,
     connect,
@@ -664,3 +665,44 @@ def test_ctrl_c_keeps_the_finished_points_in_the_table_and_exits_130(tmp_path):
     completed = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert completed.returncode == 0, completed.stderr
     assert load_sweep(folder).table["error"].isna().all()
+
+
+README_SWEEP = """\
+import json
+import shakermill as sm
+
+table = sm.sweep(sm.default_parameters(solver="averaged", duration=600),
+                 {"omega": [100, 110, 120], "amplitude": ["24 mm", "26 mm"]}, "results/small")
+print(json.dumps(table.pivot(index="amplitude", columns="omega", values="theta_inf_C").to_dict()))
+"""
+
+
+@pytest.mark.parametrize("guarded", [False, True], ids=["plain script", "guarded script"])
+def test_the_readme_sweep_runs_from_a_script_with_or_without_a_main_guard(tmp_path, guarded):
+    source = README_SWEEP if not guarded else "if __name__ == '__main__':\n" + "".join(
+        f"    {line}\n" for line in README_SWEEP.splitlines()
+    )
+    (tmp_path / "script.py").write_text(source)
+    completed = subprocess.run(
+        [sys.executable, "script.py"], cwd=tmp_path, capture_output=True, text=True, timeout=300
+    )
+    assert completed.returncode == 0, completed.stderr
+    assert "BrokenProcessPool" not in completed.stderr and "Error" not in completed.stderr
+    pivot = json.loads(completed.stdout)
+    assert sorted(float(omega) for omega in pivot) == [100.0, 110.0, 120.0]
+    assert all(len(column) == 2 and all(np.isfinite(value) for value in column.values()) for column in pivot.values())
+
+
+def test_a_sweep_where_every_point_fails_raises_naming_the_first_failure(base, tmp_path):
+    with pytest.raises(SweepFailed, match=r"all 2 points failed \(first: [0-9a-f]{16}: .*omega") as raised:
+        sweep(base, {"omega": [-1.0, -2.0]}, tmp_path / "failed", workers=1)
+    assert len(raised.value.table) == 2
+    assert pd.read_csv(tmp_path / "failed" / TABLE_CSV)["error"].notna().all()
+
+
+def test_cli_sweep_where_every_point_fails_exits_1_with_one_line(tmp_path):
+    folder = tmp_path / "failed"
+    command = [str(SHAKERMILL), "sweep", "--grid", "omega=-2:-1:2", "--set", "duration=60", "--out", str(folder), "--workers", "1"]
+    completed = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert completed.returncode == 1
+    assert_one_error_line(completed.stderr, "2 of 2 points failed", "omega")

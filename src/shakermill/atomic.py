@@ -7,6 +7,10 @@ import secrets
 from pathlib import Path
 
 
+class StorageError(Exception):
+    """A run folder cannot be written to, or read from, the given path (raised by :mod:`shakermill.storage`)."""
+
+
 def partial_path(path: Path) -> Path:
     """A hidden, unique sibling of ``path`` to write into before the rename."""
     return path.with_name(f".{path.name}.partial-{secrets.token_hex(4)}")

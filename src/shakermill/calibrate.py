@@ -32,13 +32,13 @@ from scipy.optimize import least_squares
 
 from . import __version__
 from .atomic import write_text_atomically
+from .defaults import DEFAULT_FREE
 from .params import ParameterError, Parameters, check_known_keys
-from .simulate import Result, simulate
+from .simulate import Result, simulate_whole
 from .validation import CURVE_TOLERANCE_K, TARGET_KEYS, Curve, experiment_curve
 
 # The free set of the shipped calibrated preset: the smallest set that follows the experiment's curve
 # within 1 K RMS with every value inside its defensible range (see README, "Against the experiment").
-DEFAULT_FREE = ("beta", "vial_mass", "h_outer", "lam")
 # A free parameter may move this factor either way from its starting value.
 BOUND_FACTOR = 100.0
 # Relative step of the finite-difference Jacobian in log space: large enough to rise above the
@@ -240,7 +240,7 @@ def calibrate(
         if key not in cache:
             # The fit needs the configured motion only: probing other attractors would cost every evaluation.
             params = base.replace(solver=solver, attractor_starts=1, **{name: float(math.exp(v)) for name, v in zip(free, x)})
-            result = simulate(params)
+            result = simulate_whole(params)
             cache[key] = (_residuals(result, targets, curve), result)
         return cache[key]
 

@@ -16,51 +16,40 @@ import sys
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
-from typing import Annotated, Any, Callable, Iterator, NoReturn, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, NoReturn, Sequence
 
-import pandas as pd
 import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
+# Only light modules here: `shakermill --help` and the listing commands must not wait for NumPy, Numba,
+# pandas, xarray, SciPy or Matplotlib. Each command imports what it uses.
 from . import __version__
-from .calibrate import DEFAULT_FREE, free_set_study, parse_free, parse_targets, write_preset
-from .calibrate import calibrate as fit_parameters
+from .atomic import StorageError
 from .config import load_config
+from .defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
 from .params import (
     DEFAULT_PRESET,
     FIELD_NAMES,
     PRESETS,
     ParameterError,
-    Parameters,
     allowed_range,
     field_description,
     field_unit,
     preset_values,
     unit_slip_warnings,
 )
-from .plotting import PNG_DPI, bifurcation_figure, contour_notes, impact_figures, parse_contour, plot_figures, plot_run, run_figures, sweep_context, sweep_figures
-from .regime import bifurcation as regime_scan
-from .regime import write_bifurcation
-from .report import REPORT_FILE, save_report
-from .simulate import INTERRUPTED, Result, simulate
-from .sweep import (
-    DEFAULT_SCHEDULER_TIMEOUT_S,
-    TABLE_CSV,
-    TABLE_PARQUET,
-    failed_points,
-    is_sweep_folder,
-    load_sweep,
-    parse_grid,
-    plan_sweep,
-    sweep_parameters,
-)
-from .sweep import sweep as run_sweep
-from .storage import RunData, StorageError, check_target, load_run, to_jsonable, write_run
 from .validation import EXPERIMENT, TABLE5, TARGET_KEYS, Curve
 from .validation import validate as run_validation
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from .params import Parameters
+    from .simulate import Result
+    from .storage import RunData
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
@@ -125,6 +114,15 @@ def _user_errors() -> Iterator[None]:
         _fail(str(exc))
 
 
+@contextmanager
+def _nothing_written_when_interrupted(what: str) -> Iterator[None]:
+    """Ctrl-C before anything was written: one line and exit code 130."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        _fail(f"interrupted; nothing was written ({what})", EXIT_INTERRUPTED)
+
+
 # Options shared by several commands, declared once.
 ConfigArgument = Annotated[
     Path | None,
@@ -138,6 +136,9 @@ SettingsOption = Annotated[
     typer.Option("--set", "-s", metavar="KEY=VALUE", help="Override one key, units allowed: --set ball_radius='5 mm'."),
 ]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")]
+OverwriteOption = Annotated[
+    bool, typer.Option("--overwrite", help="Replace what --out holds (never a folder that shakermill did not write).")
+]
 FullResolutionOption = Annotated[
     bool, typer.Option("--full-resolution", help="Use the full-resolution solver (default: averaged).")
 ]
@@ -154,20 +155,28 @@ def run(
     ] = None,
     json_output: JsonOption = False,
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
+    overwrite: OverwriteOption = False,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
+    from .simulate import INTERRUPTED
+    from .storage import check_target, to_jsonable
+
     overrides = settings or []
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=overrides)
         target = out if out is not None else timestamped_folder("run")
-        check_target(target)
+        check_target(target, overwrite=overwrite)
     # Unit slips are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)
     echo_warnings(said_first)
-    result = simulate_with_progress(run_config.params)
-    echo_warnings([line for line in result.warnings if line not in said_first])
+    # A full-resolution run keeps what it computed when interrupted; the averaged solver has nothing to keep.
+    with _nothing_written_when_interrupted("the averaged solver keeps no part of a run"):
+        result = simulate_with_progress(run_config.params)
+    if result.status != INTERRUPTED:
+        # An interrupted run is short by choice: its warnings (run length, steady state) stay in summary.json.
+        echo_warnings([line for line in result.warnings if line not in said_first])
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
-    target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots)
+    target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots, overwrite=overwrite)
     if json_output:
         summary = to_jsonable({**result.summary, "output_dir": str(target)})
         typer.echo(json.dumps(summary, sort_keys=True, allow_nan=False))
@@ -195,6 +204,8 @@ def timestamped_folder(kind: str) -> Path:
 
 def simulate_with_progress(params: Parameters) -> Result:
     """``simulate``, with a transient progress bar on stderr for long runs when stderr is a terminal."""
+    from .simulate import simulate
+
     if params.duration < PROGRESS_MIN_DURATION_S:
         return simulate(params)
     with _progress_bar("simulating", "{task.completed:.0f}/{task.total:.0f} s simulated", params.duration) as update:
@@ -217,15 +228,21 @@ def _progress_bar(verb: str, counter: str, total: float, **fields: Any) -> Itera
         yield lambda completed, **updates: bar.update(task, completed=completed, **updates)
 
 
-def _write(result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool) -> Path:
+def _write(
+    result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool, overwrite: bool
+) -> Path:
     """Write the run folder (with figures unless told not to); return its absolute path."""
+    from .plotting import plot_run
+    from .storage import write_run
+
 
     def add_figures(folder: Path) -> None:
         plot_run(result, folder / FIGURES_FOLDER)
 
     try:
         return write_run(
-            result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None
+            result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None,
+            overwrite=overwrite,
         )
     except StorageError as exc:
         _fail(str(exc))
@@ -236,6 +253,8 @@ def _write(result: Result, target: Path, preset: str, provenance: dict[str, Any]
 
 
 def _exit_for_status(result: Result, target: Path) -> None:
+    from .simulate import INTERRUPTED
+
     if result.status == INTERRUPTED:
         typer.echo(f"interrupted: {result.message} Partial results in {target}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
@@ -314,6 +333,9 @@ def compare_solvers(
     json_output: JsonOption = False,
 ) -> None:
     """Run the same configuration with the full and the averaged solver; print both, the differences and the speed ratio."""
+    from .simulate import simulate
+    from .storage import to_jsonable
+
     with _user_errors():
         params = load_config(config, preset=preset, overrides=settings or []).params
     full = simulate_with_progress(params.replace(solver="full"))
@@ -375,8 +397,18 @@ def keys() -> None:
     _stdout_console().print(table)
 
 
+def _check_free_folder(target: Path, overwrite: bool) -> None:
+    """Before any work: ``target`` is absent or an empty folder, or ``overwrite`` lets files there be replaced."""
+    if target.exists() and not target.is_dir():
+        _fail(f"{target}: exists and is not a folder; choose another --out")
+    if target.is_dir() and any(target.iterdir()) and not overwrite:
+        _fail(f"{target}: not empty; choose another --out, or add --overwrite to replace the files of the same names")
+
+
 def _load_run_or_fail(folder: Path) -> RunData:
     """The run folder at ``folder``, or one ``error:`` line and exit code 2."""
+    from .storage import load_run
+
     try:
         return load_run(folder)
     except StorageError as exc:
@@ -404,6 +436,9 @@ def plot(
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG files.")] = PNG_DPI,
 ) -> None:
     """Draw the figures of a run folder (paper Figs. 4, 5a, 5b, impact statistics) or of a sweep folder (maps or lines)."""
+    from .plotting import contour_notes, impact_figures, parse_contour, plot_figures, run_figures, sweep_context, sweep_figures
+    from .sweep import is_sweep_folder, load_sweep
+
     target = out if out is not None else folder / FIGURES_FOLDER
     if is_sweep_folder(folder):
         if impacts:
@@ -438,11 +473,16 @@ def report(
         Path | None,
         typer.Option("--compare", metavar="OTHER_RUN_DIR", help="Add a side-by-side comparison with this run folder."),
     ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the report file if it exists.")] = False,
 ) -> None:
     """Write one self-contained HTML report of a run folder (figures embedded, no external resources)."""
+    from .report import save_report
+
     run_data = _load_run_or_fail(run_dir)
     other = _load_run_or_fail(compare) if compare is not None else None
     target = out if out is not None else run_dir / REPORT_FILE
+    if target.is_file() and not overwrite:
+        _fail(f"{target}: exists; choose another --out, or add --overwrite to replace it")
     try:
         save_report(run_data, target, other)
     except OSError as exc:
@@ -495,6 +535,9 @@ def sweep(
     json_output: JsonOption = False,
 ) -> None:
     """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
+    from .sweep import TABLE_CSV, TABLE_PARQUET, SweepFailed, failed_points, plan_sweep, sweep_parameters
+    from .sweep import sweep as run_sweep
+
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
         plan = plan_sweep(grid or [], points)
@@ -507,6 +550,9 @@ def sweep(
                 run_config.params, plan, target, workers=workers, scheduler=scheduler,
                 keep_runs=keep_runs, progress=progress, preset=run_config.preset, scheduler_timeout=scheduler_timeout,
             )
+    except SweepFailed as exc:
+        # Said below like any failed point, after the table's preview.
+        table = exc.table
     except KeyboardInterrupt:
         _fail(f"interrupted; the finished points are stored in {target}; re-run with --out {target} to finish", EXIT_INTERRUPTED)
     except OSError as exc:
@@ -536,6 +582,10 @@ def sweep(
 
 def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path) -> Table:
     """The first rows of a sweep table: swept values, regime and the main results."""
+    import pandas as pd
+
+    from .sweep import TABLE_CSV, TABLE_PARQUET, failed_points
+
     preview = Table(title=f"shakermill sweep: {len(table)} points, {len(failed_points(table))} failed")
     for key in keys:
         preview.add_column(f"{key} ({field_unit(key)})" if field_unit(key) else key, justify="right")
@@ -554,6 +604,8 @@ def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path) -> Tab
 
 
 def _cell(value: Any, spec: str) -> str:
+    import pandas as pd
+
     if value is None or (not isinstance(value, str) and pd.isna(value)):
         return "n/a"
     return value if isinstance(value, str) else _number(value, spec)
@@ -574,8 +626,14 @@ def bifurcation(
         bool, typer.Option("--full-resolution", help="Settle with the full-resolution solver (default: averaged).")
     ] = False,
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG file.")] = PNG_DPI,
+    overwrite: OverwriteOption = False,
 ) -> None:
     """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
+    from .plotting import bifurcation_figure, plot_figures, sweep_context
+    from .regime import bifurcation as regime_scan
+    from .regime import write_bifurcation
+    from .sweep import parse_grid, sweep_parameters
+
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
         key, values = parse_grid(grid)
@@ -583,11 +641,11 @@ def bifurcation(
         for value in (values[0], values[-1]):
             run_config.params.replace(**{key: float(value)})
     target = out if out is not None else timestamped_folder("bifurcation")
-    with _progress_bar("scanning", "{task.completed}/{task.total} runs", len(values)) as update:
-        try:
-            scan = regime_scan(run_config.params, values, key, progress=None if update is None else lambda done, _total: update(done))
-        except KeyboardInterrupt:
-            _fail("interrupted; nothing was written (a scan is quick to repeat)", EXIT_INTERRUPTED)
+    _check_free_folder(target, overwrite)
+    with _nothing_written_when_interrupted("a scan is quick to repeat"), _progress_bar(
+        "scanning", "{task.completed}/{task.total} runs", len(values)
+    ) as update:
+        scan = regime_scan(run_config.params, values, key, progress=None if update is None else lambda done, _total: update(done))
     try:
         paths = write_bifurcation(scan, target)
         context = sweep_context({"preset": run_config.preset, "base": run_config.params.model_dump()}, (key,))
@@ -656,6 +714,9 @@ def validate(
 ) -> None:
     """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
     calibrated parameters, and which free sets of a calibration can follow the curve."""
+    from .calibrate import free_set_study
+    from .storage import to_jsonable
+
     if solver not in ("full", "averaged"):
         _fail(f"solver: {solver!r} is not allowed; allowed: one of 'full', 'averaged'")
     runs = run_validation(solver)
@@ -773,8 +834,13 @@ def calibrate(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
 ) -> None:
     """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
+    from .calibrate import calibrate as fit_parameters
+    from .calibrate import parse_free, parse_targets, write_preset
+    from .storage import to_jsonable
+
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])
         targets = parse_targets(target or [])
@@ -782,7 +848,11 @@ def calibrate(
         measured = Curve.from_csv(curve) if curve is not None else None
         if out is not None and out.exists() and out.is_dir():
             raise ParameterError(f"out: {out} is a folder; give a .toml file name")
-        calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
+        if out is not None and out.exists() and not overwrite:
+            # Checked before the fit, which takes a while.
+            raise ParameterError(f"out: {out} exists; choose another --out, or add --overwrite to replace it")
+        with _nothing_written_when_interrupted("the fit starts again from the beginning"):
+            calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
     if out is not None:
         command = "shakermill calibrate " + " ".join(sys.argv[2:])
         fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]

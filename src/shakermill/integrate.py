@@ -28,8 +28,12 @@ progress and keep what was computed when interrupted.
 
 from __future__ import annotations
 
+import signal
+import threading
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from fractions import Fraction
+from typing import Iterator
 
 import numpy as np
 from numba import njit
@@ -646,15 +650,19 @@ class Integrator:
         return float(self.clock[0])
 
     def advance(self, t_stop: float) -> int:
-        """Integrate up to ``t_stop``; returns a status code (see ``STATUS_MESSAGES``)."""
-        status, self._window_buffer, self._impact_buffer = _advance(
-            t_stop, self.clock, self.y, self.f, self._a, self._b, self._error_weights, self._c, self.constants,
-            self.tolerances.rtol, self.tolerances.atol, self.tolerances.origin, self.tolerances.contact_step_limit,
-            self.tolerances.max_overlap, self.controller.safety, self.controller.min_factor,
-            self.controller.max_factor, -1.0 / (self.tableau.error_order + 1),
-            self.sample_times, self.samples, self.windows, self._window_buffer, self._impact_buffer,
-            self._impact, self.counters, self.project_energy, self.diagnostics,
-        )
+        """Integrate up to ``t_stop``; returns a status code (see ``STATUS_MESSAGES``).
+
+        Ctrl-C during the call raises ``KeyboardInterrupt`` once the compiled loop has returned.
+        """
+        with _interrupt_after_compiled_code():
+            status, self._window_buffer, self._impact_buffer = _advance(
+                t_stop, self.clock, self.y, self.f, self._a, self._b, self._error_weights, self._c, self.constants,
+                self.tolerances.rtol, self.tolerances.atol, self.tolerances.origin, self.tolerances.contact_step_limit,
+                self.tolerances.max_overlap, self.controller.safety, self.controller.min_factor,
+                self.controller.max_factor, -1.0 / (self.tableau.error_order + 1),
+                self.sample_times, self.samples, self.windows, self._window_buffer, self._impact_buffer,
+                self._impact, self.counters, self.project_energy, self.diagnostics,
+            )
         return int(status)
 
     @property
@@ -670,3 +678,25 @@ class Integrator:
     @property
     def impacts(self) -> np.ndarray:
         return self._impact_buffer[: self.counters[IMPACTS]].copy()
+
+
+@contextmanager
+def _interrupt_after_compiled_code() -> Iterator[None]:
+    """Hold a SIGINT that arrives while compiled code runs and deliver it to the previous handler afterwards.
+
+    A KeyboardInterrupt raised inside a Numba call surfaces as ``SystemError: CPUDispatcher(...) returned a
+    result with an exception set``, which no caller can tell from a crash. Only the main thread can set
+    handlers; elsewhere, and where SIGINT is ignored (sweep workers) or default, nothing changes.
+    """
+    previous = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or not callable(previous):
+        yield
+        return
+    received: list[object] = []
+    signal.signal(signal.SIGINT, lambda signum, frame: received.append(frame))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if received:
+        previous(signal.SIGINT, received[0])

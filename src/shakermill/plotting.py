@@ -27,6 +27,7 @@ import xarray as xr
 
 from . import drive
 from .atomic import partial_path
+from .defaults import PNG_DPI
 from .fit import ExponentialFit
 from .params import Parameters
 
@@ -37,7 +38,6 @@ if TYPE_CHECKING:
 PAPER_FIGURES = ("temperatures", "ball_motion", "ball_heating_zoom")
 IMPACT_FIGURES = ("impact_speed_histogram", "impact_energy_histogram", "impacts_per_second", "impact_phase_histogram")
 FORMATS = ("png", "svg")
-PNG_DPI = 150
 KELVIN_OFFSET = 273.15
 # The paper's Fig. 5b zooms into the heating at 10 min; the window starting nearest to it is shown.
 HEATING_ZOOM_TIME = 600.0

@@ -132,14 +132,11 @@ def bifurcation(
     of that run. Ctrl-C during a run raises ``KeyboardInterrupt``.
     """
     from .attractors import probed
-    from .simulate import INTERRUPTED, simulate
+    from .simulate import simulate_whole
 
     regimes, attractors, phases = [], [], []
     for index, value in enumerate(values):
-        result = simulate(base.replace(**{key: float(value)}))
-        if result.status == INTERRUPTED:
-            # simulate() turns Ctrl-C into a status; the scan must stop, not go on to the next value.
-            raise KeyboardInterrupt
+        result = simulate_whole(base.replace(**{key: float(value)}))
         scan = probed(result)
         label, period = classify(result)
         regimes.append(

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping, Sequence
 
 from . import __version__
 from .atomic import write_text_atomically
+from .defaults import REPORT_FILE
 from .params import DEFAULT_PRESET, PRESETS, Preset, field_description, field_unit
 from .plotting import (
     PAPER_FIGURES,
@@ -47,7 +48,6 @@ from .views import answer_sentences, esc, number
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-REPORT_FILE = "report.html"
 # Screen resolution: sharp enough in a browser, and keeps a report of six figures well under a megabyte.
 EMBED_DPI = 100
 # Keys that change what is stored or reported, not what is simulated: a calibration still holds when they differ.

@@ -183,6 +183,15 @@ def simulate(params: Parameters, progress: ProgressCallback | None = None) -> Re
     return simulate_full(params, progress)
 
 
+def simulate_whole(params: Parameters) -> Result:
+    """:func:`simulate` for callers built on many runs (scans, fits): Ctrl-C raises ``KeyboardInterrupt``
+    instead of returning a partial result they would use as if it were whole."""
+    result = simulate(params)
+    if result.status == INTERRUPTED:
+        raise KeyboardInterrupt
+    return result
+
+
 def integrator_for(params: Parameters, sample_times: np.ndarray) -> Integrator:
     """A compiled integrator set up for ``params`` from its initial state."""
     constants = model.constants_from(params)

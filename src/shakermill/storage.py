@@ -33,7 +33,7 @@ import pyarrow.parquet as pq
 import xarray as xr
 
 from . import __version__
-from .atomic import partial_path
+from .atomic import StorageError, partial_path
 from .config import load_config, write_config_toml
 from .fit import ExponentialFit
 from .integrate import REACHED_STOP
@@ -48,11 +48,12 @@ CONFIG_FILE = "config.toml"
 RUN_FILES = (TIMESERIES_FILE, WINDOWS_FILE, IMPACTS_FILE, SUMMARY_FILE, CONFIG_FILE)
 # Key of the impact table's units in the Parquet schema metadata.
 UNITS_METADATA_KEY = b"units"
+# Key of what a file covers, where it is less than the whole run (averaged solver): attribute and Parquet metadata.
+COVERAGE_KEY = "coverage"
+# Variables of an averaged run's timeseries.nc: never computed, or rates of the averaging window times time.
+AVERAGED_MOTION_VARIABLES = ("x", "p", "velocity")
+AVERAGED_FLOW_VARIABLES = ("work_vial", "dissipated", "heat_generated", "velocity_term_integral")
 NETCDF_ENGINE = "h5netcdf"
-
-
-class StorageError(Exception):
-    """A run folder cannot be written to, or read from, the given path."""
 
 
 @dataclass(frozen=True)
@@ -91,18 +92,22 @@ def to_jsonable(value: Any) -> Any:
     return value
 
 
-def check_target(path: Path) -> None:
-    """Raise :class:`StorageError` unless ``path`` is free, an empty folder or a run folder to replace.
+def check_target(path: Path, *, overwrite: bool = False) -> None:
+    """Raise :class:`StorageError` unless ``path`` is free, an empty folder, or a run folder and ``overwrite``.
 
-    Replacing deletes the old folder, so anything else (a file, a folder of the
-    user's own) is refused rather than destroyed.
+    Replacing deletes the old folder: a run only when asked to, anything else (a file, a folder of
+    the user's own) never.
     """
     if not path.exists() and not path.is_symlink():
         return
     if path.is_symlink() or not path.is_dir():
         raise StorageError(f"{path}: exists and is not a folder; choose another --out")
-    if any(path.iterdir()) and not (path / SUMMARY_FILE).is_file():
+    if not any(path.iterdir()):
+        return
+    if not (path / SUMMARY_FILE).is_file():
         raise StorageError(f"{path}: a non-empty folder that is not a shakermill run; choose another --out")
+    if not overwrite:
+        raise StorageError(f"{path}: holds a run already; choose another --out, or add --overwrite to replace it")
 
 
 def write_run(
@@ -112,15 +117,16 @@ def write_run(
     preset: str,
     extra_provenance: Mapping[str, Any] | None = None,
     add_files: Callable[[Path], object] | None = None,
+    overwrite: bool = False,
 ) -> Path:
-    """Write ``result`` as a run folder at ``path``, replacing a previous run folder there.
+    """Write ``result`` as a run folder at ``path``; a previous run folder there is replaced only with ``overwrite``.
 
     ``add_files(folder)`` may add more files (figures) before the folder is
     moved into place. Returns the folder's absolute path.
     """
     # Absolute, so that "." has a name to derive the sibling folders from.
     target = Path(path).absolute()
-    check_target(target)
+    check_target(target, overwrite=overwrite)
     target.parent.mkdir(parents=True, exist_ok=True)
     partial = partial_path(target)
     partial.mkdir()
@@ -138,10 +144,13 @@ def write_run(
 
 def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenance: Mapping[str, Any]) -> None:
     attributes = _run_attributes(result, preset)
-    write_dataset(result.timeseries, folder / TIMESERIES_FILE, title="shakermill sampled state history", **attributes)
-    windows_title = "shakermill full-resolution state in the record windows"
-    write_dataset(result.windows, folder / WINDOWS_FILE, title=windows_title, **attributes)
-    write_impacts(result.impacts, folder / IMPACTS_FILE)
+    coverage = averaging_coverage(result)
+    timeseries = _mark_averaged_variables(result.timeseries, coverage) if coverage else result.timeseries
+    title = "shakermill sampled state history"
+    write_dataset(timeseries, folder / TIMESERIES_FILE, title=title, **attributes, **_covers(coverage, "timeseries"))
+    title = "shakermill full-resolution state in the record windows"
+    write_dataset(result.windows, folder / WINDOWS_FILE, title=title, **attributes, **_covers(coverage, "motion"))
+    write_impacts(result.impacts, folder / IMPACTS_FILE, coverage=coverage.get("impacts"))
     (folder / SUMMARY_FILE).write_text(summary_json(result, preset), encoding="utf-8")
     provenance = {"status": result.status, "message": result.message, "simulated_s": result.t_end, **extra_provenance}
     write_config_toml(result.params, folder / CONFIG_FILE, preset=preset, extra_provenance=provenance)
@@ -159,6 +168,44 @@ def _run_attributes(result: Result, preset: str) -> dict[str, Any]:
     }
 
 
+def averaging_coverage(result: Result) -> dict[str, str]:
+    """What the files of an averaged run cover, in words (the motion only over the averaging window); empty for a full run."""
+    averages = result.averages
+    if result.impact_window is None or averages is None:
+        return {}
+    start, end = averages.transient, averages.transient + averages.window
+    motion = (
+        f"the ball's motion was integrated at full resolution only up to t = {end:.6g} s (the averaged solver's "
+        f"mechanics phase); record windows after that hold no points"
+    )
+    return {
+        "timeseries": (
+            f"averaged solver: the temperatures cover the whole run; {', '.join(AVERAGED_MOTION_VARIABLES)} are NaN "
+            f"(not computed), and {', '.join(AVERAGED_FLOW_VARIABLES)} are the averaging window's mean rates times time"
+        ),
+        "motion": motion,
+        "impacts": (
+            f"averaged solver: only the impacts of the averaging window, t = {start:.6g} to {end:.6g} s; the summary's "
+            "impacts and impact_rate_hz extend this window's rate to the whole run"
+        ),
+        "motion_variable": "not computed by the averaged solver (NaN); the motion is in windows.nc and impacts.parquet",
+        "flow_variable": "averaged solver: the averaging window's mean rate times time",
+    }
+
+
+def _covers(coverage: Mapping[str, str], part: str) -> dict[str, str]:
+    return {COVERAGE_KEY: coverage[part]} if coverage else {}
+
+
+def _mark_averaged_variables(dataset: xr.Dataset, coverage: Mapping[str, str]) -> xr.Dataset:
+    marked = dataset.copy()
+    for name in AVERAGED_MOTION_VARIABLES:
+        marked[name].attrs[COVERAGE_KEY] = coverage["motion_variable"]
+    for name in AVERAGED_FLOW_VARIABLES:
+        marked[name].attrs[COVERAGE_KEY] = coverage["flow_variable"]
+    return marked
+
+
 def write_dataset(dataset: xr.Dataset, path: Path, *, title: str, **attributes: Any) -> None:
     """Write ``dataset`` with global attributes; per-variable ``units`` and ``long_name`` are kept as they are."""
     stored = dataset.copy()
@@ -166,12 +213,15 @@ def write_dataset(dataset: xr.Dataset, path: Path, *, title: str, **attributes: 
     stored.to_netcdf(path, engine=NETCDF_ENGINE)
 
 
-def write_impacts(impacts: pd.DataFrame, path: Path) -> None:
-    """Write the impact table with the column units as JSON in the Parquet schema metadata."""
+def write_impacts(impacts: pd.DataFrame, path: Path, *, coverage: str | None = None) -> None:
+    """Write the impact table with the column units as JSON in the Parquet schema metadata, and what
+    the table covers (``coverage``) where it is not the whole run."""
     table = pa.Table.from_pandas(impacts, preserve_index=False)
     units = {column: IMPACT_UNITS.get(column, "") for column in impacts.columns}
     metadata = dict(table.schema.metadata or {})
     metadata[UNITS_METADATA_KEY] = json.dumps(units).encode()
+    if coverage is not None:
+        metadata[COVERAGE_KEY.encode()] = coverage.encode()
     pq.write_table(table.replace_schema_metadata(metadata), path)
 
 

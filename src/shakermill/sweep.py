@@ -21,6 +21,7 @@ in which they finish, or whether the points ran on a Dask cluster.
 
 from __future__ import annotations
 
+import ast
 import csv
 import hashlib
 import itertools
@@ -29,6 +30,8 @@ import logging
 import math
 import os
 import re
+import sys
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
@@ -40,6 +43,7 @@ import pandas as pd
 
 from . import __version__
 from .atomic import partial_path, write_text_atomically
+from .defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from .config import RunConfig, load_config, parse_overrides, read_config_file
 from .params import DEFAULT_PRESET, ParameterError, Parameters, check_known_keys, field_unit
 from .simulate import INTERRUPTED, Result, simulate
@@ -58,7 +62,6 @@ TABLE_CSV = f"{TABLE_STEM}.csv"
 MANIFEST_FORMAT = "shakermill-sweep/1"
 # 64 bits of SHA-256: collisions are out of reach for any sweep that fits on a disk.
 POINT_ID_LENGTH = 16
-DEFAULT_SCHEDULER_TIMEOUT_S = 10.0
 # Columns that measure the machine, not the model: they differ between two runs of the same point.
 TIMING_COLUMNS = ("wall_time_s",)
 # A summary key that is also a swept key (only ``solver``: the averaged solver may fall back to
@@ -280,6 +283,18 @@ def sweep_parameters(
 # One point --------------------------------------------------------------------------------------
 
 
+class SweepFailed(RuntimeError):
+    """Every point of a sweep failed; ``table`` is the sweep's table (written too), each row saying why."""
+
+    def __init__(self, table: pd.DataFrame, folder: Path) -> None:
+        first = failed_points(table).iloc[0]
+        super().__init__(
+            f"all {len(table)} points failed (first: {first['point_id']}: {first['error']}); "
+            f"see the error column of {folder / TABLE_CSV}"
+        )
+        self.table = table
+
+
 class PointInterrupted(Exception):
     """The user interrupted a point: it is not finished and must not be recorded as failed."""
 
@@ -348,7 +363,8 @@ def sweep(
     (default: one per core; 1 runs them in this process) or on the Dask cluster at ``scheduler``
     ("tcp://host:8786"). Each finished point is stored at once in ``out_dir``; points stored by an
     earlier run of the same sweep are skipped. Raises :class:`ParameterError` (one line) for bad
-    input, a folder that holds another sweep, or an unreachable scheduler.
+    input, a folder that holds another sweep, or an unreachable scheduler, and :class:`SweepFailed`
+    (naming the first failure) when no point succeeded.
     """
     plan = as_plan(grid_points)
     _check_execution(workers, scheduler)
@@ -374,6 +390,8 @@ def sweep(
             # Also on Ctrl-C: the table then holds the finished points, the others marked not finished.
             table = build_table(folder, plan.keys, ids, plan.points, unfinished)
             write_table(table, folder)
+    if len(failed_points(table)) == len(table):
+        raise SweepFailed(table, folder)
     return table
 
 
@@ -481,7 +499,8 @@ def _store_point(folder: Path, identifier: str, outcome: PointOutcome, preset: s
 
         target = folder / RUNS_FOLDER / identifier
         provenance = {"command": "shakermill sweep", "sweep": str(folder.absolute()), "point_id": identifier}
-        row["output_dir"] = str(write_run(outcome.result, target, preset=preset, extra_provenance=provenance))
+        # A run folder without its point file was left by a killed sweep: this point's, so it is replaced.
+        row["output_dir"] = str(write_run(outcome.result, target, preset=preset, extra_provenance=provenance, overwrite=True))
     document = {"point_id": identifier, "shakermill_version": __version__, "row": row}
     write_text_atomically(_point_path(folder, identifier), json.dumps(document, indent=1, allow_nan=False) + "\n")
     return row
@@ -572,7 +591,16 @@ def _backend(workers: int | None, scheduler: str | None, timeout: float, pending
     if size <= 1:
         yield _InProcess()
         return
-    executor = _process_pool(size)
+    context = _start_context()
+    if context is None:
+        warnings.warn(
+            "sweep: called from the top level of a script without an `if __name__ == \"__main__\":` guard, where "
+            "worker processes cannot start on this platform; the points run one after another in this process",
+            stacklevel=4,
+        )
+        yield _InProcess()
+        return
+    executor = _process_pool(size, context)
     try:
         yield _LocalPool(size, executor)
     except BaseException:
@@ -582,23 +610,65 @@ def _backend(workers: int | None, scheduler: str | None, timeout: float, pending
     executor.shutdown()
 
 
-def _process_pool(size: int) -> Any:
-    """A process pool whose workers import shakermill once, from a clean single-threaded server.
-
-    forkserver, where the platform has it: fork from a process with threads (a progress bar, a
-    Dask client) can deadlock, and spawn would re-import everything in every worker. Workers
-    ignore Ctrl-C; the sweep's own process handles it and stops the pool.
-    """
-    import multiprocessing
+def _process_pool(size: int, context: Any) -> Any:
+    """A process pool of ``context`` whose workers ignore Ctrl-C; the sweep's own process handles it and stops the pool."""
     from concurrent.futures import ProcessPoolExecutor
 
-    methods = multiprocessing.get_all_start_methods()
-    context = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-    if "forkserver" in methods:
-        context.set_forkserver_preload([__name__])
     return ProcessPoolExecutor(
         max_workers=size, mp_context=context, initializer=_start_worker, initargs=(os.getpid(),)
     )
+
+
+def _start_context() -> Any:
+    """How to start the workers: None when no worker could start, and the points must run in this process.
+
+    forkserver, where the platform has it: its workers import shakermill once, from a clean
+    single-threaded server, whereas fork from a process with threads (a progress bar, a Dask client)
+    can deadlock, and spawn re-imports everything in every worker. But forkserver and spawn also run
+    the main script again in each worker; called from a script's top level without a
+    ``__main__`` guard, each worker would start a sweep of its own and fail. There, Linux forks (the
+    script has no threads of shakermill's, and Numba's compiled code survives a fork); elsewhere,
+    where fork is unsafe, there is no way to start workers.
+    """
+    import multiprocessing
+
+    methods = multiprocessing.get_all_start_methods()
+    if _called_from_unguarded_main():
+        return multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
+    context = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+    if "forkserver" in methods:
+        context.set_forkserver_preload([__name__])
+    return context
+
+
+def _called_from_unguarded_main() -> bool:
+    """Whether this call comes from the top level of the main script, outside ``if __name__ == "__main__":``.
+
+    A notebook's or the interpreter's ``__main__`` has no file and is not run again by the workers.
+    """
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if main is None or path is None or getattr(main, "__spec__", None) is not None:
+        return False  # run with -m, the workers import it under its own name with the guard honoured
+    frame = sys._getframe(1)
+    while frame is not None and not (frame.f_globals is vars(main) and frame.f_code.co_name == "<module>"):
+        frame = frame.f_back
+    if frame is None:
+        return False
+    try:
+        tree = ast.parse(Path(path).read_text(encoding="utf-8"))
+    except (OSError, SyntaxError, ValueError):
+        return True
+    return not any(_is_main_guard(node) and node.lineno <= frame.f_lineno <= node.end_lineno for node in tree.body)
+
+
+def _is_main_guard(node: ast.stmt) -> bool:
+    if not isinstance(node, ast.If) or not isinstance(node.test, ast.Compare):
+        return False
+    operands = [node.test.left, *node.test.comparators]
+    names = {operand.id for operand in operands if isinstance(operand, ast.Name)}
+    constants = {operand.value for operand in operands if isinstance(operand, ast.Constant)}
+    return names == {"__name__"} and constants == {"__main__"}
 
 
 # How often a pool worker checks that the sweep that started it is still alive.

@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
-import pint
+if TYPE_CHECKING:
+    import pint
 
 
 class UnitError(ValueError):
@@ -18,6 +20,8 @@ class UnitError(ValueError):
 
 @lru_cache(maxsize=1)
 def _registry() -> pint.UnitRegistry:
+    import pint  # 0.3 s: only when a value carries a unit
+
     registry = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
     return registry
 
@@ -45,6 +49,8 @@ def to_si(value: object, unit: str, *, key: str) -> float:
         return float(text)
     except ValueError:
         pass
+    import pint  # loaded once a value carries a unit (see _registry)
+
     registry = _registry()
     try:
         quantity = registry.Quantity(text)
