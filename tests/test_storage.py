@@ -56,6 +56,8 @@ def test_netcdf_files_hold_the_result_values_with_units(run_folder, short_result
             assert stored[name].attrs["units"] == expected[name].attrs["units"]
             assert stored[name].attrs["long_name"] == expected[name].attrs["long_name"]
         assert stored["theta_ball"].attrs["units"] == "K"
+        assert stored["theta_ball_C"].attrs["units"] == "degC"
+        assert "theta_*_C" in stored.attrs["temperature_note"]
         assert stored["time"].attrs["units"] == "s"
         assert stored.attrs["shakermill_version"] == sm.__version__
         assert stored.attrs["status"] == short_result.status

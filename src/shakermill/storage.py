@@ -164,7 +164,7 @@ def _run_attributes(result: Result, preset: str) -> dict[str, Any]:
         "status": int(result.status),
         "message": result.message,
         "simulated_s": float(result.t_end),
-        "temperature_note": "temperatures in kelvin",
+        "temperature_note": "theta_ball, theta_vial, theta_air in kelvin; the same temperatures in degC as theta_*_C",
     }
 
 
