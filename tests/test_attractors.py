@@ -180,7 +180,7 @@ def test_a_start_that_fails_is_reported_not_grouped(monkeypatch):
         settled = real_settle(params, start)
         if start != 2:
             return settled
-        return SettledStart(start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan, settled.impacts[:0], "step size too small")
+        return SettledStart(start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan, {name: values[:0] for name, values in settled.impacts.items()}, "step size too small")
 
     monkeypatch.setattr(module, "settle", third_fails)
     scan = find_attractors(sm.default_parameters(omega=110.0, attractor_starts=4))

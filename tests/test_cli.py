@@ -562,3 +562,26 @@ def test_ctrl_c_in_the_averaged_solver_says_so_in_one_line_and_writes_nothing(tm
     assert result.exit_code == 130
     assert_one_error_line(result.stderr, "interrupted; nothing was written")
     assert list(tmp_path.iterdir()) == []
+
+
+# What a run without figures must not import: xarray's first Dataset imports dask and pint, and these
+# together are most of a second of start-up (benchmarks/bench_startup.py). Figures and read-back use them.
+NOT_FOR_A_RUN_WITHOUT_FIGURES = ("xarray", "pandas", "dask", "pint", "matplotlib", "distributed")
+
+
+def test_a_run_without_figures_writes_its_files_without_the_heavy_libraries(tmp_path):
+    script = (
+        "import sys\n"
+        "from shakermill import cli\n"
+        f"sys.argv = ['shakermill', 'run', '--set', 'solver=averaged', '--set', 'duration=120', '--no-plots', '--out', {str(tmp_path / 'run')!r}]\n"
+        "try:\n"
+        "    cli.app()\n"
+        "except SystemExit as exit:\n"
+        "    assert exit.code in (0, None), exit.code\n"
+        f"print('imported:', *(name for name in {NOT_FOR_A_RUN_WITHOUT_FIGURES!r} if name in sys.modules))\n"
+    )
+    completed = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    assert completed.stdout.splitlines()[-1] == "imported:"
+    run = load_run(tmp_path / "run")  # and what it wrote reads back as a full run's files do
+    assert run.summary["solver"] == "averaged" and run.timeseries["theta_ball_C"].attrs["units"] == "degC"
+    assert len(run.impacts) == len(run.impacts["wall"].dropna()) > 0

@@ -230,7 +230,7 @@ def test_rate_bins_span_the_impacts_in_bins_of_at_least_a_second_and_at_most_120
 
 
 def test_no_impacts_no_impact_figures(result):
-    run = dataclasses.replace(result, impacts=result.impacts.iloc[:0])
+    run = dataclasses.replace(result, impact_columns={name: values[:0] for name, values in result.impact_columns.items()})
     assert impact_figures(run) == {}
 
 

@@ -221,3 +221,20 @@ def test_full_run_files_cover_the_whole_run(tmp_path):
     with xr.open_dataset(folder / "timeseries.nc", engine="h5netcdf") as series:
         assert "coverage" not in series.attrs and "coverage" not in series["x"].attrs
     assert b"coverage" not in pq.read_schema(folder / "impacts.parquet").metadata
+
+
+@pytest.mark.parametrize(
+    "values",
+    [
+        np.array(["left", "right", "left"]),
+        np.array(["é", "", "naïve wall"]),  # multi-byte UTF-8 and an empty string
+        np.empty(0, dtype=str),
+        np.arange(12.0).reshape(4, 3)[:, 1],  # a strided column of the impact records
+        np.array([1, -2, 3], dtype=np.int64),
+        np.array([np.nan, np.inf, -0.0]),
+    ],
+)
+def test_arrow_arrays_built_from_buffers_hold_the_values(values):
+    array = storage.arrow_array(values)
+    assert len(array) == values.size and array.null_count == 0
+    np.testing.assert_array_equal(array.to_numpy(zero_copy_only=False), values)

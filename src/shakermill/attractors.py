@@ -23,10 +23,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from . import model
 from .integrate import REACHED_STOP, STATUS_MESSAGES
@@ -43,7 +42,10 @@ from .regime import (
     period_signatures,
     signatures_match,
 )
-from .simulate import Result, impact_table, integrator_for, summarize
+from .simulate import Result, impact_columns, integrator_for, summarize
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 # Drive periods before the measurement. Over ω 90–130 rad/s and strokes of 23–28 mm, 250 periods
 # already give the same basins as 400 (200 do not), but at rtol 1e-5 slow period doublings still
@@ -90,7 +92,7 @@ class SettledStart:
     impact_rate_hz: float
     heat_power_W: float
     heat_power_stderr_W: float  # from batch means; what separates irregular motions
-    impacts: pd.DataFrame  # the settled impacts: time (s), wall
+    impacts: dict[str, np.ndarray]  # the settled impacts: "time" (s), "wall"
     message: str = ""
 
 
@@ -158,6 +160,8 @@ class AttractorScan:
 
     def table(self) -> pd.DataFrame:
         """One row per attractor: attractor, regime, period, basin_fraction, impact_rate_hz, heat_power_W, starts."""
+        import pandas as pd
+
         rows = [
             {
                 "attractor": attractor.label,
@@ -177,6 +181,8 @@ class AttractorScan:
 
     def phases(self, omega: float, phase: float) -> pd.DataFrame:
         """The drive phase of every settled impact of every start that settled: start, attractor, phase, wall."""
+        import pandas as pd
+
         label_of = {start: attractor.label for attractor in self.attractors for start in attractor.starts}
         parts = []
         for settled in self.settled:
@@ -242,10 +248,11 @@ def settle(params: Parameters, start: int = 0) -> SettledStart:
     if status != REACHED_STOP:
         return SettledStart(
             start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan,
-            pd.DataFrame(columns=["time", "wall"]), STATUS_MESSAGES[status],
+            {"time": np.empty(0), "wall": np.empty(0, dtype=str)}, STATUS_MESSAGES[status],
         )
-    impacts = impact_table(integrator.impacts, params.lam)[["time", "wall"]]
-    impacts = impacts[impacts["time"] >= settled_at].reset_index(drop=True)
+    columns = impact_columns(integrator.impacts, params.lam)
+    kept = columns["time"] >= settled_at
+    impacts = {"time": columns["time"][kept], "wall": columns["wall"][kept]}
     regime, cycle = classify_impacts(impacts, params.omega, params.phase)
     # Whole cycles of a periodic motion, so that its heat and rate carry no part-cycle bias.
     measured = MEASURE_PERIODS - MEASURE_PERIODS % cycle if cycle else MEASURE_PERIODS
@@ -327,18 +334,18 @@ def _cycle_groups(
     return [sorted(members, key=lambda start: start.start) for _, members in cycles], unmatched
 
 
-def _signatures(impacts: pd.DataFrame, omega: float, phase: float) -> list[Signature]:
+def _signatures(impacts: dict[str, np.ndarray], omega: float, phase: float) -> list[Signature]:
     return period_signatures(impact_phases(impacts, omega, phase))
 
 
-def _mirrored(impacts: pd.DataFrame, omega: float) -> pd.DataFrame:
+def _mirrored(impacts: dict[str, np.ndarray], omega: float) -> dict[str, np.ndarray]:
     """The same motion seen from the other end: x → −x is the drive half a period later, walls swapped.
 
     The vial's two ends are alike, so a motion and its mirror image are one attractor (the same heat,
     rate and regime), reached by mirror-image starts.
     """
-    swapped = impacts["wall"].map({"left": "right", "right": "left"})
-    return pd.DataFrame({"time": impacts["time"] + math.pi / omega, "wall": swapped})
+    swapped = np.where(impacts["wall"] == "left", "right", "left")
+    return {"time": impacts["time"] + math.pi / omega, "wall": swapped}
 
 
 def _ends_on(window: list[Signature], cycle: list[Signature]) -> bool:

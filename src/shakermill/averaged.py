@@ -29,7 +29,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 from scipy.integrate import solve_ivp
 
 from . import model
@@ -42,12 +41,12 @@ from .simulate import (
     ProgressCallback,
     Result,
     conclude,
-    impact_table,
+    impact_columns,
     integrator_for,
     no_impact_note,
     sample_times,
     simulate_full,
-    state_dataset,
+    state_history,
     summarize,
 )
 
@@ -265,9 +264,10 @@ def averaged_states(params: Parameters, averages: MechanicsAverages, times: np.n
     return states
 
 
-def impacts_of_window(integrator: Integrator, lam: float, transient: float) -> pd.DataFrame:
-    table = impact_table(integrator.impacts, lam)
-    return table[table["time"] >= transient].reset_index(drop=True)
+def impacts_of_window(integrator: Integrator, lam: float, transient: float) -> dict[str, np.ndarray]:
+    columns = impact_columns(integrator.impacts, lam)
+    kept = columns["time"] >= transient
+    return {name: values[kept] for name, values in columns.items()}
 
 
 def simulate_averaged(params: Parameters, progress: ProgressCallback | None = None) -> Result:
@@ -328,9 +328,9 @@ def _simulate_configured_start(params: Parameters, progress: ProgressCallback | 
         message=f"Averaged solver: {averages.message}; thermal network integrated to {params.duration:g} s."
         + no_impact_note(params, int(np.isfinite(averages.impact_interval))),
         t_end=params.duration,
-        timeseries=state_dataset(thermal.t, states, constants, params),
-        windows=state_dataset(window_points[:, 0], window_points[:, 1:], constants, params),
-        impacts=impacts_of_window(integrator, params.lam, averages.transient),
+        history=state_history(thermal.t, states, constants, params),
+        window_history=state_history(window_points[:, 0], window_points[:, 1:], constants, params),
+        impact_columns=impacts_of_window(integrator, params.lam, averages.transient),
         counters=counters,
         wall_time=time.perf_counter() - started,
         energy=energy,

@@ -10,6 +10,7 @@ time, and only when stderr is a terminal, so pipes and logs stay clean.
 
 from __future__ import annotations
 
+import gc
 import json
 import math
 import sys
@@ -70,7 +71,12 @@ app = typer.Typer(
 
 def main() -> None:
     """Entry point of the ``shakermill`` console script."""
-    app()
+    try:
+        app()
+    finally:
+        # Everything is written by now. Tearing down NumPy, SciPy, Numba and pandas at exit collects
+        # every object they made, about 0.4 s of a short run; frozen objects are left to the OS instead.
+        gc.freeze()
 
 
 def _version(show: bool) -> None:
@@ -232,11 +238,11 @@ def _write(
     result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool, overwrite: bool
 ) -> Path:
     """Write the run folder (with figures unless told not to); return its absolute path."""
-    from .plotting import plot_run
     from .storage import write_run
 
-
     def add_figures(folder: Path) -> None:
+        from .plotting import plot_run
+
         plot_run(result, folder / FIGURES_FOLDER)
 
     try:

@@ -406,7 +406,7 @@ def impact_phase_figure(run: RunLike) -> Figure:
     axis.set_ylim(0.0, axis.get_ylim()[1] * HISTOGRAM_HEADROOM)
     axis.set_xlabel("drive phase at impact, ωt + φ mod 2π (rad)")
     axis.set_ylabel("impacts per 5° bin (count)")
-    axis.set_title(f"Impact phases of the settled motion ({len(settled)} impacts, {regime})")
+    axis.set_title(f"Impact phases of the settled motion ({len(settled['time'])} impacts, {regime})")
     axis.legend(loc="upper left")
     axis.grid(alpha=0.3)
     return figure

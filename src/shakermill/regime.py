@@ -12,13 +12,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
-import pandas as pd
 
 from .params import Parameters
 from .simulate import Result
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+# Impacts as columns: at least "time" (s) and "wall" ("left"/"right"); a dict of arrays or a DataFrame.
+ImpactColumns = Mapping[str, Any]
 
 # Longest period searched for; motions that repeat more slowly are called irregular.
 MAX_PERIOD = 16
@@ -41,24 +46,25 @@ class ImpactPhases:
     wall: np.ndarray
 
 
-def settled_impacts(impacts: pd.DataFrame, solver: str, end_time: float) -> pd.DataFrame:
-    """The impacts after the start-up transient: the second half of a full run (the averaged solver already cut it)."""
-    if solver == "averaged":
-        return impacts
-    return impacts[impacts["time"] >= 0.5 * end_time]
+def settled_impacts(impacts: ImpactColumns, solver: str, end_time: float) -> dict[str, np.ndarray]:
+    """Time and wall of the impacts after the start-up transient: the second half of a full run (the
+    averaged solver already cut it)."""
+    time, wall = np.asarray(impacts["time"]), np.asarray(impacts["wall"])
+    kept = np.full(time.shape, True) if solver == "averaged" else time >= 0.5 * end_time
+    return {"time": time[kept], "wall": wall[kept]}
 
 
-def settled_run_impacts(run: Any) -> pd.DataFrame:
+def settled_run_impacts(run: Any) -> dict[str, np.ndarray]:
     """:func:`settled_impacts` of a :class:`~shakermill.simulate.Result` or a stored run (from its summary)."""
     return settled_impacts(run.impacts, str(run.summary["solver"]), float(run.summary["simulated_s"]))
 
 
-def impact_phases(impacts: pd.DataFrame, omega: float, phase: float) -> ImpactPhases:
-    angle = omega * impacts["time"].to_numpy() + phase
+def impact_phases(impacts: ImpactColumns, omega: float, phase: float) -> ImpactPhases:
+    angle = omega * np.asarray(impacts["time"]) + phase
     return ImpactPhases(
         period_index=np.floor(angle / (2 * math.pi)).astype(np.int64),
         phase=np.mod(angle, 2 * math.pi),
-        wall=impacts["wall"].to_numpy(),
+        wall=np.asarray(impacts["wall"]),
     )
 
 
@@ -94,9 +100,9 @@ def classify(result: Result) -> tuple[str, int | None]:
     return classify_impacts(settled, result.params.omega, result.params.phase)
 
 
-def classify_impacts(settled: pd.DataFrame, omega: float, phase: float) -> tuple[str, int | None]:
+def classify_impacts(settled: ImpactColumns, omega: float, phase: float) -> tuple[str, int | None]:
     """The regime of a settled motion from its impacts (columns ``time`` and ``wall``), drive ω and φ."""
-    if settled.empty:
+    if len(settled["time"]) == 0:
         return NO_IMPACTS, None
     signatures = period_signatures(impact_phases(settled, omega, phase))
     for period in range(1, MAX_PERIOD + 1):
@@ -131,6 +137,8 @@ def bifurcation(
     resolution (:mod:`shakermill.attractors`); the phase of an impact is ωt + φ (mod 2π) with the ω
     of that run. Ctrl-C during a run raises ``KeyboardInterrupt``.
     """
+    import pandas as pd
+
     from .attractors import probed
     from .simulate import simulate_whole
 

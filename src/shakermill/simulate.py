@@ -5,11 +5,10 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Callable
+from functools import cached_property
+from typing import TYPE_CHECKING, Callable, Mapping
 
 import numpy as np
-import pandas as pd
-import xarray as xr
 
 from . import contact, model
 from .fit import ExponentialFit, fit_exponential, increment_ratio
@@ -25,6 +24,9 @@ from .params import Parameters, unit_slip_warnings
 from .steady import SteadyState, run_length_warning, settled_means, steady_state
 
 if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
+
     from .attractors import AttractorScan
     from .averaged import MechanicsAverages
     from .views import FigureSet
@@ -110,9 +112,9 @@ class Result:
     status: int
     message: str
     t_end: float
-    timeseries: xr.Dataset
-    windows: xr.Dataset
-    impacts: pd.DataFrame
+    history: StateHistory  # the sampled states; ``timeseries`` is its xarray view
+    window_history: StateHistory  # the full-resolution states in the record windows; ``windows``
+    impact_columns: dict[str, np.ndarray]  # one entry per impact; ``impacts`` is the table
     counters: dict[str, int]
     wall_time: float
     energy: EnergyAudit
@@ -129,6 +131,27 @@ class Result:
     @property
     def success(self) -> bool:
         return self.status == REACHED_STOP
+
+    @property
+    def impact_count(self) -> int:
+        return int(self.impact_columns["time"].size)
+
+    @cached_property
+    def timeseries(self) -> xr.Dataset:
+        """The sampled state history (units in the attributes, temperatures also in °C as ``theta_*_C``)."""
+        return self.history.dataset()
+
+    @cached_property
+    def windows(self) -> xr.Dataset:
+        """The full-resolution state inside the record windows."""
+        return self.window_history.dataset()
+
+    @cached_property
+    def impacts(self) -> pd.DataFrame:
+        """One row per impact, SI units (:data:`IMPACT_UNITS`)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.impact_columns)
 
     def plot(self, *, impacts: bool = False) -> FigureSet:
         """The paper's figures of this run (and the impact figures if asked), by name; a notebook shows them."""
@@ -250,30 +273,28 @@ def _assemble(
         # Close the series with the state where the run stopped, so a failed run shows its last state.
         times = np.append(times, t_end)
         samples = np.vstack([samples, integrator.y])
-    timeseries = state_dataset(times, samples, constants, params)
+    history = state_history(times, samples, constants, params)
     window_points = integrator.window_points
-    windows = state_dataset(window_points[:, 0], window_points[:, 1:], constants, params)
-    impacts = impact_table(integrator.impacts, params.lam)
+    window_history = state_history(window_points[:, 0], window_points[:, 1:], constants, params)
+    impacts = impact_columns(integrator.impacts, params.lam)
     counters = {name: int(integrator.counters[i]) for i, name in enumerate(COUNTER_NAMES)}
     energy = energy_audit(y0, integrator.y, constants, t_end, params, integrator.energy_correction)
     theta_0 = params.initial_temperature
-    ball_fit = fit_exponential(timeseries["time"].values, timeseries["theta_ball"].values, theta_0)
+    ball_fit = fit_exponential(times, history["theta_ball"], theta_0)
     result = Result(
         params=params,
         status=status,
-        message=message + no_impact_note(params, len(impacts)),
+        message=message + no_impact_note(params, impacts["time"].size),
         t_end=t_end,
-        timeseries=timeseries,
-        windows=windows,
-        impacts=impacts,
+        history=history,
+        window_history=window_history,
+        impact_columns=impacts,
         counters=counters,
         wall_time=wall_time,
         energy=energy,
         ball_fit=ball_fit,
     )
-    heat_power, velocity_term = settled_means(
-        times, timeseries["heat_generated"].values, timeseries["velocity_term_integral"].values
-    )
+    heat_power, velocity_term = settled_means(times, history["heat_generated"], history["velocity_term_integral"])
     return conclude(result, heat_power, velocity_term)
 
 
@@ -298,8 +319,8 @@ def conclude(result: Result, heat_power: float, velocity_term: float) -> Result:
 
 def physical_bounds_problem(result: Result) -> str | None:
     """Why the temperatures of a run cannot be physical, or None."""
-    series = result.timeseries
-    hottest_ball = float(series["theta_ball"].max())
+    series = result.history
+    hottest_ball = float(np.nanmax(series["theta_ball"]))
     limit = result.params.ball_temperature_limit
     if hottest_ball > limit:
         return (
@@ -307,7 +328,7 @@ def physical_bounds_problem(result: Result) -> str | None:
             f"({kelvin_to_celsius(limit):.4g} °C): the model does not hold there. Check omega, amplitude and the "
             "units of the inputs (bare numbers are SI)."
         )
-    coldest = min(float(series[name].min()) for name in ("theta_ball", "theta_vial", "theta_air"))
+    coldest = min(float(np.nanmin(series[name])) for name in ("theta_ball", "theta_vial", "theta_air"))
     if coldest < 0.0:
         return f"A temperature fell to {coldest:.4g} K, below absolute zero: the thermal network is not physical here."
     return None
@@ -362,36 +383,70 @@ _VARIABLES = {
 CELSIUS_VARIABLES = ("theta_ball", "theta_vial", "theta_air")
 
 
-def state_dataset(times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters) -> xr.Dataset:
-    """The state history as an xarray Dataset with units in the attributes."""
-    data_vars = {
-        name: ("time", states[:, index], {"units": units, "long_name": long_name})
+TIME_ATTRIBUTES = {"units": "s", "long_name": "simulated time"}
+
+
+@dataclass(frozen=True)
+class StateHistory:
+    """A state history as NumPy arrays over ``times`` (s), each variable with its attributes (units, long_name).
+
+    Run files are written from it directly, and :meth:`dataset` is the xarray view: a run that only
+    writes its files never imports xarray, whose first Dataset imports dask and pint (half a second).
+    """
+
+    times: np.ndarray
+    variables: dict[str, tuple[np.ndarray, dict[str, str]]]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.variables[name][0]
+
+    def with_attributes(self, extra: Mapping[str, Mapping[str, str]]) -> StateHistory:
+        """The same history with ``extra[name]`` added to the attributes of variable ``name``."""
+        variables = {
+            name: (values, {**attributes, **extra.get(name, {})}) for name, (values, attributes) in self.variables.items()
+        }
+        return StateHistory(self.times, variables)
+
+    def dataset(self) -> xr.Dataset:
+        import xarray as xr
+
+        data_vars = {name: ("time", values, dict(attributes)) for name, (values, attributes) in self.variables.items()}
+        return xr.Dataset(data_vars, coords={"time": ("time", self.times, dict(TIME_ATTRIBUTES))})
+
+
+def state_history(times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters) -> StateHistory:
+    """The state history with units and long names, temperatures also in °C, the ball's velocity and the vial's position."""
+    variables = {
+        name: (states[:, index], {"units": units, "long_name": long_name})
         for name, (index, units, long_name) in _VARIABLES.items()
     }
     # The same temperatures in °C beside the kelvin ones: ``ds.theta_ball_C.plot()`` is then labelled with the
     # unit of its values, which converting ``theta_ball`` by hand would not change from [K].
     for name in CELSIUS_VARIABLES:
-        kelvin = data_vars[name]
-        data_vars[f"{name}_C"] = ("time", kelvin_to_celsius(kelvin[1]), {"units": "degC", "long_name": kelvin[2]["long_name"]})
-    data_vars["velocity"] = ("time", states[:, model.P] / constants.ball_mass, {"units": "m s-1", "long_name": "ball velocity"})
-    data_vars["vial_position"] = (
-        "time",
+        kelvin, attributes = variables[name]
+        variables[f"{name}_C"] = (kelvin_to_celsius(kelvin), {"units": "degC", "long_name": attributes["long_name"]})
+    variables["velocity"] = (states[:, model.P] / constants.ball_mass, {"units": "m s-1", "long_name": "ball velocity"})
+    variables["vial_position"] = (
         params.amplitude * np.sin(params.omega * times + params.phase),
         {"units": "m", "long_name": "vial centre position"},
     )
-    return xr.Dataset(
-        data_vars,
-        coords={"time": ("time", times, {"units": "s", "long_name": "simulated time"})},
-    )
+    return StateHistory(times, variables)
+
+
+def impact_columns(records: np.ndarray, lam: float) -> dict[str, np.ndarray]:
+    """The impact records as columns with SI units (see :data:`IMPACT_UNITS`), the wall by name."""
+    columns = {name: records[:, index] for index, name in enumerate(IMPACT_COLUMNS)}
+    columns["wall"] = np.where(columns["wall"] == model.LEFT_WALL, "left", "right")
+    columns["heat_to_ball"] = lam * columns["heat_generated"]
+    columns["heat_to_vial"] = (1.0 - lam) * columns["heat_generated"]
+    return columns
 
 
 def impact_table(records: np.ndarray, lam: float) -> pd.DataFrame:
-    """One row per impact with SI units (see :data:`IMPACT_UNITS`)."""
-    table = pd.DataFrame(records, columns=list(IMPACT_COLUMNS))
-    table["wall"] = np.where(table["wall"].to_numpy() == model.LEFT_WALL, "left", "right")
-    table["heat_to_ball"] = lam * table["heat_generated"]
-    table["heat_to_vial"] = (1.0 - lam) * table["heat_generated"]
-    return table
+    """One row per impact (:func:`impact_columns`) as a table."""
+    import pandas as pd
+
+    return pd.DataFrame(impact_columns(records, lam))
 
 
 IMPACT_UNITS = {
@@ -465,14 +520,15 @@ def understood_inputs(params: Parameters) -> dict[str, float]:
 def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]:
     """The flat summary printed by ``run --json`` and stored as ``summary.json``."""
     params = result.params
-    series = result.timeseries
-    last = series.isel(time=-1)
+    series = result.history
+    last = {name: float(series[name][-1]) for name in CELSIUS_VARIABLES}
     fit = result.ball_fit
     theta_0 = params.initial_temperature
-    impacts = result.impacts
+    impacts = result.impact_columns
+    count = result.impact_count
     duration = max(result.t_end, 1e-300)
     impact_window = result.impact_window if result.impact_window else duration
-    impact_rate = len(impacts) / impact_window if impact_window > 0 else math.nan
+    impact_rate = count / impact_window if impact_window > 0 else math.nan
     summary = {
         "status": result.status,
         "success": result.success,
@@ -489,13 +545,13 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         "air_C": kelvin_to_celsius(float(last["theta_air"])),
         "vial_ball_ratio": increment_ratio(float(last["theta_vial"]), float(last["theta_ball"]), theta_0),
         "solver": result.solver,
-        "impacts": int(len(impacts)) if result.impact_window is None else int(round(impact_rate * duration)),
+        "impacts": count if result.impact_window is None else int(round(impact_rate * duration)),
         "impact_rate_hz": impact_rate,
         "heat_power_W": result.energy.heat_generated / duration,
         "dissipated_power_W": result.energy.dissipated / duration,
-        "mean_impact_speed_m_s": float(impacts["impact_speed"].mean()) if len(impacts) else math.nan,
-        "max_impact_speed_m_s": float(impacts["impact_speed"].max()) if len(impacts) else math.nan,
-        "mean_dissipated_per_impact_J": float(impacts["dissipated_energy"].mean()) if len(impacts) else math.nan,
+        "mean_impact_speed_m_s": float(impacts["impact_speed"].mean()) if count else math.nan,
+        "max_impact_speed_m_s": float(impacts["impact_speed"].max()) if count else math.nan,
+        "mean_dissipated_per_impact_J": float(impacts["dissipated_energy"].mean()) if count else math.nan,
         "steps": result.counters["steps"],
         "rejected_steps": result.counters["rejected_steps"],
         "rhs_evaluations": result.counters["rhs_evaluations"],

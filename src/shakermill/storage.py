@@ -24,13 +24,9 @@ import secrets
 import shutil
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
-import pandas as pd
-import pyarrow as pa
-import pyarrow.parquet as pq
-import xarray as xr
 
 from . import __version__
 from .atomic import StorageError, partial_path
@@ -38,7 +34,11 @@ from .config import load_config, write_config_toml
 from .fit import ExponentialFit
 from .integrate import REACHED_STOP
 from .params import Parameters
-from .simulate import IMPACT_UNITS, Result
+from .simulate import IMPACT_UNITS, TIME_ATTRIBUTES, Result, StateHistory
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
 
 TIMESERIES_FILE = "timeseries.nc"
 WINDOWS_FILE = "windows.nc"
@@ -53,6 +53,7 @@ COVERAGE_KEY = "coverage"
 # Variables of an averaged run's timeseries.nc: never computed, or rates of the averaging window times time.
 AVERAGED_MOTION_VARIABLES = ("x", "p", "velocity")
 AVERAGED_FLOW_VARIABLES = ("work_vial", "dissipated", "heat_generated", "velocity_term_integral")
+# Reading goes through xarray with this engine; writing uses h5netcdf directly (:func:`write_history`).
 NETCDF_ENGINE = "h5netcdf"
 
 
@@ -145,12 +146,12 @@ def write_run(
 def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenance: Mapping[str, Any]) -> None:
     attributes = _run_attributes(result, preset)
     coverage = averaging_coverage(result)
-    timeseries = _mark_averaged_variables(result.timeseries, coverage) if coverage else result.timeseries
+    history = _mark_averaged_variables(result.history, coverage) if coverage else result.history
     title = "shakermill sampled state history"
-    write_dataset(timeseries, folder / TIMESERIES_FILE, title=title, **attributes, **_covers(coverage, "timeseries"))
+    write_history(history, folder / TIMESERIES_FILE, title=title, **attributes, **_covers(coverage, "timeseries"))
     title = "shakermill full-resolution state in the record windows"
-    write_dataset(result.windows, folder / WINDOWS_FILE, title=title, **attributes, **_covers(coverage, "motion"))
-    write_impacts(result.impacts, folder / IMPACTS_FILE, coverage=coverage.get("impacts"))
+    write_history(result.window_history, folder / WINDOWS_FILE, title=title, **attributes, **_covers(coverage, "motion"))
+    write_impacts(result.impact_columns, folder / IMPACTS_FILE, coverage=coverage.get("impacts"))
     (folder / SUMMARY_FILE).write_text(summary_json(result, preset), encoding="utf-8")
     provenance = {"status": result.status, "message": result.message, "simulated_s": result.t_end, **extra_provenance}
     write_config_toml(result.params, folder / CONFIG_FILE, preset=preset, extra_provenance=provenance)
@@ -197,32 +198,58 @@ def _covers(coverage: Mapping[str, str], part: str) -> dict[str, str]:
     return {COVERAGE_KEY: coverage[part]} if coverage else {}
 
 
-def _mark_averaged_variables(dataset: xr.Dataset, coverage: Mapping[str, str]) -> xr.Dataset:
-    marked = dataset.copy()
-    for name in AVERAGED_MOTION_VARIABLES:
-        marked[name].attrs[COVERAGE_KEY] = coverage["motion_variable"]
-    for name in AVERAGED_FLOW_VARIABLES:
-        marked[name].attrs[COVERAGE_KEY] = coverage["flow_variable"]
-    return marked
+def _mark_averaged_variables(history: StateHistory, coverage: Mapping[str, str]) -> StateHistory:
+    marks = {name: {COVERAGE_KEY: coverage["motion_variable"]} for name in AVERAGED_MOTION_VARIABLES}
+    marks.update({name: {COVERAGE_KEY: coverage["flow_variable"]} for name in AVERAGED_FLOW_VARIABLES})
+    return history.with_attributes(marks)
 
 
-def write_dataset(dataset: xr.Dataset, path: Path, *, title: str, **attributes: Any) -> None:
-    """Write ``dataset`` with global attributes; per-variable ``units`` and ``long_name`` are kept as they are."""
-    stored = dataset.copy()
-    stored.attrs.update(title=title, **attributes)
-    stored.to_netcdf(path, engine=NETCDF_ENGINE)
+def write_history(history: StateHistory, path: Path, *, title: str, **attributes: Any) -> None:
+    """Write ``history`` as NetCDF4 over the dimension ``time``, with global attributes and each variable's own.
+
+    h5netcdf writes it directly: building an xarray Dataset first would cost a run without figures
+    half its start-up. ``xarray.open_dataset`` reads the file as the Dataset :meth:`StateHistory.dataset` gives.
+    """
+    import h5netcdf
+
+    with h5netcdf.File(path, "w") as file:
+        file.attrs.update(title=title, **attributes)
+        file.dimensions = {"time": history.times.size}
+        for name, (values, variable_attributes) in {"time": (history.times, TIME_ATTRIBUTES), **history.variables}.items():
+            variable = file.create_variable(name, ("time",), data=values)
+            variable.attrs.update(variable_attributes)
 
 
-def write_impacts(impacts: pd.DataFrame, path: Path, *, coverage: str | None = None) -> None:
-    """Write the impact table with the column units as JSON in the Parquet schema metadata, and what
+def write_impacts(columns: Mapping[str, np.ndarray], path: Path, *, coverage: str | None = None) -> None:
+    """Write the impact columns with their units as JSON in the Parquet schema metadata, and what
     the table covers (``coverage``) where it is not the whole run."""
-    table = pa.Table.from_pandas(impacts, preserve_index=False)
-    units = {column: IMPACT_UNITS.get(column, "") for column in impacts.columns}
-    metadata = dict(table.schema.metadata or {})
-    metadata[UNITS_METADATA_KEY] = json.dumps(units).encode()
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    units = {column: IMPACT_UNITS.get(column, "") for column in columns}
+    metadata = {UNITS_METADATA_KEY: json.dumps(units).encode()}
     if coverage is not None:
         metadata[COVERAGE_KEY.encode()] = coverage.encode()
-    pq.write_table(table.replace_schema_metadata(metadata), path)
+    arrays = [arrow_array(np.asarray(values)) for values in columns.values()]
+    pq.write_table(pa.Table.from_arrays(arrays, names=list(columns), metadata=metadata), path)
+
+
+def arrow_array(values: np.ndarray) -> Any:
+    """``values`` (numbers, or strings) as a ``pyarrow.Array`` built from its buffers.
+
+    ``pyarrow.array`` would build the same, but first imports pandas to see whether it was handed a
+    pandas object: a quarter of the start-up of a run that writes its table without pandas.
+    """
+    import pyarrow as pa
+
+    if values.dtype.kind in "US":
+        encoded = np.char.encode(values.astype(str), "utf-8")
+        offsets = np.zeros(values.size + 1, dtype=np.int32)
+        np.cumsum(np.char.str_len(encoded), out=offsets[1:])
+        buffers = [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(encoded.tolist()))]
+        return pa.Array.from_buffers(pa.string(), values.size, buffers)
+    contiguous = np.ascontiguousarray(values)
+    return pa.Array.from_buffers(pa.from_numpy_dtype(contiguous.dtype), contiguous.size, [None, pa.py_buffer(contiguous)])
 
 
 def summary_document(result: Result, preset: str) -> dict[str, Any]:
@@ -267,6 +294,8 @@ def load_run(path: Path | str) -> RunData:
     summary_path = folder / SUMMARY_FILE
     if not summary_path.is_file():
         raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
+    import xarray as xr
+
     document = json.loads(summary_path.read_text(encoding="utf-8"))
     config = load_config(folder / CONFIG_FILE)
     impacts, impact_units = read_impacts(folder / IMPACTS_FILE)
@@ -289,6 +318,8 @@ def load_run(path: Path | str) -> RunData:
 
 def read_impacts(path: Path) -> tuple[pd.DataFrame, dict[str, str]]:
     """The impact table and its column units."""
+    import pyarrow.parquet as pq
+
     table = pq.read_table(path)
     metadata = table.schema.metadata or {}
     units = json.loads(metadata.get(UNITS_METADATA_KEY, b"{}"))
