@@ -1,0 +1,93 @@
+"""The corpus of hostile and careless inputs (issue 12): every case ends cleanly and in time.
+
+Each ``tests/hostile/*.toml`` file lists cases as ``[[case]]`` tables:
+
+* ``name``    what the case is, unique across the corpus;
+* ``args``    the command line after ``shakermill``; ``{tmp}`` is a fresh folder of the case's own;
+* ``expect``  ``"refused"``: exit code 2 and exactly one line on stderr, ``error: ...``, containing every
+  fragment of ``match`` (a string or a list); ``"ok"``: exit code 0;
+* ``seconds`` the time the command may take (default 20); the case fails beyond it;
+* ``files``   optional, files made in ``{tmp}`` first: a string (written as UTF-8), or a table
+  ``{ text = "...", encoding = "utf-8-sig" }`` for any Python codec, or ``{ hex = "..." }`` for raw bytes;
+* ``before``  optional, command lines run first, each of which must succeed (to build a run or sweep
+  folder that the case then damages through ``files``);
+* ``absent``  optional, paths (with ``{tmp}``) that must not exist afterwards: nothing that looks complete.
+
+The commands run in this process (typer's runner), so hundreds of cases take seconds, not minutes.
+"""
+
+from __future__ import annotations
+
+import time
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import pytest
+from typer.testing import CliRunner
+
+from shakermill import cli
+
+CORPUS = Path(__file__).parent / "hostile"
+DEFAULT_SECONDS = 20.0
+EXIT_USAGE = 2
+
+
+def load_cases() -> list[dict[str, Any]]:
+    cases = []
+    for path in sorted(CORPUS.glob("*.toml")):
+        with path.open("rb") as file:
+            for case in tomllib.load(file)["case"]:
+                cases.append({**case, "corpus": path.stem})
+    return cases
+
+
+CASES = load_cases()
+
+
+def expand(text: str, tmp: Path) -> str:
+    return text.replace("{tmp}", str(tmp))
+
+
+def make_files(files: dict[str, Any], tmp: Path) -> None:
+    for name, content in files.items():
+        path = tmp / expand(name, tmp)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(content, str):
+            path.write_bytes(content.encode("utf-8"))
+        elif "hex" in content:
+            path.write_bytes(bytes.fromhex(content["hex"]))
+        else:
+            path.write_bytes(content["text"].encode(content["encoding"]))
+
+
+def test_the_corpus_is_large_and_its_names_unique():
+    names = [case["name"] for case in CASES]
+    assert len(names) == len(set(names)), sorted(name for name in names if names.count(name) > 1)
+    assert len(CASES) >= 150
+    assert {case["expect"] for case in CASES} <= {"refused", "ok"}
+
+
+@pytest.mark.parametrize("case", CASES, ids=[f"{case['corpus']}: {case['name']}" for case in CASES])
+def test_hostile_input_ends_cleanly_and_in_time(case, tmp_path):
+    runner = CliRunner()
+    for command in case.get("before", []):
+        prepared = runner.invoke(cli.app, [expand(argument, tmp_path) for argument in command])
+        assert prepared.exit_code == 0, (command, prepared.stderr, prepared.exception)
+    make_files(case.get("files", {}), tmp_path)
+    started = time.perf_counter()
+    outcome = runner.invoke(cli.app, [expand(argument, tmp_path) for argument in case["args"]])
+    elapsed = time.perf_counter() - started
+    assert elapsed <= case.get("seconds", DEFAULT_SECONDS), f"took {elapsed:.1f} s"
+    assert "Traceback" not in outcome.stderr + outcome.stdout
+    if case["expect"] == "ok":
+        assert outcome.exit_code == 0, (outcome.stderr, outcome.exception)
+    else:
+        assert outcome.exit_code == EXIT_USAGE, (outcome.exit_code, outcome.stderr, outcome.exception)
+        lines = outcome.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error: "), outcome.stderr
+        fragments = case.get("match", [])
+        for fragment in [fragments] if isinstance(fragments, str) else fragments:
+            assert fragment in lines[0], (fragment, lines[0])
+    for path in case.get("absent", []):
+        assert not Path(expand(path, tmp_path)).exists(), path
