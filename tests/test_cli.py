@@ -516,11 +516,21 @@ def test_bifurcation_onto_a_non_empty_folder_is_refused_unless_overwrite(tmp_pat
     arguments = ["bifurcation", *QUICK_BASE, "--grid", "omega=100:120:2", "--out", str(folder)]
     refused = invoke(*arguments)
     assert refused.exit_code == 2
-    assert_one_error_line(refused.stderr, str(folder), "not empty", "--overwrite")
+    assert_one_error_line(refused.stderr, str(folder), "holds a bifurcation scan already", "--overwrite")
     assert (folder / "bifurcation_regimes.csv").read_text() == "earlier scan"
     replaced = invoke(*arguments, "--overwrite")
     assert replaced.exit_code == 0, replaced.stderr
     assert pd.read_csv(folder / "bifurcation_regimes.csv")["omega"].tolist() == [100.0, 120.0]
+
+
+def test_bifurcation_never_writes_into_a_folder_of_the_users_own(tmp_path):
+    (tmp_path / "bifurcation_regimes.csv").write_text("earlier scan")
+    (tmp_path / "thesis.tex").write_text("precious")
+    refused = invoke("bifurcation", *QUICK_BASE, "--grid", "omega=100:120:2", "--out", str(tmp_path), "--overwrite")
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, str(tmp_path), "not a shakermill bifurcation scan")
+    assert sorted(entry.name for entry in tmp_path.iterdir()) == ["bifurcation_regimes.csv", "thesis.tex"]
+    assert (tmp_path / "bifurcation_regimes.csv").read_text() == "earlier scan"
 
 
 def test_report_onto_an_existing_file_is_refused_unless_overwrite(tmp_path):

@@ -172,7 +172,7 @@ def fail_midway(*_args, **_kwargs):
 
 
 def test_interrupted_write_leaves_no_folder_at_all(short_result, tmp_path, monkeypatch):
-    monkeypatch.setattr(storage, "write_impacts", fail_midway)
+    monkeypatch.setattr(storage, "impacts_parquet", fail_midway)
     with pytest.raises(KeyboardInterrupt):
         write_run(short_result, tmp_path / "run", preset=DEFAULT_PRESET)
     assert list(tmp_path.iterdir()) == []
@@ -190,7 +190,7 @@ def test_failure_in_added_files_leaves_no_folder(short_result, tmp_path):
 
 def test_interrupted_replacement_keeps_the_previous_run(run_folder, short_result, monkeypatch):
     before = (run_folder / "summary.json").read_text(encoding="utf-8")
-    monkeypatch.setattr(storage, "write_impacts", fail_midway)
+    monkeypatch.setattr(storage, "impacts_parquet", fail_midway)
     with pytest.raises(KeyboardInterrupt):
         write_run(short_result, run_folder, preset=DEFAULT_PRESET, overwrite=True)
     assert (run_folder / "summary.json").read_text(encoding="utf-8") == before

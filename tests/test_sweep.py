@@ -6,6 +6,7 @@ amplitudes are >= 23 mm so that a ball starting at rest is hit (the free gap is 
 
 from __future__ import annotations
 
+import importlib
 import itertools
 import json
 import os
@@ -43,7 +44,9 @@ from shakermill.sweep import (
 DURATION = 60.0  # simulated seconds per point
 GRID = ("omega=100:120:3", "amplitude=23mm:29mm:2")  # 6 points
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
-UNREACHABLE = "tcp://127.0.0.1:1"  # port 1 on loopback: nothing listens, connections are refused
+UNREACHABLE = "tcp://127.0.0.1:1"
+# The module, not the function that shadows it as ``shakermill.sweep``.
+SWEEP_MODULE = importlib.import_module("shakermill.sweep")  # port 1 on loopback: nothing listens, connections are refused
 
 
 @pytest.fixture(scope="module")
@@ -706,3 +709,123 @@ def test_cli_sweep_where_every_point_fails_exits_1_with_one_line(tmp_path):
     completed = subprocess.run(command, capture_output=True, text=True, timeout=120)
     assert completed.returncode == 1
     assert_one_error_line(completed.stderr, "2 of 2 points failed", "omega")
+
+
+# Damaged folders, races, orphaned workers, interrupted points, TLS (issue 12) ----------------------
+
+
+SMALL = ("omega=100:120:3",)
+
+
+@pytest.mark.parametrize(
+    "damage",
+    [b"", b'{"point_id": "', b"[]", b'{"row": 3}', b"\xff\xfe\x00garbage"],
+    ids=["empty", "truncated", "a JSON array", "a row that is no object", "not UTF-8"],
+)
+def test_an_unreadable_point_file_is_computed_again(base, tmp_path, damage):
+    plan = plan_sweep(SMALL)
+    folder = tmp_path / "damaged"
+    sweep(base, plan, folder, workers=1)
+    files = point_files(folder)
+    damaged = files[1]
+    damaged.write_bytes(damage)
+    untouched = {path: path.stat().st_mtime_ns for path in files if path != damaged}
+    # Without the table, the damaged point reads as not finished rather than crashing the reader.
+    (folder / TABLE_PARQUET).unlink()
+    assert load_sweep(folder).table.set_index("point_id").loc[damaged.stem, "error"].startswith("not finished")
+
+    with pytest.warns(UserWarning, match=rf"unreadable point file .*{damaged.name}.*computing those points again"):
+        table = sweep(base, plan, folder, workers=1)
+    assert table["error"].isna().all() and len(table) == 3
+    assert json.loads(damaged.read_text(encoding="utf-8"))["row"]["point_id"] == damaged.stem
+    assert {path: path.stat().st_mtime_ns for path in untouched} == untouched
+
+
+def test_cli_says_in_one_warning_line_that_it_recomputes_an_unreadable_point(tmp_path):
+    folder = tmp_path / "damaged"
+    command = ["sweep", "--grid", SMALL[0], "--set", f"duration={DURATION}", "--workers", "1", "--out", str(folder)]
+    assert run_cli(*command).returncode == 0
+    point_files(folder)[0].write_text('{"point_id": "trunc', encoding="utf-8")
+    completed = run_cli(*command)
+    assert completed.returncode == 0, completed.stderr
+    lines = completed.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: sweep: unreadable point file"), completed.stderr
+    assert load_sweep(folder).table["error"].isna().all()
+
+
+def test_two_sweeps_racing_into_one_new_folder_one_wins_the_other_is_refused(base, tmp_path, monkeypatch):
+    import threading
+
+    folder = tmp_path / "race"
+    plans = {"low": plan_sweep(["omega=100:105:2"]), "high": plan_sweep(["omega=110:115:2"])}
+    # Both sweeps find the folder free before either creates it: the moment the race is decided.
+    both_checked = threading.Barrier(len(plans), timeout=60)
+    check_folder = SWEEP_MODULE._check_folder
+
+    def check_then_wait_for_the_other(*args):
+        check_folder(*args)
+        both_checked.wait()
+
+    monkeypatch.setattr(SWEEP_MODULE, "_check_folder", check_then_wait_for_the_other)
+    outcomes: dict[str, object] = {}
+
+    def start(name: str) -> None:
+        try:
+            outcomes[name] = sweep(base, plans[name], folder, workers=1)
+        except ParameterError as exc:
+            outcomes[name] = exc
+
+    threads = [threading.Thread(target=start, args=(name,)) for name in plans]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=120)
+    winners = [name for name, outcome in outcomes.items() if isinstance(outcome, pd.DataFrame)]
+    losers = [name for name, outcome in outcomes.items() if isinstance(outcome, ParameterError)]
+    assert len(winners) == 1 and len(losers) == 1, outcomes
+    assert "holds a sweep over other points" in str(outcomes[losers[0]])
+    winning_ids = point_ids(base, plans[winners[0]])
+    assert sorted(path.stem for path in point_files(folder)) == sorted(winning_ids)
+    assert list(load_sweep(folder).table["point_id"]) == winning_ids
+
+
+def test_two_sweep_processes_started_at_once_into_one_new_folder(tmp_path):
+    folder = tmp_path / "race"
+    grids = ["omega=100:105:2", "omega=110:115:2"]
+    processes = [
+        subprocess.Popen(
+            [str(SHAKERMILL), "sweep", "--grid", grid, "--set", f"duration={DURATION}", "--workers", "1", "--out", str(folder)],
+            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+        )
+        for grid in grids
+    ]
+    outcomes = [(process.wait(timeout=300), process.stderr.read()) for process in processes]
+    for process in processes:
+        process.stderr.close()
+    codes = sorted(code for code, _ in outcomes)
+    assert codes == [0, 2], outcomes
+    winner = next(index for index, (code, _) in enumerate(outcomes) if code == 0)
+    assert_one_error_line(outcomes[1 - winner][1], str(folder), "choose another --out")
+    table = load_sweep(folder).table
+    assert list(table["omega"]) == list(parse_grid(grids[winner])[1])
+    assert sorted(path.stem for path in point_files(folder)) == sorted(table["point_id"])
+
+
+@pytest.mark.parametrize("crafted", ["../../outside", "/etc/hostname", "0123456789abcdef/../../../outside", "0123456789ABCDEF", 17])
+def test_a_crafted_point_id_in_the_manifest_is_refused_and_nothing_outside_is_read(base, tmp_path, crafted):
+    folder = tmp_path / "crafted"
+    sweep(base, {"omega": [100.0, 110.0]}, folder, workers=1)
+    # What the crafted id would have the table read: a file outside the sweep folder.
+    (tmp_path / "outside.json").write_text(json.dumps({"row": {"point_id": "stolen", "secret": 42}}), encoding="utf-8")
+    manifest = json.loads((folder / MANIFEST_FILE).read_text(encoding="utf-8"))
+    manifest["points"][0]["point_id"] = crafted
+    (folder / MANIFEST_FILE).write_text(json.dumps(manifest), encoding="utf-8")
+    (folder / TABLE_PARQUET).unlink()  # the table is then built from the point files the manifest names
+
+    with pytest.raises(ParameterError, match="sweep.json is damaged") as caught:
+        load_sweep(folder)
+    assert "\n" not in str(caught.value)
+    completed = run_cli("plot", str(folder))
+    assert completed.returncode == 2
+    assert_one_error_line(completed.stderr, "sweep.json is damaged", "point 1")
+    assert not (folder / "figures").exists()

@@ -31,7 +31,7 @@ import tomli_w
 from scipy.optimize import least_squares
 
 from . import __version__
-from .atomic import write_text_atomically
+from .atomic import remove_abandoned_writes, write_text_atomically
 from .defaults import DEFAULT_FREE
 from .params import ParameterError, Parameters, check_known_keys
 from .simulate import Result, simulate_whole
@@ -391,6 +391,8 @@ def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str
         document["provenance"]["curve_rms_K"] = calibration.curve_rms_K
         document["provenance"]["curve"] = calibration.curve_source
     header = f"# shakermill preset fitted by calibration; keys not listed come from {base_preset!r}.\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    remove_abandoned_writes(path.parent)
     return write_text_atomically(path, header + tomli_w.dumps(document))
 
 

@@ -28,7 +28,7 @@ from rich.text import Text
 # Only light modules here: `shakermill --help` and the listing commands must not wait for NumPy, Numba,
 # pandas, xarray, SciPy or Matplotlib. Each command imports what it uses.
 from . import __version__
-from .atomic import StorageError
+from .atomic import StorageError, check_writable_place
 from .config import load_config
 from .defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
 from .params import (
@@ -129,6 +129,15 @@ def _nothing_written_when_interrupted(what: str) -> Iterator[None]:
         _fail(f"interrupted; nothing was written ({what})", EXIT_INTERRUPTED)
 
 
+@contextmanager
+def _writing(target: Path, what: str) -> Iterator[None]:
+    """A write that fails (a full or read-only disk, a path under a file): one ``error:`` line and exit code 2."""
+    try:
+        yield
+    except OSError as exc:
+        _fail(f"{target}: cannot write {what} ({exc.strerror or exc})")
+
+
 # Options shared by several commands, declared once.
 ConfigArgument = Annotated[
     Path | None,
@@ -197,6 +206,16 @@ def echo_warnings(warnings: Sequence[str]) -> None:
         typer.echo(f"warning: {' '.join(warning.splitlines())}", err=True)
 
 
+@contextmanager
+def _warnings_as_lines() -> Iterator[None]:
+    """The library's warnings (an unreadable point file) as ``warning: ...`` lines, like a run's own."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.showwarning = lambda message, *_: echo_warnings([str(message)])
+        yield
+
+
 def timestamped_folder(kind: str) -> Path:
     """``results/<kind>-<local timestamp>``, with a counter if one started in the same second."""
     stem = f"{kind}-{datetime.now():%Y%m%d-%H%M%S}"
@@ -246,14 +265,11 @@ def _write(
         plot_run(result, folder / FIGURES_FOLDER)
 
     try:
-        return write_run(
-            result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None,
-            overwrite=overwrite,
-        )
-    except StorageError as exc:
-        _fail(str(exc))
-    except OSError as exc:
-        _fail(f"{target}: cannot write the run folder ({exc.strerror or exc})")
+        with _user_errors(), _writing(target, "the run folder"):
+            return write_run(
+                result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None,
+                overwrite=overwrite,
+            )
     except KeyboardInterrupt:
         _fail(f"interrupted while writing {target}; no partial folder was left there", EXIT_INTERRUPTED)
 
@@ -403,25 +419,12 @@ def keys() -> None:
     _stdout_console().print(table)
 
 
-def _check_free_folder(target: Path, overwrite: bool) -> None:
-    """Before any work: ``target`` is absent or an empty folder, or ``overwrite`` lets files there be replaced."""
-    if target.exists() and not target.is_dir():
-        _fail(f"{target}: exists and is not a folder; choose another --out")
-    if target.is_dir() and any(target.iterdir()) and not overwrite:
-        _fail(f"{target}: not empty; choose another --out, or add --overwrite to replace the files of the same names")
-
-
 def _load_run_or_fail(folder: Path) -> RunData:
     """The run folder at ``folder``, or one ``error:`` line and exit code 2."""
     from .storage import load_run
 
-    try:
+    with _user_errors():
         return load_run(folder)
-    except StorageError as exc:
-        _fail(str(exc))
-    except (OSError, ValueError, KeyError) as exc:
-        # A folder with summary.json but damaged or missing data files, or a configuration that no longer validates.
-        _fail(f"{folder}: not a readable shakermill run folder ({exc})")
 
 
 @app.command()
@@ -461,10 +464,8 @@ def plot(
             _fail("--contour: contours are drawn on the maps of a sweep folder, not on a run")
         run_data = _load_run_or_fail(folder)
         figures = impact_figures(run_data) if impacts else run_figures(run_data, impacts=True)
-    try:
+    with _writing(target, "the figures"):
         paths = plot_figures(figures, target, dpi=dpi)
-    except OSError as exc:
-        _fail(f"{target}: cannot write the figures ({exc.strerror or exc})")
     typer.echo(f"{len(paths)} files written to {target}")
 
 
@@ -489,10 +490,8 @@ def report(
     target = out if out is not None else run_dir / REPORT_FILE
     if target.is_file() and not overwrite:
         _fail(f"{target}: exists; choose another --out, or add --overwrite to replace it")
-    try:
+    with _writing(target, "the report"):
         save_report(run_data, target, other)
-    except OSError as exc:
-        _fail(f"{target}: cannot write the report ({exc.strerror or exc})")
     typer.echo(f"report written to {target}")
 
 
@@ -541,7 +540,7 @@ def sweep(
     json_output: JsonOption = False,
 ) -> None:
     """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
-    from .sweep import TABLE_CSV, TABLE_PARQUET, SweepFailed, failed_points, plan_sweep, sweep_parameters
+    from .sweep import TABLE_CSV, TABLE_PARQUET, SweepFailed, failed_points, is_sweep_folder, plan_sweep, sweep_parameters
     from .sweep import sweep as run_sweep
 
     with _user_errors():
@@ -550,7 +549,7 @@ def sweep(
     target = out if out is not None else timestamped_folder("sweep")
     try:
         counter = "{task.completed}/{task.total} points · {task.fields[running]} running · {task.fields[failed]} failed"
-        with _user_errors(), _progress_bar("sweep", counter, len(plan.points), running=0, failed=0) as update:
+        with _user_errors(), _warnings_as_lines(), _progress_bar("sweep", counter, len(plan.points), running=0, failed=0) as update:
             progress = None if update is None else lambda state: update(state.done, running=state.running, failed=state.failed)
             table = run_sweep(
                 run_config.params, plan, target, workers=workers, scheduler=scheduler,
@@ -562,7 +561,8 @@ def sweep(
     except KeyboardInterrupt:
         _fail(f"interrupted; the finished points are stored in {target}; re-run with --out {target} to finish", EXIT_INTERRUPTED)
     except OSError as exc:
-        _fail(f"{target}: cannot write the sweep ({exc.strerror or exc})")
+        resume = f"; re-run with --out {target} to finish" if is_sweep_folder(target) else ""
+        _fail(f"{target}: cannot write the sweep ({exc.strerror or exc}){resume}")
     failed = failed_points(table)
     if json_output:
         payload = {
@@ -637,7 +637,8 @@ def bifurcation(
     """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
     from .plotting import bifurcation_figure, plot_figures, sweep_context
     from .regime import bifurcation as regime_scan
-    from .regime import write_bifurcation
+    from .regime import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
+    from .storage import check_target, write_folder
     from .sweep import parse_grid, sweep_parameters
 
     with _user_errors():
@@ -647,18 +648,21 @@ def bifurcation(
         for value in (values[0], values[-1]):
             run_config.params.replace(**{key: float(value)})
     target = out if out is not None else timestamped_folder("bifurcation")
-    _check_free_folder(target, overwrite)
+    with _user_errors():
+        check_target(target, overwrite=overwrite, kind=BIFURCATION_FOLDER)
     with _nothing_written_when_interrupted("a scan is quick to repeat"), _progress_bar(
         "scanning", "{task.completed}/{task.total} runs", len(values)
     ) as update:
         scan = regime_scan(run_config.params, values, key, progress=None if update is None else lambda done, _total: update(done))
-    try:
-        paths = write_bifurcation(scan, target)
+
+    def fill(folder: Path) -> None:
+        write_bifurcation(scan, folder)
         context = sweep_context({"preset": run_config.preset, "base": run_config.params.model_dump()}, (key,))
         figure = bifurcation_figure(scan.phases, scan.attractors, key, context=context)
-        paths += plot_figures({"bifurcation": figure}, target, dpi=dpi)
-    except OSError as exc:
-        _fail(f"{target}: cannot write the results ({exc.strerror or exc})")
+        plot_figures({BIFURCATION_FIGURE: figure}, folder, dpi=dpi)
+
+    with _user_errors(), _writing(target, "the results"):
+        written = write_folder(target, fill, overwrite=overwrite, kind=BIFURCATION_FOLDER)
     counts = scan.regimes["regime"].value_counts()
     table = Table("regime", "runs", f"{key} ({field_unit(key)})", title=f"bifurcation scan over {key}: {len(values)} runs")
     for label, count in counts.items():
@@ -667,7 +671,7 @@ def bifurcation(
     console = _stdout_console()
     console.print(table)
     console.print(coexisting_attractors_table(scan.attractors, key, run_config.params.attractor_starts))
-    console.print(Text(f"{len(paths)} files written to {target}"))
+    console.print(Text(f"{len(list(written.iterdir()))} files written to {target}"))
 
 
 COEXISTING_PREVIEW_ROWS = 20
@@ -857,6 +861,8 @@ def calibrate(
         if out is not None and out.exists() and not overwrite:
             # Checked before the fit, which takes a while.
             raise ParameterError(f"out: {out} exists; choose another --out, or add --overwrite to replace it")
+        if out is not None:
+            check_writable_place(out)
         with _nothing_written_when_interrupted("the fit starts again from the beginning"):
             calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
     if out is not None:
@@ -866,7 +872,8 @@ def calibrate(
             f"{run_config.preset} with {', '.join(free_keys)} fitted to {', '.join(fitted_to)}; "
             f"{', '.join(calibration.predictions)} are predictions"
         )
-        write_preset(calibration, out, base_preset=run_config.preset, command=command, description=description)
+        with _writing(out, "the preset"):
+            write_preset(calibration, out, base_preset=run_config.preset, command=command, description=description)
     if json_output:
         typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False))
     else:

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import io
 import math
-import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping, Protocol, Sequence
 
@@ -26,7 +25,7 @@ import pandas as pd
 import xarray as xr
 
 from . import drive
-from .atomic import partial_path
+from .atomic import remove_abandoned_writes, write_files_atomically
 from .defaults import PNG_DPI
 from .fit import ExponentialFit
 from .params import Parameters
@@ -132,18 +131,13 @@ def _paper_figures(run: RunLike) -> dict[str, Figure]:
 
 
 def save_figure(figure: Figure, stem: Path, *, dpi: int = PNG_DPI) -> list[Path]:
-    """Save ``figure`` as ``stem.png`` and ``stem.svg``, each through a temporary file and an atomic rename."""
-    paths = []
+    """Save ``figure`` as ``stem.png`` and ``stem.svg``, drawn in memory and written atomically."""
+    files = {}
     for fmt in FORMATS:
-        path = stem.with_suffix(f".{fmt}")
-        partial = partial_path(path)
-        try:
-            figure.savefig(partial, format=fmt, dpi=dpi, bbox_inches="tight")
-            os.replace(partial, path)
-        finally:
-            partial.unlink(missing_ok=True)
-        paths.append(path)
-    return paths
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format=fmt, dpi=dpi, bbox_inches="tight")
+        files[stem.with_suffix(f".{fmt}")] = buffer.getbuffer()
+    return write_files_atomically(files)
 
 
 def _new_figure(rows: int = 1, height: float = 4.5) -> tuple[Figure, list]:
@@ -863,6 +857,7 @@ def plot_figures(figures: dict[str, Figure], out_dir: Path | str, *, dpi: int = 
     """Save each of ``figures`` as PNG and SVG in ``out_dir``; return the files."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    remove_abandoned_writes(out)
     written: list[Path] = []
     for name, figure in figures.items():
         written.extend(save_figure(figure, out / name, dpi=dpi))

@@ -18,6 +18,7 @@ import numpy as np
 
 from .params import Parameters
 from .simulate import Result
+from .storage import FolderKind
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -166,13 +167,26 @@ def _keyed(table: pd.DataFrame, key: str, value: float) -> pd.DataFrame:
     return table
 
 
+BIFURCATION_TABLES = ("bifurcation_regimes", "bifurcation_attractors", "bifurcation_phases")
+BIFURCATION_FIGURE = "bifurcation"
+
+
 def write_bifurcation(scan: Bifurcation, folder: Path) -> list[Path]:
     """``bifurcation_regimes``, ``bifurcation_attractors`` and ``bifurcation_phases`` tables (Parquet and CSV) in ``folder``."""
     from .sweep import write_table
 
     folder.mkdir(parents=True, exist_ok=True)
-    return [
-        *write_table(scan.regimes, folder, "bifurcation_regimes"),
-        *write_table(scan.attractors, folder, "bifurcation_attractors"),
-        *write_table(scan.phases, folder, "bifurcation_phases"),
-    ]
+    tables = dict(zip(BIFURCATION_TABLES, (scan.regimes, scan.attractors, scan.phases)))
+    return [path for stem, table in tables.items() for path in write_table(table, folder, stem)]
+
+
+def is_bifurcation_folder(folder: Path) -> bool:
+    """Whether ``folder`` holds only files that ``shakermill bifurcation`` writes, and so may be replaced."""
+    from .plotting import FORMATS
+
+    names = {f"{stem}.{suffix}" for stem in BIFURCATION_TABLES for suffix in ("parquet", "csv")}
+    names |= {f"{BIFURCATION_FIGURE}.{suffix}" for suffix in FORMATS}
+    return all(entry.name in names and entry.is_file() for entry in folder.iterdir())
+
+
+BIFURCATION_FOLDER = FolderKind("bifurcation scan", is_bifurcation_folder)

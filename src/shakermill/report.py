@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping, Sequence
 
 from . import __version__
-from .atomic import write_text_atomically
+from .atomic import remove_abandoned_writes, write_text_atomically
 from .defaults import REPORT_FILE
 from .params import DEFAULT_PRESET, PRESETS, Preset, field_description, field_unit
 from .plotting import (
@@ -171,6 +171,7 @@ def save_report(run: RunData, target: Path, other: RunData | None = None) -> Pat
         # Checked first: the rename would fail only after the whole report was drawn and written beside it.
         raise IsADirectoryError(errno.EISDIR, "a folder; give the report a file name", str(target))
     target.parent.mkdir(parents=True, exist_ok=True)
+    remove_abandoned_writes(target.parent)
     write_text_atomically(target, render_report(run, other))
     return target
 

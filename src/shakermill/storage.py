@@ -10,17 +10,18 @@ A run folder holds
 
 plus whatever ``add_files`` puts there (the command line adds ``figures/``).
 
-The folder is built in a hidden sibling ``.<name>.partial-<random>`` and moved
-into place only when complete, so an interrupted write never leaves a folder at
-the target path that looks like a finished run.
+The folder is built in a hidden sibling ``.<name>.partial-<machine>-<pid>-<random>`` and
+moved into place only when complete, so an interrupted write or a full disk never leaves a folder
+at the target path that looks like a finished run (:func:`write_folder`).
 """
 
 from __future__ import annotations
 
+import errno
+import io
 import json
 import math
 import os
-import secrets
 import shutil
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -29,7 +30,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 import numpy as np
 
 from . import __version__
-from .atomic import StorageError, partial_path
+from .atomic import SET_ASIDE, StorageError, check_writable_place, partial_path, remove_abandoned_writes
 from .config import load_config, write_config_toml
 from .fit import ExponentialFit
 from .integrate import REACHED_STOP
@@ -53,7 +54,7 @@ COVERAGE_KEY = "coverage"
 # Variables of an averaged run's timeseries.nc: never computed, or rates of the averaging window times time.
 AVERAGED_MOTION_VARIABLES = ("x", "p", "velocity")
 AVERAGED_FLOW_VARIABLES = ("work_vial", "dissipated", "heat_generated", "velocity_term_integral")
-# Reading goes through xarray with this engine; writing uses h5netcdf directly (:func:`write_history`).
+# Reading goes through xarray with this engine; writing uses h5netcdf directly (:func:`netcdf_bytes`).
 NETCDF_ENGINE = "h5netcdf"
 
 
@@ -93,22 +94,64 @@ def to_jsonable(value: Any) -> Any:
     return value
 
 
-def check_target(path: Path, *, overwrite: bool = False) -> None:
-    """Raise :class:`StorageError` unless ``path`` is free, an empty folder, or a run folder and ``overwrite``.
+@dataclass(frozen=True)
+class FolderKind:
+    """What one command writes as a folder: its name in messages, and how to recognise one it wrote."""
 
-    Replacing deletes the old folder: a run only when asked to, anything else (a file, a folder of
-    the user's own) never.
+    noun: str
+    written_by_shakermill: Callable[[Path], bool]
+
+
+RUN_FOLDER = FolderKind("run", lambda folder: (folder / SUMMARY_FILE).is_file())
+
+
+def check_target(path: Path, *, overwrite: bool = False, kind: FolderKind = RUN_FOLDER) -> None:
+    """Raise :class:`StorageError` unless ``path`` can be created, or is an empty folder, or a folder
+    of ``kind`` and ``overwrite``.
+
+    Replacing deletes the old folder: one shakermill wrote only when asked to, anything else (a file,
+    a folder of the user's own) never.
     """
     if not path.exists() and not path.is_symlink():
+        check_writable_place(path)
         return
     if path.is_symlink() or not path.is_dir():
         raise StorageError(f"{path}: exists and is not a folder; choose another --out")
     if not any(path.iterdir()):
         return
-    if not (path / SUMMARY_FILE).is_file():
-        raise StorageError(f"{path}: a non-empty folder that is not a shakermill run; choose another --out")
+    if not kind.written_by_shakermill(path):
+        raise StorageError(f"{path}: a non-empty folder that is not a shakermill {kind.noun}; choose another --out")
     if not overwrite:
-        raise StorageError(f"{path}: holds a run already; choose another --out, or add --overwrite to replace it")
+        raise StorageError(
+            f"{path}: holds a {kind.noun} already; choose another --out, or add --overwrite to replace it"
+        )
+
+
+def write_folder(
+    path: Path | str, fill: Callable[[Path], object], *, overwrite: bool = False, kind: FolderKind = RUN_FOLDER
+) -> Path:
+    """Have ``fill(folder)`` write a folder's files, then move the folder to ``path`` whole.
+
+    What ``path`` holds is replaced only as :func:`check_target` allows. The folder is built in a
+    hidden sibling, so a failure (a full disk) or an interruption leaves nothing at ``path`` that
+    looks complete, and the hidden sibling is removed, or, after a kill, by a later write to the same
+    parent folder. Returns the folder's absolute path.
+    """
+    # Absolute, so that "." has a name to derive the sibling folders from.
+    target = Path(path).absolute()
+    check_target(target, overwrite=overwrite, kind=kind)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    remove_abandoned_writes(target.parent)
+    partial = partial_path(target)
+    partial.mkdir()
+    try:
+        fill(partial)
+        _move_into_place(partial, target)
+    except BaseException:
+        # KeyboardInterrupt included: the half-written folder must not survive.
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
+    return target
 
 
 def write_run(
@@ -125,22 +168,13 @@ def write_run(
     ``add_files(folder)`` may add more files (figures) before the folder is
     moved into place. Returns the folder's absolute path.
     """
-    # Absolute, so that "." has a name to derive the sibling folders from.
-    target = Path(path).absolute()
-    check_target(target, overwrite=overwrite)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    partial = partial_path(target)
-    partial.mkdir()
-    try:
-        _write_contents(result, partial, preset=preset, extra_provenance=extra_provenance or {})
+
+    def fill(folder: Path) -> None:
+        _write_contents(result, folder, preset=preset, extra_provenance=extra_provenance or {})
         if add_files is not None:
-            add_files(partial)
-        _move_into_place(partial, target)
-    except BaseException:
-        # KeyboardInterrupt included: the half-written folder must not survive.
-        shutil.rmtree(partial, ignore_errors=True)
-        raise
-    return target
+            add_files(folder)
+
+    return write_folder(path, fill, overwrite=overwrite)
 
 
 def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenance: Mapping[str, Any]) -> None:
@@ -148,10 +182,12 @@ def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenan
     coverage = averaging_coverage(result)
     history = _mark_averaged_variables(result.history, coverage) if coverage else result.history
     title = "shakermill sampled state history"
-    write_history(history, folder / TIMESERIES_FILE, title=title, **attributes, **_covers(coverage, "timeseries"))
+    series = netcdf_bytes(history, title=title, **attributes, **_covers(coverage, "timeseries"))
+    (folder / TIMESERIES_FILE).write_bytes(series)
     title = "shakermill full-resolution state in the record windows"
-    write_history(result.window_history, folder / WINDOWS_FILE, title=title, **attributes, **_covers(coverage, "motion"))
-    write_impacts(result.impact_columns, folder / IMPACTS_FILE, coverage=coverage.get("impacts"))
+    windows = netcdf_bytes(result.window_history, title=title, **attributes, **_covers(coverage, "motion"))
+    (folder / WINDOWS_FILE).write_bytes(windows)
+    (folder / IMPACTS_FILE).write_bytes(impacts_parquet(result.impact_columns, coverage=coverage.get("impacts")))
     (folder / SUMMARY_FILE).write_text(summary_json(result, preset), encoding="utf-8")
     provenance = {"status": result.status, "message": result.message, "simulated_s": result.t_end, **extra_provenance}
     write_config_toml(result.params, folder / CONFIG_FILE, preset=preset, extra_provenance=provenance)
@@ -204,24 +240,28 @@ def _mark_averaged_variables(history: StateHistory, coverage: Mapping[str, str])
     return history.with_attributes(marks)
 
 
-def write_history(history: StateHistory, path: Path, *, title: str, **attributes: Any) -> None:
-    """Write ``history`` as NetCDF4 over the dimension ``time``, with global attributes and each variable's own.
+def netcdf_bytes(history: StateHistory, *, title: str, **attributes: Any) -> bytes:
+    """``history`` as a NetCDF4 file over the dimension ``time``, with global attributes and each variable's own.
 
     h5netcdf writes it directly: building an xarray Dataset first would cost a run without figures
     half its start-up. ``xarray.open_dataset`` reads the file as the Dataset :meth:`StateHistory.dataset` gives.
+    HDF5 writes into memory, never onto the disk: a full disk makes the HDF5 library fail to close
+    the file and crash the interpreter at exit (exit code 139); Python's own write fails cleanly.
     """
     import h5netcdf
 
-    with h5netcdf.File(path, "w") as file:
+    buffer = io.BytesIO()
+    with h5netcdf.File(buffer, "w") as file:
         file.attrs.update(title=title, **attributes)
         file.dimensions = {"time": history.times.size}
         for name, (values, variable_attributes) in {"time": (history.times, TIME_ATTRIBUTES), **history.variables}.items():
             variable = file.create_variable(name, ("time",), data=values)
             variable.attrs.update(variable_attributes)
+    return buffer.getvalue()
 
 
-def write_impacts(columns: Mapping[str, np.ndarray], path: Path, *, coverage: str | None = None) -> None:
-    """Write the impact columns with their units as JSON in the Parquet schema metadata, and what
+def impacts_parquet(columns: Mapping[str, np.ndarray], *, coverage: str | None = None) -> memoryview:
+    """The impact columns as a Parquet file, with their units as JSON in the schema metadata, and what
     the table covers (``coverage``) where it is not the whole run."""
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -231,7 +271,9 @@ def write_impacts(columns: Mapping[str, np.ndarray], path: Path, *, coverage: st
     if coverage is not None:
         metadata[COVERAGE_KEY.encode()] = coverage.encode()
     arrays = [arrow_array(np.asarray(values)) for values in columns.values()]
-    pq.write_table(pa.Table.from_arrays(arrays, names=list(columns), metadata=metadata), path)
+    sink = pa.BufferOutputStream()
+    pq.write_table(pa.Table.from_arrays(arrays, names=list(columns), metadata=metadata), sink)
+    return memoryview(sink.getvalue())
 
 
 def arrow_array(values: np.ndarray) -> Any:
@@ -278,7 +320,7 @@ def _move_into_place(partial: Path, target: Path) -> None:
     if not target.exists():
         os.rename(partial, target)
         return
-    aside = target.with_name(f".{target.name}.old-{secrets.token_hex(4)}")
+    aside = partial_path(target, SET_ASIDE)
     os.rename(target, aside)
     try:
         os.rename(partial, target)
@@ -289,24 +331,28 @@ def _move_into_place(partial: Path, target: Path) -> None:
 
 
 def load_run(path: Path | str) -> RunData:
-    """Read a run folder written by :func:`write_run` (datasets are loaded into memory, files closed)."""
+    """Read a run folder written by :func:`write_run` (datasets are loaded into memory, files closed).
+
+    Raises :class:`StorageError` naming the file, in one line, for a folder that is not a run or a
+    file that is missing, truncated or damaged.
+    """
     folder = Path(path)
     summary_path = folder / SUMMARY_FILE
     if not summary_path.is_file():
         raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
     import xarray as xr
 
-    document = json.loads(summary_path.read_text(encoding="utf-8"))
-    config = load_config(folder / CONFIG_FILE)
-    impacts, impact_units = read_impacts(folder / IMPACTS_FILE)
+    document = _read_part(summary_path, _summary_document)
+    config = _read_part(folder / CONFIG_FILE, load_config)
+    impacts, impact_units = _read_part(folder / IMPACTS_FILE, read_impacts)
     return RunData(
         path=folder,
         params=config.params,
         preset=config.preset,
-        status=int(document["status"]),
-        message=str(document["message"]),
-        timeseries=xr.load_dataset(folder / TIMESERIES_FILE, engine=NETCDF_ENGINE),
-        windows=xr.load_dataset(folder / WINDOWS_FILE, engine=NETCDF_ENGINE),
+        status=document["status"],
+        message=document["message"],
+        timeseries=_read_part(folder / TIMESERIES_FILE, lambda file: xr.load_dataset(file, engine=NETCDF_ENGINE)),
+        windows=_read_part(folder / WINDOWS_FILE, lambda file: xr.load_dataset(file, engine=NETCDF_ENGINE)),
         impacts=impacts,
         impact_units=impact_units,
         summary=document["summary"],
@@ -314,6 +360,41 @@ def load_run(path: Path | str) -> RunData:
         ball_fit=_fit_from_dict(document["ball_fit"]),
         counters=document["counters"],
     )
+
+
+# What summary.json must hold, and of which JSON type, for the tools that read a run folder back.
+SUMMARY_SHAPE = {
+    "status": int,
+    "message": str,
+    "summary": dict,
+    "energy_audit": dict,
+    "ball_fit": dict,
+    "counters": dict,
+}
+
+
+def _summary_document(path: Path) -> dict[str, Any]:
+    document = json.loads(path.read_text(encoding="utf-8"))
+    if not isinstance(document, dict):
+        raise ValueError(f"a JSON {type(document).__name__}, not an object")
+    for key, kind in SUMMARY_SHAPE.items():
+        if type(document.get(key)) is not kind:  # not isinstance: true is no status
+            raise ValueError(f"{key!r} is missing or not a JSON {kind.__name__}")
+    return document
+
+
+def _read_part(path: Path, read: Callable[[Path], Any]) -> Any:
+    """``read(path)``, or :class:`StorageError` naming the run folder, the file and why it cannot be read."""
+    try:
+        if not path.is_file():
+            raise FileNotFoundError(errno.ENOENT, "missing")
+        return read(path)
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        # ValueError covers malformed JSON, TOML and Parquet (ArrowInvalid) and a configuration that no longer validates.
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else " ".join(str(exc).split())
+        # A configuration error names the file already.
+        reason = reason.removeprefix(f"{path}: ") or type(exc).__name__
+        raise StorageError(f"{path.parent}: not a readable shakermill run folder ({path.name}: {reason})") from None
 
 
 def read_impacts(path: Path) -> tuple[pd.DataFrame, dict[str, str]]:

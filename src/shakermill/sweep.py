@@ -14,7 +14,7 @@ A sweep folder holds
 * ``runs/<id>/``        with ``keep_runs``: each point's run folder, as ``shakermill run`` writes it.
 
 A point's id is a hash of the base parameters and the point's values, so re-running the same
-sweep into the same folder skips the points whose file exists. Every point is computed on its
+sweep into the same folder skips the points whose file exists and can be read. Every point is computed on its
 own from its parameters alone, so the table does not depend on the number of workers, the order
 in which they finish, or whether the points ran on a Dask cluster.
 """
@@ -24,6 +24,7 @@ from __future__ import annotations
 import ast
 import csv
 import hashlib
+import io
 import itertools
 import json
 import logging
@@ -32,7 +33,7 @@ import os
 import re
 import sys
 import warnings
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -42,7 +43,7 @@ import numpy as np
 import pandas as pd
 
 from . import __version__
-from .atomic import partial_path, write_text_atomically
+from .atomic import check_writable_place, create_exclusively, remove_abandoned_writes, write_files_atomically, write_text_atomically
 from .defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from .config import RunConfig, load_config, parse_overrides, read_config_file
 from .params import DEFAULT_PRESET, ParameterError, Parameters, check_known_keys, field_unit
@@ -62,6 +63,8 @@ TABLE_CSV = f"{TABLE_STEM}.csv"
 MANIFEST_FORMAT = "shakermill-sweep/1"
 # 64 bits of SHA-256: collisions are out of reach for any sweep that fits on a disk.
 POINT_ID_LENGTH = 16
+# What a point id looks like: file names are built from ids, and only from ids that match.
+POINT_ID_PATTERN = re.compile(rf"[0-9a-f]{{{POINT_ID_LENGTH}}}")
 # Columns that measure the machine, not the model: they differ between two runs of the same point.
 TIMING_COLUMNS = ("wall_time_s",)
 # A summary key that is also a swept key (only ``solver``: the averaged solver may fall back to
@@ -363,8 +366,9 @@ def sweep(
     (default: one per core; 1 runs them in this process) or on the Dask cluster at ``scheduler``
     ("tcp://host:8786"). Each finished point is stored at once in ``out_dir``; points stored by an
     earlier run of the same sweep are skipped. Raises :class:`ParameterError` (one line) for bad
-    input, a folder that holds another sweep, or an unreachable scheduler, and :class:`SweepFailed`
-    (naming the first failure) when no point succeeded.
+    input, a folder that holds another sweep, or an unreachable scheduler,
+    :class:`~shakermill.atomic.StorageError` for a place where the folder cannot be created, and
+    :class:`SweepFailed` (naming the first failure) when no point succeeded.
     """
     plan = as_plan(grid_points)
     _check_execution(workers, scheduler)
@@ -372,13 +376,14 @@ def sweep(
     ids = point_ids(base_params, plan)
     manifest = sweep_manifest(base_params, plan, ids, preset)
     _check_folder(folder, manifest)
-    pending = [(identifier, values) for identifier, values in zip(ids, plan.points) if not _point_path(folder, identifier).exists()]
+    stored = stored_rows(folder, ids, warn=True)
+    pending = [(identifier, values) for identifier, values in zip(ids, plan.points) if identifier not in stored]
     unfinished: dict[str, str] = {}
     # The backend first: an unreachable scheduler leaves no folder behind.
     with _backend(workers, scheduler, scheduler_timeout, len(pending)) as backend:
-        _create_folder(folder, manifest)
+        _claim_folder(folder, manifest)
         try:
-            tracker = _Tracker(len(ids), _finished_counts(folder, ids), backend.slots, progress)
+            tracker = _Tracker(len(ids), _finished_counts(stored), backend.slots, progress)
             for identifier, outcome in backend.outcomes(base_params, pending, keep_runs):
                 if isinstance(outcome, BaseException):
                     unfinished[identifier] = f"not finished ({type(outcome).__name__}: {outcome}); re-run the sweep to retry"
@@ -426,15 +431,33 @@ def _check_folder(folder: Path, manifest: dict[str, Any]) -> None:
         _check_same_sweep(folder, read_manifest(folder), manifest)
     elif folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
         raise ParameterError(f"{folder}: exists and is not a shakermill sweep folder; choose another --out")
+    elif not folder.exists():
+        check_writable_place(folder)
 
 
-def _create_folder(folder: Path, manifest: dict[str, Any]) -> None:
-    """The sweep folder with its manifest and points folder, cleared of files a killed sweep was writing."""
-    (folder / POINTS_FOLDER).mkdir(parents=True, exist_ok=True)
-    _remove_partial_files(folder / POINTS_FOLDER)
-    manifest_path = folder / MANIFEST_FILE
-    if not manifest_path.is_file():
-        write_text_atomically(manifest_path, json.dumps(manifest, indent=2, allow_nan=False) + "\n")
+def _claim_folder(folder: Path, manifest: dict[str, Any]) -> None:
+    """Make ``folder`` this sweep's: create its manifest, or find this very sweep's there; clear
+    what killed writers left in it.
+
+    The manifest is created exclusively: of two sweeps started at once into one new folder, one
+    creates it and the other finds it and is refused unless it is the same sweep, before either
+    stores a point. A manifest that cannot be written (a full disk) leaves no folder behind that
+    the same command would later refuse.
+    """
+    created = not folder.exists()
+    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        create_exclusively(folder / MANIFEST_FILE, json.dumps(manifest, indent=2, allow_nan=False) + "\n")
+    except FileExistsError:
+        _check_same_sweep(folder, read_manifest(folder), manifest)
+    except BaseException:
+        if created:
+            with suppress(OSError):  # not empty: someone else's files arrived meanwhile, and stay
+                folder.rmdir()
+        raise
+    (folder / POINTS_FOLDER).mkdir(exist_ok=True)
+    for place in (folder, folder / POINTS_FOLDER, folder / RUNS_FOLDER):
+        remove_abandoned_writes(place)
 
 
 def _check_same_sweep(folder: Path, stored: dict[str, Any], wanted: dict[str, Any]) -> None:
@@ -460,35 +483,74 @@ def _first_difference(stored: Mapping[str, Any], wanted: Mapping[str, Any]) -> t
     return None
 
 
-def _remove_partial_files(points_folder: Path) -> None:
-    # Left by a sweep killed while writing a point; that point has no file and runs again.
-    for leftover in points_folder.glob(".*.partial-*"):
-        leftover.unlink(missing_ok=True)
-
-
 def read_manifest(folder: Path) -> dict[str, Any]:
+    """``sweep.json`` of ``folder``, checked: paths are built from its point ids, so each must be one."""
     try:
         manifest = json.loads((folder / MANIFEST_FILE).read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
-        raise ParameterError(f"{folder}: cannot read {MANIFEST_FILE} ({exc})") from None
+        raise ParameterError(f"{folder}: cannot read {MANIFEST_FILE} ({_reason(exc)})") from None
     if not isinstance(manifest, dict) or manifest.get("format") != MANIFEST_FORMAT:
         raise ParameterError(f"{folder}: {MANIFEST_FILE} is not a shakermill sweep manifest")
+    problem = _manifest_problem(manifest)
+    if problem is not None:
+        raise ParameterError(f"{folder}: {MANIFEST_FILE} is damaged ({problem}); run the sweep into a new folder")
     return manifest
 
 
+def _manifest_problem(manifest: Mapping[str, Any]) -> str | None:
+    keys, points = manifest.get("keys"), manifest.get("points")
+    if not isinstance(keys, list) or not keys or not all(isinstance(key, str) for key in keys):
+        return "keys is not a list of parameter keys"
+    if not isinstance(points, list) or not points:
+        return "points is not a list of points"
+    for number, entry in enumerate(points, start=1):
+        if not isinstance(entry, dict) or not isinstance(entry.get("values"), dict):
+            return f"point {number} is not an object with values"
+        identifier = entry.get("point_id")
+        if not isinstance(identifier, str) or not POINT_ID_PATTERN.fullmatch(identifier):
+            return f"point {number} has the id {identifier!r}, not {POINT_ID_LENGTH} hexadecimal digits"
+    return None
+
+
 def _point_path(folder: Path, identifier: str) -> Path:
+    if not POINT_ID_PATTERN.fullmatch(identifier):
+        raise ValueError(f"{identifier!r} is not a point id")  # ids from read_manifest or point_id only
     return folder / POINTS_FOLDER / f"{identifier}.json"
 
 
-def _read_row(folder: Path, identifier: str) -> dict[str, Any]:
-    return json.loads(_point_path(folder, identifier).read_text(encoding="utf-8"))["row"]
+def stored_rows(folder: Path, ids: Sequence[str], *, warn: bool = False) -> dict[str, dict[str, Any]]:
+    """The rows of the points of ``ids`` stored in ``folder``, by id.
+
+    A point file that cannot be read (empty, truncated, not JSON, not a row: a disk that filled up,
+    a hand edit) counts as not stored, so the sweep computes that point again; with ``warn``, one
+    warning says so.
+    """
+    rows, unreadable = {}, []
+    for identifier in ids:
+        path = _point_path(folder, identifier)
+        if not path.exists():
+            continue
+        try:
+            rows[identifier] = _read_row(path)
+        except (OSError, ValueError) as exc:
+            unreadable.append(f"{path} ({_reason(exc)})")
+    if warn and unreadable:
+        more = f" and {len(unreadable) - 1} more" if len(unreadable) > 1 else ""
+        warnings.warn(f"sweep: unreadable point file {unreadable[0]}{more}; computing those points again", stacklevel=3)
+    return rows
 
 
-def _finished_counts(folder: Path, ids: Sequence[str]) -> tuple[int, int]:
+def _read_row(path: Path) -> dict[str, Any]:
+    document = json.loads(path.read_text(encoding="utf-8"))
+    row = document.get("row") if isinstance(document, dict) else None
+    if not isinstance(row, dict):
+        raise ValueError("not a shakermill point file")
+    return row
+
+
+def _finished_counts(stored: Mapping[str, Mapping[str, Any]]) -> tuple[int, int]:
     """(points stored by an earlier run, how many of them failed)."""
-    stored = [identifier for identifier in ids if _point_path(folder, identifier).exists()]
-    failed = sum(_read_row(folder, identifier).get("error") is not None for identifier in stored)
-    return len(stored), failed
+    return len(stored), sum(row.get("error") is not None for row in stored.values())
 
 
 def _store_point(folder: Path, identifier: str, outcome: PointOutcome, preset: str) -> dict[str, Any]:
@@ -776,12 +838,13 @@ def build_table(
     points: Sequence[Mapping[str, Any]],
     unfinished: Mapping[str, str] | None = None,
 ) -> pd.DataFrame:
-    """One row per point in grid order, from the point files; a point without a file says why."""
+    """One row per point in grid order, from the point files; a point without a readable file says why."""
     unfinished = unfinished or {}
+    stored = stored_rows(folder, ids)
     rows = []
     for identifier, values in zip(ids, points):
-        if _point_path(folder, identifier).exists():
-            rows.append(_read_row(folder, identifier))
+        if identifier in stored:
+            rows.append(stored[identifier])
         else:
             reason = unfinished.get(identifier, "not finished; re-run the sweep to compute it")
             rows.append({"point_id": identifier, **failed_row(values, reason)})
@@ -811,31 +874,40 @@ def _integer_columns(rows: list[dict[str, Any]], columns: Sequence[str]) -> list
     return integer
 
 
-def write_table(table: pd.DataFrame, folder: Path, stem: str = TABLE_STEM) -> tuple[Path, Path]:
-    """Write ``<stem>.parquet`` and ``<stem>.csv`` atomically; return their paths."""
-    parquet = folder / f"{stem}.parquet"
-    partial = partial_path(parquet)
-    try:
-        table.to_parquet(partial, index=False)
-        os.replace(partial, parquet)
-    finally:
-        partial.unlink(missing_ok=True)
-    csv_path = write_text_atomically(folder / f"{stem}.csv", table.to_csv(index=False))
-    return parquet, csv_path
+def write_table(table: pd.DataFrame, folder: Path, stem: str = TABLE_STEM) -> list[Path]:
+    """Write ``<stem>.parquet`` and ``<stem>.csv`` atomically, both or neither; return their paths."""
+    parquet = io.BytesIO()
+    table.to_parquet(parquet, index=False)
+    csv_text = table.to_csv(index=False).encode("utf-8")
+    return write_files_atomically({folder / f"{stem}.parquet": parquet.getbuffer(), folder / f"{stem}.csv": csv_text})
 
 
 def load_sweep(path: Path | str) -> SweepData:
-    """A sweep folder's manifest and table (rebuilt from the point files if the table is missing)."""
+    """A sweep folder's manifest and table (rebuilt from the point files if the table is missing).
+
+    Raises :class:`ParameterError` (one line) for a damaged manifest or table.
+    """
     folder = Path(path)
     manifest = read_manifest(folder)
     keys = tuple(manifest["keys"])
     parquet = folder / TABLE_PARQUET
     if parquet.is_file():
-        table = pd.read_parquet(parquet)
+        table = _read_table(parquet, keys)
     else:
         entries = manifest["points"]
         table = build_table(folder, keys, [entry["point_id"] for entry in entries], [entry["values"] for entry in entries])
     return SweepData(folder, manifest, keys, table)
+
+
+def _read_table(path: Path, keys: Sequence[str]) -> pd.DataFrame:
+    try:
+        table = pd.read_parquet(path)
+    except (OSError, ValueError) as exc:  # pyarrow's ArrowInvalid is a ValueError
+        raise ParameterError(f"{path}: cannot read the table ({_reason(exc)}); re-run the sweep to rebuild it") from None
+    missing = [column for column in (*FIRST_COLUMNS, *keys, *OUTCOME_COLUMNS) if column not in table.columns]
+    if missing:
+        raise ParameterError(f"{path}: not this sweep's table (no column {missing[0]}); re-run the sweep to rebuild it")
+    return table
 
 
 def is_sweep_folder(path: Path | str) -> bool:
