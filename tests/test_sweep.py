@@ -15,6 +15,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any, Callable
 
 import numpy as np
 import pandas as pd
@@ -829,3 +830,46 @@ def test_a_crafted_point_id_in_the_manifest_is_refused_and_nothing_outside_is_re
     assert completed.returncode == 2
     assert_one_error_line(completed.stderr, "sweep.json is damaged", "point 1")
     assert not (folder / "figures").exists()
+
+
+def _interrupted_second_point(how: str, simulate: Callable[..., Any]) -> Callable[..., Any]:
+    """``simulate`` that is interrupted by Ctrl-C on its second call, the way ``how`` says."""
+    from shakermill.simulate import simulate_full
+
+    calls = []
+
+    def ctrl_c(*_progress) -> None:
+        raise KeyboardInterrupt
+
+    def interrupted(params):
+        calls.append(params)
+        if len(calls) != 2:
+            return simulate(params)
+        if how == "a run cut short":
+            return simulate_full(params.replace(solver="full"), progress=ctrl_c)
+        try:
+            ctrl_c()
+        except KeyboardInterrupt as interrupt:
+            # What Python makes of a KeyboardInterrupt raised inside a Numba call.
+            raise SystemError("CPUDispatcher(<function _advance>) returned a result with an exception set") from interrupt
+
+    return interrupted
+
+
+@pytest.mark.parametrize("how", ["a run cut short", "an error caused by Ctrl-C"])
+def test_an_interrupted_point_is_not_done_and_runs_again_on_resume(base, tmp_path, monkeypatch, how):
+    plan = plan_sweep(SMALL)
+    ids = point_ids(base, plan)
+    folder = tmp_path / "interrupted"
+    monkeypatch.setattr(SWEEP_MODULE, "simulate", _interrupted_second_point(how, SWEEP_MODULE.simulate))
+    with pytest.raises(KeyboardInterrupt):
+        sweep(base, plan, folder, workers=1)
+    assert [path.stem for path in point_files(folder)] == [ids[0]]
+    table = pd.read_parquet(folder / TABLE_PARQUET)
+    assert table.loc[1, "error"].startswith("not finished") and table.loc[2, "error"].startswith("not finished")
+
+    monkeypatch.undo()
+    reports = []
+    resumed = sweep(base, plan, folder, workers=1, progress=reports.append)
+    assert reports[0].done == 1
+    assert resumed["error"].isna().all()

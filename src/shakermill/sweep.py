@@ -315,14 +315,18 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
         return PointOutcome(failed_row(swept, str(exc)))
     try:
         result = simulate(params)
+        if result.status == INTERRUPTED:
+            # Not classified: a run cut short may be too short for it, and the point is not done anyway.
+            raise PointInterrupted(result.message)
         regime, period = classify(result)
-        if result.status != INTERRUPTED:
-            # The averaged solver probed the other starts already; a full run has them probed here.
-            probed(result)
+        # The averaged solver probed the other starts already; a full run has them probed here.
+        probed(result)
+    except PointInterrupted:
+        raise
     except Exception as exc:  # noqa: BLE001 - one point's crash must not stop the sweep; its row says why
+        if _caused_by_ctrl_c(exc):
+            raise PointInterrupted(str(exc)) from None
         return PointOutcome(failed_row(swept, f"{type(exc).__name__}: {exc}"))
-    if result.status == INTERRUPTED:
-        raise PointInterrupted(result.message)
     summary = {(f"{key}{USED_SUFFIX}" if key in swept else key): value for key, value in result.summary.items()}
     # A table cell holds one value: the warnings become one string, or none (CSV cannot tell "" from missing).
     summary["warnings"] = "; ".join(result.warnings) or None
@@ -335,6 +339,18 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
         "output_dir": None,
     }
     return PointOutcome(to_jsonable(row), result if keep_run else None)
+
+
+def _caused_by_ctrl_c(error: BaseException | None) -> bool:
+    """Whether a ``KeyboardInterrupt`` is behind ``error``: one raised inside compiled code (Numba,
+    SciPy) surfaces as another exception, a ``SystemError`` with the interrupt as its cause."""
+    seen: set[int] = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return True
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return False
 
 
 def failed_row(values: Mapping[str, Any], error: str) -> dict[str, Any]:
