@@ -873,3 +873,45 @@ def test_an_interrupted_point_is_not_done_and_runs_again_on_resume(base, tmp_pat
     resumed = sweep(base, plan, folder, workers=1, progress=reports.append)
     assert reports[0].done == 1
     assert resumed["error"].isna().all()
+
+
+def _live(process) -> bool:
+    """Whether ``process`` (psutil) still runs: neither gone nor a zombie waiting to be reaped."""
+    import psutil
+
+    try:
+        return process.is_running() and process.status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+def test_workers_stop_when_the_sweep_is_killed_and_not_yet_reaped(tmp_path):
+    import psutil
+
+    folder = tmp_path / "orphans"
+    command = [str(SHAKERMILL), "sweep", "--grid", "omega=90:130:40", "--set", "duration=600", "--workers", "2", "--out", str(folder)]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    descendants = []
+    try:
+        deadline = time.monotonic() + 120
+        while not ((folder / POINTS_FOLDER).is_dir() and point_files(folder)):
+            assert process.poll() is None and time.monotonic() < deadline, "the sweep ended or stalled before the kill"
+            time.sleep(0.01)
+        descendants = psutil.Process(process.pid).children(recursive=True)
+        assert len(descendants) >= 2  # the two workers, and the processes that start them
+        # SIGKILL to the sweep alone, not its group; this test, its parent, reaps it only at the end,
+        # so meanwhile it is a zombie that still holds its process id.
+        os.kill(process.pid, signal.SIGKILL)
+        killed = time.monotonic()
+        while any(_live(descendant) for descendant in descendants) and time.monotonic() - killed < 10:
+            time.sleep(0.05)
+        assert psutil.Process(process.pid).status() == psutil.STATUS_ZOMBIE
+        assert [descendant.pid for descendant in descendants if _live(descendant)] == [], "workers outlived the sweep"
+        print(f"every process of the sweep gone {time.monotonic() - killed:.1f} s after the kill")
+    finally:
+        for descendant in descendants:
+            if _live(descendant):
+                descendant.kill()
+        if process.poll() is None:
+            process.kill()
+        process.wait(timeout=30)

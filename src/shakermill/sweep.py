@@ -757,24 +757,38 @@ def _start_worker(sweep_pid: int) -> None:
     """Ignore Ctrl-C (the sweep handles it), and exit when the sweep's process is gone.
 
     A sweep killed with SIGKILL (by the user, or the out-of-memory killer) cannot stop its pool;
-    without this, its workers would wait for more points forever. The check runs in a thread, so a
-    worker inside compiled code (which holds the GIL) exits once it returns, within a point's time.
+    without this, its workers would wait for more points forever. A thread watches the sweep's
+    process and ends the worker once that process is gone or a zombie: killed, but not yet reaped
+    by its own parent (a shell or a job runner may take its time), when it still has its process id.
+
+    Why not ``prctl(PR_SET_PDEATHSIG)``, or watching ``os.getppid()``: a worker's parent is the
+    forkserver, not the sweep, and the forkserver lives on as long as its workers hold their end of
+    its "alive" pipe, so neither ever fires. psutil tells a zombie from a live process on every
+    platform, and compares start times, so a process id reused by another process is not taken
+    for the sweep. The thread runs between compiled chunks, so a worker ends within seconds.
     """
     import signal
     import threading
     import time
 
+    import psutil
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        sweep_process = psutil.Process(sweep_pid)
+    except psutil.NoSuchProcess:
+        os._exit(1)
+
+    def alive() -> bool:
+        try:
+            return sweep_process.is_running() and sweep_process.status() != psutil.STATUS_ZOMBIE
+        except psutil.NoSuchProcess:
+            return False
 
     def exit_with_the_sweep() -> None:
-        while True:
+        while alive():
             time.sleep(PARENT_CHECK_INTERVAL_S)
-            try:
-                os.kill(sweep_pid, 0)
-            except ProcessLookupError:
-                os._exit(1)
-            except PermissionError:  # the pid was reused by another user's process: the sweep is gone too
-                os._exit(1)
+        os._exit(1)
 
     threading.Thread(target=exit_with_the_sweep, name="exit-with-the-sweep", daemon=True).start()
 
