@@ -10,6 +10,7 @@ import importlib
 import itertools
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -915,3 +916,76 @@ def test_workers_stop_when_the_sweep_is_killed_and_not_yet_reaped(tmp_path):
         if process.poll() is None:
             process.kill()
         process.wait(timeout=30)
+
+
+@pytest.fixture(scope="module")
+def tls_certificates(tmp_path_factory) -> dict[str, str]:
+    """A certificate authority and a certificate it signed for 127.0.0.1, made with the openssl command."""
+    if shutil.which("openssl") is None:
+        pytest.skip("no openssl command to make the test certificates with")
+    folder = tmp_path_factory.mktemp("tls")
+    files = {"ca": folder / "ca.pem", "cert": folder / "node.pem", "key": folder / "node.key"}
+    (folder / "extensions.cnf").write_text("subjectAltName=DNS:localhost,IP:127.0.0.1\n", encoding="ascii")
+    commands = [
+        ["req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", "ca.key", "-out", "ca.pem", "-days", "2", "-subj", "/CN=shakermill test CA"],
+        ["req", "-newkey", "rsa:2048", "-nodes", "-keyout", "node.key", "-out", "node.csr", "-subj", "/CN=localhost"],
+        ["x509", "-req", "-in", "node.csr", "-CA", "ca.pem", "-CAkey", "ca.key", "-CAcreateserial", "-out", "node.pem",
+         "-days", "2", "-extfile", "extensions.cnf"],
+    ]  # fmt: skip
+    for command in commands:
+        made = subprocess.run(["openssl", *command], cwd=folder, capture_output=True, text=True, timeout=60)
+        assert made.returncode == 0, made.stderr
+    return {name: str(path) for name, path in files.items()}
+
+
+@pytest.fixture(scope="module")
+def tls_scheduler(tls_certificates):
+    """The address of a local Dask cluster that speaks TLS only, with one single-threaded worker."""
+    distributed = pytest.importorskip("distributed")
+    from distributed.security import Security
+
+    ca, cert, key = tls_certificates["ca"], tls_certificates["cert"], tls_certificates["key"]
+    security = Security(
+        tls_ca_file=ca, tls_scheduler_cert=cert, tls_scheduler_key=key, tls_worker_cert=cert, tls_worker_key=key,
+        tls_client_cert=cert, tls_client_key=key, require_encryption=True,
+    )
+    cluster = distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tls://", host="127.0.0.1",
+        security=security, dashboard_address=None,
+    )
+    try:
+        yield cluster.scheduler_address
+    finally:
+        cluster.close()
+
+
+def environment_without_dask_tls() -> dict[str, str]:
+    return {name: value for name, value in os.environ.items() if not name.startswith("DASK_DISTRIBUTED__COMM__TLS")}
+
+
+def test_a_tls_scheduler_runs_the_sweep_with_the_environments_tls_settings(in_process, tls_certificates, tls_scheduler, tmp_path):
+    assert tls_scheduler.startswith("tls://127.0.0.1:")
+    _, reference, _ = in_process
+    environment = {
+        **environment_without_dask_tls(),
+        "DASK_DISTRIBUTED__COMM__TLS__CA_FILE": tls_certificates["ca"],
+        "DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT": tls_certificates["cert"],
+        "DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY": tls_certificates["key"],
+    }
+    folder = tmp_path / "tls"
+    grids = [argument for spec in GRID for argument in ("--grid", spec)]
+    command = [str(SHAKERMILL), "sweep", *grids, "--set", f"duration={DURATION}", "--scheduler", tls_scheduler,
+               "--scheduler-timeout", "10", "--out", str(folder), "--json"]  # fmt: skip
+    completed = subprocess.run(command, capture_output=True, text=True, timeout=300, env=environment)
+    assert completed.returncode == 0, completed.stderr
+    assert json.loads(completed.stdout)["failed"] == 0
+    assert_frame_equal(comparable(load_sweep(folder).table), comparable(reference))
+
+
+def test_a_tls_scheduler_without_tls_settings_is_one_line(tls_scheduler, tmp_path):
+    folder = tmp_path / "no-tls"
+    command = [str(SHAKERMILL), "sweep", "--grid", SMALL[0], "--scheduler", tls_scheduler, "--scheduler-timeout", "5", "--out", str(folder)]
+    completed = subprocess.run(command, capture_output=True, text=True, timeout=120, env=environment_without_dask_tls())
+    assert completed.returncode == 2
+    assert_one_error_line(completed.stderr, tls_scheduler, "TLS")
+    assert not folder.exists()

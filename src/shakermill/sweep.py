@@ -799,15 +799,20 @@ def connect(address: str, timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S) -> Clien
         from distributed import Client
     except ImportError:
         raise ParameterError("scheduler: dask.distributed is not installed (pip install 'dask[distributed]')") from None
+    from distributed.security import Security
+
+    # The environment's TLS settings (distributed.comm.tls.* in Dask's configuration, or the
+    # DASK_DISTRIBUTED__COMM__TLS__* variables): the same for the handshake as for the client.
+    security = Security()
     with _quiet_dask_logging():
-        _check_scheduler_answers(address, timeout)
+        _check_scheduler_answers(address, timeout, security)
         try:
-            return Client(address, timeout=timeout, set_as_default=False)
+            return Client(address, timeout=timeout, set_as_default=False, security=security)
         except Exception as exc:  # noqa: BLE001 - whatever Dask raises, the user gets one line
             raise ParameterError(f"scheduler: cannot connect to {address}: {_reason(exc)}") from None
 
 
-def _check_scheduler_answers(address: str, timeout: float) -> None:
+def _check_scheduler_answers(address: str, timeout: float, security: Any) -> None:
     """Open one connection to ``address`` and complete Dask's handshake, within ``timeout`` for each.
 
     Done before a :class:`~distributed.Client` is made, because a Client waits for the handshake
@@ -822,7 +827,7 @@ def _check_scheduler_answers(address: str, timeout: float) -> None:
 
     async def handshake() -> None:
         # open_comm bounds the connection by ``timeout`` but not the handshake; wait_for bounds both.
-        comm = await open_comm(address, timeout=timeout)
+        comm = await open_comm(address, timeout=timeout, **security.get_connection_args("client"))
         await comm.close()
 
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="scheduler-probe") as probe:
