@@ -115,6 +115,35 @@ def test_load_run_refuses_a_folder_without_summary(tmp_path):
         load_run(tmp_path)
 
 
+def write_foreign_netcdf(path: Path) -> None:
+    import h5netcdf
+
+    with h5netcdf.File(path, "w") as file:
+        file.dimensions = {"step": 2}
+        file.create_variable("temperature", ("step",), data=np.array([1.0, 2.0]))
+
+
+def write_foreign_parquet(path: Path) -> None:
+    import pyarrow as pa
+
+    pq.write_table(pa.table({"sample": [1, 2], "value": [0.5, 0.25]}), path)
+
+
+@pytest.mark.parametrize(
+    ("name", "write_foreign", "missing"),
+    [
+        ("timeseries.nc", write_foreign_netcdf, "variable 'time'"),
+        ("windows.nc", write_foreign_netcdf, "variable 'time'"),
+        ("impacts.parquet", write_foreign_parquet, "column 'time'"),
+    ],
+)
+def test_load_run_refuses_a_file_of_the_right_format_that_no_run_wrote(run_folder, name, write_foreign, missing):
+    write_foreign(run_folder / name)
+    with pytest.raises(StorageError, match=f"not a readable shakermill run folder \\({name}: no {missing}") as caught:
+        load_run(run_folder)
+    assert "\n" not in str(caught.value)
+
+
 def test_nan_values_are_written_as_null(tmp_path):
     # Too short to fit an exponential and without impacts: the summary holds NaNs.
     result = sm.simulate(sm.default_parameters(duration=0.001, record_windows=()))

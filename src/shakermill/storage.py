@@ -25,7 +25,7 @@ import os
 import shutil
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Container, Iterable, Mapping
 
 import numpy as np
 
@@ -340,19 +340,17 @@ def load_run(path: Path | str) -> RunData:
     summary_path = folder / SUMMARY_FILE
     if not summary_path.is_file():
         raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
-    import xarray as xr
-
     document = _read_part(summary_path, _summary_document)
     config = _read_part(folder / CONFIG_FILE, load_config)
-    impacts, impact_units = _read_part(folder / IMPACTS_FILE, read_impacts)
+    impacts, impact_units = _read_part(folder / IMPACTS_FILE, _read_impact_table)
     return RunData(
         path=folder,
         params=config.params,
         preset=config.preset,
         status=document["status"],
         message=document["message"],
-        timeseries=_read_part(folder / TIMESERIES_FILE, lambda file: xr.load_dataset(file, engine=NETCDF_ENGINE)),
-        windows=_read_part(folder / WINDOWS_FILE, lambda file: xr.load_dataset(file, engine=NETCDF_ENGINE)),
+        timeseries=_read_part(folder / TIMESERIES_FILE, _read_history),
+        windows=_read_part(folder / WINDOWS_FILE, _read_history),
         impacts=impacts,
         impact_units=impact_units,
         summary=document["summary"],
@@ -362,6 +360,8 @@ def load_run(path: Path | str) -> RunData:
     )
 
 
+# Variables of timeseries.nc and windows.nc that plot and report read (every version wrote them).
+HISTORY_VARIABLES_READ_BACK = ("time", "x", "p", "theta_ball", "theta_vial", "theta_air")
 # What summary.json must hold, and of which JSON type, for the tools that read a run folder back.
 SUMMARY_SHAPE = {
     "status": int,
@@ -381,6 +381,27 @@ def _summary_document(path: Path) -> dict[str, Any]:
         if type(document.get(key)) is not kind:  # not isinstance: true is no status
             raise ValueError(f"{key!r} is missing or not a JSON {kind.__name__}")
     return document
+
+
+def _read_history(path: Path) -> xr.Dataset:
+    import xarray as xr
+
+    dataset = xr.load_dataset(path, engine=NETCDF_ENGINE)
+    _require(HISTORY_VARIABLES_READ_BACK, dataset.variables, "variable")
+    return dataset
+
+
+def _read_impact_table(path: Path) -> tuple[pd.DataFrame, dict[str, str]]:
+    impacts, units = read_impacts(path)
+    _require(IMPACT_UNITS, impacts.columns, "column")
+    return impacts, units
+
+
+def _require(names: Iterable[str], present: Container[str], kind: str) -> None:
+    """A file of the right format but not written by a run (another tool's, an empty one) lacks what plot and report read."""
+    missing = [name for name in names if name not in present]
+    if missing:
+        raise ValueError(f"no {kind} {missing[0]!r}; not written by shakermill run")
 
 
 def _read_part(path: Path, read: Callable[[Path], Any]) -> Any:
