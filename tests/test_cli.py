@@ -395,6 +395,19 @@ def test_plot_of_a_sweep_folder_refuses_bad_options_with_one_line(sweep_folder, 
     assert not (tmp_path / "maps").exists()
 
 
+def test_plot_of_a_sweep_over_the_solver_draws_every_figure(tmp_path):
+    # The README's sweep over a string key: --points with a solver column.
+    points = tmp_path / "solvers.csv"
+    points.write_text("solver\nfull\naveraged\n", encoding="utf-8")
+    folder = tmp_path / "sweep"
+    swept = invoke("sweep", "--points", str(points), "--set", "duration=2", "--set", "record_windows=",
+                   "--set", "attractor_starts=1", "--workers", "1", "--out", str(folder))
+    assert swept.exit_code == 0, swept.stderr
+    outcome = invoke("plot", str(folder), "--out", str(tmp_path / "lines"))
+    assert outcome.exit_code == 0, outcome.stderr
+    assert "14 files written" in outcome.stdout
+
+
 def test_contour_on_a_run_folder_is_refused(tmp_path):
     assert invoke("run", *SHORT, "--no-plots", "--out", str(tmp_path / "run")).exit_code == 0
     outcome = invoke("plot", str(tmp_path / "run"), "--contour", "theta_inf_C=60")
