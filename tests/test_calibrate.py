@@ -11,6 +11,7 @@ from shakermill.calibrate import (
     DEFENSIBLE_RANGES,
     calibrate,
     free_set_study,
+    log_bounds,
     parse_free,
     parse_targets,
     write_preset,
@@ -129,3 +130,91 @@ def test_curve_csv_is_read_in_minutes_or_seconds(tmp_path) -> None:
     (tmp_path / "bad.csv").write_text("t,T\n0,20\n")
     with pytest.raises(ParameterError, match="needs columns"):
         Curve.from_csv(tmp_path / "bad.csv")
+
+
+# --- targets and curves that cannot be fitted (issue 12) -----------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("item", "fragment"),
+    [
+        ("theta_inf_C=nan", "target: theta_inf_C = nan is not allowed; allowed (0, 1400] °C"),
+        ("theta_inf_C=inf", "target: theta_inf_C = inf is not allowed"),
+        ("theta_inf_C=0", "target: theta_inf_C = 0 is not allowed; allowed (0, 1400] °C"),
+        ("tau_min=-5", "target: tau_min = -5 is not allowed; allowed (0, 10000] min"),
+        ("rate0_C_per_min=1e308", "allowed (0, 1000] °C/min"),
+        ("vial_ball_ratio=0", "target: vial_ball_ratio = 0 is not allowed; allowed (0, 10]"),
+        ("tau_min=" + "1" * 10_000, "target: tau_min needs a number, got '1111"),
+    ],
+)
+def test_targets_must_be_finite_and_inside_their_range(item, fragment) -> None:
+    with pytest.raises(ParameterError) as info:
+        parse_targets([item])
+    assert fragment in str(info.value) and len(str(info.value)) < 200
+
+
+def test_calibrate_checks_its_targets_before_any_run() -> None:
+    with pytest.raises(ParameterError, match="theta_inf_C = nan is not allowed"):
+        calibrate(sm.default_parameters(), ("beta",), {"theta_inf_C": float("nan")})
+    with pytest.raises(ParameterError, match="unknown target 'theta'"):
+        calibrate(sm.default_parameters(), ("beta",), {"theta": 48.0})
+
+
+@pytest.mark.parametrize(
+    ("times", "temperatures", "fragment"),
+    [
+        ([0, 600, 1200], [20, float("nan"), 40], "point 2 has ball_C = nan; allowed a finite temperature above -273.15 °C"),
+        ([0, 600, float("inf")], [20, 30, 40], "point 3 is at inf s; allowed times in [0, 1e+06] s"),
+        ([0, 600, 1e308], [20, 30, 40], "point 3 is at 1e+308 s"),
+        ([-60, 600], [20, 30], "point 1 is at -60 s"),
+        ([0, 600, 300], [20, 30, 35], "point 3 at 300 s does not come after the one before (600 s); times must increase"),
+        ([0, 600, 600], [20, 30, 31], "point 3 at 600 s does not come after"),
+        ([0, 600], [20, -300], "point 2 has ball_C = -300"),
+        ([], [], "0 times and 0 temperatures; allowed 1 to 100,000 of each"),
+        ([0, 600], [20], "2 times and 1 temperatures"),
+    ],
+)
+def test_a_curve_is_checked_when_it_is_made(times, temperatures, fragment) -> None:
+    with pytest.raises(ParameterError) as info:
+        Curve(np.array(times, dtype=float), np.array(temperatures, dtype=float), "lab")
+    assert str(info.value).startswith("curve lab: ") and fragment in str(info.value)
+
+
+def test_a_curve_file_with_a_byte_order_mark_is_read(tmp_path) -> None:
+    path = tmp_path / "curve.csv"
+    path.write_text("time_s,ball_C\n0,20\n600,30\n", encoding="utf-8-sig")
+    np.testing.assert_allclose(Curve.from_csv(path).times, [0.0, 600.0])
+
+
+@pytest.mark.parametrize(
+    ("content", "fragment"),
+    [
+        ("time_s,ball_C\n0,20\n# gemessen bei 20 °C\n".encode("latin-1"), "not UTF-8 text"),
+        ("time_s,ball_C\n0,20\n".encode("utf-16"), "not UTF-8 text"),
+        (b"time_s,ball_C\n0," + b"2" * 150 + b"\n", "line 2: a cell of 150 characters; allowed at most 100"),
+        (b'time_s,ball_C\n0,"' + b"2" * 140_000 + b'"\n', "malformed CSV at line 2"),
+        (b"time_s,ball_C\n0,20\n600\n", "line 3: needs a number in time_s and in ball_C"),
+        (b"time_s,ball_C\n", "has no data rows"),
+    ],
+)
+def test_a_curve_file_that_cannot_be_read_is_one_line_naming_it(tmp_path, content, fragment) -> None:
+    path = tmp_path / "curve.csv"
+    path.write_bytes(content)
+    with pytest.raises(ParameterError) as info:
+        Curve.from_csv(path)
+    message = str(info.value)
+    assert message.startswith(f"curve {path}") and fragment in message
+
+
+@pytest.mark.parametrize(("key", "low", "high"), [("ball_density", 500.0, 25_000.0), ("vial_mass", 0.02, 1.0)])
+def test_fit_bounds_stay_inside_the_hard_bounds(key, low, high) -> None:
+    # ball_density has no defensible range: a factor 100 either way of 7800, cut to its hard bounds.
+    start = getattr(sm.default_parameters(), key)
+    assert np.exp(log_bounds(key, start)) == pytest.approx((low, high), rel=1e-12)
+
+
+def test_fit_bounds_keep_off_an_open_hard_bound() -> None:
+    # air_heat_capacity_ratio > 1: a factor 100 below 1.4 would be 0.014.
+    low, high = np.exp(log_bounds("air_heat_capacity_ratio", 1.4))
+    assert 1.0 < low < 1.0 + 1e-8 and high == pytest.approx(5 / 3)
+    sm.default_parameters(air_heat_capacity_ratio=float(low))

@@ -157,3 +157,51 @@ def test_written_config_has_provenance_and_no_leftover_temporary_file(tmp_path):
     assert provenance["status"] == 0 and provenance["overrides"] == ["eta=0.5"]
     assert "config_file" not in provenance  # None has no TOML form and is left out
     assert [entry.name for entry in tmp_path.iterdir()] == ["config.toml"]
+
+
+# --- hostile files (issue 12) ---------------------------------------------------------------------
+
+
+def test_a_byte_order_mark_is_read_as_utf8(tmp_path):
+    path = tmp_path / "bom.toml"
+    path.write_text("eta = 0.7\n", encoding="utf-8-sig")
+    assert path.read_bytes().startswith(b"\xef\xbb\xbf")
+    assert load_config(path).params.eta == 0.7
+
+
+@pytest.mark.parametrize("encoding", ["latin-1", "utf-16"])
+def test_a_file_in_another_encoding_is_one_line_naming_it(tmp_path, encoding):
+    path = tmp_path / "other.toml"
+    path.write_text("# für die Mühle\neta = 0.7\n", encoding=encoding)
+    with pytest.raises(ParameterError, match=r"other.toml: not UTF-8 text \(byte 0x.. at offset \d+\); save it as UTF-8"):
+        load_config(path)
+
+
+def test_a_file_larger_than_any_configuration_is_refused_unread(tmp_path):
+    path = write_toml(tmp_path, "#" * 1_000_001 + "\n")
+    with pytest.raises(ParameterError, match="larger than 1,000,000 bytes"):
+        load_config(path)
+
+
+@pytest.mark.parametrize(
+    ("text", "fragments"),
+    [
+        ("omega = inf\n", ("omega: inf is not a finite number", "allowed [1, 10000] rad/s")),
+        ("phase = nan\n", ("phase: nan is not a finite number",)),
+        ("attractor_starts = true\n", ("attractor_starts: expected a whole number, got True", "allowed a whole number")),
+        ("duration = false\n", ("duration: expected a number or a quantity with units, got False",)),
+        ("no_tension = 1\n", ("no_tension: expected true or false, got 1",)),
+        ("duration = " + "9" * 5000 + "\n", ("malformed TOML: a number too long to read",)),
+        ("record_windows = [[0.0, inf]]\n", ("record_windows: inf is not a finite number",)),
+    ],
+)
+def test_bad_values_in_a_file_are_one_line_naming_the_key(tmp_path, text, fragments):
+    with pytest.raises(ParameterError) as info:
+        load_config(write_toml(tmp_path, text))
+    for fragment in fragments:
+        assert fragment in str(info.value)
+
+
+def test_windows_with_units_in_a_file_are_converted(tmp_path):
+    path = write_toml(tmp_path, 'record_windows = [["0 s", "100 ms"], [600, "1 min"]]\n')
+    assert load_config(path).params.record_windows == ((0.0, 0.1), (600.0, 60.0))

@@ -20,8 +20,6 @@ runner = CliRunner()
     [
         ("omega", 1060, "did you mean 1060 rpm?"),
         ("omega", 17.7, "did you mean 17.7 Hz?"),
-        ("amplitude", 25, "did you mean 25 mm?"),
-        ("vial_length", 58, "did you mean 58 mm?"),
     ],
 )
 def test_a_bare_number_far_outside_what_mills_use_warns_with_the_likely_unit(key, value, meant):
@@ -31,12 +29,20 @@ def test_a_bare_number_far_outside_what_mills_use_warns_with_the_likely_unit(key
     assert meant in lines[0]
 
 
-def test_a_geometry_error_caused_by_a_unit_slip_names_the_likely_unit():
+@pytest.mark.parametrize(
+    ("key", "value", "refusal", "meant"),
+    [
+        ("amplitude", 25, "amplitude: 25 is out of range; allowed (0, 0.5] m", "did you mean 25 mm?"),
+        ("vial_length", 58, "vial_length: 58 is out of range; allowed [0.001, 1] m", "did you mean 58 mm?"),
+        ("ball_radius", 6.35, "ball_radius: 6.35 is out of range; allowed [2.5e-05, 0.1] m", "did you mean 6.35 mm?"),
+    ],
+)
+def test_a_bare_number_beyond_the_hard_bounds_is_refused_with_the_likely_unit(key, value, refusal, meant):
     with pytest.raises(ParameterError) as error:
-        sm.default_parameters(ball_radius=6.35)
+        sm.default_parameters(**{key: value})
     message = str(error.value)
-    assert message.startswith("ball_radius: a ball of diameter")
-    assert "did you mean 6.35 mm?" in message
+    assert message.startswith(refusal)
+    assert meant in message
 
 
 def test_the_default_preset_draws_no_unit_warning():

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pydantic
 import pytest
 
@@ -13,9 +14,11 @@ from shakermill.params import (
     FIELD_NAMES,
     PRESETS,
     SPEX_8000M,
+    Bounds,
     ParameterError,
     Parameters,
     allowed_range,
+    bounds,
     build_parameters,
     default_parameters,
     preset_values,
@@ -165,8 +168,9 @@ def test_restitution_out_of_range(value: float) -> None:
 
 def test_allowed_range_text() -> None:
     assert allowed_range("restitution") == "(0, 1]"
-    assert allowed_range("ball_radius") == "(0, inf) m"
+    assert allowed_range("ball_radius") == "[2.5e-05, 0.1] m"
     assert allowed_range("eta") == "[0, 1]"
+    assert allowed_range("attractor_starts") == "a whole number in [1, 100]"
 
 
 def test_restitution_of_one_is_allowed() -> None:
@@ -196,7 +200,7 @@ def test_non_positive_values_are_rejected(key: str, value: object) -> None:
         default_parameters(**{key: value})
     message = str(info.value)
     assert message.startswith(f"{key}:")
-    assert "(0, inf)" in message
+    assert f"allowed {allowed_range(key)}" in message
 
 
 def test_ball_longer_than_the_vial_is_rejected() -> None:
@@ -326,3 +330,179 @@ def test_record_windows_from_a_string() -> None:
 def test_unknown_option_value_is_rejected() -> None:
     with pytest.raises(ParameterError, match="heat_model"):
         default_parameters(heat_model="lab")
+
+
+# --- hard bounds and the limits of issue 12 -------------------------------------------------------
+
+NUMERIC_KEYS = [key for key in FIELD_NAMES if Parameters.model_fields[key].annotation in (float, int)]
+
+
+@pytest.mark.parametrize("key", NUMERIC_KEYS)
+def test_every_numeric_key_has_finite_bounds_that_hold_its_preset_values(key: str) -> None:
+    hard = bounds(key)
+    assert math.isfinite(hard.low) and math.isfinite(hard.high) and hard.low < hard.high
+    for name in PRESETS:
+        assert hard.contains(preset_values(name)[key]), (name, key)
+
+
+@pytest.mark.parametrize("key", NUMERIC_KEYS)
+@pytest.mark.parametrize("value", [math.inf, -math.inf, math.nan, "inf", "nan", "-inf"])
+def test_non_finite_values_are_refused_naming_the_key_and_its_range(key: str, value: object) -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(**{key: value})
+    message = str(info.value)
+    assert message.startswith(f"{key}: ")
+    assert "not a finite number" in message
+    assert message.endswith(f"allowed {allowed_range(key)}")
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("omega", 1e5, "omega: 100000 is out of range; allowed [1, 10000] rad/s"),
+        ("beta", 1e12, "beta: 1e+12 is out of range; allowed [0, 100]"),
+        ("vial_mass", 1e-12, "vial_mass: 1e-12 is out of range; allowed [0.001, 100] kg"),
+        ("ball_density", 1e308, "ball_density: 1e+308 is out of range; allowed [500, 25000] kg/m^3"),
+        ("ball_density", 1e-6, "ball_density: 1e-06 is out of range; allowed [500, 25000] kg/m^3"),
+        ("duration", 1e308, "duration: 1e+308 is out of range; allowed [1e-06, 1e+06] s"),
+        ("phase", 7.0, "phase: 7 is out of range; allowed [-6.28319, 6.28319] rad"),
+        ("ball_poisson_ratio", 0.5, "ball_poisson_ratio: 0.5 is out of range; allowed [-0.5, 0.5)"),
+        ("attractor_starts", 101, "attractor_starts: 101 is out of range; allowed a whole number in [1, 100]"),
+        ("ball_position", 0.50000001, "ball_position: 0.50000001 is out of range; allowed [-0.5, 0.5] m"),
+    ],
+)
+def test_values_beyond_the_hard_bounds_get_one_line_with_the_range(key: str, value: float, message: str) -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(**{key: value})
+    # Keys with a plausible range add the unit slip that may be behind the value.
+    assert str(info.value).startswith(message)
+
+
+def test_a_value_on_a_closed_bound_is_allowed_and_just_past_it_is_not() -> None:
+    assert default_parameters(beta=100.0).beta == 100.0
+    assert default_parameters(omega="1 rad/s").omega == 1.0
+    with pytest.raises(ParameterError, match="beta"):
+        default_parameters(beta=100.0 * (1 + 1e-15))
+
+
+def test_bounds_read_open_and_closed_ends() -> None:
+    assert bounds("restitution") == Bounds(0.0, 1.0, low_open=True, high_open=False)
+    assert str(bounds("restitution")) == "(0, 1]"
+    assert not bounds("restitution").contains(0.0) and bounds("restitution").contains(1.0)
+    assert bounds("air_heat_capacity_ratio").high == pytest.approx(5 / 3)
+
+
+@pytest.mark.parametrize("key", ["omega", "duration", "attractor_starts", "averaging_batch_periods"])
+def test_booleans_are_not_numbers(key: str) -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(**{key: True})
+    message = str(info.value)
+    assert message.startswith(f"{key}: ") and "True" in message and f"allowed {allowed_range(key)}" in message
+
+
+def test_counts_are_whole_numbers_from_ints_strings_or_whole_floats() -> None:
+    assert default_parameters(attractor_starts="3").attractor_starts == 3
+    assert default_parameters(attractor_starts=4.0).attractor_starts == 4
+    assert default_parameters(attractor_starts=np.int64(5)).attractor_starts == 5
+    for value in (2.5, "2.5", "three"):
+        with pytest.raises(ParameterError, match=r"attractor_starts: .*allowed a whole number in \[1, 100\]"):
+            default_parameters(attractor_starts=value)
+
+
+def test_switches_take_true_or_false_not_numbers() -> None:
+    assert default_parameters(no_tension=True).no_tension is True
+    with pytest.raises(ParameterError, match="no_tension: expected true or false, got 1; allowed true or false"):
+        default_parameters(no_tension=1)
+
+
+def test_an_integer_beyond_the_largest_float_is_not_finite() -> None:
+    with pytest.raises(ParameterError, match=r"duration: 1000.*\(401 characters\) is not a finite number"):
+        default_parameters(duration=10**400)
+
+
+def test_long_values_are_quoted_short_in_the_error() -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(solver="x" * 100_000)
+    message = str(info.value)
+    assert len(message) < 200 and "(100002 characters)" in message and message.startswith("solver: ")
+
+
+def test_a_long_unknown_key_gets_no_suggestion_and_a_short_quote() -> None:
+    with pytest.raises(ParameterError) as info:
+        default_parameters(**{"k" * 10_000: 1})
+    message = str(info.value)
+    assert len(message) < 200 and "unknown parameter" in message and "did you mean" not in message
+
+
+def test_the_stored_samples_are_capped_with_the_interval_that_fits() -> None:
+    # 3600 s / 1e6 samples = 3.6 ms.
+    assert default_parameters(output_interval=0.0036).output_interval == 0.0036
+    with pytest.raises(ParameterError) as info:
+        default_parameters(output_interval=1e-5)
+    assert str(info.value) == (
+        "output_interval: 1e-05 s over duration = 3600 s makes 3.6e+08 samples; "
+        "allowed output_interval >= duration/1,000,000 = 0.0036 s"
+    )
+
+
+def test_record_windows_are_capped_in_number_and_in_time() -> None:
+    with pytest.raises(ParameterError, match="record_windows: 101 windows are too many; allowed at most 100"):
+        default_parameters(record_windows=",".join(f"{i}:0.1" for i in range(101)))
+    with pytest.raises(ParameterError, match="record_windows: they hold 800 s .* allowed at most 600 s in all"):
+        default_parameters(record_windows=((0.0, 400.0), (1000.0, 400.0)))
+    # Only the part inside the run counts: a 600-s window of a 1-s run stores one second.
+    assert default_parameters(duration=1.0, record_windows="0:600").record_windows == ((0.0, 600.0),)
+
+
+@pytest.mark.parametrize("windows", [[[0, 1, 2]], [[0]], "bogus", [["0 s", True]], True])
+def test_malformed_windows_name_the_key(windows: object) -> None:
+    with pytest.raises(ParameterError, match="^record_windows: .*allowed at most 100"):
+        default_parameters(record_windows=windows)
+
+
+def test_the_full_solver_keeps_at_most_two_million_drive_periods() -> None:
+    # 2e6 periods at 111 rad/s: 2e6 · 2π / 111 = 113 208 s.
+    with pytest.raises(ParameterError) as info:
+        default_parameters(duration=2e5)
+    message = str(info.value)
+    assert message.startswith("duration: 200000 s at omega = 111 rad/s is 3.53e+06 drive periods")
+    assert "allowed duration <= 1.132e+05 s here" in message and "solver = 'averaged'" in message
+    assert default_parameters(duration=2e5, solver="averaged").duration == 2e5
+
+
+def test_thermal_time_constants_at_rest_against_hand_values(defaults: Parameters) -> None:
+    constants = {node: value for node, (value, _) in defaults.thermal_time_constants_at_rest.items()}
+    # Ball: ρ_b R² c_b / (3 β k_a) = 7800 · 0.00635² · 461 / (3 · 0.3 · 0.0241) = 6684.7 s.
+    assert constants["ball"] == pytest.approx(7800 * 0.00635**2 * 461 / (3 * 0.3 * 0.0241), rel=1e-12)
+    # Vial: m_v c_v / ((h_i + h_o) A) = 0.05 · 461 / (245 · 5.6706e-4) = 165.9 s.
+    assert constants["vial"] == pytest.approx(0.05 * 461 / (245 * defaults.end_face_area), rel=1e-12)
+    # Air: m_a c_a / (h_i A + 4π R β k_a) ≈ 0.118 s, the fastest node.
+    ball_conductance = 4 * math.pi * 0.00635 * 0.3 * 0.0241
+    expected_air = defaults.air_mass * defaults.air_heat_capacity / (200 * defaults.end_face_area + ball_conductance)
+    assert constants["air"] == pytest.approx(expected_air, rel=1e-12)
+    assert 0.11 < constants["air"] < 0.13
+
+
+def test_a_thermal_network_faster_than_the_integrator_can_follow_is_refused() -> None:
+    # Vial: 1e-3 kg · 461 / (1e4 · 10 + 45 · 5.67e-4) = 4.6e-6 s.
+    with pytest.raises(ParameterError) as info:
+        default_parameters(vial_mass="1 g", h_inner=1e4, inner_area=10.0)
+    message = str(info.value)
+    assert message.startswith("vial_mass, vial_heat_capacity, h_inner, inner_area, h_outer, outer_area: ")
+    assert "the vial's thermal time constant is 4.61e-06 s" in message and "allowed >= 0.0001 s" in message
+
+
+def test_the_ball_only_model_has_no_vial_or_air_node_to_check() -> None:
+    # The same stiff vial, but the predecessor model holds vial and air at ambient.
+    params = default_parameters(model="ball_only", vial_mass="1 g", h_inner=1e4, inner_area=10.0)
+    assert set(params.thermal_time_constants_at_rest) == {"ball"}
+
+
+def test_direct_construction_refuses_non_finite_values(defaults: Parameters) -> None:
+    with pytest.raises(pydantic.ValidationError):
+        Parameters(**{**defaults.model_dump(), "omega": math.inf})
+
+
+def test_replace_refuses_what_default_parameters_refuses(defaults: Parameters) -> None:
+    with pytest.raises(ParameterError, match=r"^phase: 'nan' is not a finite number; allowed \[-6.28319, 6.28319\] rad$"):
+        defaults.replace(phase="nan")

@@ -511,6 +511,31 @@ def test_one_key_sweep_lines_break_where_the_regime_changes_and_mark_the_missing
     assert axis.get_legend().get_texts()[0].get_text() == "failed or no value (2)"
 
 
+def test_a_sweep_over_a_named_key_has_one_tick_per_name():
+    # A points file may sweep the solver: its values are names, drawn one tick apart in sorted order.
+    table = synthetic_sweep().iloc[[0, 2, 4]].drop(columns="amplitude")
+    table["solver"] = ["full", "averaged", "full"]
+    table["regime"] = "period-1"
+    table = table.drop(columns="omega")
+    (axis,) = sweep_figures(table, ("solver",))["sweep_theta_inf_C"].axes
+    assert [tick.get_text() for tick in axis.get_xticklabels()] == ["averaged", "full"]
+    assert axis.get_lines()[0].get_xdata().tolist() == [0.0, 1.0, 1.0]
+    assert axis.get_xlabel() == "solver (–)"
+
+
+def test_a_map_over_a_named_and_a_numeric_key_fills_its_grid():
+    table = synthetic_sweep()
+    table["model"] = table["amplitude"].map({0.024: "three_node", 0.028: "ball_only"})
+    table = table.drop(columns="amplitude")
+    figures = sweep_figures(table, ("omega", "model"))
+    axis, _ = figures["sweep_theta_inf_C"].axes
+    assert [tick.get_text() for tick in axis.get_yticklabels()] == ["ball_only", "three_node"]
+    cells = np.ma.filled(axis.collections[0].get_array(), np.nan).reshape(2, 3)
+    np.testing.assert_allclose(cells, [[54.0, 74.0, 94.0], [50.0, 70.0, 90.0]])  # ball_only (28 mm) first
+    (regime_axis,) = figures["sweep_regime"].axes
+    assert [tick.get_text() for tick in regime_axis.get_yticklabels()] == ["ball_only", "three_node"]
+
+
 def test_omega_axes_also_read_in_rpm():
     figures = sweep_figures(synthetic_sweep(), ("amplitude", "omega"))
     axis = figures["sweep_theta_inf_C"].axes[0]

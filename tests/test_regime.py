@@ -128,3 +128,12 @@ def test_bifurcation_stops_at_ctrl_c_inside_a_run(monkeypatch) -> None:
     with pytest.raises(KeyboardInterrupt):
         bifurcation(base, [100.0, 110.0, 120.0])
     assert calls == [100.0, 110.0]
+
+
+def test_a_bifurcation_of_more_values_than_a_diagram_can_show_is_refused_before_any_run(monkeypatch) -> None:
+    import sys
+
+    simulate_module = sys.modules["shakermill.simulate"]
+    monkeypatch.setattr(simulate_module, "simulate", lambda params: pytest.fail("no run may start"))
+    with pytest.raises(sm.ParameterError, match="bifurcation: 10,001 values; allowed at most 10,000"):
+        bifurcation(sm.default_parameters(), np.linspace(90.0, 130.0, 10_001))

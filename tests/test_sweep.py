@@ -143,7 +143,7 @@ def test_plan_is_the_product_with_the_first_grid_slowest():
         ("amplitude=23 kg:30mm:3", ["amplitude", "kg", "expected m"]),
         ("amplitude=23mm:30 s:3", ["amplitude", "expected m"]),
         ("amplitude=23 blorps:30mm:3", ["amplitude", "cannot parse"]),
-        ("omega=nan:130:3", ["START and STOP must be finite"]),
+        ("omega=nan:130:3", ["omega", "'nan' is not a finite number"]),
         ("averaging_batch_periods=8:32:4", ["averaging_batch_periods", "real-valued", "--points"]),
     ],
 )
@@ -216,6 +216,67 @@ def test_bad_points_file_is_one_line_naming_the_problem(tmp_path, text, fragment
 def test_missing_points_file(tmp_path):
     with pytest.raises(ParameterError, match="cannot read"):
         read_points(tmp_path / "absent.csv")
+
+
+@pytest.mark.parametrize(
+    ("content", "fragments"),
+    [
+        ("omega\n100\n# Mühle\n".encode("latin-1"), ["not UTF-8 text"]),
+        (b"omega\n" + b"1" * 500 + b"\n", ["line 2: a cell of 500 characters; allowed at most 100"]),
+        (b'omega\n"' + b"1" * 140_000 + b'"\n', ["malformed CSV at line 2"]),
+        (b"omega\n100\nnan\n", ["line 3", "omega: 'nan' is not a finite number"]),
+        (b"omega\n" + b"100\n" * 100_001, ["more than 100,000 rows after the header; allowed at most 100,000"]),
+    ],
+)
+def test_a_points_file_beyond_the_limits_is_one_line_naming_it(tmp_path, content, fragments):
+    path = tmp_path / "points.csv"
+    path.write_bytes(content)
+    with pytest.raises(ParameterError) as caught:
+        read_points(path)
+    message = str(caught.value)
+    assert message.startswith(f"points {path}"), message
+    for fragment in fragments:
+        assert fragment in message, (fragment, message)
+
+
+@pytest.mark.parametrize(
+    ("grids", "message"),
+    [
+        (["omega=90:130:100000000000"], "N must be a whole number of points in [1, 100,000], got '100000000000'"),
+        (["omega=90:130:" + "9" * 5000], "(5002 characters)"),
+        (["omega=90:130:1000", "amplitude=20mm:30mm:1000"], "sweep: 1,000,000 points; allowed at most 100,000"),
+    ],
+)
+def test_grids_are_capped_before_their_points_are_made(grids, message):
+    started = time.perf_counter()
+    with pytest.raises(ParameterError) as caught:
+        plan_sweep(grids)
+    assert message in str(caught.value)
+    assert time.perf_counter() - started < 1.0
+
+
+def test_a_grid_times_a_points_file_is_capped_as_a_product(tmp_path):
+    path = tmp_path / "points.csv"
+    path.write_text("restitution\n0.6\n0.8\n", encoding="utf-8")
+    with pytest.raises(ParameterError, match="sweep: 200,000 points"):
+        plan_sweep(["omega=90:130:100000"], points_file=path)
+
+
+def test_the_python_api_caps_the_points_it_is_given(tmp_path):
+    with pytest.raises(ParameterError, match="sweep: 1,000,000 points"):
+        sweep(default_parameters(), {"omega": np.linspace(90, 130, 1000), "amplitude": np.linspace(0.02, 0.03, 1000)},
+              tmp_path / "sweep")
+    assert not (tmp_path / "sweep").exists()
+
+
+def test_an_averaged_sweep_is_not_held_to_the_full_solvers_limits():
+    # Eleven simulated days: too many drive periods for the full solver, nothing for the averaged one.
+    base = sweep_parameters(None, preset=None, overrides=["duration=1e6", "output_interval=60"], full_resolution=False)
+    assert base.params.solver == "averaged" and base.params.duration == 1e6
+    with pytest.raises(ParameterError, match="duration: 1e\\+06 s at omega = 111 rad/s"):
+        sweep_parameters(None, preset=None, overrides=["duration=1e6", "output_interval=60"], full_resolution=True)
+    with pytest.raises(ParameterError, match="--full-resolution contradicts solver = 'averaged'"):
+        sweep_parameters(None, preset=None, overrides=["solver=averaged"], full_resolution=True)
 
 
 # Execution: in process, local pool, Dask cluster ---------------------------------------------------

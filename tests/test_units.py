@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 
 import pytest
 
@@ -75,3 +76,46 @@ def test_bad_values_raise_a_unit_error_naming_the_key(value: object, unit: str, 
 
 def test_unit_error_is_a_value_error() -> None:
     assert issubclass(UnitError, ValueError)
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        "10**10**10 rad/s",  # 10 to the ten billion: pint would compute it
+        "9**9**9",
+        "(((((((10**9)**9)**9)**9)**9)**9)**9) m",
+        "m**9**9**9",
+        "10 ** 9 m",
+        "2^2^2^2^2^2 kg",
+        "(1 m)**9",
+        "1e5e5 m",
+        "0x10 m",
+    ],
+)
+def test_arithmetic_in_a_quantity_is_refused_before_pint_sees_it(value: str) -> None:
+    started = time.perf_counter()
+    with pytest.raises(UnitError, match="cannot read .* as a number with a unit"):
+        to_si(value, "m", key="k")
+    assert time.perf_counter() - started < 0.1
+
+
+@pytest.mark.parametrize(
+    ("value", "unit", "expected"),
+    [("9.81 m/s^2", "m/s^2", 9.81), ("9.81 m/s**2", "m/s^2", 9.81), ("461 J/(kg*K)", "J/(kg*K)", 461.0), ("1 / min", "1/s", 1 / 60)],
+)
+def test_single_digit_powers_and_reciprocals_of_units_are_read(value: str, unit: str, expected: float) -> None:
+    assert to_si(value, unit, key="k") == pytest.approx(expected, rel=1e-12)
+
+
+def test_a_value_longer_than_any_number_is_refused_before_it_is_parsed() -> None:
+    started = time.perf_counter()
+    with pytest.raises(UnitError, match="k: a value of 100000 characters is too long; allowed at most 100"):
+        to_si("1" * 100_000, "m", key="k")
+    assert time.perf_counter() - started < 0.1
+    assert to_si("1" * 100, "m", key="k") == pytest.approx(1.111111111111111e99, rel=1e-12)
+
+
+@pytest.mark.parametrize("value", ["inf", "-inf", "nan", "1e400", "1e308 km", math.inf, math.nan, 10**400])
+def test_non_finite_values_are_refused(value: object) -> None:
+    with pytest.raises(UnitError, match="^k: .* is not a finite number$"):
+        to_si(value, "m", key="k")

@@ -33,9 +33,10 @@ from scipy.optimize import least_squares
 from . import __version__
 from .atomic import remove_abandoned_writes, write_text_atomically
 from .defaults import DEFAULT_FREE
-from .params import ParameterError, Parameters, check_known_keys
+from .limits import MAX_VALUE_LENGTH, quoted
+from .params import ParameterError, Parameters, bounds, check_known_keys
 from .simulate import Result, simulate_whole
-from .validation import CURVE_TOLERANCE_K, TARGET_KEYS, Curve, experiment_curve
+from .validation import CURVE_TOLERANCE_K, TARGET_KEYS, Curve, check_targets, experiment_curve, target_range
 
 # The free set of the shipped calibrated preset: the smallest set that follows the experiment's curve
 # within 1 K RMS with every value inside its defensible range (see README, "Against the experiment").
@@ -125,12 +126,23 @@ def parse_targets(items: Sequence[str]) -> dict[str, float]:
         if not separator:
             raise ParameterError(f"target: expected NAME=VALUE, got {item!r}")
         if name not in TARGET_KEYS:
-            raise ParameterError(f"target: unknown target {name!r}; allowed: {', '.join(TARGET_KEYS)}")
-        try:
-            targets[name] = float(value)
-        except ValueError:
-            raise ParameterError(f"target: {name} needs a number, got {value!r}") from None
+            raise ParameterError(f"target: unknown target {quoted(name)}; allowed: {', '.join(TARGET_KEYS)}")
+        number = _plain_number(value)
+        if number is None:
+            raise ParameterError(f"target: {name} needs a number, got {quoted(value)}; allowed {target_range(name)}")
+        targets[name] = number
+    check_targets(targets)
     return targets
+
+
+def _plain_number(text: str) -> float | None:
+    """``text`` as a float; None when it is not one, or longer than any number is written."""
+    if len(text) > MAX_VALUE_LENGTH:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return None
 
 
 def parse_free(items: Sequence[str]) -> tuple[str, ...]:
@@ -143,14 +155,6 @@ def parse_free(items: Sequence[str]) -> tuple[str, ...]:
     if len(set(keys)) != len(keys):
         raise ParameterError(f"free: a key is listed twice in {', '.join(keys)}")
     return keys
-
-
-def _upper_limit(key: str) -> float:
-    for constraint in Parameters.model_fields[key].metadata:
-        for attribute in ("le", "lt"):
-            if hasattr(constraint, attribute):
-                return float(getattr(constraint, attribute))
-    return math.inf
 
 
 @dataclass(frozen=True)
@@ -200,13 +204,21 @@ DEFENSIBLE_RANGES: dict[str, DefensibleRange] = {
 }
 
 
-def _log_bounds(key: str, start: float) -> tuple[float, float]:
-    """Bounds in log space: the defensible range (widened to include the start), else a factor either way."""
+# An open hard bound is approached to this relative distance: exp(log(bound)) may round onto it.
+OPEN_BOUND_MARGIN = 1e-9
+
+
+def log_bounds(key: str, start: float) -> tuple[float, float]:
+    """Bounds in log space: the defensible range (widened to include the start), else a factor either way;
+    always inside the key's hard bounds, so that no step of the fit tries a value the model refuses."""
     if key in DEFENSIBLE_RANGES:
         defensible = DEFENSIBLE_RANGES[key]
         low, high = min(defensible.low, start), max(defensible.high, start)
     else:
-        low, high = start / BOUND_FACTOR, min(start * BOUND_FACTOR, _upper_limit(key))
+        low, high = start / BOUND_FACTOR, start * BOUND_FACTOR
+    hard = bounds(key)
+    low = max(low, hard.low * (1 + OPEN_BOUND_MARGIN) if hard.low_open else hard.low)
+    high = min(high, hard.high * (1 - OPEN_BOUND_MARGIN) if hard.high_open else hard.high)
     # A start on the upper limit still needs an open interval.
     return math.log(low), max(math.log(high), math.log(start) + 1e-12)
 
@@ -221,6 +233,7 @@ def calibrate(
 ) -> Calibration:
     """Fit ``free`` keys of ``base`` to ``targets`` and/or ``curve``; see the module docstring."""
     targets = dict(targets or {})
+    check_targets(targets)
     if not targets and curve is None:
         curve = experiment_curve()
     free = tuple(free)
@@ -230,16 +243,16 @@ def calibrate(
     solver = "full" if full_resolution else "averaged"
     start = {key: float(getattr(base, key)) for key in free}
     x0 = np.log([start[key] for key in free])
-    lower, upper = (np.array(side) for side in zip(*(_log_bounds(key, start[key]) for key in free)))
-    if curve is not None and curve.times.max() > base.duration:
-        base = base.replace(duration=float(curve.times.max()))
+    lower, upper = (np.array(side) for side in zip(*(log_bounds(key, start[key]) for key in free)))
+    # The fit needs the configured motion only: probing other attractors would cost every evaluation.
+    longest = float(curve.times.max()) if curve is not None else 0.0
+    fitting = base.replace(solver=solver, attractor_starts=1, duration=max(base.duration, longest))
     cache: dict[tuple[float, ...], tuple[np.ndarray, Result]] = {}
 
     def evaluate(x: np.ndarray) -> tuple[np.ndarray, Result]:
         key = tuple(np.round(x, 14))
         if key not in cache:
-            # The fit needs the configured motion only: probing other attractors would cost every evaluation.
-            params = base.replace(solver=solver, attractor_starts=1, **{name: float(math.exp(v)) for name, v in zip(free, x)})
+            params = fitting.replace(**{name: float(math.exp(v)) for name, v in zip(free, x)})
             result = simulate_whole(params)
             cache[key] = (_residuals(result, targets, curve), result)
         return cache[key]

@@ -31,6 +31,7 @@ from . import __version__
 from .atomic import StorageError, check_writable_place
 from .config import load_config
 from .defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
+from .limits import MAX_BIFURCATION_VALUES
 from .params import (
     DEFAULT_PRESET,
     FIELD_NAMES,
@@ -360,8 +361,10 @@ def compare_solvers(
 
     with _user_errors():
         params = load_config(config, preset=preset, overrides=settings or []).params
-    full = simulate_with_progress(params.replace(solver="full"))
-    averaged = simulate(params.replace(solver="averaged"))
+        # The full solver has limits of its own (the drive periods it keeps every impact of).
+        full_params, averaged_params = params.replace(solver="full"), params.replace(solver="averaged")
+    full = simulate_with_progress(full_params)
+    averaged = simulate(averaged_params)
     rows = [
         (label, unit, full.summary[key], averaged.summary[key], averaged.summary[key] - full.summary[key])
         for key, label, unit in COMPARED_QUANTITIES
@@ -643,7 +646,7 @@ def bifurcation(
 
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
-        key, values = parse_grid(grid)
+        key, values = parse_grid(grid, most=MAX_BIFURCATION_VALUES)
         # Checked before the scan: a value out of range would otherwise stop it midway.
         for value in (values[0], values[-1]):
             run_config.params.replace(**{key: float(value)})

@@ -22,6 +22,7 @@ import tomli_w
 
 from . import __version__
 from .atomic import write_text_atomically
+from .limits import MAX_CONFIG_BYTES, quoted
 from .params import (
     DEFAULT_PRESET,
     ParameterError,
@@ -31,7 +32,6 @@ from .params import (
     field_unit,
     preset_values,
 )
-from .units import UnitError, to_si
 
 PRESET_KEY = "preset"
 PROVENANCE_TABLE = "provenance"
@@ -73,45 +73,45 @@ def load_config(
 
 def read_config_file(path: Path) -> dict[str, Any]:
     """The parameter entries of a TOML configuration (``preset`` included, ``[provenance]`` dropped)."""
+    text = _config_text(path)
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        # tomllib's message already ends with "(at line L, column C)".
+        raise ParameterError(f"{path}: malformed TOML: {exc}") from None
+    except ValueError:  # an integer of more digits than Python converts
+        raise ParameterError(f"{path}: malformed TOML: a number too long to read") from None
+    document.pop(PROVENANCE_TABLE, None)
+    return document
+
+
+def _config_text(path: Path) -> str:
+    """The text of the TOML file at ``path``, or :class:`ParameterError` with one line saying why not."""
     try:
         with path.open("rb") as stream:
-            document = tomllib.load(stream)
+            # One byte more than allowed tells a file at the limit from a longer one without reading it all.
+            data = stream.read(MAX_CONFIG_BYTES + 1)
     except FileNotFoundError:
         raise ParameterError(f"{path}: no such configuration file") from None
     except IsADirectoryError:
         raise ParameterError(f"{path}: is a directory, expected a TOML configuration file") from None
     except OSError as exc:
         raise ParameterError(f"{path}: cannot read the configuration file ({exc.strerror})") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        # tomllib's message already ends with "(at line L, column C)".
-        raise ParameterError(f"{path}: malformed TOML: {exc}") from None
-    document.pop(PROVENANCE_TABLE, None)
-    if "record_windows" in document:
-        document["record_windows"] = _windows_from_toml(document["record_windows"])
-    return document
+    if len(data) > MAX_CONFIG_BYTES:
+        raise ParameterError(f"{path}: larger than {MAX_CONFIG_BYTES:,} bytes; a configuration holds a few kilobytes")
+    try:
+        # -sig: editors on Windows start UTF-8 files with a byte-order mark, which TOML itself does not allow.
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{path}: not UTF-8 text (byte {data[exc.start]:#04x} at offset {exc.start}); save it as UTF-8") from None
 
 
 def _file_preset(values: dict[str, Any], path: Path) -> str | None:
     """Remove and return the file's ``preset`` entry; it names a preset, it is not a parameter."""
     name = values.pop(PRESET_KEY, None)
     if name is not None and not isinstance(name, str):
-        raise ParameterError(f"{path}: preset must be a string naming a preset, got {name!r}")
+        raise ParameterError(f"{path}: preset must be a string naming a preset, got {quoted(name)}")
     return name
-
-
-def _windows_from_toml(value: Any) -> Any:
-    """Convert the strings with units inside a TOML array of windows; the shape is checked by ``Parameters``."""
-    if not isinstance(value, list):
-        return value
-    try:
-        return [
-            [to_si(item, "s", key="record_windows") if isinstance(item, str) else item for item in pair]
-            if isinstance(pair, list)
-            else pair
-            for pair in value
-        ]
-    except UnitError as exc:
-        raise ParameterError(str(exc)) from None
 
 
 def parse_overrides(items: Sequence[str]) -> dict[str, str]:
@@ -121,7 +121,7 @@ def parse_overrides(items: Sequence[str]) -> dict[str, str]:
         key, separator, value = item.partition("=")
         key = key.strip()
         if not separator or not key:
-            raise ParameterError(f"--set {item!r}: expected KEY=VALUE, for example --set restitution=0.8")
+            raise ParameterError(f"--set {quoted(item)}: expected KEY=VALUE, for example --set restitution=0.8")
         overrides[key] = value.strip()
     return overrides
 

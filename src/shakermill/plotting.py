@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import io
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping, Protocol, Sequence
 
@@ -520,6 +521,30 @@ def display_values(key: str, values: np.ndarray) -> np.ndarray:
     return np.asarray(values, dtype=float) * DISPLAY_UNITS.get(field_unit(key), (1.0, ""))[0]
 
 
+@dataclass(frozen=True)
+class KeyAxis:
+    """Where each value of a swept key lies on an axis, and the tick labels when the values are names."""
+
+    positions: np.ndarray
+    names: tuple[str, ...] = ()
+
+    def mark(self, axis: object, which: str = "x") -> None:
+        """One tick per name (nothing for numbers, whose ticks matplotlib chooses)."""
+        if self.names:
+            set_ticks = axis.set_xticks if which == "x" else axis.set_yticks  # type: ignore[attr-defined]
+            set_ticks(range(len(self.names)), self.names)
+
+
+def key_axis(key: str, values: Sequence[Any]) -> KeyAxis:
+    """Numbers in their display unit; names (a points file sweeping ``solver`` or ``model``) one tick apart, sorted."""
+    try:
+        return KeyAxis(display_values(key, np.asarray(values)))
+    except ValueError:
+        text = [str(value) for value in values]
+        names = tuple(sorted(set(text)))
+        return KeyAxis(np.array([names.index(value) for value in text], dtype=float), names)
+
+
 def parse_contour(spec: str, columns: Sequence[str]) -> tuple[str, float]:
     """``"theta_inf_C=60"`` -> ``("theta_inf_C", 60.0)``, the column checked against ``columns``."""
     from .params import ParameterError
@@ -612,7 +637,8 @@ def sweep_line_figure(
 ) -> Figure:
     figure, (axis,) = _new_figure(height=4.0)
     ordered = table.sort_values(key)
-    x = display_values(key, ordered[key].to_numpy())
+    key_values = key_axis(key, ordered[key].to_numpy())
+    x = key_values.positions
     y = _numeric(ordered, column)
     axis.plot(*_broken_at_regime_changes(x, y, _regimes(ordered)), "o-", color="tab:blue", ms=4)
     missing = ~np.isfinite(y)
@@ -631,6 +657,7 @@ def sweep_line_figure(
     if axis.get_legend_handles_labels()[0]:
         axis.legend(loc="best")
     axis.set_xlabel(axis_label(key))
+    key_values.mark(axis)
     rpm_axis(axis, key)
     axis.set_ylabel(f"{quantity} ({unit})")
     axis.set_title(f"{quantity} against {key} ({len(ordered)} points; lines break where the regime changes)")
@@ -666,15 +693,13 @@ def _crossings(x: np.ndarray, values: np.ndarray, level: float) -> np.ndarray:
     return np.asarray(found)
 
 
-def _grid_of(table: pd.DataFrame, keys: Sequence[str], column: str) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """(x values, y values, Z[y, x]) when the points form a complete grid over the two keys, else None."""
-    x_key, y_key = keys
-    xs, ys = np.unique(table[x_key].to_numpy(dtype=float)), np.unique(table[y_key].to_numpy(dtype=float))
-    if len(xs) < 2 or len(ys) < 2 or len(table) != len(xs) * len(ys):
+def _grid_of(x: np.ndarray, y: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """(x values, y values, Z[y, x]) when the points (x, y) form a complete grid, else None."""
+    xs, ys = np.unique(x), np.unique(y)
+    if len(xs) < 2 or len(ys) < 2 or len(values) != len(xs) * len(ys):
         return None
     grid = np.full((len(ys), len(xs)), np.nan)
-    for _, row in table.iterrows():
-        grid[np.searchsorted(ys, row[y_key]), np.searchsorted(xs, row[x_key])] = pd.to_numeric(row[column], errors="coerce")
+    grid[np.searchsorted(ys, y), np.searchsorted(xs, x)] = values
     return xs, ys, grid
 
 
@@ -694,26 +719,28 @@ def sweep_map_figure(
     """A heat map over a grid of the two keys (first key across), or coloured points for scattered points."""
     figure, (axis,) = _new_figure(height=5.0)
     x_key, y_key = keys
-    gridded = _grid_of(table, keys, column) if not table.empty else None
+    x_values, y_values = key_axis(x_key, table[x_key].to_numpy()), key_axis(y_key, table[y_key].to_numpy())
+    x_all, y_all = x_values.positions, y_values.positions
+    gridded = _grid_of(x_all, y_all, _numeric(table, column)) if not table.empty else None
     if gridded is not None:
-        xs, ys, values = gridded
-        x, y = display_values(x_key, xs), display_values(y_key, ys)
+        x, y, values = gridded
         mesh = axis.pcolormesh(_cell_edges(x), _cell_edges(y), np.ma.masked_invalid(values), cmap="inferno", shading="flat")
         for contour_column, level in contours:
-            _, _, levels = _grid_of(table, keys, contour_column)  # type: ignore[misc]
+            _, _, levels = _grid_of(x_all, y_all, _numeric(table, contour_column))  # type: ignore[misc]
             if _straddled(levels, level):
                 lines = axis.contour(x, y, levels, levels=[level], **CONTOUR_STYLE)
                 axis.clabel(lines, fmt=contour_label(contour_column, level), fontsize="small")
     else:
         # A points file: no cells to fill.
-        x, y = display_values(x_key, table[x_key].to_numpy()), display_values(y_key, table[y_key].to_numpy())
-        mesh = axis.scatter(x, y, c=_numeric(table, column), cmap="inferno", s=60, edgecolors="0.3")
+        mesh = axis.scatter(x_all, y_all, c=_numeric(table, column), cmap="inferno", s=60, edgecolors="0.3")
         for contour_column, level in contours:
             levels = _numeric(table, contour_column)
-            if len(x) >= 3 and _straddled(levels, level):
-                lines = axis.tricontour(x, y, levels, levels=[level], colors="0.3", linestyles="--")
+            if len(x_all) >= 3 and _straddled(levels, level):
+                lines = axis.tricontour(x_all, y_all, levels, levels=[level], colors="0.3", linestyles="--")
                 axis.clabel(lines, fmt=contour_label(contour_column, level), fontsize="small")
-    _mark_missing(axis, table, keys, column)
+    _mark_missing(axis, x_all, y_all, _numeric(table, column))
+    x_values.mark(axis)
+    y_values.mark(axis, "y")
     figure.colorbar(mesh, ax=axis, label=f"{quantity} ({unit})")
     axis.set_xlabel(axis_label(x_key))
     axis.set_ylabel(axis_label(y_key))
@@ -723,12 +750,11 @@ def sweep_map_figure(
     return figure
 
 
-def _mark_missing(axis: object, table: pd.DataFrame, keys: Sequence[str], column: str) -> None:
+def _mark_missing(axis: object, x: np.ndarray, y: np.ndarray, values: np.ndarray) -> None:
     """A red x on each point without a value (failed, or NaN), so that a blank cell reads as a missing point."""
-    missing = ~np.isfinite(_numeric(table, column))
+    missing = ~np.isfinite(values)
     if missing.any():
-        x, y = (display_values(key, table.loc[missing, key].to_numpy()) for key in keys)
-        axis.scatter(x, y, label=f"failed or no value ({missing.sum()})", **MISSING_STYLE)  # type: ignore[attr-defined]
+        axis.scatter(x[missing], y[missing], label=f"failed or no value ({missing.sum()})", **MISSING_STYLE)  # type: ignore[attr-defined]
         axis.legend(loc="upper left", bbox_to_anchor=(0.0, -0.12), fontsize="small", frameon=False)  # type: ignore[attr-defined]
 
 
@@ -738,8 +764,9 @@ def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
     The regime is the configured start's; points where other starts settle elsewhere are framed.
     """
     figure, (axis,) = _new_figure(height=4.0 if len(keys) == 1 else 5.0)
-    x = display_values(keys[0], table[keys[0]].to_numpy())
-    y = display_values(keys[1], table[keys[1]].to_numpy()) if len(keys) == 2 else np.zeros(len(table))
+    x_values = key_axis(keys[0], table[keys[0]].to_numpy())
+    y_values = key_axis(keys[1], table[keys[1]].to_numpy()) if len(keys) == 2 else KeyAxis(np.zeros(len(table)))
+    x, y = x_values.positions, y_values.positions
     labels = table["regime"].astype(object).where(table["error"].isna(), "failed")
     present = sorted(set(labels), key=_regime_order)
     periods = [label for label in present if label.startswith("period-")]
@@ -758,9 +785,11 @@ def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
             label=f"more than one attractor ({several.sum()})",
         )
     axis.set_xlabel(axis_label(keys[0]))
+    x_values.mark(axis)
     rpm_axis(axis, keys[0])
     if len(keys) == 2:
         axis.set_ylabel(axis_label(keys[1]))
+        y_values.mark(axis, "y")
         rpm_axis(axis, keys[1], which="y")
     else:
         axis.set_yticks([])

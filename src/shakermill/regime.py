@@ -16,7 +16,8 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from .params import Parameters
+from .limits import MAX_BIFURCATION_VALUES
+from .params import ParameterError, Parameters
 from .simulate import Result
 from .storage import FolderKind
 
@@ -143,6 +144,8 @@ def bifurcation(
     from .attractors import probed
     from .simulate import simulate_whole
 
+    if len(values) > MAX_BIFURCATION_VALUES:
+        raise ParameterError(f"bifurcation: {len(values):,} values; allowed at most {MAX_BIFURCATION_VALUES:,}")
     regimes, attractors, phases = [], [], []
     for index, value in enumerate(values):
         result = simulate_whole(base.replace(**{key: float(value)}))

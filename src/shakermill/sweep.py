@@ -22,7 +22,6 @@ in which they finish, or whether the points ran on a Dask cluster.
 from __future__ import annotations
 
 import ast
-import csv
 import hashlib
 import io
 import itertools
@@ -46,6 +45,9 @@ from . import __version__
 from .atomic import check_writable_place, create_exclusively, remove_abandoned_writes, write_files_atomically, write_text_atomically
 from .defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from .config import RunConfig, load_config, parse_overrides, read_config_file
+from .csvinput import read_csv_rows
+from .defaults import DEFAULT_SCHEDULER_TIMEOUT_S
+from .limits import MAX_SWEEP_POINTS, quoted
 from .params import DEFAULT_PRESET, ParameterError, Parameters, check_known_keys, field_unit
 from .simulate import INTERRUPTED, Result, simulate
 from .storage import to_jsonable
@@ -132,50 +134,55 @@ def normalize_value(key: str, value: Any) -> Any:
     return to_jsonable(value)
 
 
-def parse_grid(spec: str) -> tuple[str, np.ndarray]:
-    """``"omega=90:130:9"`` -> ``("omega", linspace(90, 130, 9))``; START and STOP may carry units."""
+def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray]:
+    """``"omega=90:130:9"`` -> ``("omega", linspace(90, 130, 9))``; START and STOP may carry units; N <= ``most``."""
+    shown = quoted(spec)
     match = GRID_PATTERN.match(spec)
     if match is None:
-        raise ParameterError(f"grid {spec!r}: expected KEY=START:STOP:N, for example omega=90:130:9")
+        raise ParameterError(f"grid {shown}: expected KEY=START:STOP:N, for example omega=90:130:9")
     key, bounds = match["key"], match["range"].split(":")
     try:
         check_known_keys([key])
     except ParameterError as exc:
-        raise ParameterError(f"grid {spec!r}: {exc}") from None
+        raise ParameterError(f"grid {shown}: {exc}") from None
     if Parameters.model_fields[key].annotation is not float:
         raise ParameterError(
-            f"grid {spec!r}: grids are for real-valued parameters and {key} is not one; list its values with --points"
+            f"grid {shown}: grids are for real-valued parameters and {key} is not one; list its values with --points"
         )
     if len(bounds) != 3:
-        raise ParameterError(f"grid {spec!r}: expected KEY=START:STOP:N (three fields after '='), got {len(bounds)}")
+        raise ParameterError(f"grid {shown}: expected KEY=START:STOP:N (three fields after '='), got {len(bounds)}")
     start, stop, count = (part.strip() for part in bounds)
-    if not (count.isascii() and count.isdigit()) or int(count) < 1:
-        raise ParameterError(f"grid {spec!r}: N must be a whole number of points >= 1, got {count!r}")
+    # Digits beyond the limit's are refused before int() would read a number of any length.
+    if not (count.isascii() and count.isdigit()) or len(count) > len(str(most)) or not 1 <= int(count) <= most:
+        raise ParameterError(f"grid {shown}: N must be a whole number of points in [1, {most:,}], got {quoted(count)}")
     try:
         low, high = normalize_value(key, start), normalize_value(key, stop)
     except ParameterError as exc:
-        raise ParameterError(f"grid {spec!r}: {exc}") from None
-    if not (math.isfinite(low) and math.isfinite(high)):
-        raise ParameterError(f"grid {spec!r}: START and STOP must be finite numbers")
+        raise ParameterError(f"grid {shown}: {exc}") from None
     return key, np.linspace(low, high, int(count))
 
 
-def product_points(grids: Sequence[tuple[str, Sequence[Any]]]) -> list[dict[str, Any]]:
-    """Every combination of the grids' values; the first grid varies slowest (row-major order)."""
+def product_points(grids: Sequence[tuple[str, Sequence[Any]]], listed: int = 1) -> list[dict[str, Any]]:
+    """Every combination of the grids' values; the first grid varies slowest (row-major order).
+
+    ``listed`` points of a file are combined with each; their product is capped before it is built.
+    """
     keys = [key for key, _ in grids]
     _check_distinct(keys, "grid")
+    check_point_count(listed * math.prod(len(values) for _, values in grids))
     value_lists = [[normalize_value(key, value) for value in values] for key, values in grids]
     return [dict(zip(keys, combination)) for combination in itertools.product(*value_lists)]
+
+
+def check_point_count(count: int) -> None:
+    if count > MAX_SWEEP_POINTS:
+        raise ParameterError(f"sweep: {count:,} points; allowed at most {MAX_SWEEP_POINTS:,} in one sweep")
 
 
 def read_points(path: Path | str) -> list[dict[str, Any]]:
     """The points of a CSV file: a header of canonical keys, one point per row, values with or without units."""
     source = Path(path)
-    try:
-        with source.open(newline="", encoding="utf-8-sig") as stream:  # -sig: spreadsheets write a BOM
-            rows = list(csv.reader(stream))
-    except OSError as exc:
-        raise ParameterError(f"points {source}: cannot read the file ({exc.strerror or exc})") from None
+    rows = read_csv_rows(source, f"points {source}", MAX_SWEEP_POINTS)
     rows = [row for row in rows if any(cell.strip() for cell in row)]
     if len(rows) < 2:
         raise ParameterError(f"points {source}: expected a header of parameter keys and at least one row of values")
@@ -211,8 +218,8 @@ def _check_distinct(keys: Sequence[str], what: str) -> None:
 def plan_sweep(grids: Sequence[str] = (), points_file: Path | str | None = None) -> SweepPlan:
     """The points of ``--grid`` specifications and/or a ``--points`` file (each row times the grid's product)."""
     parsed = [parse_grid(spec) for spec in grids]
-    grid_points = product_points(parsed) if parsed else [{}]
     listed = read_points(points_file) if points_file is not None else [{}]
+    grid_points = product_points(parsed, len(listed)) if parsed else [{}]
     keys = [*listed[0], *(key for key, _ in parsed)]
     if not keys:
         raise ParameterError("sweep: nothing to sweep; give --grid KEY=START:STOP:N or --points FILE.csv")
@@ -231,6 +238,7 @@ def as_plan(grid_points: SweepPlan | Mapping[str, Sequence[Any]] | Sequence[Mapp
     points = [dict(point) for point in grid_points]
     if not points:
         raise ParameterError("sweep: no points to run")
+    check_point_count(len(points))
     keys = tuple(points[0])
     for number, point in enumerate(points, start=1):
         check_known_keys(list(point))
@@ -272,15 +280,20 @@ def sweep_parameters(
     it applies (it falls back to full resolution, and says so, where it does not). A ``solver``
     set in the file or with ``--set`` is respected; ``full_resolution`` asks for the full solver.
     """
-    run_config = load_config(config, preset=preset, overrides=overrides)
-    explicit = "solver" in parse_overrides(overrides) or (config is not None and "solver" in read_config_file(Path(config)))
-    if full_resolution:
-        if explicit and run_config.params.solver != "full":
-            raise ParameterError(f"--full-resolution contradicts solver = {run_config.params.solver!r}")
-        solver = "full"
-    else:
-        solver = run_config.params.solver if explicit else "averaged"
-    return RunConfig(run_config.params.replace(solver=solver), run_config.preset, run_config.source)
+    explicit = _named_solver(config, overrides)
+    if full_resolution and explicit not in (None, "full"):
+        raise ParameterError(f"--full-resolution contradicts solver = {quoted(explicit)}")
+    solver = "full" if full_resolution else "averaged" if explicit is None else explicit
+    # Validated with the solver it will run: the full solver's limits do not apply to an averaged sweep.
+    return load_config(config, preset=preset, overrides=[*overrides, f"solver={solver}"])
+
+
+def _named_solver(config: Path | str | None, overrides: Sequence[str]) -> Any:
+    """The solver that ``--set`` or else the configuration file names, or None."""
+    named = parse_overrides(overrides)
+    if "solver" in named:
+        return named["solver"]
+    return read_config_file(Path(config)).get("solver") if config is not None else None
 
 
 # One point --------------------------------------------------------------------------------------

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -10,7 +9,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .params import ParameterError, field_unit
+from .csvinput import read_csv_rows
+from .limits import MAX_CURVE_POINTS, quoted
+from .params import LONGEST_RUN_S, Bounds, ParameterError, field_unit
 
 PAPER = "Son 2025, Mathematics 13, 446"
 EXPERIMENT = "Takacs & McHenry 2006 (J. Mater. Sci. 41, 5246), one ball, SPEX 8000"
@@ -51,6 +52,7 @@ VIAL_KEYS = ("vial_length", "vial_diameter")
 OPERATING_POINT_TOLERANCE = 0.02
 
 TARGET_KEYS: tuple[str, ...] = tuple(quantity.key for quantity in TABLE5)
+ABSOLUTE_ZERO_C = -273.15
 # The experiment's curve is an exponential with these three numbers: a calibration to the curve fits them.
 CURVE_QUANTITIES = ("theta_inf_C", "tau_min", "rate0_C_per_min")
 # A model that follows the experiment's curve this closely (RMS over the hour) reproduces its shape.
@@ -65,9 +67,37 @@ EXPERIMENT_CURVE_MINUTES = 60
 EXPERIMENT_CURVE_SIGMA_K = 0.5
 
 
+# Targets are matched relative to their values (calibrate.py), so none may be 0; each range spans what a
+# mill can show: θ∞ above 0 °C (a mill at room temperature only heats) up to where steel melts, τ up to
+# a week, heating rates up to 1000 °C/min, and a vial heated up to ten times as much as the ball.
+TARGET_BOUNDS: dict[str, Bounds] = {
+    "theta_inf_C": Bounds(0.0, 1400.0, low_open=True, high_open=False),
+    "tau_min": Bounds(0.0, 1e4, low_open=True, high_open=False),
+    "rate0_C_per_min": Bounds(0.0, 1000.0, low_open=True, high_open=False),
+    "vial_ball_ratio": Bounds(0.0, 10.0, low_open=True, high_open=False),
+}
+
+
+def check_targets(targets: Mapping[str, float]) -> None:
+    """Raise :class:`ParameterError` naming the first target that is unknown, not finite or out of its range."""
+    for name, value in targets.items():
+        if name not in TARGET_BOUNDS:
+            raise ParameterError(f"target: unknown target {quoted(name)}; allowed: {', '.join(TARGET_KEYS)}")
+        if not (math.isfinite(value) and TARGET_BOUNDS[name].contains(value)):
+            raise ParameterError(f"target: {name} = {value:g} is not allowed; allowed {target_range(name)}")
+
+
+def target_range(name: str) -> str:
+    return f"{TARGET_BOUNDS[name]} {quantity(name).unit}".rstrip()
+
+
 @dataclass(frozen=True)
 class Curve:
-    """A measured ball-temperature history: times in s, temperatures in °C."""
+    """A measured ball-temperature history: times in s, temperatures in °C.
+
+    Checked on creation: finite times in [0, the longest run] that increase, finite temperatures above
+    absolute zero, at most :data:`MAX_CURVE_POINTS` points; :class:`ParameterError` names the first point that is not.
+    """
 
     times: np.ndarray
     ball_C: np.ndarray
@@ -75,27 +105,36 @@ class Curve:
     # Measurement error of each point (K) where the curve itself has no scatter to estimate it from.
     sigma_K: float | None = None
 
+    def __post_init__(self) -> None:
+        what = f"curve {self.source}".rstrip()
+        if not 1 <= self.times.size <= MAX_CURVE_POINTS or self.times.shape != self.ball_C.shape:
+            raise ParameterError(
+                f"{what}: {self.times.size} times and {self.ball_C.size} temperatures; allowed 1 to {MAX_CURVE_POINTS:,} of each"
+            )
+        for index, (time, temperature) in enumerate(zip(self.times.tolist(), self.ball_C.tolist())):
+            _check_point(what, index, time, temperature, self.times[index - 1] if index else None)
+
     @classmethod
     def from_csv(cls, path: Path | str) -> Curve:
-        """Read ``time_s`` or ``time_min`` and ``ball_C`` columns (header required)."""
+        """Read ``time_s`` or ``time_min`` and ``ball_C`` columns (header required; other columns ignored)."""
         path = Path(path)
-        try:
-            with path.open(newline="") as handle:
-                rows = list(csv.DictReader(handle))
-        except OSError as exc:
-            raise ParameterError(f"curve: cannot read {path} ({exc.strerror or exc})") from None
-        if not rows:
-            raise ParameterError(f"curve: {path} has no data rows")
-        columns = set(rows[0])
-        if "ball_C" not in columns or not columns & {"time_s", "time_min"}:
-            raise ParameterError(f"curve: {path} needs columns time_s (or time_min) and ball_C, found {sorted(columns)}")
-        scale, column = (1.0, "time_s") if "time_s" in columns else (60.0, "time_min")
-        try:
-            times = np.array([float(row[column]) * scale for row in rows])
-            temperatures = np.array([float(row["ball_C"]) for row in rows])
-        except (TypeError, ValueError):
-            raise ParameterError(f"curve: {path} has a value that is not a number") from None
-        return cls(times, temperatures, str(path))
+        what = f"curve {path}"
+        rows = [row for row in read_csv_rows(path, what, MAX_CURVE_POINTS) if any(cell.strip() for cell in row)]
+        if len(rows) < 2:
+            raise ParameterError(f"{what}: has no data rows")
+        header = [cell.strip() for cell in rows[0]]
+        if "ball_C" not in header or not {"time_s", "time_min"} & set(header):
+            raise ParameterError(f"{what}: needs columns time_s (or time_min) and ball_C, found {quoted(header)}")
+        scale, column = (1.0, "time_s") if "time_s" in header else (60.0, "time_min")
+        times, temperatures = [], []
+        for number, row in enumerate(rows[1:], start=2):
+            cells = dict(zip(header, row))
+            try:
+                times.append(float(cells[column]) * scale)
+                temperatures.append(float(cells["ball_C"]))
+            except (KeyError, ValueError):
+                raise ParameterError(f"{what} line {number}: needs a number in {column} and in ball_C") from None
+        return cls(np.array(times), np.array(temperatures), str(path))
 
     def residuals_K(self, times: np.ndarray, theta_ball_K: np.ndarray) -> np.ndarray:
         """A modelled ball temperature history (s, K) minus this curve at its times (K)."""
@@ -103,6 +142,18 @@ class Curve:
 
     def rms_K(self, times: np.ndarray, theta_ball_K: np.ndarray) -> float:
         return float(np.sqrt(np.mean(self.residuals_K(times, theta_ball_K) ** 2)))
+
+
+def _check_point(what: str, index: int, time: float, temperature: float, previous: float | None) -> None:
+    point = f"point {index + 1}"
+    if not (math.isfinite(time) and 0.0 <= time <= LONGEST_RUN_S):
+        raise ParameterError(f"{what}: {point} is at {time:g} s; allowed times in [0, {LONGEST_RUN_S:g}] s")
+    if previous is not None and time <= previous:
+        raise ParameterError(f"{what}: {point} at {time:g} s does not come after the one before ({previous:g} s); times must increase")
+    if not (math.isfinite(temperature) and temperature > ABSOLUTE_ZERO_C):
+        raise ParameterError(
+            f"{what}: {point} has ball_C = {temperature:g}; allowed a finite temperature above {ABSOLUTE_ZERO_C:g} °C"
+        )
 
 
 def experiment_curve() -> Curve:
