@@ -9,7 +9,6 @@ this machine allows a user namespace, on a small tmpfs mounted for the child alo
 from __future__ import annotations
 
 import errno
-import json
 import os
 import pathlib
 import resource

@@ -31,7 +31,6 @@ from . import model
 from .integrate import REACHED_STOP, STATUS_MESSAGES
 from .params import Parameters
 from .regime import (
-    IRREGULAR,
     MAX_PERIOD,
     MIN_REPEATS,
     NO_IMPACTS,

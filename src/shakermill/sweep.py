@@ -43,7 +43,6 @@ import pandas as pd
 
 from . import __version__
 from .atomic import check_writable_place, create_exclusively, remove_abandoned_writes, write_files_atomically, write_text_atomically
-from .defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from .config import RunConfig, load_config, parse_overrides, read_config_file
 from .csvinput import read_csv_rows
 from .defaults import DEFAULT_SCHEDULER_TIMEOUT_S
