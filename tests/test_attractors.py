@@ -176,8 +176,8 @@ def test_a_start_that_fails_is_reported_not_grouped(monkeypatch):
 
     real_settle = module.settle
 
-    def third_fails(params, start=0):
-        settled = real_settle(params, start)
+    def third_fails(params, start=0, *budget_and_heartbeat):
+        settled = real_settle(params, start, *budget_and_heartbeat)
         if start != 2:
             return settled
         return SettledStart(start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan, {name: values[:0] for name, values in settled.impacts.items()}, "step size too small")

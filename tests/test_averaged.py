@@ -82,3 +82,18 @@ def test_mser_cuts_the_transient() -> None:
     transient = np.linspace(0.5, 0.95, 8)
     assert mser_truncation(np.concatenate([transient, settled])) == pytest.approx(8, abs=1)
     assert mser_truncation(settled) <= 5
+
+
+def test_averaged_solver_reports_the_progress_of_each_phase() -> None:
+    from shakermill.attractors import settle_span
+
+    params = sm.default_parameters(solver="averaged", duration=600.0, attractor_starts=2, record_windows=())
+    reports: list[tuple[float, float]] = []
+    result = sm.simulate(params, progress=lambda done, total: reports.append((done, total)))
+    assert result.success
+    mechanics = [done for done, total in reports if total == params.averaging_max_time]
+    probe = [done for done, total in reports if total == 2 * settle_span(params)]
+    assert len(mechanics) >= params.averaging_min_batches and mechanics == sorted(mechanics)
+    assert (params.duration, params.duration) in reports
+    assert probe == sorted(probe) and probe[-1] == 2 * settle_span(params)
+    assert reports[-1] == (probe[-1], probe[-1])

@@ -220,10 +220,18 @@ def terminal_fixture(monkeypatch) -> io.StringIO:
     return screen
 
 
-def test_progress_bar_is_drawn_on_a_terminal_for_long_runs(terminal):
-    result = cli.simulate_with_progress(sm.default_parameters(duration=60.0, record_windows=()))
+@pytest.mark.parametrize("solver", ["full", "averaged"])
+def test_progress_bar_is_drawn_on_a_terminal_once_a_run_takes_a_while(terminal, monkeypatch, solver):
+    monkeypatch.setattr(cli, "PROGRESS_DELAY_S", 0.0)
+    result = cli.simulate_with_progress(sm.default_parameters(solver=solver, duration=60.0, attractor_starts=2, record_windows=()))
     assert result.success
     assert "s simulated" in terminal.getvalue()
+
+
+def test_a_quick_run_draws_no_progress_bar(terminal):
+    result = cli.simulate_with_progress(sm.default_parameters(duration=2.0, record_windows=()))
+    assert result.success
+    assert terminal.getvalue() == ""
 
 
 def test_sweep_progress_bar_shows_points_done_running_and_failed(terminal, tmp_path):
@@ -463,13 +471,14 @@ def start_up_s(tmp_path_factory) -> float:
     return time.monotonic() - started
 
 
-def interrupt_after(command: list[str], after_s: float) -> str:
-    """Run ``command``, send it SIGINT after ``after_s`` seconds, and return its stderr once it exited with 130."""
+def interrupt_after(command: list[str], after_s: float, exits_within_s: float = 120.0) -> str:
+    """Run ``command``, send it SIGINT after ``after_s`` seconds, and return its stderr once it exited with 130
+    (within ``exits_within_s`` of the signal)."""
     process = subprocess.Popen([str(SHAKERMILL), *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(after_s)
     assert process.poll() is None, f"{command[0]} ended before it could be interrupted"
     process.send_signal(signal.SIGINT)
-    _, stderr = process.communicate(timeout=120)
+    _, stderr = process.communicate(timeout=exits_within_s)
     assert process.returncode == 130, stderr
     assert len(stderr.strip().splitlines()) == 1 and "Traceback" not in stderr, stderr
     return stderr
@@ -499,6 +508,39 @@ def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up
     stderr = interrupt_after([*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0)
     assert stderr.startswith("error: interrupted; nothing was written")
     assert list(tmp_path.iterdir()) == []
+
+
+# A vacuum vial (~1 mPa): the air node's time constant falls to ~1e-8 s, and the steps with it. One chunk
+# of a full run (10 simulated s) is then ~10⁹ steps, a batch of the averaged solver's mechanics ~10⁸.
+TINY_STEPS = ["--set", "air_density=1e-8", "--set", "record_windows="]
+
+
+@pytest.mark.parametrize(
+    "command, first_words",
+    [
+        (["run", "--set", "solver=full", "--set", "duration=60", "--no-plots", "--out", "{out}"], "interrupted:"),
+        (["run", "--set", "solver=averaged", "--no-plots", "--out", "{out}"], "error: interrupted; nothing was written"),
+        (["bifurcation", "--grid", "omega=100:120:2", "--out", "{out}"], "error: interrupted; nothing was written"),
+        (["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", "{out}.toml"], "error: interrupted; nothing was written"),
+    ],
+    ids=["full run", "averaged run", "bifurcation", "calibrate"],
+)
+def test_real_ctrl_c_stops_a_run_stuck_on_tiny_steps_at_once(tmp_path, start_up_s, command, first_words):
+    # Before the compiled loop handed control back within a chunk, the signal waited for minutes.
+    arguments = [argument.replace("{out}", str(tmp_path / "out")) for argument in command]
+    stderr = interrupt_after([*arguments, *TINY_STEPS], start_up_s + 2.0, exits_within_s=30.0)
+    assert stderr.startswith(first_words)
+
+
+def test_a_run_that_uses_up_its_budget_keeps_its_folder_and_exits_1(tmp_path):
+    out = tmp_path / "run"
+    result = invoke("run", *SHORT, "--set", "max_steps=1000", "--no-plots", "--out", str(out))
+    assert result.exit_code == 1
+    assert "max_steps = 1000" in result.stdout  # the status row of the usual table
+    errors = [line for line in result.stderr.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and "--set max_steps=2000" in errors[0] and str(out) in errors[0]
+    summary = load_run(out).summary
+    assert summary["status"] == -4 and summary["steps"] == 1000
 
 
 def test_run_onto_a_run_folder_is_refused_unless_overwrite(tmp_path):

@@ -116,9 +116,9 @@ def test_bifurcation_stops_at_ctrl_c_inside_a_run(monkeypatch) -> None:
     real_simulate = simulate_module.simulate
     calls = []
 
-    def interrupted_second_run(params):
+    def interrupted_second_run(params, **budget):
         calls.append(params.omega)
-        result = real_simulate(params)
+        result = real_simulate(params, **budget)
         if len(calls) == 2:
             result.status = INTERRUPTED
         return result

@@ -23,12 +23,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
 from . import model
-from .integrate import REACHED_STOP, STATUS_MESSAGES
+from .budget import RunBudget
+from .integrate import REACHED_STOP
 from .params import Parameters
 from .regime import (
     MAX_PERIOD,
@@ -41,7 +42,7 @@ from .regime import (
     period_signatures,
     signatures_match,
 )
-from .simulate import Result, impact_columns, integrator_for, summarize
+from .simulate import ProgressCallback, Result, impact_columns, integrator_for, summarize
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -154,7 +155,12 @@ class AttractorScan:
     def warnings(self) -> list[str]:
         """One line per other attractor with a different heat power, and one per failed start."""
         lines = [_difference_warning(attractor, self.configured, len(self.settled)) for attractor in self.differing()]
-        lines += [f"attractor probe: start {start.start} did not settle ({start.message})" for start in self.failed]
+        # One line per reason: once a run's budget is spent, every start left fails for it.
+        failed_for: dict[str, list[str]] = {}
+        for start in self.failed:
+            failed_for.setdefault(start.message, []).append(str(start.start))
+        for message, starts in failed_for.items():
+            lines.append(f"attractor probe: start{'s' if len(starts) > 1 else ''} {', '.join(starts)} did not settle ({message})")
         return lines
 
     def table(self) -> pd.DataFrame:
@@ -233,21 +239,32 @@ def initial_states(params: Parameters, count: int) -> list[tuple[float, float]]:
     return states
 
 
-def settle(params: Parameters, start: int = 0) -> SettledStart:
+def settle_span(params: Parameters) -> float:
+    """Simulated seconds :func:`settle` integrates: SETTLE_PERIODS and MEASURE_PERIODS drive periods."""
+    return (SETTLE_PERIODS + MEASURE_PERIODS) * 2.0 * math.pi / params.omega
+
+
+def settle(
+    params: Parameters,
+    start: int = 0,
+    budget: RunBudget | None = None,
+    heartbeat: Callable[[float], None] | None = None,
+) -> SettledStart:
     """Settle the mechanics of ``params`` from its initial state and measure the motion it reached.
 
     The whole state is integrated, but only the motion is used (temperatures do not act back on it).
-    Ctrl-C raises ``KeyboardInterrupt``.
+    A spent ``budget`` (``params``' own if None) makes the start ``FAILED`` with the budget's message;
+    ``heartbeat(t)`` is called while steps are tiny. Ctrl-C raises ``KeyboardInterrupt``.
     """
     period = 2.0 * math.pi / params.omega
     settled_at = SETTLE_PERIODS * period
     boundaries = settled_at + period * np.arange(MEASURE_PERIODS + 1)
-    integrator = integrator_for(params.replace(record_windows=()), sample_times=boundaries)
-    status = integrator.advance(boundaries[-1])
+    integrator = integrator_for(params.replace(record_windows=()), sample_times=boundaries, budget=budget)
+    status = integrator.advance(boundaries[-1], heartbeat)
     if status != REACHED_STOP:
         return SettledStart(
             start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan,
-            {"time": np.empty(0), "wall": np.empty(0, dtype=str)}, STATUS_MESSAGES[status],
+            {"time": np.empty(0), "wall": np.empty(0, dtype=str)}, integrator.explain(status),
         )
     columns = impact_columns(integrator.impacts, params.lam)
     kept = columns["time"] >= settled_at
@@ -287,13 +304,25 @@ def attach(result: Result, scan: AttractorScan) -> None:
     result.summary = summarize(result)
 
 
-def find_attractors(params: Parameters) -> AttractorScan:
-    """Settle ``params.attractor_starts`` initial states and group them into attractors."""
-    settled = tuple(
-        settle(params.replace(ball_position=position, ball_momentum=momentum), index)
-        for index, (position, momentum) in enumerate(initial_states(params, params.attractor_starts))
-    )
-    return AttractorScan(settled, group(settled, params.omega, params.phase))
+def find_attractors(
+    params: Parameters, budget: RunBudget | None = None, progress: ProgressCallback | None = None
+) -> AttractorScan:
+    """Settle ``params.attractor_starts`` initial states and group them into attractors.
+
+    One ``budget`` (``params``' own if None) covers all the starts; once it is spent, the remaining
+    starts fail at once. ``progress(done, total)`` is told the simulated seconds settled, over all starts.
+    """
+    budget = budget if budget is not None else RunBudget.of(params)
+    starts = initial_states(params, params.attractor_starts)
+    span = settle_span(params)
+    total = len(starts) * span
+    settled = []
+    for index, (position, momentum) in enumerate(starts):
+        heartbeat = None if progress is None else lambda t, before=index * span: progress(before + t, total)
+        settled.append(settle(params.replace(ball_position=position, ball_momentum=momentum), index, budget, heartbeat))
+        if heartbeat is not None:
+            heartbeat(span)
+    return AttractorScan(tuple(settled), group(tuple(settled), params.omega, params.phase))
 
 
 def group(settled: tuple[SettledStart, ...], omega: float, phase: float) -> tuple[Attractor, ...]:

@@ -33,13 +33,15 @@ from scipy.integrate import solve_ivp
 
 from . import model
 from .attractors import attach, find_attractors
+from .budget import RunBudget
 from .fit import fit_exponential
-from .integrate import COUNTER_NAMES, REACHED_STOP, STATUS_MESSAGES, Integrator
+from .integrate import BUDGET_EXCEEDED, COUNTER_NAMES, REACHED_STOP, Integrator
 from .params import Parameters
 from .simulate import (
     EnergyAudit,
     ProgressCallback,
     Result,
+    assemble,
     conclude,
     impact_columns,
     integrator_for,
@@ -121,10 +123,11 @@ def _standard_error(values: np.ndarray) -> float:
     return float(values.std(ddof=1) / math.sqrt(values.size)) if values.size > 1 else math.inf
 
 
-def measure_mechanics(params: Parameters, integrator: Integrator) -> MechanicsWindow:
+def measure_mechanics(params: Parameters, integrator: Integrator, progress: ProgressCallback | None = None) -> MechanicsWindow:
     """Integrate the mechanics batch by batch until the averages converge (or the time bound is hit).
 
     Returns the averages with the integrator, which holds the impacts and windows of that stretch.
+    ``progress(t, averaging_max_time)`` is told how far the mechanics has got.
     """
     batch_length = params.averaging_batch_periods * 2.0 * math.pi / params.omega
     heat = [float(integrator.y[model.HEAT_GENERATED])]
@@ -135,11 +138,14 @@ def measure_mechanics(params: Parameters, integrator: Integrator) -> MechanicsWi
     converged, message = False, ""
     heat_rates = term_rates = np.empty(0)
     cut = 0
+    heartbeat = None if progress is None else lambda t: progress(t, params.averaging_max_time)
     while True:
-        status = integrator.advance(integrator.t + batch_length)
+        status = integrator.advance(integrator.t + batch_length, heartbeat)
         if status != REACHED_STOP:
-            message = f"the mechanics failed: {STATUS_MESSAGES[status]}"
+            message = f"the mechanics failed: {integrator.explain(status)}"
             break
+        if heartbeat is not None:
+            heartbeat(integrator.t)
         heat.append(float(integrator.y[model.HEAT_GENERATED]))
         dissipated.append(float(integrator.y[model.DISSIPATED]))
         velocity_term.append(float(integrator.y[model.VELOCITY_TERM]))
@@ -270,34 +276,54 @@ def impacts_of_window(integrator: Integrator, lam: float, transient: float) -> d
     return {name: values[kept] for name, values in columns.items()}
 
 
-def simulate_averaged(params: Parameters, progress: ProgressCallback | None = None) -> Result:
+def simulate_averaged(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
     """Run ``params`` with the multiscale solver (module docstring); same :class:`Result` as a full run.
 
     The run follows the configured start. With ``attractor_starts`` > 1 the other starts are settled
     too (:mod:`shakermill.attractors`, ~0.02 s each): the summary counts the attractors, and a warning
     names every one whose heat power differs from the configured start's by more than 1 %. The
     result's wall time is the solver's own: the probe is an analysis beside it, as in a full run.
+    One ``budget`` (``params``' own if None) covers the mechanics, a fall-back and the probe.
+    ``progress(done, total)`` is told the simulated seconds of each phase in turn.
     """
-    result = _simulate_configured_start(params, progress)
-    if params.attractor_starts > 1:
-        attach(result, find_attractors(params))
+    budget = budget if budget is not None else RunBudget.of(params)
+    result = _simulate_configured_start(params, progress, budget)
+    if params.attractor_starts > 1 and result.status != BUDGET_EXCEEDED:
+        _probe_attractors(result, budget, progress)
     return result
 
 
-def _simulate_configured_start(params: Parameters, progress: ProgressCallback | None) -> Result:
+def _probe_attractors(result: Result, budget: RunBudget, progress: ProgressCallback | None) -> None:
+    """Attach the attractors of the run's parameters; a probe that used up the budget makes the run stopped."""
+    scan = find_attractors(result.params, budget, progress)
+    attach(result, scan)
+    if budget.reason is not None and result.success:
+        result.status = BUDGET_EXCEEDED
+        result.message = (
+            f"{budget.reason} It ran out while probing attractors ({len(scan.failed)} of {len(scan.settled)} starts "
+            "not settled); the run itself finished."
+        )
+        result.summary = summarize(result)
+
+
+def _simulate_configured_start(params: Parameters, progress: ProgressCallback | None, budget: RunBudget) -> Result:
     started = time.perf_counter()
-    integrator = integrator_for(params, sample_times=np.empty(0))
-    mechanics = measure_mechanics(params, integrator)
+    # The start's state as a sample: a run stopped in the mechanics phase then shows where it began.
+    integrator = integrator_for(params, sample_times=np.zeros(1), budget=budget)
+    mechanics = measure_mechanics(params, integrator, progress)
+    if mechanics.status == BUDGET_EXCEEDED:
+        return _stopped_in_mechanics(params, mechanics)
     averages = mechanics.averages
     problem = validity_problem(params, averages)
     if problem is not None:
-        return _refuse(params, mechanics, problem, progress, started)
+        return _refuse(params, mechanics, problem, progress, budget, started)
     times = sample_times(params)
     thermal = integrate_thermal_network(params, averages, times)
     if progress is not None:
         progress(params.duration, params.duration)
     if not thermal.success:
-        return _refuse(params, mechanics, f"the thermal network solver failed: {thermal.message}", progress, started)
+        problem = f"the thermal network solver failed: {thermal.message}"
+        return _refuse(params, mechanics, problem, progress, budget, started)
     constants = integrator.constants
     states = averaged_states(params, averages, thermal.t, thermal.y)
     window_points = integrator.window_points
@@ -342,18 +368,37 @@ def _simulate_configured_start(params: Parameters, progress: ProgressCallback | 
     return conclude(result, averages.heat_power, averages.velocity_term)
 
 
+def _stopped_in_mechanics(params: Parameters, mechanics: MechanicsWindow) -> Result:
+    """The budget ran out in the mechanics phase: what it integrated, as a full run of that stretch."""
+    integrator = mechanics.integrator
+    message = (
+        f"{integrator.explain(BUDGET_EXCEEDED)} Stopped in the averaged solver's mechanics phase at t = "
+        f"{integrator.t:.6g} s; the motion and impacts up to then are kept."
+    )
+    y0 = model.initial_state(params)
+    result = assemble(params, integrator.constants, y0, integrator, BUDGET_EXCEEDED, message, mechanics.wall_time)
+    result.solver, result.averages = "averaged", mechanics.averages
+    result.summary = summarize(result)
+    return result
+
+
 def _refuse(
-    params: Parameters, mechanics: MechanicsWindow, problem: str, progress: ProgressCallback | None, started: float
+    params: Parameters,
+    mechanics: MechanicsWindow,
+    problem: str,
+    progress: ProgressCallback | None,
+    budget: RunBudget,
+    started: float,
 ) -> Result:
     """Averaging is not valid: fall back to full resolution, or fail, as ``averaging_fallback`` says."""
     if params.averaging_fallback == "fail":
         reason = f"Averaging is not valid: {problem}. Set averaging_fallback = 'full' to run at full resolution."
-        result = simulate_full(params.replace(duration=mechanics.integrator.t), progress=None)
+        result = simulate_full(params.replace(duration=mechanics.integrator.t), progress=None, budget=budget)
         result.status, result.message = AVERAGING_FAILED, reason
         result.solver, result.averages = "averaged", mechanics.averages
         result.summary = summarize(result)
         return result
-    result = simulate_full(params, progress)
+    result = simulate_full(params, progress, budget)
     result.message = f"Averaging is not valid ({problem}); ran at full resolution instead. {result.message}"
     result.averages = mechanics.averages
     result.wall_time = time.perf_counter() - started

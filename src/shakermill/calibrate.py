@@ -24,7 +24,7 @@ import math
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 import tomli_w
@@ -230,8 +230,13 @@ def calibrate(
     curve: Curve | None = None,
     *,
     full_resolution: bool = False,
+    progress: Callable[[int], None] | None = None,
 ) -> Calibration:
-    """Fit ``free`` keys of ``base`` to ``targets`` and/or ``curve``; see the module docstring."""
+    """Fit ``free`` keys of ``base`` to ``targets`` and/or ``curve``; see the module docstring.
+
+    ``progress(evaluations)`` is called after every model evaluation. A run that uses up its budget
+    stops the fit (:class:`~shakermill.budget.BudgetExceeded`): its partial result is no evaluation.
+    """
     targets = dict(targets or {})
     check_targets(targets)
     if not targets and curve is None:
@@ -255,6 +260,8 @@ def calibrate(
             params = fitting.replace(**{name: float(math.exp(v)) for name, v in zip(free, x)})
             result = simulate_whole(params)
             cache[key] = (_residuals(result, targets, curve), result)
+            if progress is not None:
+                progress(len(cache))
         return cache[key]
 
     solution = least_squares(

@@ -1,11 +1,13 @@
 """The ``shakermill`` command line: parse, call the library, write files. No physics here.
 
-Exit codes: 0 success; 1 the integrator stopped early (the run folder is still
-written); 2 bad input (one ``error: ...`` line on stderr, no traceback); 130
-interrupted by the user (partial results are written).
+Exit codes: 0 success; 1 the run ended with a failed status: the integrator
+stopped early, the run used up its budget (``max_wall_time``, ``max_steps``) or
+its results cannot be trusted (the run folder is still written); 2 bad input
+(one ``error: ...`` line on stderr, no traceback); 130 interrupted by the user
+(partial results are written).
 
-A progress bar is drawn on stderr for runs of at least a minute of simulated
-time, and only when stderr is a terminal, so pipes and logs stay clean.
+A progress bar is drawn on stderr once a run has taken a second, and only when
+stderr is a terminal, so pipes and logs stay clean.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import gc
 import json
 import math
 import sys
+import time
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
@@ -29,6 +32,7 @@ from rich.text import Text
 # pandas, xarray, SciPy or Matplotlib. Each command imports what it uses.
 from . import __version__
 from .atomic import StorageError, check_writable_place
+from .budget import BudgetExceeded
 from .config import load_config
 from .defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
 from .limits import MAX_BIFURCATION_VALUES
@@ -56,7 +60,8 @@ if TYPE_CHECKING:
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
-PROGRESS_MIN_DURATION_S = 60.0
+# A run's or a fit's progress bar appears once it has taken this long (s): quick ones end without a flicker.
+PROGRESS_DELAY_S = 1.0
 FIGURES_FOLDER = "figures"
 PIPED_TABLE_WIDTH = 160
 DEFAULT_RESULTS_FOLDER = Path("results")
@@ -137,6 +142,15 @@ def _writing(target: Path, what: str) -> Iterator[None]:
         yield
     except OSError as exc:
         _fail(f"{target}: cannot write {what} ({exc.strerror or exc})")
+
+
+@contextmanager
+def _nothing_written_when_a_run_is_stopped(what: str) -> Iterator[None]:
+    """A run of a scan or fit used up its budget: one line and exit code 1, as a failed run."""
+    try:
+        yield
+    except BudgetExceeded as exc:
+        _fail(f"{what} stopped, nothing was written: {exc}", EXIT_FAILED_RUN)
 
 
 # Options shared by several commands, declared once.
@@ -229,19 +243,25 @@ def timestamped_folder(kind: str) -> Path:
 
 
 def simulate_with_progress(params: Parameters) -> Result:
-    """``simulate``, with a transient progress bar on stderr for long runs when stderr is a terminal."""
+    """``simulate``, with a transient progress bar on stderr once the run takes a while, when stderr is a terminal.
+
+    The bar counts the simulated seconds of each phase in turn: the averaged solver's mechanics (out of
+    averaging_max_time), the whole duration, then its attractor probe (all starts together).
+    """
     from .simulate import simulate
 
-    if params.duration < PROGRESS_MIN_DURATION_S:
-        return simulate(params)
-    with _progress_bar("simulating", "{task.completed:.0f}/{task.total:.0f} s simulated", params.duration) as update:
-        return simulate(params, progress=None if update is None else lambda t, _duration: update(t))
+    counter = "{task.completed:.5g}/{task.total:.5g} s simulated"
+    with _progress_bar("simulating", counter, params.duration, delay_s=PROGRESS_DELAY_S) as update:
+        return simulate(params, progress=None if update is None else lambda done, total: update(done, total=total))
 
 
 @contextmanager
-def _progress_bar(verb: str, counter: str, total: float, **fields: Any) -> Iterator[Callable[..., None] | None]:
+def _progress_bar(
+    verb: str, counter: str, total: float | None, delay_s: float = 0.0, **fields: Any
+) -> Iterator[Callable[..., None] | None]:
     """``update(completed, **fields)`` of a transient progress bar with an ETA on stderr; None when stderr is not a terminal.
 
+    The bar shows from the first update ``delay_s`` seconds after the start, or at once without a delay.
     Pipes and logs stay clean: a bar redrawn many times a second would fill them.
     """
     console = Console(stderr=True)
@@ -249,9 +269,24 @@ def _progress_bar(verb: str, counter: str, total: float, **fields: Any) -> Itera
         yield None
         return
     columns = (TextColumn(verb), BarColumn(), TextColumn(counter), TimeRemainingColumn())
-    with Progress(*columns, console=console, transient=True) as bar:
-        task = bar.add_task(verb, total=total, **fields)
-        yield lambda completed, **updates: bar.update(task, completed=completed, **updates)
+    bar = Progress(*columns, console=console, transient=True)
+    task = bar.add_task(verb, total=total, **fields)
+    shown_from = time.monotonic() + delay_s
+
+    def show_when_due() -> None:
+        if not bar.live.is_started and time.monotonic() >= shown_from:
+            bar.start()
+
+    def update(completed: float, **updates: Any) -> None:
+        bar.update(task, completed=completed, **updates)
+        show_when_due()
+
+    show_when_due()
+    try:
+        yield update
+    finally:
+        if bar.live.is_started:
+            bar.stop()
 
 
 def _write(
@@ -356,15 +391,15 @@ def compare_solvers(
     json_output: JsonOption = False,
 ) -> None:
     """Run the same configuration with the full and the averaged solver; print both, the differences and the speed ratio."""
-    from .simulate import simulate
     from .storage import to_jsonable
 
     with _user_errors():
         params = load_config(config, preset=preset, overrides=settings or []).params
         # The full solver has limits of its own (the drive periods it keeps every impact of).
         full_params, averaged_params = params.replace(solver="full"), params.replace(solver="averaged")
-    full = simulate_with_progress(full_params)
-    averaged = simulate(averaged_params)
+    with _nothing_written_when_interrupted("compare-solvers writes no files"):
+        full = _uninterrupted(simulate_with_progress(full_params))
+        averaged = _uninterrupted(simulate_with_progress(averaged_params))
     rows = [
         (label, unit, full.summary[key], averaged.summary[key], averaged.summary[key] - full.summary[key])
         for key, label, unit in COMPARED_QUANTITIES
@@ -379,14 +414,27 @@ def compare_solvers(
             "speed_ratio": speed_ratio,
         }
         typer.echo(json.dumps(to_jsonable(payload), sort_keys=True, allow_nan=False))
-        return
-    table = Table("quantity", "full", "averaged", "averaged − full", "unit", title="full vs averaged solver")
-    for label, unit, full_value, averaged_value, difference in rows:
-        _add_plain_row(table, label, _number(full_value, ".4g"), _number(averaged_value, ".4g"), _number(difference, "+.3g"), unit)
-    console = _stdout_console()
-    console.print(table)
-    console.print(Text(f"averaged solver: {averaged.message}"))
-    console.print(Text(f"speed ratio full/averaged: {speed_ratio:.0f}x"))
+    else:
+        table = Table("quantity", "full", "averaged", "averaged − full", "unit", title="full vs averaged solver")
+        for label, unit, full_value, averaged_value, difference in rows:
+            _add_plain_row(table, label, _number(full_value, ".4g"), _number(averaged_value, ".4g"), _number(difference, "+.3g"), unit)
+        console = _stdout_console()
+        console.print(table)
+        console.print(Text(f"averaged solver: {averaged.message}"))
+        console.print(Text(f"speed ratio full/averaged: {speed_ratio:.0f}x"))
+    for result in (full, averaged):
+        if not result.success:
+            typer.echo(f"error: the {result.params.solver} run did not finish cleanly: {result.message}", err=True)
+            raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def _uninterrupted(result: Result) -> Result:
+    """``result``, unless Ctrl-C cut it short: a comparison with part of a run means nothing."""
+    from .simulate import INTERRUPTED
+
+    if result.status == INTERRUPTED:
+        raise KeyboardInterrupt
+    return result
 
 
 @app.command()
@@ -653,9 +701,9 @@ def bifurcation(
     target = out if out is not None else timestamped_folder("bifurcation")
     with _user_errors():
         check_target(target, overwrite=overwrite, kind=BIFURCATION_FOLDER)
-    with _nothing_written_when_interrupted("a scan is quick to repeat"), _progress_bar(
-        "scanning", "{task.completed}/{task.total} runs", len(values)
-    ) as update:
+    with _nothing_written_when_interrupted("a scan is quick to repeat"), _nothing_written_when_a_run_is_stopped(
+        "the scan"
+    ), _progress_bar("scanning", "{task.completed}/{task.total} runs", len(values)) as update:
         scan = regime_scan(run_config.params, values, key, progress=None if update is None else lambda done, _total: update(done))
 
     def fill(folder: Path) -> None:
@@ -866,8 +914,12 @@ def calibrate(
             raise ParameterError(f"out: {out} exists; choose another --out, or add --overwrite to replace it")
         if out is not None:
             check_writable_place(out)
-        with _nothing_written_when_interrupted("the fit starts again from the beginning"):
-            calibration = fit_parameters(run_config.params, free_keys, targets, measured, full_resolution=full_resolution)
+        with _nothing_written_when_interrupted("the fit starts again from the beginning"), _nothing_written_when_a_run_is_stopped(
+            "the fit"
+        ), _progress_bar("fitting", "{task.completed} model evaluations", None, delay_s=PROGRESS_DELAY_S) as update:
+            calibration = fit_parameters(
+                run_config.params, free_keys, targets, measured, full_resolution=full_resolution, progress=update
+            )
     if out is not None:
         command = "shakermill calibrate " + " ".join(sys.argv[2:])
         fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]

@@ -23,22 +23,26 @@ Contacts are events of the mechanics, handled in the compiled loop:
 * One record per impact is written when the ball leaves the wall.
 
 Everything runs in chunks (:meth:`Integrator.advance`), so a caller can show
-progress and keep what was computed when interrupted.
+progress and keep what was computed when interrupted. Within a chunk the
+compiled loop also hands control back about every CALL_SECONDS of wall time, so
+that tiny steps cannot hold off Ctrl-C, the run's budget or progress.
 """
 
 from __future__ import annotations
 
 import signal
 import threading
+import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Iterator
+from typing import Callable, Iterator
 
 import numpy as np
 from numba import njit
 
 from . import drive
+from .budget import RunBudget
 from .contact import elastic_energy, hertz_contact_time, hertz_max_overlap
 from .model import (
     DISSIPATED,
@@ -62,6 +66,16 @@ REACHED_STOP = 0
 NOT_FINITE = -1
 OVERLAP_TOO_LARGE = -2
 STEP_UNDERFLOW = -3
+# Checked between compiled calls (Integrator.advance), not in the loop: the run's budget (RunBudget.reason
+# says which limit) and the size of the record windows.
+BUDGET_EXCEEDED = -4
+WINDOWS_FULL = -7
+# Every step inside a record window is kept: ~1000 rows a simulated second at the defaults (35 min of
+# windows fit, 4 min at rtol 1e-6), but tiny steps would fill memory and disk (a vacuum vial,
+# air_density = 1e-8, takes 1.7e8 steps a second). 2·10⁶ rows are ~220 MB, in memory and in windows.nc.
+MAX_WINDOW_POINTS = 2_000_000
+# Not an outcome: the loop took the steps it was allowed and hands control back mid-chunk.
+_PAUSED = 2
 
 STATUS_MESSAGES = {
     REACHED_STOP: "The solver reached the end of the integration interval.",
@@ -71,7 +85,20 @@ STATUS_MESSAGES = {
         "this impact speed (check ball_youngs_modulus and vial_youngs_modulus), or the step control failed."
     ),
     STEP_UNDERFLOW: "The step size fell below the resolution of the time variable.",
+    BUDGET_EXCEEDED: "The run used up its budget (max_wall_time or max_steps).",
+    WINDOWS_FULL: (
+        f"The record windows filled the {MAX_WINDOW_POINTS:,} points (~220 MB) a run keeps of them: the steps "
+        "inside them are tiny. Shorten record_windows, or leave it empty, to run on."
+    ),
 }
+
+# Wall time (s) a compiled call aims at before it hands control back to Python. The steps it may take
+# adapt to this: a step costs ~0.5 µs in flight, but up to ~0.4 ms where the contact search is hard
+# (ω ~ 1e5 rad/s), so no fixed count keeps Ctrl-C prompt. After its first call a default run's 10-s
+# chunks (~10⁴ steps, ~5 ms) end long before the adapted count, so it makes no further calls.
+CALL_SECONDS = 0.1
+FIRST_STEPS_PER_CALL = 1_000
+MAX_STEPS_PER_CALL = 10_000_000
 
 # Columns of the impact records.
 IMPACT_COLUMNS = (
@@ -449,9 +476,10 @@ def _advance(
     t_stop, clock, y, f0, a, b, error_weights, c, k, rtol, atol, origin, contact_step_limit, max_overlap,
     safety, min_factor, max_factor, error_exponent,
     sample_times, samples, windows, window_buffer, impact_buffer, impact, counters,
-    project_energy, diagnostics,
+    project_energy, diagnostics, steps_allowed,
 ):
-    """Integrate from ``clock[0]`` to ``t_stop``; see :meth:`Integrator.advance`. Returns (status, buffers)."""
+    """Integrate from ``clock[0]`` to ``t_stop``, or for ``steps_allowed`` accepted steps (status _PAUSED)
+    if that comes first; see :meth:`Integrator.advance`. Returns (status, buffers)."""
     n = y.shape[0]
     stages = np.empty((c.shape[0], n))
     y_new = np.empty(n)
@@ -463,6 +491,7 @@ def _advance(
     drive_period = 2.0 * np.pi / k.omega
     t = clock[0]
     h = clock[1]
+    last_step = counters[STEPS] + steps_allowed
     rejected_last = False
     while t < t_stop:
         in_contact = impact[_ACTIVE] != 0.0
@@ -603,8 +632,12 @@ def _advance(
                 h = max(h, drive_period)
         else:
             h = min(contact_step_limit, _shortest_contact_step(impact[_SPEED_IN], k))
+        if counters[STEPS] == last_step:
+            # After an accepted step: t, h and the state in the arrays are all the next call needs, and
+            # rejected_last is False as on entry, so a pause leaves the integration bit for bit unchanged.
+            break
     clock[0], clock[1] = t, h
-    return REACHED_STOP, window_buffer, impact_buffer
+    return (REACHED_STOP if t >= t_stop else _PAUSED), window_buffer, impact_buffer
 
 
 @dataclass
@@ -621,6 +654,7 @@ class Integrator:
     controller: StepController = field(default_factory=StepController)
     initial_step: float = 1e-5
     project_energy: bool = True
+    budget: RunBudget = field(default_factory=RunBudget.unlimited)
 
     def __post_init__(self) -> None:
         self._a, self._b, self._error_weights, self._c = self.tableau.arrays()
@@ -635,6 +669,7 @@ class Integrator:
         self.counters = np.zeros(6, dtype=np.int64)
         self.counters[RHS_EVALUATIONS] = 1
         self.diagnostics = np.zeros(2)
+        self._steps_per_call = FIRST_STEPS_PER_CALL
 
     @property
     def energy_correction(self) -> float:
@@ -649,11 +684,39 @@ class Integrator:
     def t(self) -> float:
         return float(self.clock[0])
 
-    def advance(self, t_stop: float) -> int:
+    def advance(self, t_stop: float, heartbeat: Callable[[float], None] | None = None) -> int:
         """Integrate up to ``t_stop``; returns a status code (see ``STATUS_MESSAGES``).
 
-        Ctrl-C during the call raises ``KeyboardInterrupt`` once the compiled loop has returned.
+        The compiled loop runs in calls of about CALL_SECONDS each. Before every call the budget and
+        the record windows' size are checked: a spent budget ends the integration with BUDGET_EXCEEDED
+        (:meth:`explain` says which limit), full windows with WINDOWS_FULL.
+        After a call that stopped short of ``t_stop``, ``heartbeat(t)`` is called. Ctrl-C during a call
+        raises ``KeyboardInterrupt`` once it has returned.
         """
+        while (limit := self._limit_reached()) is None:
+            steps_before = int(self.counters[STEPS])
+            started = time.perf_counter()
+            status = self._compiled_call(t_stop, min(self._steps_per_call, self.budget.steps_left))
+            steps = int(self.counters[STEPS]) - steps_before
+            self.budget.steps += steps
+            if status != _PAUSED:
+                return status
+            self._steps_per_call = _steps_for_call_seconds(steps, time.perf_counter() - started)
+            if heartbeat is not None:
+                heartbeat(self.t)
+        return limit
+
+    def _limit_reached(self) -> int | None:
+        """BUDGET_EXCEEDED or WINDOWS_FULL when the integration may not go on, else None."""
+        if self.budget.spent():
+            return BUDGET_EXCEEDED
+        return WINDOWS_FULL if self.counters[WINDOW_POINTS] >= MAX_WINDOW_POINTS else None
+
+    def explain(self, status: int) -> str:
+        """The message of ``status``; for BUDGET_EXCEEDED, which limit was reached and how to raise it."""
+        return str(self.budget.reason) if status == BUDGET_EXCEEDED else STATUS_MESSAGES[status]
+
+    def _compiled_call(self, t_stop: float, steps_allowed: int) -> int:
         with _interrupt_after_compiled_code():
             status, self._window_buffer, self._impact_buffer = _advance(
                 t_stop, self.clock, self.y, self.f, self._a, self._b, self._error_weights, self._c, self.constants,
@@ -661,7 +724,7 @@ class Integrator:
                 self.tolerances.max_overlap, self.controller.safety, self.controller.min_factor,
                 self.controller.max_factor, -1.0 / (self.tableau.error_order + 1),
                 self.sample_times, self.samples, self.windows, self._window_buffer, self._impact_buffer,
-                self._impact, self.counters, self.project_energy, self.diagnostics,
+                self._impact, self.counters, self.project_energy, self.diagnostics, steps_allowed,
             )
         return int(status)
 
@@ -678,6 +741,12 @@ class Integrator:
     @property
     def impacts(self) -> np.ndarray:
         return self._impact_buffer[: self.counters[IMPACTS]].copy()
+
+
+def _steps_for_call_seconds(steps: int, seconds: float) -> int:
+    """The steps that take about CALL_SECONDS at the rate of the last call (``steps`` in ``seconds``)."""
+    rate = steps / max(seconds, 1e-9)
+    return int(min(max(rate * CALL_SECONDS, 1.0), MAX_STEPS_PER_CALL))
 
 
 @contextmanager

@@ -167,6 +167,14 @@ class Parameters(BaseModel):
         strict=True,
         json_schema_extra={"description": "enforce the mechanical energy balance of each contact step by projection"},
     )
+    # Budget of one run (shakermill.budget): beyond either limit it stops with a non-ok status, keeping its results
+    max_wall_time: float = _quantity(
+        "s", "wall-clock budget of one run, its mechanics phase, fall-back and attractor probe included", gt=0
+    )
+    max_steps: int = Field(
+        gt=0,
+        json_schema_extra={"unit": "", "description": "step budget of one run: accepted integrator steps, all its integrations together"},
+    )
     # Solver choice (full resolution, or the multiscale averaged solver)
     solver: Literal["full", "averaged"] = Field(
         json_schema_extra={"description": "'full': every impact for the whole run; 'averaged': mechanics until its statistics converge, then the slow thermal network"}
@@ -473,6 +481,16 @@ SPEX_8000M = Preset(
             "speed; ~0.02 s of mechanics each",
         ),
         "energy_projection": Cited(True, "numerical choice: projection method (Hairer, Lubich & Wanner 2006, §IV.4)"),
+        "max_wall_time": Cited(
+            3600.0,
+            "numerical choice: an hour; the default 60-min run takes ~3 s, the same at rtol 1e-6 ~20 s, and 10⁹ steps "
+            "(max_steps) ~10-20 min",
+        ),
+        "max_steps": Cited(
+            1_000_000_000,
+            "numerical choice: ~290 simulated hours at the defaults (3.4 million steps an hour), ~30 h at rtol 1e-6; "
+            "beyond it the steps are tiny (a stiff node or an extreme drive)",
+        ),
         "model": Cited("three_node", f"{PAPER}: ball, vial and inner air as three lumped reservoirs"),
         "no_tension": Cited(False, "MODEL.md section 2: the total force is not clipped by default"),
         "heat_model": Cited("relative", "MODEL.md section 3: frame-invariant dissipation c·ζ̇²"),

@@ -137,18 +137,23 @@ def bifurcation(
     averaged solver's mechanics phase, transient cut by MSER, or the second half of a full run).
     ``attractors`` and ``phases`` come from ``base.attractor_starts`` starts settled at full
     resolution (:mod:`shakermill.attractors`); the phase of an impact is ωt + φ (mod 2π) with the ω
-    of that run. Ctrl-C during a run raises ``KeyboardInterrupt``.
+    of that run. Ctrl-C during a run raises ``KeyboardInterrupt``, a run that uses up its budget
+    :class:`~shakermill.budget.BudgetExceeded` naming the value.
     """
     import pandas as pd
 
     from .attractors import probed
+    from .budget import BudgetExceeded
     from .simulate import simulate_whole
 
     if len(values) > MAX_BIFURCATION_VALUES:
         raise ParameterError(f"bifurcation: {len(values):,} values; allowed at most {MAX_BIFURCATION_VALUES:,}")
     regimes, attractors, phases = [], [], []
     for index, value in enumerate(values):
-        result = simulate_whole(base.replace(**{key: float(value)}))
+        try:
+            result = simulate_whole(base.replace(**{key: float(value)}))
+        except BudgetExceeded as exc:
+            raise BudgetExceeded(f"at {key} = {float(value):g}: {exc}") from None
         scan = probed(result)
         label, period = classify(result)
         regimes.append(

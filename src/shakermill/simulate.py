@@ -11,12 +11,13 @@ from typing import TYPE_CHECKING, Callable, Mapping
 import numpy as np
 
 from . import contact, model
+from .budget import BudgetExceeded, RunBudget
 from .fit import ExponentialFit, fit_exponential, increment_ratio
 from .integrate import (
+    BUDGET_EXCEEDED,
     COUNTER_NAMES,
     IMPACT_COLUMNS,
     REACHED_STOP,
-    STATUS_MESSAGES,
     Integrator,
     Tolerances,
 )
@@ -35,13 +36,22 @@ if TYPE_CHECKING:
 RAYLEIGH_FRACTION = 0.9
 # A contact overlap beyond this fraction of the ball radius means the step control failed (issue: "a few percent").
 MAX_OVERLAP_FRACTION = 0.05
-# Simulated seconds per compiled chunk: the granularity of progress reports and of interruption.
+# Simulated seconds per chunk: the granularity of progress reports (tiny steps hand back control sooner,
+# see integrate.CALL_SECONDS). Chunk ends shorten a step, so this is part of what makes a run's numbers.
 CHUNK_SECONDS = 10.0
 
 INTERRUPTED = 1
 INTERRUPTED_MESSAGE = "Interrupted by the user; the results cover the time simulated so far."
 # The run finished, but a temperature left the range where the model means anything.
 OUT_OF_PHYSICAL_BOUNDS = -5
+# The run finished, but its energy audit does not close within ENERGY_AUDIT_TOLERANCE.
+ENERGY_AUDIT_FAILED = -6
+# Relative residual of the energy audit above which a run's heat and temperatures are not to be trusted.
+# With the energy projection the balance closes to round-off (~1e-11 over the operating range, presets
+# included); without it, it shows the contacts' truncation error: 0.2–0.8 % at the default rtol for
+# e ≤ 0.7, 5 % at e = 0.95, 9 % at rtol 0.1. A ball so light (ball_density = 1e-6) that its energies fall
+# below the temperature tolerance left 55–77 % of the heat unaccounted for.
+ENERGY_AUDIT_TOLERANCE = 1e-2
 
 ProgressCallback = Callable[[float, float], None]
 
@@ -89,7 +99,9 @@ class EnergyAudit:
 
     @property
     def relative_residual(self) -> float:
-        """|residual| over the largest flow in the balance (0 when nothing flowed)."""
+        """|residual| over the largest flow in the balance (0 when nothing flowed, NaN when a term is not finite)."""
+        if not math.isfinite(self.residual):
+            return math.nan
         scale = max(abs(self.work_by_vial), abs(self.dissipated), abs(self.heat_generated))
         return abs(self.residual) / scale if scale > 0.0 else 0.0
 
@@ -196,27 +208,31 @@ def sample_times(params: Parameters) -> np.ndarray:
     return times
 
 
-def simulate(params: Parameters, progress: ProgressCallback | None = None) -> Result:
-    """Run ``params`` with the solver it names (``params.solver``): see :func:`simulate_full` and
-    :func:`shakermill.averaged.simulate_averaged`."""
+def simulate(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
+    """Run ``params`` with the solver it names (``params.solver``), within ``budget`` (``params``' own if None):
+    see :func:`simulate_full` and :func:`shakermill.averaged.simulate_averaged`."""
     if params.solver == "averaged":
         from .averaged import simulate_averaged  # the averaged solver builds on this module
 
-        return simulate_averaged(params, progress)
-    return simulate_full(params, progress)
+        return simulate_averaged(params, progress, budget)
+    return simulate_full(params, progress, budget)
 
 
 def simulate_whole(params: Parameters) -> Result:
     """:func:`simulate` for callers built on many runs (scans, fits): Ctrl-C raises ``KeyboardInterrupt``
-    instead of returning a partial result they would use as if it were whole."""
-    result = simulate(params)
+    and a spent budget :class:`~shakermill.budget.BudgetExceeded` (saying which limit) instead of
+    returning a partial result they would use as if it were whole."""
+    budget = RunBudget.of(params)
+    result = simulate(params, budget=budget)
     if result.status == INTERRUPTED:
         raise KeyboardInterrupt
+    if result.status == BUDGET_EXCEEDED:
+        raise BudgetExceeded(str(budget.reason))
     return result
 
 
-def integrator_for(params: Parameters, sample_times: np.ndarray) -> Integrator:
-    """A compiled integrator set up for ``params`` from its initial state."""
+def integrator_for(params: Parameters, sample_times: np.ndarray, budget: RunBudget | None = None) -> Integrator:
+    """A compiled integrator set up for ``params`` from its initial state, within ``budget`` (a fresh one if None)."""
     constants = model.constants_from(params)
     windows = np.array([(start, start + length) for start, length in params.record_windows], dtype=float).reshape(-1, 2)
     return Integrator(
@@ -227,36 +243,39 @@ def integrator_for(params: Parameters, sample_times: np.ndarray) -> Integrator:
         sample_times=sample_times,
         windows=windows,
         project_energy=params.energy_projection,
+        budget=budget if budget is not None else RunBudget.of(params),
     )
 
 
-def simulate_full(params: Parameters, progress: ProgressCallback | None = None) -> Result:
-    """Run the full-resolution model for ``params.duration`` seconds.
+def simulate_full(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
+    """Run the full-resolution model for ``params.duration`` seconds, within ``budget`` (``params``' if None).
 
-    ``progress(t, duration)`` is called after every chunk of simulated time. A
-    ``KeyboardInterrupt`` ends the run early with status ``INTERRUPTED`` and
-    keeps everything computed so far; numerical failures are reported through
+    ``progress(t, duration)`` is called after every chunk of simulated time, and
+    more often when steps are tiny. A ``KeyboardInterrupt`` ends the run early
+    with status ``INTERRUPTED`` and keeps everything computed so far; a spent
+    budget (``BUDGET_EXCEEDED``) and numerical failures are reported through
     ``status`` and ``message`` likewise, never raised.
     """
-    integrator = integrator_for(params, sample_times(params))
+    integrator = integrator_for(params, sample_times(params), budget)
     y0 = integrator.y.copy()
     started = time.perf_counter()
     status = REACHED_STOP
+    heartbeat = None if progress is None else lambda t: progress(t, params.duration)
     try:
         while integrator.t < params.duration and status == REACHED_STOP:
-            status = integrator.advance(min(params.duration, integrator.t + CHUNK_SECONDS))
-            if progress is not None:
-                progress(integrator.t, params.duration)
+            status = integrator.advance(min(params.duration, integrator.t + CHUNK_SECONDS), heartbeat)
+            if heartbeat is not None:
+                heartbeat(integrator.t)
     except KeyboardInterrupt:
         status = INTERRUPTED
     wall_time = time.perf_counter() - started
-    message = INTERRUPTED_MESSAGE if status == INTERRUPTED else STATUS_MESSAGES[status]
+    message = INTERRUPTED_MESSAGE if status == INTERRUPTED else integrator.explain(status)
     if status < 0:
         message = f"{message} Stopped at t = {integrator.t:.6g} s; results up to then are kept."
-    return _assemble(params, integrator.constants, y0, integrator, status, message, wall_time)
+    return assemble(params, integrator.constants, y0, integrator, status, message, wall_time)
 
 
-def _assemble(
+def assemble(
     params: Parameters,
     constants: model.Constants,
     y0: np.ndarray,
@@ -265,6 +284,7 @@ def _assemble(
     message: str,
     wall_time: float,
 ) -> Result:
+    """The result of a full-resolution integration from ``y0`` to where ``integrator`` stands."""
     t_end = integrator.t
     written = integrator.samples_written
     times = integrator.sample_times[:written]
@@ -299,7 +319,7 @@ def _assemble(
 
 
 def conclude(result: Result, heat_power: float, velocity_term: float) -> Result:
-    """Steady state, physical bounds and warnings of a finished run of either solver, then its summary.
+    """Steady state, physical bounds, energy audit and warnings of a finished run of either solver, then its summary.
 
     ``heat_power`` (W) and ``velocity_term`` are the means of the settled motion that drive the
     thermal network (MODEL.md §11).
@@ -307,12 +327,15 @@ def conclude(result: Result, heat_power: float, velocity_term: float) -> Result:
     params = result.params
     result.steady = steady_state(params, heat_power, velocity_term)
     result.warnings.extend(unit_slip_warnings(params))
-    for line in (run_length_warning(result.t_end, result.steady), steady_state_bound_warning(result)):
+    lines = (run_length_warning(result.t_end, result.steady), steady_state_bound_warning(result), fit_warning(result))
+    for line in lines:
         if line is not None:
             result.warnings.append(line)
-    problem = physical_bounds_problem(result)
-    if problem is not None and result.status == REACHED_STOP:
-        result.status, result.message = OUT_OF_PHYSICAL_BOUNDS, problem
+    checks = ((OUT_OF_PHYSICAL_BOUNDS, physical_bounds_problem), (ENERGY_AUDIT_FAILED, energy_audit_problem))
+    for status, problem_of in checks:
+        problem = problem_of(result) if result.status == REACHED_STOP else None
+        if problem is not None:
+            result.status, result.message = status, problem
     result.summary = summarize(result)
     return result
 
@@ -332,6 +355,30 @@ def physical_bounds_problem(result: Result) -> str | None:
     if coldest < 0.0:
         return f"A temperature fell to {coldest:.4g} K, below absolute zero: the thermal network is not physical here."
     return None
+
+
+def energy_audit_problem(result: Result) -> str | None:
+    """Why the energy audit of a run says its heat cannot be trusted, or None."""
+    residual = result.energy.relative_residual
+    if residual <= ENERGY_AUDIT_TOLERANCE:
+        return None
+    projection = "leave energy_projection on" if result.params.energy_projection else "turn energy_projection on"
+    return (
+        f"The energy audit does not close: its relative residual is {residual:.3g}, above {ENERGY_AUDIT_TOLERANCE:g}, "
+        "so the heat and the temperatures of this run cannot be trusted. Tighten rtol and the absolute tolerances "
+        f"(atol_temperature where the energies are very small), {projection}, and check the inputs."
+    )
+
+
+def fit_warning(result: Result) -> str | None:
+    """A line when the exponential fit of the ball temperature failed: the summary's θ∞, τ and θ̇₀ then mean nothing."""
+    fit = result.ball_fit
+    if fit.success:
+        return None
+    return (
+        f"the exponential fit of the ball temperature failed ({fit.message}): theta_inf_C, tau_min and "
+        "rate0_C_per_min are not usable"
+    )
 
 
 def steady_state_bound_warning(result: Result) -> str | None:

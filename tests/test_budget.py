@@ -1,0 +1,149 @@
+"""The run's budget (max_wall_time, max_steps), the compiled loop's pauses, and results that cannot be trusted."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import shakermill as sm
+from shakermill import integrate
+from shakermill.budget import BudgetExceeded
+from shakermill.integrate import BUDGET_EXCEEDED, WINDOWS_FULL
+from shakermill.simulate import (
+    ENERGY_AUDIT_FAILED,
+    ENERGY_AUDIT_TOLERANCE,
+    EnergyAudit,
+    integrator_for,
+    sample_times,
+    simulate_full,
+    simulate_whole,
+)
+
+# A vacuum vial: the air node's time constant falls to ~1e-8 s and the explicit steps follow it.
+TINY_STEPS = {"air_density": 1e-8, "record_windows": ()}
+
+
+def test_a_step_budget_stops_the_run_exactly_and_keeps_what_it_computed() -> None:
+    result = sm.simulate(sm.default_parameters(duration=20.0, record_windows=((0.0, 1.0),), max_steps=5000))
+    assert result.status == BUDGET_EXCEEDED and not result.success
+    assert result.summary["steps"] == 5000
+    assert "max_steps = 5000" in result.message and "--set max_steps=10000" in result.message
+    assert 1.0 < result.t_end < 20.0
+    assert result.history.times[-1] == result.t_end and result.history.times[0] == 0.0
+    assert result.impact_count > 100 and len(result.window_history.times) > 100
+
+
+def test_a_wall_clock_budget_stops_a_long_run_between_chunks() -> None:
+    # Normal steps: the chunks (10 simulated s each) end long before any pause, so the clock is read there.
+    result = sm.simulate(sm.default_parameters(duration=36000.0, record_windows=(), max_wall_time=0.05))
+    assert result.status == BUDGET_EXCEEDED
+    assert "max_wall_time = 0.05 s" in result.message and "--set max_wall_time=0.1" in result.message
+    assert 0.0 < result.t_end < 36000.0
+    assert result.impact_count > 0
+
+
+def test_pauses_of_the_compiled_loop_leave_a_run_bit_for_bit_unchanged(monkeypatch) -> None:
+    params = sm.default_parameters(duration=3.0, record_windows=((0.0, 0.5), (2.0, 0.3)))
+    whole = simulate_full(params)
+    monkeypatch.setattr(integrate, "FIRST_STEPS_PER_CALL", 7)
+    monkeypatch.setattr(integrate, "MAX_STEPS_PER_CALL", 7)
+    reports: list[float] = []
+    paused = simulate_full(params, progress=lambda t, _duration: reports.append(t))
+    assert len(reports) > whole.counters["steps"] // 7 - 1
+    assert paused.counters == whole.counters
+    for name in ("x", "p", "theta_ball", "theta_vial", "theta_air", "heat_generated"):
+        np.testing.assert_array_equal(paused.history[name], whole.history[name])
+        np.testing.assert_array_equal(paused.window_history[name], whole.window_history[name])
+    np.testing.assert_array_equal(paused.window_history.times, whole.window_history.times)
+    for name, values in whole.impact_columns.items():
+        np.testing.assert_array_equal(paused.impact_columns[name], values)
+
+
+def test_tiny_steps_hand_control_back_inside_a_chunk() -> None:
+    params = sm.default_parameters(duration=10.0, max_steps=3000, **TINY_STEPS)
+    integrator = integrator_for(params, sample_times(params))
+    heartbeats: list[float] = []
+    status = integrator.advance(10.0, heartbeats.append)
+    # The first call takes FIRST_STEPS_PER_CALL steps, the next the rest of the budget; then it is spent.
+    assert status == BUDGET_EXCEEDED
+    assert len(heartbeats) == 2 and 0.0 < heartbeats[0] < heartbeats[1] == integrator.t < 0.1
+    assert int(integrator.counters[integrate.STEPS]) == 3000
+    assert "max_steps = 3000" in integrator.explain(status)
+
+
+def test_one_budget_covers_the_averaged_solvers_mechanics_phase() -> None:
+    result = sm.simulate(sm.default_parameters(solver="averaged", max_steps=3000, record_windows=()))
+    assert result.status == BUDGET_EXCEEDED and result.solver == "averaged"
+    assert "mechanics phase" in result.message
+    assert result.summary["steps"] == 3000
+    assert list(result.history.times) == [0.0, result.t_end] and result.impact_count > 0
+
+
+def test_a_probe_that_uses_up_the_budget_stops_an_averaged_run_that_finished() -> None:
+    base = sm.default_parameters(solver="averaged", duration=600.0, record_windows=())
+    mechanics_steps = sm.simulate(base.replace(attractor_starts=1)).summary["steps"]
+    result = sm.simulate(base.replace(attractor_starts=4, max_steps=mechanics_steps + 1000))
+    assert result.status == BUDGET_EXCEEDED
+    assert "probing attractors (4 of 4 starts not settled); the run itself finished" in result.message
+    assert result.t_end == 600.0 and result.summary["attractor_failed_starts"] == 4
+    probe_lines = [line for line in result.warnings if line.startswith("attractor probe")]
+    assert len(probe_lines) == 1 and probe_lines[0].startswith("attractor probe: starts 0, 1, 2, 3 did not settle")
+
+
+def test_scans_and_fits_are_told_of_a_spent_budget_by_an_exception() -> None:
+    with pytest.raises(BudgetExceeded, match="max_steps = 2000"):
+        simulate_whole(sm.default_parameters(duration=20.0, max_steps=2000, record_windows=()))
+
+
+def test_full_record_windows_stop_the_run_instead_of_filling_memory(monkeypatch) -> None:
+    monkeypatch.setattr(integrate, "MAX_WINDOW_POINTS", 50)
+    # The size is checked between calls: short calls make the check as fine as the test needs.
+    monkeypatch.setattr(integrate, "FIRST_STEPS_PER_CALL", 10)
+    monkeypatch.setattr(integrate, "MAX_STEPS_PER_CALL", 10)
+    result = sm.simulate(sm.default_parameters(duration=20.0, record_windows=((0.0, 5.0),)))
+    assert result.status == WINDOWS_FULL
+    assert "Shorten record_windows" in result.message and result.t_end < 5.0
+    assert 50 <= len(result.window_history.times) <= 70
+
+
+def test_a_run_whose_energy_audit_does_not_close_is_not_ok() -> None:
+    # Without the projection the audit shows the contacts' truncation error: ~9 % at rtol 0.1.
+    result = sm.simulate(sm.default_parameters(duration=5.0, rtol=0.1, energy_projection=False, record_windows=()))
+    residual = result.energy.relative_residual
+    assert residual > ENERGY_AUDIT_TOLERANCE
+    assert result.status == ENERGY_AUDIT_FAILED and not result.success
+    assert f"{residual:.3g}" in result.message and f"above {ENERGY_AUDIT_TOLERANCE:g}" in result.message
+    assert result.t_end == 5.0
+
+
+@pytest.mark.parametrize(
+    "preset, overrides",
+    [
+        ("spex8000m", {}),
+        ("spex8000m-calibrated", {}),
+        ("spex8000m", {"solver": "averaged", "attractor_starts": 1}),
+        ("spex8000m", {"energy_projection": False}),
+    ],
+    ids=["default", "calibrated", "averaged", "no projection"],
+)
+def test_presets_close_their_energy_audit_well_within_the_tolerance(preset: str, overrides: dict) -> None:
+    result = sm.simulate(sm.default_parameters(preset, duration=120.0, record_windows=(), **overrides))
+    assert result.success, result.message
+    assert result.energy.relative_residual < ENERGY_AUDIT_TOLERANCE
+
+
+def test_an_audit_with_a_non_finite_term_has_no_relative_residual() -> None:
+    terms = dict.fromkeys(EnergyAudit.__dataclass_fields__, 0.0)
+    closed = EnergyAudit(**terms)
+    broken = EnergyAudit(**{**terms, "stored_ball": math.nan})
+    assert closed.relative_residual == 0.0
+    assert math.isnan(broken.relative_residual)
+
+
+def test_a_failed_fit_is_said_in_a_warning() -> None:
+    # Started at rest with a stroke shorter than the free gap, the ball is never hit: nothing heats.
+    result = sm.simulate(sm.default_parameters(amplitude=1e-3, duration=5.0, record_windows=()))
+    assert result.success and not result.ball_fit.success
+    assert any(line.startswith("the exponential fit of the ball temperature failed") for line in result.warnings)
