@@ -169,10 +169,13 @@ class Parameters(BaseModel):
     )
     # Budget of one run (shakermill.budget): beyond either limit it stops with a non-ok status, keeping its results
     max_wall_time: float = _quantity(
-        "s", "wall-clock budget of one run, its mechanics phase, fall-back and attractor probe included", gt=0
+        "s", "wall-clock budget of one run, its mechanics phase, fall-back and attractor probe included", gt=0,
+        le=LONGEST_RUN_S,  # a budget beyond the longest simulated run is no budget
     )
     max_steps: int = Field(
         gt=0,
+        le=10**12,  # at ~0.5 µs a step, about a week of computing
+
         json_schema_extra={"unit": "", "description": "step budget of one run: accepted integrator steps, all its integrations together"},
     )
     # Solver choice (full resolution, or the multiscale averaged solver)
