@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, NoReturn, Sequence
 
 import typer
+from typer.core import TyperGroup
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
@@ -66,7 +67,30 @@ FIGURES_FOLDER = "figures"
 PIPED_TABLE_WIDTH = 160
 DEFAULT_RESULTS_FOLDER = Path("results")
 
+class OneLineUsageErrors(TyperGroup):
+    """typer's command group, with its own usage errors (an unknown option or command, a value of the
+    wrong type or outside an option's range) as one ``error:`` line and exit code 2, like every other
+    bad input: typer draws them in a box over several lines, which scripts and logs read badly."""
+
+    def main(self, args: Sequence[str] | None = None, *rest: Any, standalone_mode: bool = True, **extra: Any) -> Any:
+        arguments = sys.argv[1:] if args is None else list(args)
+        if not standalone_mode or not arguments:  # no arguments: typer shows the help, as it should
+            return super().main(args, *rest, standalone_mode=standalone_mode, **extra)
+        try:
+            outcome = super().main(arguments, *rest, standalone_mode=False, **extra)
+        except typer.Abort:
+            _fail("aborted", EXIT_FAILED_RUN)
+        except Exception as exc:
+            # Click's usage errors, told by what they carry: typer vendors Click and exports none of its classes.
+            if getattr(exc, "exit_code", None) != EXIT_USAGE or not hasattr(exc, "format_message"):
+                raise
+            typer.echo(f"error: {' '.join(exc.format_message().splitlines())}", err=True)
+            sys.exit(EXIT_USAGE)
+        sys.exit(outcome if isinstance(outcome, int) else 0)
+
+
 app = typer.Typer(
+    cls=OneLineUsageErrors,
     name="shakermill",
     help="Simulate a high-energy shaker mill (SPEX 8000M type): ball motion, impacts and temperatures.",
     no_args_is_help=True,
@@ -584,7 +608,7 @@ def sweep(
         str | None, typer.Option("--scheduler", metavar="ADDRESS", help="Run on this Dask distributed scheduler (tcp://host:8786).")
     ] = None,
     scheduler_timeout: Annotated[
-        float, typer.Option("--scheduler-timeout", min=0.1, metavar="SECONDS", help="Give up connecting to the scheduler after this long.")
+        float, typer.Option("--scheduler-timeout", min=0.1, max=86400.0, metavar="SECONDS", help="Give up connecting to the scheduler after this long.")
     ] = DEFAULT_SCHEDULER_TIMEOUT_S,
     keep_runs: Annotated[bool, typer.Option("--keep-runs", help="Also write each point's run folder under DIR/runs.")] = False,
     full_resolution: FullResolutionOption = False,
