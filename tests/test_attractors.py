@@ -9,19 +9,9 @@ import pandas as pd
 import pytest
 
 import shakermill as sm
-from shakermill.attractors import (
-    FAILED,
-    AttractorScan,
-    MEASURE_PERIODS,
-    POSITION_SPREAD,
-    SettledStart,
-    find_attractors,
-    group,
-    initial_states,
-    settle,
-)
-from shakermill.regime import IRREGULAR, NO_IMPACTS, PHASE_TOLERANCE
-from shakermill.sweep import sweep
+from shakermill.analysis.attractors import FAILED, AttractorScan, MEASURE_PERIODS, POSITION_SPREAD, SettledStart, find_attractors, group, initial_states, settle
+from shakermill.analysis.regime import IRREGULAR, NO_IMPACTS, PHASE_TOLERANCE
+from shakermill.studies.sweep import sweep
 
 # A stroke of 23 mm, just above the free gap of 22.65 mm: period-1 and period-2 coexist at every ω of
 # 90–130 rad/s, at rtol 1e-3 and at 1e-5 alike. At the default 25 mm and ω = 110 rad/s all starts
@@ -172,7 +162,7 @@ def test_resting_starts_are_one_attractor_and_failed_starts_none():
 
 
 def test_a_start_that_fails_is_reported_not_grouped(monkeypatch):
-    from shakermill import attractors as module
+    from shakermill.analysis import attractors as module
 
     real_settle = module.settle
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.averaged import AVERAGING_FAILED, mser_truncation
+from shakermill.solvers.averaged import AVERAGING_FAILED, mser_truncation
 
 NUDGE_SPEED = 1.0  # m/s: with amplitudes below the free gap a ball at rest is never hit
 
@@ -85,7 +85,7 @@ def test_mser_cuts_the_transient() -> None:
 
 
 def test_averaged_solver_reports_the_progress_of_each_phase() -> None:
-    from shakermill.attractors import settle_span
+    from shakermill.analysis.attractors import settle_span
 
     params = sm.default_parameters(solver="averaged", duration=600.0, attractor_starts=2, record_windows=())
     reports: list[tuple[float, float]] = []

@@ -8,18 +8,13 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill import integrate
-from shakermill.budget import BudgetExceeded
-from shakermill.integrate import BUDGET_EXCEEDED, WINDOWS_FULL
-from shakermill.simulate import (
-    ENERGY_AUDIT_FAILED,
-    ENERGY_AUDIT_TOLERANCE,
-    EnergyAudit,
-    integrator_for,
-    sample_times,
-    simulate_full,
-    simulate_whole,
-)
+from shakermill.engines.one_d import integrator as integrate
+from shakermill.engines.budget import BudgetExceeded
+from shakermill.engines.one_d.integrator import BUDGET_EXCEEDED, WINDOWS_FULL
+from shakermill.solvers.result import ENERGY_AUDIT_FAILED, ENERGY_AUDIT_TOLERANCE, EnergyAudit
+from shakermill.engines.one_d.setup import integrator_for, sample_times
+from shakermill.solvers.full import simulate_full
+from shakermill.solvers.simulate import simulate_whole
 
 # The tightest tolerances allowed: ~30,000 steps per simulated second, so a 10-s chunk is ~3·10⁵ steps.
 TINY_STEPS = {

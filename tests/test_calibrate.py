@@ -6,19 +6,10 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.calibrate import (
-    DEFAULT_FREE,
-    DEFENSIBLE_RANGES,
-    calibrate,
-    free_set_study,
-    log_bounds,
-    parse_free,
-    parse_targets,
-    write_preset,
-)
-from shakermill.config import load_config
-from shakermill.params import PRESETS, ParameterError
-from shakermill.validation import CURVE_TOLERANCE_K, TABLE5, Curve, experiment_curve
+from shakermill.studies.calibrate import DEFAULT_FREE, DEFENSIBLE_RANGES, calibrate, free_set_study, log_bounds, parse_free, parse_targets, write_preset
+from shakermill.parameters.config import load_config
+from shakermill.parameters.schema import PRESETS, ParameterError
+from shakermill.studies.validation import CURVE_TOLERANCE_K, TABLE5, Curve, experiment_curve
 
 TABLE5_TARGETS = {entry.key: entry.experiment for entry in TABLE5 if entry.key != "vial_ball_ratio"}
 

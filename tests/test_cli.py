@@ -19,12 +19,12 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
-from shakermill.calibrate import DEFAULT_FREE
-from shakermill.config import load_config
-from shakermill.params import FIELD_NAMES
-from shakermill.simulate import INTERRUPTED
-from shakermill.storage import RUN_FILES, load_run
-from shakermill.sweep import load_sweep
+from shakermill.studies.calibrate import DEFAULT_FREE
+from shakermill.parameters.config import load_config
+from shakermill.parameters.schema import FIELD_NAMES
+from shakermill.solvers.result import INTERRUPTED
+from shakermill.io.runs import RUN_FILES, load_run
+from shakermill.studies.sweep import load_sweep
 
 # Short runs with small windows keep every invocation well under a second once Numba's cache is warm.
 SHORT = ["--set", "duration=2", "--set", "record_windows=0:0.2"]
@@ -49,8 +49,8 @@ REQUIRED_SUMMARY_KEYS = {
     "output_dir",
 }
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
-# The module, not the function that shadows it as ``shakermill.simulate``; the command line calls it there.
-SIMULATE_MODULE = importlib.import_module("shakermill.simulate")
+# The module whose ``simulate`` the command line calls.
+SIMULATE_MODULE = importlib.import_module("shakermill.solvers.simulate")
 
 runner = CliRunner()
 
@@ -607,7 +607,7 @@ def test_report_onto_an_existing_file_is_refused_unless_overwrite(tmp_path):
 def test_calibrate_onto_an_existing_preset_file_is_refused_unless_overwrite(tmp_path, monkeypatch):
     preset_file = tmp_path / "fitted.toml"
     preset_file.write_text("# an earlier fit\n")
-    calibrate_module = importlib.import_module("shakermill.calibrate")
+    calibrate_module = importlib.import_module("shakermill.studies.calibrate")
     monkeypatch.setattr(calibrate_module, "calibrate", lambda *_args, **_kwargs: pytest.fail("must not fit"))
     arguments = ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", str(preset_file)]
     refused = invoke(*arguments)

@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from shakermill import params as params_module
-from shakermill.config import load_config, parse_overrides, write_config_toml
-from shakermill.params import DEFAULT_PRESET, Cited, ParameterError, Preset, default_parameters
+from shakermill.parameters import schema as params_module
+from shakermill.parameters.config import load_config, parse_overrides, write_config_toml
+from shakermill.parameters.schema import DEFAULT_PRESET, Cited, ParameterError, Preset, default_parameters
 
 
 def write_toml(tmp_path: Path, text: str, name: str = "run.toml") -> Path:

@@ -15,7 +15,7 @@ import math
 import pytest
 from scipy.integrate import solve_ivp
 
-from shakermill import contact
+from shakermill.physics import contact
 
 RADIUS = 6.35e-3
 DENSITY = 7800.0

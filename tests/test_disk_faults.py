@@ -23,9 +23,9 @@ import pytest
 from typer.testing import CliRunner
 
 from shakermill import cli
-from shakermill.atomic import PARTIAL, create_exclusively, partial_path, remove_abandoned_writes, this_machine
-from shakermill.storage import load_run
-from shakermill.sweep import MANIFEST_FILE, load_sweep
+from shakermill.support.atomic import PARTIAL, create_exclusively, partial_path, remove_abandoned_writes, this_machine
+from shakermill.io.runs import load_run
+from shakermill.studies.sweep import MANIFEST_FILE, load_sweep
 
 # One simulated second without record windows: the run folder is ~50 kB, written in a second.
 RUN = ["run", "--set", "duration=1", "--set", "record_windows=", "--set", "attractor_starts=1", "--no-plots"]
@@ -294,7 +294,7 @@ def test_a_killed_write_leaves_a_partial_folder_that_the_next_write_removes(tmp_
     script = textwrap.dedent(
         f"""\
         import os, signal
-        from shakermill.storage import write_folder
+        from shakermill.io.runs import write_folder
 
         def killed_midway(folder):
             (folder / "timeseries.nc").write_bytes(b"half a file")

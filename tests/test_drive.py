@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from shakermill import drive
+from shakermill.physics import kinematics as drive
 
 # SPEX 8000M drive of MODEL.md §9: X_v = 25 mm, ω = 111 rad/s, l_v = 58 mm.
 AMPLITUDE = 25e-3

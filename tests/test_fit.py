@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from shakermill.fit import ExponentialFit, exponential_approach, fit_exponential, increment_ratio
+from shakermill.analysis.fit import ExponentialFit, exponential_approach, fit_exponential, increment_ratio
 
 THETA_0 = 293.15  # 20 °C
 # The paper's model (Table 5): θ_∞ = 47.89 °C, τ = 16.70 min

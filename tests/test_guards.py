@@ -9,8 +9,8 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
-from shakermill.params import ParameterError, unit_slip_warnings
-from shakermill.simulate import OUT_OF_PHYSICAL_BOUNDS
+from shakermill.parameters.schema import ParameterError, unit_slip_warnings
+from shakermill.solvers.result import OUT_OF_PHYSICAL_BOUNDS
 
 runner = CliRunner()
 

@@ -1,7 +1,7 @@
 """Right-hand side of the one-ball model (MODEL.md §§1–6) against hand computations.
 
 Every expected value here is recomputed from the formulas of MODEL.md with plain arithmetic on the
-raw parameter fields (never with the functions of shakermill.contact or shakermill.thermal).
+raw parameter fields (never with the functions of shakermill.physics.contact or shakermill.physics.thermal).
 """
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from shakermill import model
-from shakermill.params import Parameters, default_parameters
+from shakermill.engines.one_d import model
+from shakermill.parameters.schema import Parameters, default_parameters
 
 # The thermal state used throughout (K)
 THETA_B, THETA_V, THETA_A = 320.0, 300.0, 305.0

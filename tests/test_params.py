@@ -10,19 +10,7 @@ import pytest
 
 import shakermill as sm
 from conftest import PAPER_TOML, SHARED_PAPER_TOML
-from shakermill.params import (
-    FIELD_NAMES,
-    PRESETS,
-    SPEX_8000M,
-    Bounds,
-    ParameterError,
-    Parameters,
-    allowed_range,
-    bounds,
-    build_parameters,
-    default_parameters,
-    preset_values,
-)
+from shakermill.parameters.schema import FIELD_NAMES, PRESETS, SPEX_8000M, Bounds, ParameterError, Parameters, allowed_range, bounds, build_parameters, default_parameters, preset_values
 
 @pytest.fixture(scope="module")
 def defaults() -> Parameters:

@@ -17,28 +17,9 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
-from shakermill.params import DEFAULT_PRESET
-from shakermill.plotting import (
-    IMPACT_FIGURES,
-    PAPER_FIGURES,
-    SWEEP_QUANTITIES,
-    bifurcation_figure,
-    contour_notes,
-    heating_zoom_figure,
-    heating_zoom_window,
-    impact_figures,
-    motion_figure,
-    parse_contour,
-    plot_run,
-    png_bytes,
-    rate_bin_edges,
-    run_figures,
-    sweep_context,
-    sweep_figures,
-    temperature_figure,
-    window_data,
-)
-from shakermill.storage import load_run, write_run
+from shakermill.parameters.schema import DEFAULT_PRESET
+from shakermill.views.figures import IMPACT_FIGURES, PAPER_FIGURES, SWEEP_QUANTITIES, bifurcation_figure, contour_notes, heating_zoom_figure, heating_zoom_window, impact_figures, motion_figure, parse_contour, plot_run, png_bytes, rate_bin_edges, run_figures, sweep_context, sweep_figures, temperature_figure, window_data
+from shakermill.io.runs import load_run, write_run
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 ALL_FIGURES = ("ball_heating_zoom", "ball_motion", "temperatures")
@@ -249,9 +230,9 @@ def test_png_bytes_is_a_png(result):
 def test_matplotlib_is_imported_lazily_and_pyplot_never():
     script = (
         "import sys\n"
-        "import shakermill as sm, shakermill.cli, shakermill.report\n"
+        "import shakermill as sm, shakermill.cli, shakermill.views.report\n"
         "assert 'matplotlib' not in sys.modules, 'imported at package import'\n"
-        "from shakermill.plotting import run_figures\n"
+        "from shakermill.views.figures import run_figures\n"
         "run = sm.simulate(sm.default_parameters(duration=0.5, record_windows='0:0.2'))\n"
         "run_figures(run, impacts=True)\n"
         "assert 'matplotlib' in sys.modules\n"

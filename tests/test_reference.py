@@ -7,7 +7,7 @@ import math
 import pytest
 
 import shakermill as sm
-from shakermill.reference import simulate_scipy
+from shakermill.solvers.reference import simulate_scipy
 
 SETTLING_TIME = 3.0  # s: the start from rest at the centre is over after ~1 s
 COMPARISON_TIME = 10.0  # s

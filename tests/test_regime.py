@@ -10,7 +10,8 @@ import pandas as pd
 import pytest
 
 import shakermill as sm
-from shakermill.regime import IRREGULAR, NO_IMPACTS, bifurcation, classify, settled_impacts, write_bifurcation
+from shakermill.analysis.regime import IRREGULAR, NO_IMPACTS, classify, settled_impacts
+from shakermill.studies.bifurcation import bifurcation, write_bifurcation
 
 OMEGA = 100.0
 PERIOD = 2 * math.pi / OMEGA
@@ -110,9 +111,9 @@ def test_bifurcation_stops_at_ctrl_c_inside_a_run(monkeypatch) -> None:
     # must raise it rather than go on to the next value.
     import sys
 
-    from shakermill.simulate import INTERRUPTED
+    from shakermill.solvers.result import INTERRUPTED
 
-    simulate_module = sys.modules["shakermill.simulate"]
+    simulate_module = sys.modules["shakermill.solvers.simulate"]
     real_simulate = simulate_module.simulate
     calls = []
 
@@ -133,7 +134,7 @@ def test_bifurcation_stops_at_ctrl_c_inside_a_run(monkeypatch) -> None:
 def test_a_bifurcation_of_more_values_than_a_diagram_can_show_is_refused_before_any_run(monkeypatch) -> None:
     import sys
 
-    simulate_module = sys.modules["shakermill.simulate"]
+    simulate_module = sys.modules["shakermill.solvers.simulate"]
     monkeypatch.setattr(simulate_module, "simulate", lambda params: pytest.fail("no run may start"))
     with pytest.raises(sm.ParameterError, match="bifurcation: 10,001 values; allowed at most 10,000"):
         bifurcation(sm.default_parameters(), np.linspace(90.0, 130.0, 10_001))

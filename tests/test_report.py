@@ -17,12 +17,12 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
-from shakermill.params import DEFAULT_PRESET, FIELD_NAMES, PRESETS
-from shakermill.regime import classify_impacts, settled_run_impacts
-from shakermill.report import REPORT_FILE, fitted_targets, number, render_report, write_report
-from shakermill.storage import load_run, write_run
-from shakermill.storage import RunData
-from shakermill.validation import TABLE5
+from shakermill.parameters.schema import DEFAULT_PRESET, FIELD_NAMES, PRESETS
+from shakermill.analysis.regime import classify_impacts, settled_run_impacts
+from shakermill.views.report import REPORT_FILE, fitted_targets, number, render_report, write_report
+from shakermill.io.runs import load_run, write_run
+from shakermill.io.runs import RunData
+from shakermill.studies.validation import TABLE5
 
 CALIBRATED_PRESET = "spex8000m-calibrated"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

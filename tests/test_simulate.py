@@ -7,8 +7,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import shakermill as sm
-from shakermill import model
-from shakermill.simulate import INTERRUPTED
+from shakermill.engines.one_d import model
+from shakermill.solvers.result import INTERRUPTED
 
 RESTING_WALL_AMPLITUDE = 1e-12
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.steady import SETTLED_TIME_CONSTANTS, run_length_warning, settled_means, steady_state
+from shakermill.analysis.steady import SETTLED_TIME_CONSTANTS, run_length_warning, settled_means, steady_state
 
 
 def test_steady_state_of_a_ball_at_rest_matches_the_hand_solution():
@@ -51,7 +51,7 @@ def test_time_constants_are_those_of_the_hand_built_linear_network():
 
 
 def test_steady_state_with_moving_ball_is_a_root_of_the_nonlinear_network():
-    from shakermill import model
+    from shakermill.engines.one_d import model
 
     params = sm.default_parameters()
     steady = steady_state(params, 1.2, 30.0)

@@ -13,11 +13,11 @@ import pytest
 import xarray as xr
 
 import shakermill as sm
-from shakermill import storage
-from shakermill.config import load_config
-from shakermill.params import DEFAULT_PRESET
-from shakermill.simulate import IMPACT_UNITS
-from shakermill.storage import StorageError, load_run, to_jsonable, write_run
+from shakermill.io import runs as storage
+from shakermill.parameters.config import load_config
+from shakermill.parameters.schema import DEFAULT_PRESET
+from shakermill.engines.one_d.setup import IMPACT_UNITS
+from shakermill.io.runs import StorageError, load_run, to_jsonable, write_run
 
 
 @pytest.fixture(scope="module")

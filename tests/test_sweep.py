@@ -23,32 +23,14 @@ import pandas as pd
 import pytest
 from pandas.testing import assert_frame_equal
 
-from shakermill.params import ParameterError, default_parameters
-from shakermill.sweep import (
-    MANIFEST_FILE,
-    POINTS_FOLDER,
-    TABLE_CSV,
-    TABLE_PARQUET,
-    SweepFailed,
-    SweepPlan,
-    comparable_columns,
-    connect,
-    failed_points,
-    load_sweep,
-    parse_grid,
-    plan_sweep,
-    point_ids,
-    read_points,
-    sweep,
-    sweep_parameters,
-)
+from shakermill.parameters.schema import ParameterError, default_parameters
+from shakermill.studies.sweep import MANIFEST_FILE, POINTS_FOLDER, TABLE_CSV, TABLE_PARQUET, SweepFailed, SweepPlan, comparable_columns, connect, failed_points, load_sweep, parse_grid, plan_sweep, point_ids, read_points, sweep, sweep_parameters
 
 DURATION = 60.0  # simulated seconds per point
 GRID = ("omega=100:120:3", "amplitude=23mm:29mm:2")  # 6 points
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
-UNREACHABLE = "tcp://127.0.0.1:1"
-# The module, not the function that shadows it as ``shakermill.sweep``.
-SWEEP_MODULE = importlib.import_module("shakermill.sweep")  # port 1 on loopback: nothing listens, connections are refused
+UNREACHABLE = "tcp://127.0.0.1:1"  # port 1 on loopback: nothing listens, connections are refused
+SWEEP_MODULE = importlib.import_module("shakermill.studies.sweep")
 
 
 @pytest.fixture(scope="module")
@@ -299,7 +281,7 @@ def test_in_process_table(base, in_process, tmp_path):
     assert "wall_time_s" in table and "wall_time_s" not in comparable_columns(table)
     assert "output_dir" not in comparable_columns(table)
     # The same run on its own gives the row's figures: the sweep adds nothing of its own.
-    from shakermill.simulate import simulate
+    from shakermill.solvers.simulate import simulate
 
     alone = simulate(base.replace(**plan.points[4])).summary
     for key in ("theta_inf_C", "tau_min", "impacts", "heat_power_W"):
@@ -555,7 +537,7 @@ def test_a_folder_with_another_sweep_is_refused(base, tmp_path):
 
 
 def test_keep_runs_writes_each_point_run_folder(base, tmp_path):
-    from shakermill.storage import load_run
+    from shakermill.io.runs import load_run
 
     plan = plan_sweep(["amplitude=24mm:26mm:2"])
     kept = sweep(base, plan, tmp_path / "kept", workers=1, keep_runs=True)
@@ -896,7 +878,7 @@ def test_a_crafted_point_id_in_the_manifest_is_refused_and_nothing_outside_is_re
 
 def _interrupted_second_point(how: str, simulate: Callable[..., Any]) -> Callable[..., Any]:
     """``simulate`` that is interrupted by Ctrl-C on its second call, the way ``how`` says."""
-    from shakermill.simulate import simulate_full
+    from shakermill.solvers.full import simulate_full
 
     calls = []
 

@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from shakermill import thermal
+from shakermill.physics import thermal
 
 MU_REF = 1.716e-5
 T_REF = 273.15

@@ -1,4 +1,4 @@
-"""Unit parsing at the edges (shakermill.units.to_si), against hand conversions."""
+"""Unit parsing at the edges (shakermill.parameters.units.to_si), against hand conversions."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from shakermill.units import UnitError, to_si
+from shakermill.parameters.units import UnitError, to_si
 
 
 @pytest.mark.parametrize(

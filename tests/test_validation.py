@@ -6,16 +6,7 @@ import pytest
 
 import numpy as np
 
-from shakermill.validation import (
-    CURVE_QUANTITIES,
-    CURVE_TOLERANCE_K,
-    TABLE5,
-    Curve,
-    compare,
-    fitted_quantities,
-    relative_error,
-    validate,
-)
+from shakermill.studies.validation import CURVE_QUANTITIES, CURVE_TOLERANCE_K, TABLE5, Curve, compare, fitted_quantities, relative_error, validate
 
 
 def test_table5_holds_the_published_numbers(paper: dict) -> None:

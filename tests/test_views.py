@@ -11,8 +11,8 @@ import pytest
 from xarray.plot.utils import label_from_attrs
 
 import shakermill as sm
-from shakermill.storage import load_run, write_run
-from shakermill.views import CALIBRATED_PRESET, answer_sentences
+from shakermill.io.runs import load_run, write_run
+from shakermill.views.notebook import CALIBRATED_PRESET, answer_sentences
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

@@ -31,13 +31,13 @@ from rich.text import Text
 
 # Only light modules here: `shakermill --help` and the listing commands must not wait for NumPy, Numba,
 # pandas, xarray, SciPy or Matplotlib. Each command imports what it uses.
-from . import __version__
-from .atomic import StorageError, check_writable_place
-from .budget import BudgetExceeded
-from .config import load_config
-from .defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
-from .limits import MAX_BIFURCATION_VALUES
-from .params import (
+from shakermill.support.version import __version__
+from shakermill.support.atomic import StorageError, check_writable_place
+from shakermill.engines.budget import BudgetExceeded
+from shakermill.parameters.config import load_config
+from shakermill.parameters.defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
+from shakermill.support.limits import MAX_BIFURCATION_VALUES
+from shakermill.parameters.schema import (
     DEFAULT_PRESET,
     FIELD_NAMES,
     PRESETS,
@@ -48,15 +48,15 @@ from .params import (
     preset_values,
     unit_slip_warnings,
 )
-from .validation import EXPERIMENT, TABLE5, TARGET_KEYS, Curve
-from .validation import validate as run_validation
+from shakermill.studies.validation import EXPERIMENT, TABLE5, TARGET_KEYS, Curve
+from shakermill.studies.validation import validate as run_validation
 
 if TYPE_CHECKING:
     import pandas as pd
 
-    from .params import Parameters
-    from .simulate import Result
-    from .storage import RunData
+    from shakermill.parameters.schema import Parameters
+    from shakermill.solvers.result import Result
+    from shakermill.io.runs import RunData
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
@@ -212,8 +212,8 @@ def run(
     overwrite: OverwriteOption = False,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
-    from .simulate import INTERRUPTED
-    from .storage import check_target, to_jsonable
+    from shakermill.solvers.result import INTERRUPTED
+    from shakermill.io.runs import check_target, to_jsonable
 
     overrides = settings or []
     with _user_errors():
@@ -272,7 +272,7 @@ def simulate_with_progress(params: Parameters) -> Result:
     The bar counts the simulated seconds of each phase in turn: the averaged solver's mechanics (out of
     averaging_max_time), the whole duration, then its attractor probe (all starts together).
     """
-    from .simulate import simulate
+    from shakermill.solvers.simulate import simulate
 
     counter = "{task.completed:.5g}/{task.total:.5g} s simulated"
     with _progress_bar("simulating", counter, params.duration, delay_s=PROGRESS_DELAY_S) as update:
@@ -317,10 +317,10 @@ def _write(
     result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool, overwrite: bool
 ) -> Path:
     """Write the run folder (with figures unless told not to); return its absolute path."""
-    from .storage import write_run
+    from shakermill.io.runs import write_run
 
     def add_figures(folder: Path) -> None:
-        from .plotting import plot_run
+        from shakermill.views.figures import plot_run
 
         plot_run(result, folder / FIGURES_FOLDER)
 
@@ -335,7 +335,7 @@ def _write(
 
 
 def _exit_for_status(result: Result, target: Path) -> None:
-    from .simulate import INTERRUPTED
+    from shakermill.solvers.result import INTERRUPTED
 
     if result.status == INTERRUPTED:
         typer.echo(f"interrupted: {result.message} Partial results in {target}", err=True)
@@ -415,7 +415,7 @@ def compare_solvers(
     json_output: JsonOption = False,
 ) -> None:
     """Run the same configuration with the full and the averaged solver; print both, the differences and the speed ratio."""
-    from .storage import to_jsonable
+    from shakermill.io.runs import to_jsonable
 
     with _user_errors():
         params = load_config(config, preset=preset, overrides=settings or []).params
@@ -454,7 +454,7 @@ def compare_solvers(
 
 def _uninterrupted(result: Result) -> Result:
     """``result``, unless Ctrl-C cut it short: a comparison with part of a run means nothing."""
-    from .simulate import INTERRUPTED
+    from shakermill.solvers.result import INTERRUPTED
 
     if result.status == INTERRUPTED:
         raise KeyboardInterrupt
@@ -496,7 +496,7 @@ def keys() -> None:
 
 def _load_run_or_fail(folder: Path) -> RunData:
     """The run folder at ``folder``, or one ``error:`` line and exit code 2."""
-    from .storage import load_run
+    from shakermill.io.runs import load_run
 
     with _user_errors():
         return load_run(folder)
@@ -520,8 +520,8 @@ def plot(
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG files.")] = PNG_DPI,
 ) -> None:
     """Draw the figures of a run folder (paper Figs. 4, 5a, 5b, impact statistics) or of a sweep folder (maps or lines)."""
-    from .plotting import contour_notes, impact_figures, parse_contour, plot_figures, run_figures, sweep_context, sweep_figures
-    from .sweep import is_sweep_folder, load_sweep
+    from shakermill.views.figures import contour_notes, impact_figures, parse_contour, plot_figures, run_figures, sweep_context, sweep_figures
+    from shakermill.studies.sweep import is_sweep_folder, load_sweep
 
     target = out if out is not None else folder / FIGURES_FOLDER
     if is_sweep_folder(folder):
@@ -558,7 +558,7 @@ def report(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the report file if it exists.")] = False,
 ) -> None:
     """Write one self-contained HTML report of a run folder (figures embedded, no external resources)."""
-    from .report import save_report
+    from shakermill.views.report import save_report
 
     run_data = _load_run_or_fail(run_dir)
     other = _load_run_or_fail(compare) if compare is not None else None
@@ -615,8 +615,8 @@ def sweep(
     json_output: JsonOption = False,
 ) -> None:
     """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
-    from .sweep import TABLE_CSV, TABLE_PARQUET, SweepFailed, failed_points, is_sweep_folder, plan_sweep, sweep_parameters
-    from .sweep import sweep as run_sweep
+    from shakermill.studies.sweep import TABLE_CSV, TABLE_PARQUET, SweepFailed, failed_points, is_sweep_folder, plan_sweep, sweep_parameters
+    from shakermill.studies.sweep import sweep as run_sweep
 
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
@@ -665,7 +665,7 @@ def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path) -> Tab
     """The first rows of a sweep table: swept values, regime and the main results."""
     import pandas as pd
 
-    from .sweep import TABLE_CSV, TABLE_PARQUET, failed_points
+    from shakermill.studies.sweep import TABLE_CSV, TABLE_PARQUET, failed_points
 
     preview = Table(title=f"shakermill sweep: {len(table)} points, {len(failed_points(table))} failed")
     for key in keys:
@@ -710,11 +710,11 @@ def bifurcation(
     overwrite: OverwriteOption = False,
 ) -> None:
     """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
-    from .plotting import bifurcation_figure, plot_figures, sweep_context
-    from .regime import bifurcation as regime_scan
-    from .regime import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
-    from .storage import check_target, write_folder
-    from .sweep import parse_grid, sweep_parameters
+    from shakermill.views.figures import bifurcation_figure, plot_figures, sweep_context
+    from shakermill.studies.bifurcation import bifurcation as regime_scan
+    from shakermill.studies.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
+    from shakermill.io.runs import check_target, write_folder
+    from shakermill.studies.sweep import parse_grid, sweep_parameters
 
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
@@ -799,8 +799,8 @@ def validate(
 ) -> None:
     """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
     calibrated parameters, and which free sets of a calibration can follow the curve."""
-    from .calibrate import free_set_study
-    from .storage import to_jsonable
+    from shakermill.studies.calibrate import free_set_study
+    from shakermill.io.runs import to_jsonable
 
     if solver not in ("full", "averaged"):
         _fail(f"solver: {solver!r} is not allowed; allowed: one of 'full', 'averaged'")
@@ -922,9 +922,9 @@ def calibrate(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
 ) -> None:
     """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
-    from .calibrate import calibrate as fit_parameters
-    from .calibrate import parse_free, parse_targets, write_preset
-    from .storage import to_jsonable
+    from shakermill.studies.calibrate import calibrate as fit_parameters
+    from shakermill.studies.calibrate import parse_free, parse_targets, write_preset
+    from shakermill.io.runs import to_jsonable
 
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])

@@ -1,0 +1,110 @@
+"""Regimes of the settled motion: period-n or irregular, from the impact phases (issue 5).
+
+The drive is periodic, so a settled periodic motion repeats its impacts every n
+drive periods: the same walls at the same drive phases ωt + φ (mod 2π). The
+classification looks at the impacts of the settled motion (after the averaged
+solver's transient, or the second half of a full run), groups them by drive
+period and finds the smallest n for which every period matches the one n later.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+
+
+# Impacts as columns: at least "time" (s) and "wall" ("left"/"right"); a dict of arrays or a DataFrame.
+ImpactColumns = Mapping[str, Any]
+
+# Longest period searched for; motions that repeat more slowly are called irregular.
+MAX_PERIOD = 16
+# Impact phases of matching periods may differ by this much (rad): the integrator's tolerance
+# moves impact times by ~1e-5 of a period at rtol 1e-3.
+PHASE_TOLERANCE = 1e-2
+# A classification needs at least this many repetitions of the candidate period.
+MIN_REPEATS = 3
+
+NO_IMPACTS = "no impacts"
+IRREGULAR = "irregular"
+
+
+@dataclass(frozen=True)
+class ImpactPhases:
+    """Impacts of the settled motion: drive period index, phase in [0, 2π) and wall."""
+
+    period_index: np.ndarray
+    phase: np.ndarray
+    wall: np.ndarray
+
+
+def settled_impacts(impacts: ImpactColumns, solver: str, end_time: float) -> dict[str, np.ndarray]:
+    """Time and wall of the impacts after the start-up transient: the second half of a full run (the
+    averaged solver already cut it)."""
+    time, wall = np.asarray(impacts["time"]), np.asarray(impacts["wall"])
+    kept = np.full(time.shape, True) if solver == "averaged" else time >= 0.5 * end_time
+    return {"time": time[kept], "wall": wall[kept]}
+
+
+def settled_run_impacts(run: Any) -> dict[str, np.ndarray]:
+    """:func:`settled_impacts` of a :class:`~shakermill.simulate.Result` or a stored run (from its summary)."""
+    return settled_impacts(run.impacts, str(run.summary["solver"]), float(run.summary["simulated_s"]))
+
+
+def impact_phases(impacts: ImpactColumns, omega: float, phase: float) -> ImpactPhases:
+    angle = omega * np.asarray(impacts["time"]) + phase
+    return ImpactPhases(
+        period_index=np.floor(angle / (2 * math.pi)).astype(np.int64),
+        phase=np.mod(angle, 2 * math.pi),
+        wall=np.asarray(impacts["wall"]),
+    )
+
+
+# The walls and the drive phases of the impacts of one drive period.
+Signature = tuple[tuple[str, ...], np.ndarray]
+
+
+def period_signatures(phases: ImpactPhases) -> list[Signature]:
+    """(walls, phases) of each complete drive period, first to last (the partial ends are dropped).
+
+    The impacts are in time order, so each period is one slice: linear in the number of impacts,
+    which matters for the ~10^5 impacts of a settled full-resolution hour.
+    """
+    first, last = phases.period_index.min() + 1, phases.period_index.max() - 1
+    bounds = np.searchsorted(phases.period_index, np.arange(first, last + 2))
+    return [
+        (tuple(phases.wall[start:end]), phases.phase[start:end])
+        for start, end in zip(bounds[:-1], bounds[1:])
+    ]
+
+
+def signatures_match(a: Signature, b: Signature, tolerance: float = PHASE_TOLERANCE) -> bool:
+    """Same walls in the same order, each phase within ``tolerance`` (rad, on the circle)."""
+    if a[0] != b[0]:
+        return False
+    difference = np.abs(a[1] - b[1])
+    return bool(np.all(np.minimum(difference, 2 * math.pi - difference) <= tolerance))
+
+
+def classify(result: Any) -> tuple[str, int | None]:
+    """("period-n", n), ("irregular", None) or ("no impacts", None) for the settled motion of ``result``
+    (a :class:`~shakermill.solvers.result.Result`, or a run read back from its folder)."""
+    settled = settled_impacts(result.impacts, result.solver, result.t_end)
+    return classify_impacts(settled, result.params.omega, result.params.phase)
+
+
+def classify_impacts(settled: ImpactColumns, omega: float, phase: float) -> tuple[str, int | None]:
+    """The regime of a settled motion from its impacts (columns ``time`` and ``wall``), drive ω and φ."""
+    if len(settled["time"]) == 0:
+        return NO_IMPACTS, None
+    signatures = period_signatures(impact_phases(settled, omega, phase))
+    for period in range(1, MAX_PERIOD + 1):
+        if len(signatures) < (MIN_REPEATS + 1) * period:
+            break
+        if all(signatures_match(signatures[k], signatures[k + period]) for k in range(len(signatures) - period)):
+            return f"period-{period}", period
+    return IRREGULAR, None
+
+

@@ -1,0 +1,68 @@
+"""The wall-clock and step budget of one run (keys ``max_wall_time`` and ``max_steps``).
+
+Some inputs make the integrator take tiny steps: a stiff thermal node, an extreme drive. Such a run
+would go on for hours; the budget stops it with a status of its own and keeps what it computed. One
+budget covers every integration a run does (the averaged solver's mechanics phase, its fall-back to
+full resolution and its attractor probe), and the integrators check it each time the compiled loop
+hands control back to Python, several times a second.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from shakermill.parameters.schema import Parameters
+
+
+class BudgetExceeded(Exception):
+    """A run of a scan or a fit used up its budget: a partial run must not stand in for a whole one."""
+
+
+@dataclass
+class RunBudget:
+    """What one run may spend: ``max_wall_time`` seconds of wall-clock time and ``max_steps`` accepted steps."""
+
+    max_wall_time: float  # s
+    max_steps: int
+    steps: int = 0  # accepted steps of all the run's integrations so far
+    started: float = field(default_factory=time.monotonic)
+    # Set once, by the first check that finds the budget spent: which limit, and how to raise it.
+    reason: str | None = None
+
+    @classmethod
+    def of(cls, params: Parameters) -> RunBudget:
+        """A fresh budget for a run of ``params``, its clock started now."""
+        return cls(params.max_wall_time, params.max_steps)
+
+    @classmethod
+    def unlimited(cls) -> RunBudget:
+        return cls(float("inf"), sys.maxsize)
+
+    @property
+    def steps_left(self) -> int:
+        return max(self.max_steps - self.steps, 0)
+
+    def spent(self) -> bool:
+        """Whether the run must stop now; the first time it must, ``reason`` says why."""
+        if self.reason is None:
+            self.reason = self._overrun()
+        return self.reason is not None
+
+    def _overrun(self) -> str | None:
+        if self.steps >= self.max_steps:
+            return (
+                f"The run used up its step budget (max_steps = {self.max_steps} integrator steps; a default 60-min run "
+                f"takes ~3.4 million, so many more mean tiny steps). If the run is meant to take that many, raise it, "
+                f"e.g. --set max_steps={2 * self.max_steps}."
+            )
+        elapsed = time.monotonic() - self.started
+        if elapsed > self.max_wall_time:
+            return (
+                f"The run used up its wall-clock budget (max_wall_time = {self.max_wall_time:g} s, {elapsed:.3g} s "
+                f"elapsed). If the run is meant to take that long, raise it, e.g. --set max_wall_time={2 * self.max_wall_time:g}."
+            )
+        return None

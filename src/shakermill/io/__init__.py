@@ -1,0 +1,1 @@
+"""Files of a run: run folders written atomically and read back."""

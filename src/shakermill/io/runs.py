@@ -1,0 +1,438 @@
+"""Run folders: everything a run produced, written atomically, and read back for later tools.
+
+A run folder holds
+
+* ``timeseries.nc``   the sampled state history (NetCDF4 via h5netcdf; kelvin, SI units in attributes),
+* ``windows.nc``      the full-resolution state inside the record windows,
+* ``impacts.parquet`` one row per impact, units as JSON in the schema metadata under ``units``,
+* ``summary.json``    summary, energy audit, exponential fit, counters, status and message,
+* ``config.toml``     the resolved parameters with provenance; ``shakermill run config.toml`` repeats the run,
+
+plus whatever ``add_files`` puts there (the command line adds ``figures/``).
+
+The folder is built in a hidden sibling ``.<name>.partial-<machine>-<pid>-<random>`` and
+moved into place only when complete, so an interrupted write or a full disk never leaves a folder
+at the target path that looks like a finished run (:func:`write_folder`).
+"""
+
+from __future__ import annotations
+
+import errno
+import io
+import json
+import math
+import os
+import shutil
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Container, Iterable, Mapping
+
+import numpy as np
+
+from shakermill.support.version import __version__
+from shakermill.support.atomic import SET_ASIDE, StorageError, check_writable_place, partial_path, remove_abandoned_writes
+from shakermill.parameters.config import load_config, write_config_toml
+from shakermill.analysis.fit import ExponentialFit
+from shakermill.engines.one_d.integrator import REACHED_STOP
+from shakermill.parameters.schema import Parameters
+from shakermill.engines.one_d.setup import IMPACT_UNITS
+from shakermill.solvers.result import TIME_ATTRIBUTES, Result, StateHistory
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
+
+TIMESERIES_FILE = "timeseries.nc"
+WINDOWS_FILE = "windows.nc"
+IMPACTS_FILE = "impacts.parquet"
+SUMMARY_FILE = "summary.json"
+CONFIG_FILE = "config.toml"
+RUN_FILES = (TIMESERIES_FILE, WINDOWS_FILE, IMPACTS_FILE, SUMMARY_FILE, CONFIG_FILE)
+# Key of the impact table's units in the Parquet schema metadata.
+UNITS_METADATA_KEY = b"units"
+# Key of what a file covers, where it is less than the whole run (averaged solver): attribute and Parquet metadata.
+COVERAGE_KEY = "coverage"
+# Variables of an averaged run's timeseries.nc: never computed, or rates of the averaging window times time.
+AVERAGED_MOTION_VARIABLES = ("x", "p", "velocity")
+AVERAGED_FLOW_VARIABLES = ("work_vial", "dissipated", "heat_generated", "velocity_term_integral")
+# Reading goes through xarray with this engine; writing uses h5netcdf directly (:func:`netcdf_bytes`).
+NETCDF_ENGINE = "h5netcdf"
+
+
+@dataclass(frozen=True)
+class RunData:
+    """A run read back from its folder; attribute names follow :class:`shakermill.simulate.Result`."""
+
+    path: Path
+    params: Parameters
+    preset: str
+    status: int
+    message: str
+    timeseries: xr.Dataset
+    windows: xr.Dataset
+    impacts: pd.DataFrame
+    impact_units: dict[str, str]
+    summary: dict[str, Any]
+    energy: dict[str, Any]
+    ball_fit: ExponentialFit
+    counters: dict[str, int]
+
+    @property
+    def success(self) -> bool:
+        return self.status == REACHED_STOP
+
+
+def to_jsonable(value: Any) -> Any:
+    """``value`` with numpy scalars made plain and non-finite floats made ``None`` (JSON has no NaN)."""
+    if isinstance(value, Mapping):
+        return {str(key): to_jsonable(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(item) for item in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+@dataclass(frozen=True)
+class FolderKind:
+    """What one command writes as a folder: its name in messages, and how to recognise one it wrote."""
+
+    noun: str
+    written_by_shakermill: Callable[[Path], bool]
+
+
+RUN_FOLDER = FolderKind("run", lambda folder: (folder / SUMMARY_FILE).is_file())
+
+
+def check_target(path: Path, *, overwrite: bool = False, kind: FolderKind = RUN_FOLDER) -> None:
+    """Raise :class:`StorageError` unless ``path`` can be created, or is an empty folder, or a folder
+    of ``kind`` and ``overwrite``.
+
+    Replacing deletes the old folder: one shakermill wrote only when asked to, anything else (a file,
+    a folder of the user's own) never.
+    """
+    if not path.exists() and not path.is_symlink():
+        check_writable_place(path)
+        return
+    if path.is_symlink() or not path.is_dir():
+        raise StorageError(f"{path}: exists and is not a folder; choose another --out")
+    if not any(path.iterdir()):
+        return
+    if not kind.written_by_shakermill(path):
+        raise StorageError(f"{path}: a non-empty folder that is not a shakermill {kind.noun}; choose another --out")
+    if not overwrite:
+        raise StorageError(
+            f"{path}: holds a {kind.noun} already; choose another --out, or add --overwrite to replace it"
+        )
+
+
+def write_folder(
+    path: Path | str, fill: Callable[[Path], object], *, overwrite: bool = False, kind: FolderKind = RUN_FOLDER
+) -> Path:
+    """Have ``fill(folder)`` write a folder's files, then move the folder to ``path`` whole.
+
+    What ``path`` holds is replaced only as :func:`check_target` allows. The folder is built in a
+    hidden sibling, so a failure (a full disk) or an interruption leaves nothing at ``path`` that
+    looks complete, and the hidden sibling is removed, or, after a kill, by a later write to the same
+    parent folder. Returns the folder's absolute path.
+    """
+    # Absolute, so that "." has a name to derive the sibling folders from.
+    target = Path(path).absolute()
+    check_target(target, overwrite=overwrite, kind=kind)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    remove_abandoned_writes(target.parent)
+    partial = partial_path(target)
+    partial.mkdir()
+    try:
+        fill(partial)
+        _move_into_place(partial, target)
+    except BaseException:
+        # KeyboardInterrupt included: the half-written folder must not survive.
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
+    return target
+
+
+def write_run(
+    result: Result,
+    path: Path | str,
+    *,
+    preset: str,
+    extra_provenance: Mapping[str, Any] | None = None,
+    add_files: Callable[[Path], object] | None = None,
+    overwrite: bool = False,
+) -> Path:
+    """Write ``result`` as a run folder at ``path``; a previous run folder there is replaced only with ``overwrite``.
+
+    ``add_files(folder)`` may add more files (figures) before the folder is
+    moved into place. Returns the folder's absolute path.
+    """
+
+    def fill(folder: Path) -> None:
+        _write_contents(result, folder, preset=preset, extra_provenance=extra_provenance or {})
+        if add_files is not None:
+            add_files(folder)
+
+    return write_folder(path, fill, overwrite=overwrite)
+
+
+def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenance: Mapping[str, Any]) -> None:
+    attributes = _run_attributes(result, preset)
+    coverage = averaging_coverage(result)
+    history = _mark_averaged_variables(result.history, coverage) if coverage else result.history
+    title = "shakermill sampled state history"
+    series = netcdf_bytes(history, title=title, **attributes, **_covers(coverage, "timeseries"))
+    (folder / TIMESERIES_FILE).write_bytes(series)
+    title = "shakermill full-resolution state in the record windows"
+    windows = netcdf_bytes(result.window_history, title=title, **attributes, **_covers(coverage, "motion"))
+    (folder / WINDOWS_FILE).write_bytes(windows)
+    (folder / IMPACTS_FILE).write_bytes(impacts_parquet(result.impact_columns, coverage=coverage.get("impacts")))
+    (folder / SUMMARY_FILE).write_text(summary_json(result, preset), encoding="utf-8")
+    provenance = {"status": result.status, "message": result.message, "simulated_s": result.t_end, **extra_provenance}
+    write_config_toml(result.params, folder / CONFIG_FILE, preset=preset, extra_provenance=provenance)
+
+
+def _run_attributes(result: Result, preset: str) -> dict[str, Any]:
+    # NetCDF attributes cannot be booleans, hence the integer status only.
+    return {
+        "shakermill_version": __version__,
+        "preset": preset,
+        "status": int(result.status),
+        "message": result.message,
+        "simulated_s": float(result.t_end),
+        "temperature_note": "theta_ball, theta_vial, theta_air in kelvin; the same temperatures in degC as theta_*_C",
+    }
+
+
+def averaging_coverage(result: Result) -> dict[str, str]:
+    """What the files of an averaged run cover, in words (the motion only over the averaging window); empty for a full run."""
+    averages = result.averages
+    if result.impact_window is None or averages is None:
+        return {}
+    start, end = averages.transient, averages.transient + averages.window
+    motion = (
+        f"the ball's motion was integrated at full resolution only up to t = {end:.6g} s (the averaged solver's "
+        f"mechanics phase); record windows after that hold no points"
+    )
+    return {
+        "timeseries": (
+            f"averaged solver: the temperatures cover the whole run; {', '.join(AVERAGED_MOTION_VARIABLES)} are NaN "
+            f"(not computed), and {', '.join(AVERAGED_FLOW_VARIABLES)} are the averaging window's mean rates times time"
+        ),
+        "motion": motion,
+        "impacts": (
+            f"averaged solver: only the impacts of the averaging window, t = {start:.6g} to {end:.6g} s; the summary's "
+            "impacts and impact_rate_hz extend this window's rate to the whole run"
+        ),
+        "motion_variable": "not computed by the averaged solver (NaN); the motion is in windows.nc and impacts.parquet",
+        "flow_variable": "averaged solver: the averaging window's mean rate times time",
+    }
+
+
+def _covers(coverage: Mapping[str, str], part: str) -> dict[str, str]:
+    return {COVERAGE_KEY: coverage[part]} if coverage else {}
+
+
+def _mark_averaged_variables(history: StateHistory, coverage: Mapping[str, str]) -> StateHistory:
+    marks = {name: {COVERAGE_KEY: coverage["motion_variable"]} for name in AVERAGED_MOTION_VARIABLES}
+    marks.update({name: {COVERAGE_KEY: coverage["flow_variable"]} for name in AVERAGED_FLOW_VARIABLES})
+    return history.with_attributes(marks)
+
+
+def netcdf_bytes(history: StateHistory, *, title: str, **attributes: Any) -> bytes:
+    """``history`` as a NetCDF4 file over the dimension ``time``, with global attributes and each variable's own.
+
+    h5netcdf writes it directly: building an xarray Dataset first would cost a run without figures
+    half its start-up. ``xarray.open_dataset`` reads the file as the Dataset :meth:`StateHistory.dataset` gives.
+    HDF5 writes into memory, never onto the disk: a full disk makes the HDF5 library fail to close
+    the file and crash the interpreter at exit (exit code 139); Python's own write fails cleanly.
+    """
+    import h5netcdf
+
+    buffer = io.BytesIO()
+    with h5netcdf.File(buffer, "w") as file:
+        file.attrs.update(title=title, **attributes)
+        file.dimensions = {"time": history.times.size}
+        for name, (values, variable_attributes) in {"time": (history.times, TIME_ATTRIBUTES), **history.variables}.items():
+            variable = file.create_variable(name, ("time",), data=values)
+            variable.attrs.update(variable_attributes)
+    return buffer.getvalue()
+
+
+def impacts_parquet(columns: Mapping[str, np.ndarray], *, coverage: str | None = None) -> memoryview:
+    """The impact columns as a Parquet file, with their units as JSON in the schema metadata, and what
+    the table covers (``coverage``) where it is not the whole run."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    units = {column: IMPACT_UNITS.get(column, "") for column in columns}
+    metadata = {UNITS_METADATA_KEY: json.dumps(units).encode()}
+    if coverage is not None:
+        metadata[COVERAGE_KEY.encode()] = coverage.encode()
+    arrays = [arrow_array(np.asarray(values)) for values in columns.values()]
+    sink = pa.BufferOutputStream()
+    pq.write_table(pa.Table.from_arrays(arrays, names=list(columns), metadata=metadata), sink)
+    return memoryview(sink.getvalue())
+
+
+def arrow_array(values: np.ndarray) -> Any:
+    """``values`` (numbers, or strings) as a ``pyarrow.Array`` built from its buffers.
+
+    ``pyarrow.array`` would build the same, but first imports pandas to see whether it was handed a
+    pandas object: a quarter of the start-up of a run that writes its table without pandas.
+    """
+    import pyarrow as pa
+
+    if values.dtype.kind in "US":
+        encoded = np.char.encode(values.astype(str), "utf-8")
+        offsets = np.zeros(values.size + 1, dtype=np.int32)
+        np.cumsum(np.char.str_len(encoded), out=offsets[1:])
+        buffers = [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(encoded.tolist()))]
+        return pa.Array.from_buffers(pa.string(), values.size, buffers)
+    contiguous = np.ascontiguousarray(values)
+    return pa.Array.from_buffers(pa.from_numpy_dtype(contiguous.dtype), contiguous.size, [None, pa.py_buffer(contiguous)])
+
+
+def summary_document(result: Result, preset: str) -> dict[str, Any]:
+    """The content of ``summary.json``, JSON-ready (NaN as ``None``)."""
+    return to_jsonable(
+        {
+            "status": result.status,
+            "success": result.success,
+            "message": result.message,
+            "preset": preset,
+            "shakermill_version": __version__,
+            "summary": result.summary,
+            "energy_audit": result.energy.as_dict(),
+            "ball_fit": result.ball_fit.as_dict(),
+            "counters": result.counters,
+        }
+    )
+
+
+def summary_json(result: Result, preset: str) -> str:
+    return json.dumps(summary_document(result, preset), sort_keys=True, indent=2, allow_nan=False) + "\n"
+
+
+def _move_into_place(partial: Path, target: Path) -> None:
+    """Rename ``partial`` to ``target``; an old run folder there is set aside first and deleted after."""
+    if not target.exists():
+        os.rename(partial, target)
+        return
+    aside = partial_path(target, SET_ASIDE)
+    os.rename(target, aside)
+    try:
+        os.rename(partial, target)
+    except BaseException:
+        os.rename(aside, target)
+        raise
+    shutil.rmtree(aside, ignore_errors=True)
+
+
+def load_run(path: Path | str) -> RunData:
+    """Read a run folder written by :func:`write_run` (datasets are loaded into memory, files closed).
+
+    Raises :class:`StorageError` naming the file, in one line, for a folder that is not a run or a
+    file that is missing, truncated or damaged.
+    """
+    folder = Path(path)
+    summary_path = folder / SUMMARY_FILE
+    if not summary_path.is_file():
+        raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
+    document = _read_part(summary_path, _summary_document)
+    config = _read_part(folder / CONFIG_FILE, load_config)
+    impacts, impact_units = _read_part(folder / IMPACTS_FILE, _read_impact_table)
+    return RunData(
+        path=folder,
+        params=config.params,
+        preset=config.preset,
+        status=document["status"],
+        message=document["message"],
+        timeseries=_read_part(folder / TIMESERIES_FILE, _read_history),
+        windows=_read_part(folder / WINDOWS_FILE, _read_history),
+        impacts=impacts,
+        impact_units=impact_units,
+        summary=document["summary"],
+        energy=document["energy_audit"],
+        ball_fit=_fit_from_dict(document["ball_fit"]),
+        counters=document["counters"],
+    )
+
+
+# Variables of timeseries.nc and windows.nc that plot and report read (every version wrote them).
+HISTORY_VARIABLES_READ_BACK = ("time", "x", "p", "theta_ball", "theta_vial", "theta_air")
+# What summary.json must hold, and of which JSON type, for the tools that read a run folder back.
+SUMMARY_SHAPE = {
+    "status": int,
+    "message": str,
+    "summary": dict,
+    "energy_audit": dict,
+    "ball_fit": dict,
+    "counters": dict,
+}
+
+
+def _summary_document(path: Path) -> dict[str, Any]:
+    document = json.loads(path.read_text(encoding="utf-8"))
+    if not isinstance(document, dict):
+        raise ValueError(f"a JSON {type(document).__name__}, not an object")
+    for key, kind in SUMMARY_SHAPE.items():
+        if type(document.get(key)) is not kind:  # not isinstance: true is no status
+            raise ValueError(f"{key!r} is missing or not a JSON {kind.__name__}")
+    return document
+
+
+def _read_history(path: Path) -> xr.Dataset:
+    import xarray as xr
+
+    dataset = xr.load_dataset(path, engine=NETCDF_ENGINE)
+    _require(HISTORY_VARIABLES_READ_BACK, dataset.variables, "variable")
+    return dataset
+
+
+def _read_impact_table(path: Path) -> tuple[pd.DataFrame, dict[str, str]]:
+    impacts, units = read_impacts(path)
+    _require(IMPACT_UNITS, impacts.columns, "column")
+    return impacts, units
+
+
+def _require(names: Iterable[str], present: Container[str], kind: str) -> None:
+    """A file of the right format but not written by a run (another tool's, an empty one) lacks what plot and report read."""
+    missing = [name for name in names if name not in present]
+    if missing:
+        raise ValueError(f"no {kind} {missing[0]!r}; not written by shakermill run")
+
+
+def _read_part(path: Path, read: Callable[[Path], Any]) -> Any:
+    """``read(path)``, or :class:`StorageError` naming the run folder, the file and why it cannot be read."""
+    try:
+        if not path.is_file():
+            raise FileNotFoundError(errno.ENOENT, "missing")
+        return read(path)
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        # ValueError covers malformed JSON, TOML and Parquet (ArrowInvalid) and a configuration that no longer validates.
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else " ".join(str(exc).split())
+        # A configuration error names the file already.
+        reason = reason.removeprefix(f"{path}: ") or type(exc).__name__
+        raise StorageError(f"{path.parent}: not a readable shakermill run folder ({path.name}: {reason})") from None
+
+
+def read_impacts(path: Path) -> tuple[pd.DataFrame, dict[str, str]]:
+    """The impact table and its column units."""
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(path)
+    metadata = table.schema.metadata or {}
+    units = json.loads(metadata.get(UNITS_METADATA_KEY, b"{}"))
+    return table.to_pandas(), units
+
+
+def _fit_from_dict(values: Mapping[str, Any]) -> ExponentialFit:
+    # summary.json stores NaN as null; the fit's fields are floats again here.
+    arguments = {
+        field.name: math.nan if values.get(field.name) is None else values[field.name]
+        for field in fields(ExponentialFit)
+    }
+    return ExponentialFit(**arguments)

@@ -1,0 +1,170 @@
+"""Run configuration: a preset, an optional TOML file and ``--set KEY=VALUE`` overrides.
+
+Precedence, lowest first: the preset (``spex8000m`` unless the file's ``preset``
+or the command line's ``--preset`` names another, the command line winning),
+then the file's values, then the ``--set`` overrides. The TOML file holds the
+canonical keys at top level; values may be numbers, booleans, strings with
+units ("25 mm") and, for ``record_windows``, an array of ``[start, length]``
+pairs. A ``[provenance]`` table, as written by :func:`write_config_toml`, is
+ignored on loading, so a stored run's ``config.toml`` reproduces its parameters.
+"""
+
+from __future__ import annotations
+
+import platform
+import tomllib
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import tomli_w
+
+from shakermill.support.version import __version__
+from shakermill.support.atomic import write_text_atomically
+from shakermill.support.limits import MAX_CONFIG_BYTES, quoted
+from shakermill.parameters.schema import (
+    DEFAULT_PRESET,
+    ParameterError,
+    Parameters,
+    build_parameters,
+    field_description,
+    field_unit,
+    preset_values,
+)
+
+PRESET_KEY = "preset"
+PROVENANCE_TABLE = "provenance"
+SI_NOTE = "all values are SI (m, kg, s, K, rad, Pa, J, W); strings with units are accepted on input"
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """Validated parameters and where they came from."""
+
+    params: Parameters
+    preset: str
+    source: Path | None
+
+
+def load_config(
+    path: Path | str | None = None,
+    *,
+    preset: str | None = None,
+    overrides: Sequence[str] = (),
+) -> RunConfig:
+    """Resolve ``preset`` < file at ``path`` < ``overrides`` ("KEY=VALUE" strings) into parameters.
+
+    Raises :class:`ParameterError` with one line for any bad input: a missing or
+    malformed file, a bad override, an unknown key or a value out of range.
+    """
+    file_values: dict[str, Any] = {}
+    file_preset: str | None = None
+    source = Path(path) if path is not None else None
+    if source is not None:
+        file_values = read_config_file(source)
+        file_preset = _file_preset(file_values, source)
+    chosen_preset = preset or file_preset or DEFAULT_PRESET
+    base = preset_values(chosen_preset)
+    base.update(file_values)
+    params = build_parameters(base, parse_overrides(overrides))
+    return RunConfig(params=params, preset=chosen_preset, source=source)
+
+
+def read_config_file(path: Path) -> dict[str, Any]:
+    """The parameter entries of a TOML configuration (``preset`` included, ``[provenance]`` dropped)."""
+    text = _config_text(path)
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        # tomllib's message already ends with "(at line L, column C)".
+        raise ParameterError(f"{path}: malformed TOML: {exc}") from None
+    except ValueError:  # an integer of more digits than Python converts
+        raise ParameterError(f"{path}: malformed TOML: a number too long to read") from None
+    document.pop(PROVENANCE_TABLE, None)
+    return document
+
+
+def _config_text(path: Path) -> str:
+    """The text of the TOML file at ``path``, or :class:`ParameterError` with one line saying why not."""
+    try:
+        with path.open("rb") as stream:
+            # One byte more than allowed tells a file at the limit from a longer one without reading it all.
+            data = stream.read(MAX_CONFIG_BYTES + 1)
+    except FileNotFoundError:
+        raise ParameterError(f"{path}: no such configuration file") from None
+    except IsADirectoryError:
+        raise ParameterError(f"{path}: is a directory, expected a TOML configuration file") from None
+    except OSError as exc:
+        raise ParameterError(f"{path}: cannot read the configuration file ({exc.strerror})") from None
+    if len(data) > MAX_CONFIG_BYTES:
+        raise ParameterError(f"{path}: larger than {MAX_CONFIG_BYTES:,} bytes; a configuration holds a few kilobytes")
+    try:
+        # -sig: editors on Windows start UTF-8 files with a byte-order mark, which TOML itself does not allow.
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{path}: not UTF-8 text (byte {data[exc.start]:#04x} at offset {exc.start}); save it as UTF-8") from None
+
+
+def _file_preset(values: dict[str, Any], path: Path) -> str | None:
+    """Remove and return the file's ``preset`` entry; it names a preset, it is not a parameter."""
+    name = values.pop(PRESET_KEY, None)
+    if name is not None and not isinstance(name, str):
+        raise ParameterError(f"{path}: preset must be a string naming a preset, got {quoted(name)}")
+    return name
+
+
+def parse_overrides(items: Sequence[str]) -> dict[str, str]:
+    """``["restitution=0.8", "duration=2 min"]`` -> ``{"restitution": "0.8", "duration": "2 min"}``; later wins."""
+    overrides: dict[str, str] = {}
+    for item in items:
+        key, separator, value = item.partition("=")
+        key = key.strip()
+        if not separator or not key:
+            raise ParameterError(f"--set {quoted(item)}: expected KEY=VALUE, for example --set restitution=0.8")
+        overrides[key] = value.strip()
+    return overrides
+
+
+def config_toml_text(
+    params: Parameters,
+    *,
+    preset: str,
+    extra_provenance: Mapping[str, Any] | None = None,
+) -> str:
+    """The TOML text of :func:`write_config_toml`: one commented entry per key, then ``[provenance]``."""
+    entries = [f"# shakermill run configuration; {SI_NOTE}.", tomli_w.dumps({PRESET_KEY: preset})]
+    for key, value in params.model_dump().items():
+        unit = field_unit(key)
+        comment = f"# {field_description(key)}" + (f" [{unit}]" if unit else "")
+        entries.append(comment + "\n" + tomli_w.dumps({key: value}))
+    entries.append(tomli_w.dumps({PROVENANCE_TABLE: _provenance(preset, extra_provenance or {})}))
+    return "\n".join(entries)
+
+
+def _provenance(preset: str, extra: Mapping[str, Any]) -> dict[str, Any]:
+    provenance: dict[str, Any] = {
+        "shakermill_version": __version__,
+        "preset": preset,
+        "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "python": platform.python_version(),
+        "units": SI_NOTE,
+    }
+    # TOML has no null; absent values are simply left out.
+    provenance.update({key: value for key, value in extra.items() if value is not None})
+    return provenance
+
+
+def write_config_toml(
+    params: Parameters,
+    path: Path | str,
+    *,
+    preset: str,
+    extra_provenance: Mapping[str, Any] | None = None,
+) -> Path:
+    """Write ``params`` as a TOML file that :func:`load_config` turns back into equal parameters.
+
+    Floats are written with their shortest exact representation, so the round
+    trip is exact. The file replaces any previous one atomically.
+    """
+    return write_text_atomically(path, config_toml_text(params, preset=preset, extra_provenance=extra_provenance))

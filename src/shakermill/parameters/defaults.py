@@ -1,0 +1,13 @@
+"""Defaults that the command line's help shows, in a module that imports nothing.
+
+The modules that use them import them from here, so that ``shakermill --help`` can print them
+without importing NumPy, pandas, SciPy or Matplotlib.
+"""
+
+PNG_DPI = 150
+REPORT_FILE = "report.html"
+# The files each figure is written as.
+FIGURE_FORMATS = ("png", "svg")
+DEFAULT_SCHEDULER_TIMEOUT_S = 10.0
+# The calibration's free keys when none are given.
+DEFAULT_FREE = ("beta", "vial_mass", "h_outer", "lam")

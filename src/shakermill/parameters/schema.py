@@ -1,0 +1,749 @@
+"""Validated, immutable run parameters with the canonical keys of MODEL.md section 9.
+
+Every numeric field is SI. Users may give strings with units ("25 mm"); they are
+converted by :mod:`shakermill.units` before validation, so a ``Parameters``
+object only ever holds floats in SI.
+
+Presets are plain mappings from key to :class:`Cited` values, so that every
+default carries its source (the PyBaMM habit of parameter sets with citations).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import tomllib
+import math
+import numbers
+import typing
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, Literal, Mapping
+
+import annotated_types
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from shakermill.support.limits import (
+    MAX_FULL_RESOLUTION_PERIODS,
+    MAX_RECORD_WINDOWS,
+    MAX_RECORDED_SECONDS,
+    MAX_SAMPLES,
+    QUOTED_LENGTH,
+    quoted,
+)
+from shakermill.parameters.units import UnitError, to_si
+from shakermill.support.presenters import present
+
+PAPER = "Son 2025, Mathematics 13, 446"
+
+
+class ParameterError(ValueError):
+    """Bad user input: one line naming the key and what is allowed."""
+
+
+def _quantity(unit: str, description: str, **bounds: float) -> Any:
+    return Field(json_schema_extra={"unit": unit, "description": description}, **bounds)
+
+
+def _count(description: str, **bounds: int) -> Any:
+    return Field(json_schema_extra={"unit": "", "description": description}, strict=True, **bounds)
+
+
+# Every key has hard bounds: a value outside them is refused with one line naming the key and its range.
+# They are wide enough for any real mill (PLAUSIBLE_RANGES warns about the merely unusual inside them)
+# and tight enough that the model and its integrator stay meaningful and finish; the comment above each
+# field says why its bounds are where they are. Lower bounds of 0 that stay open are physical (no
+# negative length), except where a small value makes the run misbehave.
+LONGEST_RUN_S = 1e6
+# The explicit integrator's steps follow the fastest thermal time constant: ~0.7 steps per time constant
+# and simulated second, so 0.1 ms costs ~25 million steps a simulated hour, ten times the mechanics'
+# own. The default's fastest node, the air, takes 0.1 s.
+MIN_THERMAL_TIME_CONSTANT_S = 1e-4
+Window = tuple[
+    # A window may start anywhere in the longest run; its length is capped with the others' (MAX_RECORDED_SECONDS).
+    Annotated[float, annotated_types.Ge(0), annotated_types.Le(LONGEST_RUN_S)],
+    Annotated[float, annotated_types.Gt(0), annotated_types.Le(MAX_RECORDED_SECONDS)],
+]
+
+
+class Parameters(BaseModel):
+    """One run of the one-ball shaker-mill model (MODEL.md sections 1–9)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True, allow_inf_nan=False)
+
+    # Geometry and drive (MODEL.md section 1)
+    # 25 µm: the finest beads of bead mills (50 µm across); 0.1 m: larger than any milling ball (~50 mm).
+    ball_radius: float = _quantity("m", "milling ball radius R", ge=2.5e-5, le=0.1)
+    # 1 mm to 1 m: from micro-vials to twice the largest vibratory mill's vessel.
+    vial_length: float = _quantity("m", "inner length of the vial l_v", ge=1e-3, le=1.0)
+    vial_diameter: float = _quantity("m", "inner diameter of the vial d_v", ge=1e-3, le=1.0)
+    # Open at 0: a vanishing stroke is a resting wall, the analytic test of a single impact. 0.5 m: five
+    # times the longest stroke of a shaker mill.
+    amplitude: float = _quantity("m", "vial oscillation amplitude X_v", gt=0, le=0.5)
+    # 1 rad/s (0.16 Hz): thirty times slower than any mill. 1e4 rad/s (1.6 kHz): beyond acoustic mixers
+    # (60 Hz), high enough that 1060 typed for rpm is warned about, not refused; the step count grows with ω.
+    omega: float = _quantity("rad/s", "vial angular frequency ω", ge=1.0, le=1e4)
+    # One turn either way: every phase has an equal one inside, and larger ones only cost precision in sin(ωt + φ).
+    phase: float = _quantity("rad", "vial phase φ at t = 0", ge=-2 * math.pi, le=2 * math.pi)
+    # Materials (Table 2)
+    # 500 kg/m³: below every solid milling medium (polyethylene ~950); 25 000: above osmium (22 590), the
+    # densest element. A ball of 1e-6 kg/m³ has no heat capacity and made a run take hours.
+    ball_density: float = _quantity("kg/m^3", "ball density ρ_b", ge=500.0, le=25_000.0)
+    vial_density: float = _quantity("kg/m^3", "vial density ρ_v", ge=500.0, le=25_000.0)
+    # 0.1 MPa: softer than rubber; such contacts overlap past what the integrator allows and the run stops
+    # with its status. 1.2 TPa: diamond, the stiffest solid.
+    ball_youngs_modulus: float = _quantity("Pa", "ball Young's modulus E_b", ge=1e5, le=1.2e12)
+    vial_youngs_modulus: float = _quantity("Pa", "vial Young's modulus E_v", ge=1e5, le=1.2e12)
+    # Dense solids lie in 0-0.5 (diamond 0.07, steel 0.3, rubber 0.5); -0.5 leaves room for auxetic
+    # materials. As ν -> -1 the shear modulus, and the Rayleigh time that bounds contact steps, vanish.
+    ball_poisson_ratio: float = _quantity("", "ball Poisson ratio ν_b", ge=-0.5, lt=0.5)
+    vial_poisson_ratio: float = _quantity("", "vial Poisson ratio ν_v", ge=-0.5, lt=0.5)
+    # 50 J/(kg·K): below the heaviest metals (lead, tungsten, gold ~130); 5000: above polymers (~2000)
+    # and water (4186).
+    ball_heat_capacity: float = _quantity("J/(kg*K)", "ball specific heat c_b", ge=50.0, le=5000.0)
+    vial_heat_capacity: float = _quantity("J/(kg*K)", "vial specific heat c_v", ge=50.0, le=5000.0)
+    # 1 g: less steel than one 19-mm end face 0.5 mm thick; 1e-12 kg made the vial's time constant a
+    # nanosecond and a run take hours. 100 kg: a heavy vial with its clamp, many times over.
+    vial_mass: float = _quantity("kg", "thermally active vial mass m_v", ge=1e-3, le=100.0)
+    # Air (Table 3); the bounds cover the gases mills are filled with, from a rough vacuum to high pressure.
+    # 0.01 kg/m³ (~10 mbar of air): below it the gas is no continuum for Whitaker's correlation and the
+    # air node's time constant falls under a millisecond. 200: nitrogen at ~170 bar.
+    air_density: float = _quantity("kg/m^3", "air density ρ_a", ge=0.01, le=200.0)
+    # Gases at 0 °C: hydrogen 8.4e-6 to neon 3e-5 Pa·s, with room either way.
+    air_viscosity_ref: float = _quantity("Pa*s", "air viscosity μ_r at the reference temperature", ge=1e-6, le=1e-4)
+    # The reference of Sutherland's law: 50-2000 K covers every tabulated reference point.
+    air_reference_temperature: float = _quantity(
+        "K", "reference temperature θ_r of Sutherland's law", ge=50.0, le=2000.0
+    )
+    # Gases: xenon 0.005 to hydrogen 0.18 W/(m·K).
+    air_conductivity: float = _quantity("W/(m*K)", "air thermal conductivity k_a", ge=1e-3, le=1.0)
+    # Gases: xenon 158 to hydrogen 14 300 J/(kg·K).
+    air_cp: float = _quantity("J/(kg*K)", "air specific heat at constant pressure c_p,a", ge=100.0, le=20_000.0)
+    # An ideal gas has 1 < γ <= 5/3 (monatomic).
+    air_heat_capacity_ratio: float = _quantity("", "c_p/c_v of air", gt=1, le=5 / 3)
+    # Sutherland constants of gases: hydrogen 72 K, air 111, carbon dioxide 240; 1000 leaves room.
+    sutherland: float = _quantity("K", "Sutherland constant S", ge=0, le=1000.0)
+    # 0 switches the exchange off; 1e4 W/(m²·K) is liquid cooling, far above gas convection (5-250).
+    h_inner: float = _quantity("W/(m^2*K)", "vial-to-inner-air convection coefficient h_i", ge=0, le=1e4)
+    h_outer: float = _quantity("W/(m^2*K)", "vial-to-surroundings convection coefficient h_o", ge=0, le=1e4)
+    # 10 m²: the whole surface of a vial of 1 m, the largest allowed.
+    inner_area: float = _quantity("m^2", "vial surface exchanging heat with the inner air A_i", gt=0, le=10.0)
+    outer_area: float = _quantity("m^2", "vial surface exchanging heat with the surroundings A_o", gt=0, le=10.0)
+    # Collision and heat generation (Table 4)
+    # A perfectly plastic contact (0) has no damping ratio. Towards 0 the ball chatters on the face and a
+    # run takes more steps (20 times at 0.05, 40 at 1e-6), but it stays correct and finishes.
+    restitution: float = _quantity("", "coefficient of restitution e", gt=0, le=1)
+    eta: float = _quantity("", "fraction η of dissipated power turned into heat", ge=0, le=1)
+    lam: float = _quantity("", "fraction λ of the heat that goes to the ball", ge=0, le=1)
+    # β scales Whitaker's correlation, defensible within 0.1-3 (calibrate.DEFENSIBLE_RANGES); 100 leaves
+    # room for any hand tuning, and β = 1e12 made the ball's time constant a nanosecond.
+    beta: float = _quantity("", "convection calibration factor β", ge=0, le=100.0)
+    # Run (Table 4 and assumptions)
+    # A microsecond: less than one contact step. 1e6 s (11.6 days): longer than any milling run (~100 h);
+    # the stored samples are capped too (MAX_SAMPLES), and full-resolution runs by their drive periods.
+    duration: float = _quantity("s", "simulated time", ge=1e-6, le=LONGEST_RUN_S)
+    # 50 K: below liquid-nitrogen cryomilling (77 K). 1000 K: a vial in a furnace at 700 °C.
+    ambient_temperature: float = _quantity("K", "temperature of the surroundings θ_amb", ge=50.0, le=1000.0)
+    initial_temperature: float = _quantity("K", "initial temperature θ_0 of ball, vial and air", ge=50.0, le=1000.0)
+    # Up to 4000 K: tungsten, the most refractory ball material, melts at 3695 K.
+    ball_temperature_limit: float = _quantity(
+        "K", "highest physical ball temperature: a run that exceeds it ends with a non-ok status", ge=50.0, le=4000.0
+    )
+    # Half the longest vial; the ball must also start inside this vial (checked below).
+    ball_position: float = _quantity("m", "initial ball centre, relative to the vial centre", ge=-0.5, le=0.5)
+    # A 100-g ball at 1000 m/s; faster starts only end in an overlap the integrator refuses.
+    ball_momentum: float = _quantity("kg*m/s", "initial ball momentum", ge=-100.0, le=100.0)
+    # Numerics (MODEL.md section 7)
+    # The method is third order: rtol 1e-8 costs ~40 times the default's steps, and the contact step limit
+    # bounds the error below that anyway. Above 0.1 the error control no longer resolves a contact.
+    rtol: float = _quantity("", "relative tolerance of the integrator", ge=1e-8, le=0.1)
+    # 1e-12: far below every scale of the motion (the single-impact tests use it); the upper bounds are
+    # where the tolerance would exceed the quantity itself (a ball radius, a ball's momentum, a kelvin).
+    atol_position: float = _quantity("m", "absolute tolerance on the ball position", ge=1e-12, le=1e-3)
+    atol_momentum: float = _quantity("kg*m/s", "absolute tolerance on the ball momentum", ge=1e-12, le=1e-2)
+    atol_temperature: float = _quantity("K", "absolute tolerance on temperatures", ge=1e-12, le=1.0)
+    # The sample count duration/output_interval is capped as well (MAX_SAMPLES).
+    output_interval: float = _quantity("s", "sampling interval of the stored time series", ge=1e-6, le=LONGEST_RUN_S)
+    energy_projection: bool = Field(
+        strict=True,
+        json_schema_extra={"description": "enforce the mechanical energy balance of each contact step by projection"},
+    )
+    # Budget of one run (shakermill.budget): beyond either limit it stops with a non-ok status, keeping its results
+    max_wall_time: float = _quantity(
+        "s", "wall-clock budget of one run, its mechanics phase, fall-back and attractor probe included", gt=0,
+        le=LONGEST_RUN_S,  # a budget beyond the longest simulated run is no budget
+    )
+    max_steps: int = Field(
+        gt=0,
+        le=10**12,  # at ~0.5 µs a step, about a week of computing
+
+        json_schema_extra={"unit": "", "description": "step budget of one run: accepted integrator steps, all its integrations together"},
+    )
+    # Solver choice (full resolution, or the multiscale averaged solver)
+    solver: Literal["full", "averaged"] = Field(
+        json_schema_extra={"description": "'full': every impact for the whole run; 'averaged': mechanics until its statistics converge, then the slow thermal network"}
+    )
+    # Any target is safe: one that is never reached ends at averaging_max_time, and the run falls back.
+    averaging_rel_error: float = _quantity(
+        "", "averaged solver: target relative standard error of the averages", gt=0, lt=1
+    )
+    # 10 000 periods (~10 min) per batch: already past any averaging_max_time worth waiting for.
+    averaging_batch_periods: int = _count("averaged solver: drive periods per batch of the batch-means estimate", ge=1, le=10_000)
+    averaging_min_batches: int = _count("averaged solver: fewest batches after the transient", ge=4, le=10_000)
+    # An hour of mechanics costs what a full-resolution hour does; averaging converges in ~20 s.
+    averaging_max_time: float = _quantity("s", "averaged solver: longest mechanics window before giving up", gt=0, le=3600.0)
+    averaging_fallback: Literal["full", "fail"] = Field(
+        json_schema_extra={"description": "averaged solver: what to do when averaging is not valid"}
+    )
+    # Each start costs a settled run at every point of a scan; 100 cover the gap far more densely than
+    # the basins found so far need (the default 8 finds them).
+    attractor_starts: int = _count(
+        "initial states settled to find coexisting attractors (bifurcation, sweeps, averaged solver); "
+        "1: only the configured start",
+        ge=1,
+        le=100,
+    )
+    # Model options (MODEL.md sections 2-4: the alternatives the spec allows)
+    model: Literal["three_node", "ball_only"] = Field(
+        json_schema_extra={
+            "description": "'three_node': ball, vial and air (this paper); 'ball_only': air held at ambient and no vial "
+            "reservoir, the author's 2023 predecessor"
+        }
+    )
+    no_tension: bool = Field(strict=True, json_schema_extra={"description": "clip the contact force at zero (no adhesion)"})
+    heat_model: Literal["relative", "paper"] = Field(
+        json_schema_extra={"description": "'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed"}
+    )
+    convection_velocity: Literal["ball", "relative"] = Field(
+        json_schema_extra={"description": "velocity in Re: the ball's ('ball', as the paper) or relative to the vial"}
+    )
+    record_windows: tuple[Window, ...] = Field(
+        max_length=MAX_RECORD_WINDOWS,
+        json_schema_extra={"unit": "s", "description": "(start, length) windows stored at full resolution"},
+    )
+
+    @model_validator(mode="after")
+    def _ball_fits_vial(self) -> "Parameters":
+        diameter = 2.0 * self.ball_radius
+        if diameter >= self.vial_length:
+            raise ValueError(
+                f"ball_radius: a ball of diameter {diameter * 1e3:g} mm does not fit a vial of length "
+                f"{self.vial_length * 1e3:g} mm; allowed ball_radius < vial_length/2 = {self.vial_length / 2:g} m"
+            )
+        if diameter > self.vial_diameter:
+            raise ValueError(
+                f"ball_radius: a ball of diameter {diameter * 1e3:g} mm does not fit a vial of diameter "
+                f"{self.vial_diameter * 1e3:g} mm; allowed ball_radius <= vial_diameter/2 = {self.vial_diameter / 2:g} m"
+            )
+        half_gap = self.vial_length / 2.0 - self.ball_radius
+        if abs(self.ball_position) >= half_gap:
+            raise ValueError(
+                f"ball_position: the ball must start inside the vial, allowed |ball_position| < {half_gap:g} m"
+            )
+        return self
+
+    @model_validator(mode="after")
+    def _stored_data_fits_in_memory(self) -> "Parameters":
+        samples = self.duration / self.output_interval
+        if samples > MAX_SAMPLES:
+            raise ValueError(
+                f"output_interval: {self.output_interval:g} s over duration = {self.duration:g} s makes {samples:.3g} "
+                f"samples; allowed output_interval >= duration/{MAX_SAMPLES:,} = {self.duration / MAX_SAMPLES:.4g} s"
+            )
+        recorded = sum(min(length, max(0.0, self.duration - start)) for start, length in self.record_windows)
+        if recorded > MAX_RECORDED_SECONDS:
+            raise ValueError(
+                f"record_windows: they hold {recorded:g} s of the run at full resolution; allowed at most "
+                f"{MAX_RECORDED_SECONDS:g} s in all (sample longer stretches with output_interval)"
+            )
+        periods = self.duration * self.omega / (2.0 * math.pi)
+        if self.solver == "full" and periods > MAX_FULL_RESOLUTION_PERIODS:
+            longest = MAX_FULL_RESOLUTION_PERIODS * 2.0 * math.pi / self.omega
+            raise ValueError(
+                f"duration: {self.duration:g} s at omega = {self.omega:g} rad/s is {periods:.3g} drive periods, and the "
+                f"full solver keeps every impact; allowed duration <= {longest:.4g} s here "
+                f"({MAX_FULL_RESOLUTION_PERIODS:,} periods), or solver = 'averaged' for longer runs"
+            )
+        return self
+
+    @model_validator(mode="after")
+    def _thermal_network_is_not_stiff(self) -> "Parameters":
+        for node, (time_constant, keys) in self.thermal_time_constants_at_rest.items():
+            if time_constant < MIN_THERMAL_TIME_CONSTANT_S:
+                raise ValueError(
+                    f"{', '.join(keys)}: the {node}'s thermal time constant is {time_constant:.3g} s with these values "
+                    f"(ball at rest; motion only shortens it); allowed >= {MIN_THERMAL_TIME_CONSTANT_S:g} s, or the "
+                    "integrator's steps shrink with it and a run takes hours"
+                )
+        return self
+
+    # Derived geometry used by more than one module (MODEL.md sections 1 and 6)
+    @property
+    def ball_mass(self) -> float:
+        """m_b = ρ_b·4/3·π R³ (kg)."""
+        return self.ball_density * 4.0 / 3.0 * math.pi * self.ball_radius**3
+
+    @property
+    def end_face_area(self) -> float:
+        """2·π·d_v²/4: both circular end faces (m²), MODEL.md section 1; the paper's A_i = A_o."""
+        return end_faces_area(self.vial_diameter)
+
+    @property
+    def air_mass(self) -> float:
+        """m_a = ρ_a·(π d_v²/4·l_v − 4/3·π R³) (kg), MODEL.md section 6."""
+        vial_volume = math.pi * self.vial_diameter**2 / 4.0 * self.vial_length
+        ball_volume = 4.0 / 3.0 * math.pi * self.ball_radius**3
+        return self.air_density * (vial_volume - ball_volume)
+
+    @property
+    def air_heat_capacity(self) -> float:
+        """c_a = c_p,a/γ: the trapped air is heated at constant volume (J/(kg·K))."""
+        return self.air_cp / self.air_heat_capacity_ratio
+
+    @property
+    def thermal_time_constants_at_rest(self) -> dict[str, tuple[float, tuple[str, ...]]]:
+        """Heat capacity over conductance of each node that evolves (s), and the keys that set it.
+
+        The ball's convection is taken at rest (Nu = 2, h = k_a/R): its motion raises h, so these are
+        upper bounds of what a run sees.
+        """
+        ball_conductance = 4.0 * math.pi * self.ball_radius * self.beta * self.air_conductivity
+        ball = self.ball_mass * self.ball_heat_capacity / ball_conductance if ball_conductance > 0 else math.inf
+        constants = {"ball": (ball, ("ball_density", "ball_radius", "ball_heat_capacity", "beta", "air_conductivity"))}
+        if self.model == "ball_only":
+            return constants
+        inner, outer = self.h_inner * self.inner_area, self.h_outer * self.outer_area
+        vial = self.vial_mass * self.vial_heat_capacity / (inner + outer) if inner + outer > 0 else math.inf
+        air_capacity = self.air_mass * self.air_heat_capacity
+        air = air_capacity / (inner + ball_conductance) if inner + ball_conductance > 0 else math.inf
+        constants["vial"] = (vial, ("vial_mass", "vial_heat_capacity", "h_inner", "inner_area", "h_outer", "outer_area"))
+        constants["air"] = (air, ("air_density", "vial_length", "vial_diameter", "h_inner", "inner_area"))
+        return constants
+
+    def _repr_html_(self) -> str:
+        return present("parameters html", self)
+
+    def replace(self, **changes: Any) -> "Parameters":
+        """A new validated ``Parameters`` with ``changes`` applied (values may carry units)."""
+        return build_parameters(self.model_dump(), changes)
+
+
+FIELD_NAMES: tuple[str, ...] = tuple(Parameters.model_fields)
+
+
+def field_unit(key: str) -> str:
+    extra = Parameters.model_fields[key].json_schema_extra or {}
+    return str(extra.get("unit", ""))
+
+
+def field_description(key: str) -> str:
+    extra = Parameters.model_fields[key].json_schema_extra or {}
+    return str(extra.get("description", ""))
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """The hard bounds of a numeric key in its SI unit; ``str`` gives them in interval notation."""
+
+    low: float
+    high: float
+    low_open: bool
+    high_open: bool
+
+    def __str__(self) -> str:
+        return f"{'(' if self.low_open else '['}{self.low:g}, {self.high:g}{')' if self.high_open else ']'}"
+
+    def contains(self, value: float) -> bool:
+        above = value > self.low if self.low_open else value >= self.low
+        below = value < self.high if self.high_open else value <= self.high
+        return above and below
+
+
+def bounds(key: str) -> Bounds:
+    """The hard bounds of the numeric ``key``, from its field's constraints."""
+    low, high, low_open, high_open = -math.inf, math.inf, True, True
+    for constraint in Parameters.model_fields[key].metadata:
+        if isinstance(constraint, annotated_types.Gt):
+            low, low_open = constraint.gt, True
+        elif isinstance(constraint, annotated_types.Ge):
+            low, low_open = constraint.ge, False
+        elif isinstance(constraint, annotated_types.Lt):
+            high, high_open = constraint.lt, True
+        elif isinstance(constraint, annotated_types.Le):
+            high, high_open = constraint.le, False
+    return Bounds(float(low), float(high), low_open, high_open)
+
+
+def allowed_range(key: str) -> str:
+    """Human-readable allowed values of ``key`` from its field constraints, e.g. '(0, 1]'."""
+    field = Parameters.model_fields[key]
+    choices = typing.get_args(field.annotation) if typing.get_origin(field.annotation) is Literal else ()
+    if choices:
+        return "one of " + ", ".join(repr(choice) for choice in choices)
+    if field.annotation is bool:
+        return "true or false"
+    if key == "record_windows":
+        return (
+            f"at most {MAX_RECORD_WINDOWS} (start, length) pairs in s, start in [0, {LONGEST_RUN_S:g}], length > 0, "
+            f"{MAX_RECORDED_SECONDS:g} s of the run in all"
+        )
+    if field.annotation is int:
+        return f"a whole number in {bounds(key)}"
+    return f"{bounds(key)} {field_unit(key)}".rstrip()
+
+
+def end_faces_area(vial_diameter: float) -> float:
+    """Area of the two circular end faces of a vial of inner diameter ``vial_diameter`` (m²)."""
+    return 2.0 * math.pi * vial_diameter**2 / 4.0
+
+
+@dataclass(frozen=True)
+class Cited:
+    """A preset value with where it comes from."""
+
+    value: Any
+    source: str
+
+
+@dataclass(frozen=True)
+class Preset:
+    """A named parameter set. ``fitted`` names the keys a calibration set, ``provenance`` says how."""
+
+    name: str
+    description: str
+    values: Mapping[str, Cited]
+    fitted: tuple[str, ...] = ()
+    provenance: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+
+
+SPEX_8000M = Preset(
+    name="spex8000m",
+    description="SPEX 8000M Mixer/Mill, one 12.7 mm steel ball, as in Son 2025 (published parameters).",
+    values={
+        "ball_radius": Cited(6.35e-3, f"{PAPER}, Table 1"),
+        "vial_length": Cited(58e-3, f"{PAPER}, Table 1"),
+        "vial_diameter": Cited(19e-3, f"{PAPER}, Table 1 (A_i = A_o = 567.06 mm² = 2·π·d_v²/4)"),
+        "amplitude": Cited(25e-3, f"{PAPER}, Table 1 (X_v)"),
+        "omega": Cited(111.0, "assumption: not stated (range 90-130 rad/s); ~1060 cycles/min, the SPEX 8000M on 60 Hz mains"),
+        "phase": Cited(0.0, "assumption"),
+        "ball_density": Cited(7800.0, f"{PAPER}, Table 2"),
+        "vial_density": Cited(7800.0, f"{PAPER}, Table 2"),
+        "ball_youngs_modulus": Cited(200e9, f"{PAPER}, Table 2"),
+        "vial_youngs_modulus": Cited(200e9, f"{PAPER}, Table 2"),
+        "ball_poisson_ratio": Cited(0.3, f"{PAPER}, Table 2"),
+        "vial_poisson_ratio": Cited(0.3, f"{PAPER}, Table 2"),
+        "ball_heat_capacity": Cited(461.0, f"{PAPER}, Table 2"),
+        "vial_heat_capacity": Cited(461.0, f"{PAPER}, Table 2"),
+        "vial_mass": Cited(
+            0.05,
+            "assumption: not printed in the paper; the steel near the two end faces that exchanges heat with the "
+            "inside and outside air. It sets the time constant, not the steady state; calibration fits it",
+        ),
+        "air_density": Cited(1.225, f"{PAPER}, Table 3"),
+        "air_viscosity_ref": Cited(1.716e-5, f"{PAPER}, Table 3 (at 273.15 K)"),
+        "air_reference_temperature": Cited(273.15, f"{PAPER}, Table 3 footnote (0 °C)"),
+        "air_conductivity": Cited(0.0241, f"{PAPER}, Table 3"),
+        "air_cp": Cited(1003.5, f"{PAPER}, Table 3"),
+        "air_heat_capacity_ratio": Cited(1.4, "assumption: diatomic ideal gas; c_a = c_p,a/1.4 (MODEL.md section 6)"),
+        "sutherland": Cited(111.0, f"{PAPER}, Table 3"),
+        "h_inner": Cited(200.0, f"{PAPER}, Table 3"),
+        "h_outer": Cited(45.0, f"{PAPER}, Table 3"),
+        "inner_area": Cited(end_faces_area(19e-3), f"{PAPER}, Table 1 (A_i = 567.06 mm²: the two end faces, MODEL.md §1)"),
+        "outer_area": Cited(
+            end_faces_area(19e-3),
+            f"{PAPER}, Table 1 (A_o = 567.06 mm²: the two end faces only; a real vial also loses heat through its "
+            "side, MODEL.md §11)",
+        ),
+        "restitution": Cited(0.7, f"{PAPER}, Table 4 (e)"),
+        "eta": Cited(0.9, f"{PAPER}, Table 4 (η)"),
+        "lam": Cited(0.368, f"{PAPER}, Table 4 (λ)"),
+        "beta": Cited(0.3, f"{PAPER}, Table 4 (β, tuned by hand by the author)"),
+        "duration": Cited(3600.0, f"{PAPER}, Table 4 (60 min)"),
+        "ambient_temperature": Cited(293.15, f"{PAPER}, Table 3 footnote (ambient 20 °C)"),
+        "initial_temperature": Cited(293.15, f"assumption: θ̇_0 of {PAPER} Table 5 implies θ_0 = 20 °C"),
+        "ball_temperature_limit": Cited(
+            1673.15, "assumption: carbon and bearing steels begin to melt near 1400 °C; above it the model does not hold"
+        ),
+        "ball_position": Cited(0.0, "assumption: ball starts at the vial centre"),
+        "ball_momentum": Cited(0.0, "assumption: ball starts at rest"),
+        "rtol": Cited(1e-3, "MATLAB ode23 default RelTol, as used by the paper"),
+        "atol_position": Cited(1e-6, "MATLAB ode23 default AbsTol (1e-6, in SI)"),
+        "atol_momentum": Cited(1e-6, "MATLAB ode23 default AbsTol (1e-6, in SI)"),
+        "atol_temperature": Cited(1e-6, "MATLAB ode23 default AbsTol (1e-6, in SI)"),
+        "output_interval": Cited(1.0, "assumption: 1 s sampling of the stored time series"),
+        "solver": Cited("full", "full resolution, as the paper"),
+        "averaging_rel_error": Cited(1e-3, "numerical choice: ±0.1 % on the mean heat rate, ~0.1 K on a 100 K rise"),
+        "averaging_batch_periods": Cited(16, "numerical choice: batches of 16 drive periods (~0.9 s)"),
+        "averaging_min_batches": Cited(10, "numerical choice: the usual minimum for batch means"),
+        "averaging_max_time": Cited(120.0, "numerical choice: 2 simulated minutes of mechanics at most"),
+        "averaging_fallback": Cited("full", "numerical choice: fall back to full resolution and say so"),
+        "attractor_starts": Cited(
+            8,
+            "numerical choice: the configured start and 7 spread over the free gap, at rest or at the vial's peak "
+            "speed; ~0.02 s of mechanics each",
+        ),
+        "energy_projection": Cited(True, "numerical choice: projection method (Hairer, Lubich & Wanner 2006, §IV.4)"),
+        "max_wall_time": Cited(
+            3600.0,
+            "numerical choice: an hour; the default 60-min run takes ~3 s, the same at rtol 1e-6 ~20 s, and 10⁹ steps "
+            "(max_steps) ~10-20 min",
+        ),
+        "max_steps": Cited(
+            1_000_000_000,
+            "numerical choice: ~290 simulated hours at the defaults (3.4 million steps an hour), ~30 h at rtol 1e-6; "
+            "beyond it the steps are tiny (a stiff node or an extreme drive)",
+        ),
+        "model": Cited("three_node", f"{PAPER}: ball, vial and inner air as three lumped reservoirs"),
+        "no_tension": Cited(False, "MODEL.md section 2: the total force is not clipped by default"),
+        "heat_model": Cited("relative", "MODEL.md section 3: frame-invariant dissipation c·ζ̇²"),
+        "convection_velocity": Cited("ball", f"{PAPER}, section 3.3 (Re from the ball's velocity)"),
+        "record_windows": Cited(
+            ((0.0, 1.0), (600.0, 0.1)),
+            f"the windows of {PAPER} Fig. 4 (first second) and Fig. 5b (100 ms at 10 min)",
+        ),
+    },
+)
+
+# Presets produced by a calibration ship as TOML files next to this module: a base preset, the fitted
+# values and a [provenance] table that records the fit (command, targets, residuals, date, version).
+PRESET_FOLDER = Path(__file__).parent / "presets"
+
+
+def load_preset_file(path: Path, known: Mapping[str, Preset]) -> Preset:
+    """A preset from a calibration TOML file, on top of the preset it names as its base."""
+    with path.open("rb") as handle:
+        data = tomllib.load(handle)
+    provenance = dict(data.pop("provenance", {}))
+    base = known[data.pop("preset")]
+    fitted = tuple(provenance.get("fitted", ()))
+    note = f"fitted by calibration ({path.name}, [provenance])"
+    values = dict(base.values)
+    for key, value in data.items():
+        values[key] = Cited(tuple(map(tuple, value)) if key == "record_windows" else value, note if key in fitted else f"set in {path.name}")
+    return Preset(
+        name=path.stem,
+        description=str(provenance.get("description", f"{base.name} with values from {path.name}")),
+        values=values,
+        fitted=fitted,
+        provenance=provenance,
+    )
+
+
+PRESETS: dict[str, Preset] = {SPEX_8000M.name: SPEX_8000M}
+for _preset_file in sorted(PRESET_FOLDER.glob("*.toml")):
+    PRESETS[_preset_file.stem] = load_preset_file(_preset_file, PRESETS)
+DEFAULT_PRESET = SPEX_8000M.name
+
+
+def preset_values(name: str) -> dict[str, Any]:
+    if name not in PRESETS:
+        raise ParameterError(f"preset: unknown preset {name!r}; available: {', '.join(sorted(PRESETS))}")
+    return {key: cited.value for key, cited in PRESETS[name].values.items()}
+
+
+def check_known_keys(keys: list[str] | tuple[str, ...], *, extra_allowed: tuple[str, ...] = ()) -> None:
+    """Raise :class:`ParameterError` with a did-you-mean suggestion for the first unknown key."""
+    known = FIELD_NAMES + extra_allowed
+    for key in keys:
+        if key not in known:
+            # A key longer than any known one is no typo of one; it is quoted short so the line stays readable.
+            close = difflib.get_close_matches(key, known, n=1) if len(key) <= QUOTED_LENGTH else []
+            hint = f"; did you mean {close[0]!r}?" if close else "; `shakermill keys` lists the allowed keys"
+            shown = key if len(key) <= QUOTED_LENGTH else quoted(key)
+            raise ParameterError(f"{shown}: unknown parameter{hint}")
+
+
+# Guards against unit slips. Bare numbers are SI, but people give temperatures in °C, lengths in mm and
+# frequencies in rpm or Hz: a bare temperature below this many kelvin is almost surely °C, and is refused.
+BARE_TEMPERATURE_MINIMUM = 200.0
+USER_TEMPERATURE_KEYS = ("ambient_temperature", "initial_temperature", "ball_temperature_limit")
+
+
+@dataclass(frozen=True)
+class PlausibleRange:
+    """Values real mills and laboratories use, in the key's SI unit, and the units people slip into."""
+
+    low: float
+    high: float
+    users: str
+    likely_units: tuple[str, ...]
+
+
+PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
+    # Mixer mills shake at 3-35 Hz, planetary mills turn at up to ~1100 rpm of the sun wheel.
+    "omega": PlausibleRange(30.0, 400.0, "shaker and planetary mills", ("rpm", "Hz")),
+    "amplitude": PlausibleRange(1e-3, 0.1, "shaker mills", ("mm",)),
+    "ball_radius": PlausibleRange(2.5e-4, 0.05, "milling balls", ("mm",)),
+    "vial_length": PlausibleRange(5e-3, 0.5, "milling vials", ("mm",)),
+    "vial_diameter": PlausibleRange(5e-3, 0.5, "milling vials", ("mm",)),
+    "ambient_temperature": PlausibleRange(250.0, 330.0, "laboratories", ("degC",)),
+    "initial_temperature": PlausibleRange(250.0, 400.0, "laboratories", ("degC",)),
+}
+
+
+def unit_slip(key: str, value: float) -> str | None:
+    """Why ``value`` (SI) of ``key`` looks like a unit slip, naming the unit likely meant; None if plausible."""
+    plausible = PLAUSIBLE_RANGES.get(key)
+    if plausible is None or plausible.low <= value <= plausible.high:
+        return None
+    unit = field_unit(key)
+    meant = next((alt for alt in plausible.likely_units if _plausible_in(alt, value, key)), None)
+    hint = f"; did you mean {value:g} {meant}? Write {key}='{value:g} {meant}'" if meant else ""
+    return (
+        f"{key} = {value:g} {unit} is outside what {plausible.users} use "
+        f"({plausible.low:g} to {plausible.high:g} {unit}); bare numbers are SI{hint}"
+    )
+
+
+def _plausible_in(unit: str, value: float, key: str) -> bool:
+    """Whether ``value`` read in ``unit`` is plausible for ``key`` (1e308 Hz is no frequency at all)."""
+    plausible = PLAUSIBLE_RANGES[key]
+    try:
+        return plausible.low <= to_si(f"{value:g} {unit}", field_unit(key), key=key) <= plausible.high
+    except UnitError:
+        return False
+
+
+def unit_slip_warnings(params: Parameters) -> list[str]:
+    """One line per value outside :data:`PLAUSIBLE_RANGES` (see :func:`unit_slip`)."""
+    return [line for key in PLAUSIBLE_RANGES if (line := unit_slip(key, getattr(params, key))) is not None]
+
+
+def _is_bare_number(value: Any) -> bool:
+    if isinstance(value, bool):
+        return False
+    if isinstance(value, (int, float)):
+        return True
+    try:
+        float(str(value).strip())
+    except ValueError:
+        return False
+    return True
+
+
+def _coerce(key: str, value: Any) -> Any:
+    """Convert a user value for ``key`` to SI (strings with units) or to the option's type.
+
+    Raises :class:`ParameterError` naming the key and its allowed values.
+    """
+    annotation = Parameters.model_fields[key].annotation
+    try:
+        if annotation is float:
+            return _coerce_quantity(key, value)
+        if annotation is int:
+            return _coerce_count(key, value)
+        if annotation is bool:
+            return _coerce_switch(key, value)
+        if key == "record_windows":
+            return _coerce_windows(value)
+    except UnitError as exc:
+        raise ParameterError(f"{exc}; allowed {allowed_range(key)}") from None
+    return value  # one of a few names: the model checks it
+
+
+def _coerce_quantity(key: str, value: Any) -> float:
+    number = to_si(value, field_unit(key), key=key)
+    if key in USER_TEMPERATURE_KEYS and _is_bare_number(value) and number < BARE_TEMPERATURE_MINIMUM:
+        raise ParameterError(
+            f"{key}: a bare {number:g} is read as {number:g} K ({number - 273.15:.2f} °C); bare temperatures below "
+            f"{BARE_TEMPERATURE_MINIMUM:g} are refused: write '{number:g} degC' or '{number + 273.15:g} K'"
+        )
+    return number
+
+
+def _coerce_count(key: str, value: Any) -> int:
+    # A TOML `true` is not 1, and 2.5 starts are not 2.
+    if isinstance(value, bool):
+        raise UnitError(f"{key}: expected a whole number, got {value!r}")
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    number = to_si(value, "", key=key)
+    if not number.is_integer():
+        raise UnitError(f"{key}: expected a whole number, got {quoted(value)}")
+    return int(number)
+
+
+def _coerce_switch(key: str, value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    lowered = value.strip().lower() if isinstance(value, str) else None
+    if lowered in {"true", "1", "yes", "on"}:
+        return True
+    if lowered in {"false", "0", "no", "off"}:
+        return False
+    raise UnitError(f"{key}: expected true or false, got {quoted(value)}")
+
+
+def _coerce_windows(value: Any) -> tuple[tuple[float, float], ...]:
+    """Windows from "0:1,600:0.1" (the command line; "" means none) or from (start, length) pairs (TOML, Python)."""
+    if isinstance(value, str):
+        pairs: Any = [item.split(":") for item in value.split(",") if item.strip()]
+    elif isinstance(value, (list, tuple)):
+        pairs = value
+    else:
+        raise UnitError(f"record_windows: expected (start, length) pairs, got {quoted(value)}")
+    if len(pairs) > MAX_RECORD_WINDOWS:
+        raise UnitError(f"record_windows: {len(pairs)} windows are too many")
+    return tuple(_window(pair) for pair in pairs)
+
+
+def _window(pair: Any) -> tuple[float, float]:
+    if not isinstance(pair, (list, tuple)) or len(pair) != 2:
+        raise UnitError(f"record_windows: expected START:LENGTH (or [start, length]) in seconds, got {quoted(pair)}")
+    start, length = (to_si(item, "s", key="record_windows") for item in pair)
+    return start, length
+
+
+RANGE_ERRORS = frozenset({"greater_than", "greater_than_equal", "less_than", "less_than_equal"})
+
+
+def _shown_value(value: Any) -> str:
+    """A float as short as it reads back exactly (1e+12, not 1000000000000.0); anything else quoted short."""
+    if isinstance(value, float) and float(f"{value:g}") == value:
+        return f"{value:g}"
+    return quoted(value)
+
+
+def _one_line(error: ValidationError) -> str:
+    first = error.errors()[0]
+    location = first.get("loc") or ()
+    key = str(location[0]) if location else ""
+    if key not in Parameters.model_fields:
+        return str(first["msg"]).removeprefix("Value error, ")
+    value = _shown_value(first.get("input"))
+    message = str(first["msg"])
+    problem = f"{value} is out of range" if first.get("type") in RANGE_ERRORS else f"{message[:1].lower()}{message[1:]} (got {value})"
+    return f"{key}: {problem}; allowed {allowed_range(key)}"
+
+
+def build_parameters(base: Mapping[str, Any], overrides: Mapping[str, Any] | None = None) -> Parameters:
+    """Validate ``base`` updated with ``overrides`` into :class:`Parameters`.
+
+    Raises :class:`ParameterError` with one line that names the offending key.
+    """
+    merged = dict(base)
+    merged.update(overrides or {})
+    check_known_keys(list(merged))
+    missing = [key for key in FIELD_NAMES if key not in merged]
+    if missing:
+        raise ParameterError(f"{missing[0]}: no value given and no preset supplies one")
+    coerced = {key: _coerce(key, value) for key, value in merged.items()}
+    try:
+        return Parameters(**coerced)
+    except ValidationError as exc:
+        raise ParameterError(_with_unit_hint(_one_line(exc), coerced)) from None
+
+
+def _with_unit_hint(message: str, values: Mapping[str, Any]) -> str:
+    """``message`` about a key, with the unit slip behind it when there is one.
+
+    A ball of 6.35 m does not fit the vial: the geometry error alone would hide the slip.
+    """
+    key = message.partition(":")[0]
+    slip = unit_slip(key, values[key]) if key in PLAUSIBLE_RANGES else None
+    return message if slip is None else f"{message} ({slip})"
+
+
+def default_parameters(preset: str = DEFAULT_PRESET, **overrides: Any) -> Parameters:
+    """The parameters of ``preset`` with keyword ``overrides`` (values may carry units)."""
+    return build_parameters(preset_values(preset), overrides)

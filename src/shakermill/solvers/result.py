@@ -1,0 +1,391 @@
+"""What a run produced, from either solver: :class:`Result`, its energy audit, state histories and
+summary, and the conclusions every run gets (steady state, physical bounds, warnings, attractors)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING, Any, Mapping
+
+import numpy as np
+
+from shakermill.analysis.attractors import AttractorScan, find_attractors
+from shakermill.analysis.fit import ExponentialFit, increment_ratio
+from shakermill.analysis.steady import SteadyState, run_length_warning, steady_state
+from shakermill.engines.one_d import model
+from shakermill.engines.one_d.integrator import REACHED_STOP
+from shakermill.parameters.schema import Parameters, unit_slip_warnings
+from shakermill.support.presenters import present
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
+
+    from shakermill.solvers.averaged import MechanicsAverages
+
+INTERRUPTED = 1
+INTERRUPTED_MESSAGE = "Interrupted by the user; the results cover the time simulated so far."
+# The run finished, but a temperature left the range where the model means anything.
+OUT_OF_PHYSICAL_BOUNDS = -5
+# The run finished, but its energy audit does not close within ENERGY_AUDIT_TOLERANCE.
+ENERGY_AUDIT_FAILED = -6
+# Relative residual of the energy audit above which a run's heat and temperatures are not to be trusted.
+# With the energy projection the balance closes to round-off (~1e-11 over the operating range, presets
+# included); without it, it shows the contacts' truncation error: 0.2–0.8 % at the default rtol for
+# e ≤ 0.7, 5 % at e = 0.95, 9 % at rtol 0.1. A ball so light (ball_density = 1e-6) that its energies fall
+# below the temperature tolerance left 55–77 % of the heat unaccounted for.
+ENERGY_AUDIT_TOLERANCE = 1e-2
+
+
+@dataclass(frozen=True)
+class EnergyAudit:
+    """Where the vial's work went, in J, over the simulated interval.
+
+    work_by_vial = Δkinetic + Δelastic + dissipated
+    dissipated   = heat_generated + not_converted_to_heat
+    heat_generated = Δstored (ball + vial + air) + heat_lost_to_surroundings
+
+    ``projection_correction`` is the total |Δ kinetic energy| the energy
+    projection applied at the end of contacts: the integrator's truncation
+    error in the contact mechanics, which the projection removes from the
+    balance above but which this field keeps visible.
+    """
+
+    work_by_vial: float
+    kinetic_energy_change: float
+    elastic_energy_change: float
+    dissipated: float
+    heat_generated: float
+    heat_to_ball: float
+    heat_to_vial: float
+    not_converted_to_heat: float
+    stored_ball: float
+    stored_vial: float
+    stored_air: float
+    heat_lost_to_surroundings: float
+    projection_correction: float
+
+    @property
+    def mechanical_residual(self) -> float:
+        return self.work_by_vial - self.kinetic_energy_change - self.elastic_energy_change - self.dissipated
+
+    @property
+    def thermal_residual(self) -> float:
+        stored = self.stored_ball + self.stored_vial + self.stored_air
+        return self.heat_generated - stored - self.heat_lost_to_surroundings
+
+    @property
+    def residual(self) -> float:
+        return self.mechanical_residual + self.thermal_residual
+
+    @property
+    def relative_residual(self) -> float:
+        """|residual| over the largest flow in the balance (0 when nothing flowed, NaN when a term is not finite)."""
+        if not math.isfinite(self.residual):
+            return math.nan
+        scale = max(abs(self.work_by_vial), abs(self.dissipated), abs(self.heat_generated))
+        return abs(self.residual) / scale if scale > 0.0 else 0.0
+
+    def as_dict(self) -> dict[str, float]:
+        values = dict(self.__dict__)
+        values.update(
+            mechanical_residual=self.mechanical_residual,
+            thermal_residual=self.thermal_residual,
+            residual=self.residual,
+            relative_residual=self.relative_residual,
+        )
+        return values
+
+@dataclass
+class Result:
+    """Everything a run produced. ``success`` is False when the integrator stopped early."""
+
+    params: Parameters
+    status: int
+    message: str
+    t_end: float
+    history: StateHistory  # the sampled states; ``timeseries`` is its xarray view
+    window_history: StateHistory  # the full-resolution states in the record windows; ``windows``
+    impact_columns: dict[str, np.ndarray]  # one entry per impact; ``impacts`` is the table
+    counters: dict[str, int]
+    wall_time: float
+    energy: EnergyAudit
+    ball_fit: ExponentialFit
+    solver: str = "full"
+    impact_window: float | None = None  # s covered by ``impacts``; None means the whole run
+    averages: MechanicsAverages | None = None
+    steady: SteadyState | None = None
+    attractors: AttractorScan | None = None  # the settled motions of other starts, where they were probed
+    # One line each, for things a user should know that do not stop the run (stderr and summary.json).
+    warnings: list[str] = field(default_factory=list)
+    summary: dict[str, float | int | str | bool | list[str]] = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return self.status == REACHED_STOP
+
+    @property
+    def impact_count(self) -> int:
+        return int(self.impact_columns["time"].size)
+
+    @cached_property
+    def timeseries(self) -> xr.Dataset:
+        """The sampled state history (units in the attributes, temperatures also in °C as ``theta_*_C``)."""
+        return self.history.dataset()
+
+    @cached_property
+    def windows(self) -> xr.Dataset:
+        """The full-resolution state inside the record windows."""
+        return self.window_history.dataset()
+
+    @cached_property
+    def impacts(self) -> pd.DataFrame:
+        """One row per impact, SI units (:data:`IMPACT_UNITS`)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.impact_columns)
+
+    def plot(self, *, impacts: bool = False) -> Any:
+        """The paper's figures of this run (and the impact figures if asked), by name, as a
+        :class:`~shakermill.views.notebook.FigureSet`; a notebook shows them."""
+        return present("result figures", self, impacts=impacts)
+
+    def _repr_html_(self) -> str:
+        return present("result html", self)
+
+def conclude(result: Result, heat_power: float, velocity_term: float) -> Result:
+    """Steady state, physical bounds, energy audit and warnings of a finished run of either solver, then its summary.
+
+    ``heat_power`` (W) and ``velocity_term`` are the means of the settled motion that drive the
+    thermal network (MODEL.md §11).
+    """
+    params = result.params
+    result.steady = steady_state(params, heat_power, velocity_term)
+    result.warnings.extend(unit_slip_warnings(params))
+    lines = (run_length_warning(result.t_end, result.steady), steady_state_bound_warning(result), fit_warning(result))
+    for line in lines:
+        if line is not None:
+            result.warnings.append(line)
+    checks = ((OUT_OF_PHYSICAL_BOUNDS, physical_bounds_problem), (ENERGY_AUDIT_FAILED, energy_audit_problem))
+    for status, problem_of in checks:
+        problem = problem_of(result) if result.status == REACHED_STOP else None
+        if problem is not None:
+            result.status, result.message = status, problem
+    result.summary = summarize(result)
+    return result
+
+def physical_bounds_problem(result: Result) -> str | None:
+    """Why the temperatures of a run cannot be physical, or None."""
+    series = result.history
+    hottest_ball = float(np.nanmax(series["theta_ball"]))
+    limit = result.params.ball_temperature_limit
+    if hottest_ball > limit:
+        return (
+            f"The ball temperature reached {kelvin_to_celsius(hottest_ball):.4g} °C, above ball_temperature_limit "
+            f"({kelvin_to_celsius(limit):.4g} °C): the model does not hold there. Check omega, amplitude and the "
+            "units of the inputs (bare numbers are SI)."
+        )
+    coldest = min(float(np.nanmin(series[name])) for name in ("theta_ball", "theta_vial", "theta_air"))
+    if coldest < 0.0:
+        return f"A temperature fell to {coldest:.4g} K, below absolute zero: the thermal network is not physical here."
+    return None
+
+def energy_audit_problem(result: Result) -> str | None:
+    """Why the energy audit of a run says its heat cannot be trusted, or None."""
+    residual = result.energy.relative_residual
+    if residual <= ENERGY_AUDIT_TOLERANCE:
+        return None
+    projection = "leave energy_projection on" if result.params.energy_projection else "turn energy_projection on"
+    return (
+        f"The energy audit does not close: its relative residual is {residual:.3g}, above {ENERGY_AUDIT_TOLERANCE:g}, "
+        "so the heat and the temperatures of this run cannot be trusted. Tighten rtol and the absolute tolerances "
+        f"(atol_temperature where the energies are very small), {projection}, and check the inputs."
+    )
+
+def fit_warning(result: Result) -> str | None:
+    """A line when the exponential fit of the ball temperature failed: the summary's θ∞, τ and θ̇₀ then mean nothing."""
+    fit = result.ball_fit
+    if fit.success:
+        return None
+    return (
+        f"the exponential fit of the ball temperature failed ({fit.message}): theta_inf_C, tau_min and "
+        "rate0_C_per_min are not usable"
+    )
+
+def steady_state_bound_warning(result: Result) -> str | None:
+    """A line when the run stays in range but its steady state would not."""
+    steady = result.steady
+    limit = result.params.ball_temperature_limit
+    if steady is None or not steady.solved or steady.ball <= limit:
+        return None
+    return (
+        f"the ball's steady state ({kelvin_to_celsius(steady.ball):.4g} °C) is above ball_temperature_limit "
+        f"({kelvin_to_celsius(limit):.4g} °C): a longer run would leave the model's range"
+    )
+
+def no_impact_note(params: Parameters, impacts: int) -> str:
+    """A hint for the surprising case of a run without impacts, empty otherwise."""
+    if impacts:
+        return ""
+    free_gap = params.vial_length / 2.0 - params.ball_radius
+    if params.amplitude < free_gap:
+        return (
+            f" No impact happened: the amplitude ({params.amplitude * 1e3:g} mm) is smaller than the free gap "
+            f"({free_gap * 1e3:g} mm), so in one dimension a slow ball is never reached; "
+            "give it an initial ball_momentum or ball_position."
+        )
+    return " No impact happened."
+
+_VARIABLES = {
+    # name: (state index, units, long name)
+    "x": (model.X, "m", "ball centre position"),
+    "p": (model.P, "kg m s-1", "ball momentum"),
+    "theta_ball": (model.THETA_BALL, "K", "ball temperature"),
+    "theta_vial": (model.THETA_VIAL, "K", "vial temperature"),
+    "theta_air": (model.THETA_AIR, "K", "inner air temperature"),
+    "work_vial": (model.WORK_VIAL, "J", "cumulative work done by the vial on the ball"),
+    "dissipated": (model.DISSIPATED, "J", "cumulative energy dissipated in contacts"),
+    "heat_generated": (model.HEAT_GENERATED, "J", "cumulative irreversible heat generated"),
+    "heat_lost": (model.HEAT_LOST, "J", "cumulative heat lost from the vial to the surroundings"),
+    "velocity_term_integral": (
+        model.VELOCITY_TERM,
+        "s",
+        "time integral of Whitaker's velocity term 0.4 Re^(1/2) + 0.06 Re^(2/3)",
+    ),
+}
+
+# Temperatures (K) that the datasets also carry in °C, as ``<name>_C``.
+CELSIUS_VARIABLES = ("theta_ball", "theta_vial", "theta_air")
+
+TIME_ATTRIBUTES = {"units": "s", "long_name": "simulated time"}
+
+@dataclass(frozen=True)
+class StateHistory:
+    """A state history as NumPy arrays over ``times`` (s), each variable with its attributes (units, long_name).
+
+    Run files are written from it directly, and :meth:`dataset` is the xarray view: a run that only
+    writes its files never imports xarray, whose first Dataset imports dask and pint (half a second).
+    """
+
+    times: np.ndarray
+    variables: dict[str, tuple[np.ndarray, dict[str, str]]]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.variables[name][0]
+
+    def with_attributes(self, extra: Mapping[str, Mapping[str, str]]) -> StateHistory:
+        """The same history with ``extra[name]`` added to the attributes of variable ``name``."""
+        variables = {
+            name: (values, {**attributes, **extra.get(name, {})}) for name, (values, attributes) in self.variables.items()
+        }
+        return StateHistory(self.times, variables)
+
+    def dataset(self) -> xr.Dataset:
+        import xarray as xr
+
+        data_vars = {name: ("time", values, dict(attributes)) for name, (values, attributes) in self.variables.items()}
+        return xr.Dataset(data_vars, coords={"time": ("time", self.times, dict(TIME_ATTRIBUTES))})
+
+def state_history(times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters) -> StateHistory:
+    """The state history with units and long names, temperatures also in °C, the ball's velocity and the vial's position."""
+    variables = {
+        name: (states[:, index], {"units": units, "long_name": long_name})
+        for name, (index, units, long_name) in _VARIABLES.items()
+    }
+    # The same temperatures in °C beside the kelvin ones: ``ds.theta_ball_C.plot()`` is then labelled with the
+    # unit of its values, which converting ``theta_ball`` by hand would not change from [K].
+    for name in CELSIUS_VARIABLES:
+        kelvin, attributes = variables[name]
+        variables[f"{name}_C"] = (kelvin_to_celsius(kelvin), {"units": "degC", "long_name": attributes["long_name"]})
+    variables["velocity"] = (states[:, model.P] / constants.ball_mass, {"units": "m s-1", "long_name": "ball velocity"})
+    variables["vial_position"] = (
+        params.amplitude * np.sin(params.omega * times + params.phase),
+        {"units": "m", "long_name": "vial centre position"},
+    )
+    return StateHistory(times, variables)
+
+def kelvin_to_celsius(kelvin: float) -> float:
+    return kelvin - 273.15
+
+def understood_inputs(params: Parameters) -> dict[str, float]:
+    """The inputs people most often give in other units, echoed in those units (guards against unit slips)."""
+    cycles_per_second = params.omega / (2.0 * math.pi)
+    return {
+        "omega_rad_s": params.omega,
+        "omega_hz": cycles_per_second,
+        "omega_rpm": 60.0 * cycles_per_second,
+        "amplitude_mm": params.amplitude * 1e3,
+        "ball_radius_mm": params.ball_radius * 1e3,
+        "vial_length_mm": params.vial_length * 1e3,
+        "vial_diameter_mm": params.vial_diameter * 1e3,
+        "ambient_temperature_C": kelvin_to_celsius(params.ambient_temperature),
+        "initial_temperature_C": kelvin_to_celsius(params.initial_temperature),
+    }
+
+def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]:
+    """The flat summary printed by ``run --json`` and stored as ``summary.json``."""
+    params = result.params
+    series = result.history
+    last = {name: float(series[name][-1]) for name in CELSIUS_VARIABLES}
+    fit = result.ball_fit
+    theta_0 = params.initial_temperature
+    impacts = result.impact_columns
+    count = result.impact_count
+    duration = max(result.t_end, 1e-300)
+    impact_window = result.impact_window if result.impact_window else duration
+    impact_rate = count / impact_window if impact_window > 0 else math.nan
+    summary = {
+        "status": result.status,
+        "success": result.success,
+        "message": result.message,
+        "simulated_s": result.t_end,
+        "theta_inf_C": kelvin_to_celsius(fit.theta_inf),
+        "theta_inf_stderr_K": fit.theta_inf_stderr,
+        "tau_min": fit.tau / 60.0,
+        "tau_stderr_min": fit.tau_stderr / 60.0,
+        "rate0_C_per_min": fit.initial_rate * 60.0,
+        "fit_rms_residual_K": fit.rms_residual,
+        "ball_C": kelvin_to_celsius(float(last["theta_ball"])),
+        "vial_C": kelvin_to_celsius(float(last["theta_vial"])),
+        "air_C": kelvin_to_celsius(float(last["theta_air"])),
+        "vial_ball_ratio": increment_ratio(float(last["theta_vial"]), float(last["theta_ball"]), theta_0),
+        "solver": result.solver,
+        "impacts": count if result.impact_window is None else int(round(impact_rate * duration)),
+        "impact_rate_hz": impact_rate,
+        "heat_power_W": result.energy.heat_generated / duration,
+        "dissipated_power_W": result.energy.dissipated / duration,
+        "mean_impact_speed_m_s": float(impacts["impact_speed"].mean()) if count else math.nan,
+        "max_impact_speed_m_s": float(impacts["impact_speed"].max()) if count else math.nan,
+        "mean_dissipated_per_impact_J": float(impacts["dissipated_energy"].mean()) if count else math.nan,
+        "steps": result.counters["steps"],
+        "rejected_steps": result.counters["rejected_steps"],
+        "rhs_evaluations": result.counters["rhs_evaluations"],
+        "wall_time_s": result.wall_time,
+        "energy_audit_residual": result.energy.relative_residual,
+        "energy_projection_relative": (
+            result.energy.projection_correction / result.energy.dissipated if result.energy.dissipated > 0 else 0.0
+        ),
+    }
+    summary.update(understood_inputs(params))
+    if result.steady is not None:
+        summary.update(result.steady.as_summary())
+    if result.averages is not None:
+        summary.update(result.averages.as_summary())
+    if result.attractors is not None:
+        summary.update(result.attractors.as_summary())
+    summary["warnings"] = list(result.warnings)
+    return summary
+
+
+def probed(result: Result) -> AttractorScan:
+    """The attractors at ``result``'s parameters: those its solver probed, or found now and attached."""
+    if result.attractors is None:
+        attach(result, find_attractors(result.params))
+    return result.attractors
+
+def attach(result: Result, scan: AttractorScan) -> None:
+    """Give ``result`` the scan, its warnings, and its summary keys (``n_attractors``, ``heat_power_spread_W``, ...)."""
+    result.attractors = scan
+    result.warnings.extend(scan.warnings())
+    result.summary = summarize(result)

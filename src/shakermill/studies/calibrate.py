@@ -1,0 +1,468 @@
+"""Calibration: fit free parameters to measured targets by bounded least squares.
+
+What the paper did by hand (tuning β until θ∞ and τ matched Table 5), done by
+``scipy.optimize.least_squares`` and reported honestly: which keys were free,
+which quantities were targets, the residuals, the sensitivities, and whether a
+parameter ended on a bound (a sign that the targets cannot be met with that
+choice of free parameters).
+
+The default target is the experiment's ball-temperature curve as the paper
+summarises it, θ(t) = 48 − 28·exp(−t/16.7 min) over 0–60 min
+(:func:`experiment_curve`); the Table 5 numbers of the model's own exponential
+fit (``theta_inf_C``, ``tau_min``, ``rate0_C_per_min``, ``vial_ball_ratio``)
+remain available as targets, and any measured curve can be given. Positive
+parameters are fitted in log space, so bounds are ratios and steps are
+relative; keys with a physically defensible range (:data:`DEFENSIBLE_RANGES`)
+are bounded by it, so a fitted value on its edge says the data pull beyond
+what physics allows. The averaged solver is used unless asked otherwise: it
+makes each evaluation a few hundredths of a second.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+import tomli_w
+from scipy.optimize import least_squares
+
+from shakermill.support.version import __version__
+from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
+from shakermill.parameters.defaults import DEFAULT_FREE
+from shakermill.support.limits import MAX_VALUE_LENGTH, quoted
+from shakermill.parameters.schema import ParameterError, Parameters, bounds, check_known_keys
+from shakermill.solvers.result import Result
+from shakermill.solvers.simulate import simulate_whole
+from shakermill.studies.validation import CURVE_TOLERANCE_K, TARGET_KEYS, Curve, check_targets, experiment_curve, target_range
+
+# The free set of the shipped calibrated preset: the smallest set that follows the experiment's curve
+# within 1 K RMS with every value inside its defensible range (see README, "Against the experiment").
+# A free parameter may move this factor either way from its starting value.
+BOUND_FACTOR = 100.0
+# Relative step of the finite-difference Jacobian in log space: large enough to rise above the
+# averaged solver's statistical noise (relative standard error ~1e-4 to 1e-3 on mechanical inputs).
+JACOBIAN_STEP = 1e-2
+# A parameter within this relative distance of a bound is reported as stuck on it.
+AT_BOUND = 1e-3
+# A scalar target further off than this (relative) after the fit counts as not met.
+TARGET_TOLERANCE = 5e-3
+# Scalar targets are matched relatively; curve points in kelvin: one kelvin weighs like 1 % on a target.
+CURVE_SCALE_K = 100.0
+# Quantities a calibration predicts without fitting them, reported beside the fit.
+PREDICTED_KEYS = ("vial_ball_ratio", "ball_steady_C", "vial_steady_C", "air_steady_C", "slowest_time_constant_min")
+
+
+@dataclass
+class Calibration:
+    """The outcome of :func:`calibrate`."""
+
+    params: Parameters
+    free: tuple[str, ...]
+    fitted: dict[str, float]
+    start: dict[str, float]
+    targets: dict[str, float]
+    achieved: dict[str, float]
+    curve_rms_K: float | None
+    parameter_stderr: dict[str, float]
+    # target -> parameter -> d ln(target)/d ln(parameter); for a curve, "ball_C at T min" -> K per e-fold
+    sensitivities: dict[str, dict[str, float]]
+    predictions: dict[str, float]  # what the fitted model says of quantities that were not fitted
+    at_bounds: list[str]
+    success: bool
+    message: str
+    evaluations: int
+    solver: str
+    curve_source: str = ""
+    result: Result | None = field(default=None, repr=False)
+
+    @property
+    def relative_residuals(self) -> dict[str, float]:
+        return {key: (self.achieved[key] - value) / value for key, value in self.targets.items()}
+
+    @property
+    def defensible(self) -> dict[str, str]:
+        """For each fitted key: whether its value is physically defensible, and why."""
+        verdicts = {}
+        for key, value in self.fitted.items():
+            bounds = DEFENSIBLE_RANGES.get(key)
+            if bounds is None:
+                verdicts[key] = "no defensible range is recorded for this key: judge it yourself"
+                continue
+            where = "inside" if bounds.contains(value) else "OUTSIDE"
+            edge = " (on its edge: the data pull beyond it)" if key in self.at_bounds else ""
+            verdicts[key] = f"{where} {bounds.low:g} to {bounds.high:g}{edge}: {bounds.reason}"
+        return verdicts
+
+    def as_dict(self) -> dict:
+        return {
+            "free": list(self.free),
+            "fitted": self.fitted,
+            "start": self.start,
+            "targets": self.targets,
+            "achieved": self.achieved,
+            "relative_residuals": self.relative_residuals,
+            "curve_rms_K": self.curve_rms_K,
+            "parameter_stderr": self.parameter_stderr,
+            "sensitivities": self.sensitivities,
+            "predictions": self.predictions,
+            "defensible": self.defensible,
+            "at_bounds": self.at_bounds,
+            "success": self.success,
+            "message": self.message,
+            "evaluations": self.evaluations,
+            "solver": self.solver,
+        }
+
+
+def parse_targets(items: Sequence[str]) -> dict[str, float]:
+    """``["theta_inf_C=48", ...]`` -> ``{"theta_inf_C": 48.0}`` with one-line errors."""
+    targets: dict[str, float] = {}
+    for item in items:
+        name, separator, value = item.partition("=")
+        name = name.strip()
+        if not separator:
+            raise ParameterError(f"target: expected NAME=VALUE, got {item!r}")
+        if name not in TARGET_KEYS:
+            raise ParameterError(f"target: unknown target {quoted(name)}; allowed: {', '.join(TARGET_KEYS)}")
+        number = _plain_number(value)
+        if number is None:
+            raise ParameterError(f"target: {name} needs a number, got {quoted(value)}; allowed {target_range(name)}")
+        targets[name] = number
+    check_targets(targets)
+    return targets
+
+
+def _plain_number(text: str) -> float | None:
+    """``text`` as a float; None when it is not one, or longer than any number is written."""
+    if len(text) > MAX_VALUE_LENGTH:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def parse_free(items: Sequence[str]) -> tuple[str, ...]:
+    """``["beta,vial_mass", "eta"]`` -> ``("beta", "vial_mass", "eta")``; only positive float keys."""
+    keys = tuple(key.strip() for item in items for key in item.split(",") if key.strip()) or DEFAULT_FREE
+    check_known_keys(list(keys))
+    for key in keys:
+        if Parameters.model_fields[key].annotation is not float:
+            raise ParameterError(f"free: {key} is not a numeric parameter and cannot be fitted")
+    if len(set(keys)) != len(keys):
+        raise ParameterError(f"free: a key is listed twice in {', '.join(keys)}")
+    return keys
+
+
+@dataclass(frozen=True)
+class DefensibleRange:
+    """Where a fitted value can still be argued for physically, and the argument (SI units)."""
+
+    low: float
+    high: float
+    reason: str
+
+    def contains(self, value: float) -> bool:
+        return self.low <= value <= self.high
+
+
+CENGEL = "Çengel, Heat and Mass Transfer: free convection of gases 2-25, forced 25-250 W/(m²·K)"
+DEFENSIBLE_RANGES: dict[str, DefensibleRange] = {
+    "beta": DefensibleRange(
+        0.1, 3.0,
+        "Whitaker's correlation (β = 1) holds to about ±30 % in steady flow; a factor 3 either way covers the "
+        "unsteady, wall-bounded flow round a ball that reverses every few ms (the paper's 0.3 included)",
+    ),
+    "vial_mass": DefensibleRange(
+        0.02, 1.0,
+        "from the steel of the two 19-mm end faces a few mm thick (~0.02 kg) to a whole hardened-steel vial "
+        "with its cap (order 1 kg)",
+    ),
+    "h_outer": DefensibleRange(5.0, 250.0, f"{CENGEL}; the vial moves at up to ωX_v ≈ 2.8 m/s"),
+    "h_inner": DefensibleRange(5.0, 250.0, f"{CENGEL}; the trapped air is stirred by the ball"),
+    "outer_area": DefensibleRange(
+        5.67e-4, 0.03,
+        "from the paper's two 19-mm end faces to the whole outer surface of a SPEX steel vial "
+        "(~0.02 m² if it is about 57 mm × 76 mm: no published dimensions were found)",
+    ),
+    "inner_area": DefensibleRange(
+        5.67e-4, 0.01, "from the paper's two end faces to the whole inner surface of a SPEX vial (~0.009 m², estimated)"
+    ),
+    "lam": DefensibleRange(
+        0.25, 0.75,
+        "two steel bodies share the heat of a contact about evenly (equal thermal effusivities give 0.5); "
+        "the paper's 0.368 lies inside",
+    ),
+    "eta": DefensibleRange(
+        0.7, 1.0,
+        "most plastic work in metals becomes heat (Taylor-Quinney coefficient ~0.9); with no powder in the "
+        "vial little else can store it",
+    ),
+}
+
+
+# An open hard bound is approached to this relative distance: exp(log(bound)) may round onto it.
+OPEN_BOUND_MARGIN = 1e-9
+
+
+def log_bounds(key: str, start: float) -> tuple[float, float]:
+    """Bounds in log space: the defensible range (widened to include the start), else a factor either way;
+    always inside the key's hard bounds, so that no step of the fit tries a value the model refuses."""
+    if key in DEFENSIBLE_RANGES:
+        defensible = DEFENSIBLE_RANGES[key]
+        low, high = min(defensible.low, start), max(defensible.high, start)
+    else:
+        low, high = start / BOUND_FACTOR, start * BOUND_FACTOR
+    hard = bounds(key)
+    low = max(low, hard.low * (1 + OPEN_BOUND_MARGIN) if hard.low_open else hard.low)
+    high = min(high, hard.high * (1 - OPEN_BOUND_MARGIN) if hard.high_open else hard.high)
+    # A start on the upper limit still needs an open interval.
+    return math.log(low), max(math.log(high), math.log(start) + 1e-12)
+
+
+def calibrate(
+    base: Parameters,
+    free: Sequence[str] = DEFAULT_FREE,
+    targets: Mapping[str, float] | None = None,
+    curve: Curve | None = None,
+    *,
+    full_resolution: bool = False,
+    progress: Callable[[int], None] | None = None,
+) -> Calibration:
+    """Fit ``free`` keys of ``base`` to ``targets`` and/or ``curve``; see the module docstring.
+
+    ``progress(evaluations)`` is called after every model evaluation. A run that uses up its budget
+    stops the fit (:class:`~shakermill.budget.BudgetExceeded`): its partial result is no evaluation.
+    """
+    targets = dict(targets or {})
+    check_targets(targets)
+    if not targets and curve is None:
+        curve = experiment_curve()
+    free = tuple(free)
+    for key in free:
+        if getattr(base, key) <= 0:
+            raise ParameterError(f"free: {key} must start positive to be fitted in log space, got {getattr(base, key)}")
+    solver = "full" if full_resolution else "averaged"
+    start = {key: float(getattr(base, key)) for key in free}
+    x0 = np.log([start[key] for key in free])
+    lower, upper = (np.array(side) for side in zip(*(log_bounds(key, start[key]) for key in free)))
+    # The fit needs the configured motion only: probing other attractors would cost every evaluation.
+    longest = float(curve.times.max()) if curve is not None else 0.0
+    fitting = base.replace(solver=solver, attractor_starts=1, duration=max(base.duration, longest))
+    cache: dict[tuple[float, ...], tuple[np.ndarray, Result]] = {}
+
+    def evaluate(x: np.ndarray) -> tuple[np.ndarray, Result]:
+        key = tuple(np.round(x, 14))
+        if key not in cache:
+            params = fitting.replace(**{name: float(math.exp(v)) for name, v in zip(free, x)})
+            result = simulate_whole(params)
+            cache[key] = (_residuals(result, targets, curve), result)
+            if progress is not None:
+                progress(len(cache))
+        return cache[key]
+
+    solution = least_squares(
+        lambda x: evaluate(x)[0], x0, bounds=(lower, upper), diff_step=JACOBIAN_STEP, x_scale=1.0, method="trf"
+    )
+    residuals, result = evaluate(solution.x)
+    fitted = {key: float(math.exp(v)) for key, v in zip(free, solution.x)}
+    achieved = {key: float(result.summary[key]) for key in targets}
+    at_bounds = [
+        key for key, x, lo, hi in zip(free, solution.x, lower, upper) if x - lo < AT_BOUND or hi - x < AT_BOUND
+    ]
+    missed = {key: (achieved[key] - value) / value for key, value in targets.items()}
+    missed = {key: error for key, error in missed.items() if abs(error) > TARGET_TOLERANCE}
+    curve_rms = _curve_rms(result, curve)
+    off_curve = curve_rms is not None and curve_rms > CURVE_TOLERANCE_K
+    stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
+    return Calibration(
+        params=result.params.replace(solver=base.solver, attractor_starts=base.attractor_starts),
+        free=free,
+        fitted=fitted,
+        start=start,
+        targets=targets,
+        achieved=achieved,
+        curve_rms_K=curve_rms,
+        parameter_stderr=_parameter_stderr(solution, free, fitted, residuals, curve),
+        sensitivities=_sensitivities(solution.jac, free, targets, curve),
+        predictions={key: float(result.summary[key]) for key in PREDICTED_KEYS if key not in targets},
+        at_bounds=at_bounds,
+        success=bool(solution.success) and not stuck and not missed and not off_curve and result.success,
+        message=_outcome(str(solution.message), free, missed, at_bounds, curve_rms if off_curve else None),
+        evaluations=len(cache),
+        solver=solver,
+        curve_source=curve.source if curve is not None else "",
+        result=result,
+    )
+
+
+def _outcome(
+    solver_message: str, free: Sequence[str], missed: Mapping[str, float], at_bounds: Sequence[str], curve_missed_by: float | None
+) -> str:
+    """What the fit achieved, in words: the optimiser's message, or why the targets were not met, and the
+    keys that ended on the edge of their physically defensible range."""
+    edges = [key for key in at_bounds if key in DEFENSIBLE_RANGES]
+    stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
+    message = solver_message.rstrip(".")
+    if missed or stuck or curve_missed_by is not None:
+        reasons = [f"{key} is off by {100 * error:+.2f} %" for key, error in missed.items()]
+        reasons += [f"{key} ended on a bound" for key in stuck]
+        if curve_missed_by is not None:
+            reasons.append(f"the curve is missed by {curve_missed_by:.2f} K RMS (more than {CURVE_TOLERANCE_K:g} K)")
+        message = (
+            f"the targets cannot be met by moving {', '.join(free)} alone ({'; '.join(reasons)}); "
+            "free another parameter or check the targets"
+        )
+    if edges:
+        message += (
+            f"; {', '.join(edges)} ended on the edge of {'its' if len(edges) == 1 else 'their'} physically defensible "
+            "range: the data pull beyond what physics allows"
+        )
+    return message
+
+
+def _ball_history(result: Result) -> tuple[np.ndarray, np.ndarray]:
+    series = result.timeseries
+    return series["time"].values, series["theta_ball"].values
+
+
+def _residuals(result: Result, targets: Mapping[str, float], curve: Curve | None) -> np.ndarray:
+    parts = [(float(result.summary[key]) - value) / value for key, value in targets.items()]
+    if curve is not None:
+        parts.extend(curve.residuals_K(*_ball_history(result)) / CURVE_SCALE_K)
+    values = np.array(parts, dtype=float)
+    # A failed or unfittable run must push the optimiser away, not stop it.
+    return np.where(np.isfinite(values), values, 1e3)
+
+
+def _curve_rms(result: Result, curve: Curve | None) -> float | None:
+    return None if curve is None else curve.rms_K(*_ball_history(result))
+
+
+def _parameter_stderr(solution, free, fitted, residuals, curve) -> dict[str, float]:
+    """Standard errors from the Jacobian; meaningful only for a curve with more points than parameters.
+
+    The residual variance is floored at the curve's stated measurement error, if it has one: a
+    curve that is itself a smooth summary can be fitted exactly, which says nothing about how well
+    it was measured.
+    """
+    points = residuals.size
+    if curve is None or points <= len(free):
+        return {key: math.nan for key in free}
+    variance = float(np.sum(residuals**2)) / (points - len(free))
+    if curve.sigma_K is not None:
+        variance = max(variance, (curve.sigma_K / CURVE_SCALE_K) ** 2)
+    try:
+        covariance = np.linalg.inv(solution.jac.T @ solution.jac) * variance
+    except np.linalg.LinAlgError:
+        return {key: math.nan for key in free}
+    # In log space the standard error is relative; convert to the parameter's own units.
+    return {key: float(fitted[key] * math.sqrt(max(covariance[i, i], 0.0))) for i, key in enumerate(free)}
+
+
+def _sensitivities(
+    jacobian: np.ndarray, free: Sequence[str], targets: Mapping[str, float], curve: Curve | None
+) -> dict[str, dict[str, float]]:
+    """From the least-squares Jacobian: d ln(target)/d ln(parameter) for scalar targets, and for a curve
+    d θ_ball/d ln(parameter) in K at its middle and last point."""
+    values = {
+        target: {key: float(jacobian[row, column]) for column, key in enumerate(free)}
+        for row, target in enumerate(targets)
+    }
+    if curve is not None:
+        for point in (curve.times.size // 2, curve.times.size - 1):
+            row = len(targets) + point
+            label = f"ball_C at {curve.times[point] / 60.0:g} min"
+            values[label] = {key: float(CURVE_SCALE_K * jacobian[row, column]) for column, key in enumerate(free)}
+    return values
+
+
+def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str, command: str, description: str) -> Path:
+    """Write a preset TOML usable with ``shakermill run FILE`` and as a shipped preset, with provenance."""
+    path = Path(path)
+    values = {key: calibration.fitted[key] for key in calibration.free}
+    document = {
+        "preset": base_preset,
+        **values,
+        "provenance": {
+            "description": description,
+            "command": command,
+            "fitted": list(calibration.free),
+            "targets": calibration.targets,
+            "achieved": calibration.achieved,
+            "relative_residuals": calibration.relative_residuals,
+            "sensitivities": calibration.sensitivities,
+            "parameter_stderr": calibration.parameter_stderr,
+            "predictions": calibration.predictions,
+            "defensible": calibration.defensible,
+            "at_bounds": calibration.at_bounds,
+            "start": calibration.start,
+            "solver": calibration.solver,
+            "evaluations": calibration.evaluations,
+            "message": calibration.message,
+            "shakermill_version": __version__,
+            "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        },
+    }
+    if calibration.curve_rms_K is not None:
+        document["provenance"]["curve_rms_K"] = calibration.curve_rms_K
+        document["provenance"]["curve"] = calibration.curve_source
+    header = f"# shakermill preset fitted by calibration; keys not listed come from {base_preset!r}.\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    remove_abandoned_writes(path.parent)
+    return write_text_atomically(path, header + tomli_w.dumps(document))
+
+
+# Free sets compared by `validate` and the README: which follow the experiment's curve and which cannot.
+FREE_SET_STUDY: tuple[tuple[str, ...], ...] = (
+    ("beta", "vial_mass"),
+    ("beta", "vial_mass", "h_outer"),
+    ("beta", "vial_mass", "outer_area"),
+    ("vial_mass", "h_outer", "lam"),
+    DEFAULT_FREE,
+    ("beta", "vial_mass", "h_outer", "lam", "eta"),
+)
+# The experiment's time constant (min): a model whose slowest one is far longer still rises at the hour.
+EXPERIMENT_TAU_MIN = 16.7
+
+
+@dataclass(frozen=True)
+class FreeSetOutcome:
+    """One free set fitted to the experiment's curve, and why it does or does not follow it."""
+
+    free: tuple[str, ...]
+    calibration: Calibration
+
+    @property
+    def follows_curve(self) -> bool:
+        rms = self.calibration.curve_rms_K
+        return rms is not None and rms <= CURVE_TOLERANCE_K
+
+    @property
+    def verdict(self) -> str:
+        calibration = self.calibration
+        rms = calibration.curve_rms_K
+        slowest = calibration.predictions.get("slowest_time_constant_min", math.nan)
+        parts = [f"{'follows' if self.follows_curve else 'does not follow'} the curve ({rms:.2f} K RMS)"]
+        if not self.follows_curve and slowest > 1.5 * EXPERIMENT_TAU_MIN:
+            parts.append(
+                f"its slowest time constant is {slowest:.0f} min against the experiment's {EXPERIMENT_TAU_MIN:g}: "
+                f"the ball is still rising at the hour (steady state {calibration.predictions['ball_steady_C']:.1f} °C)"
+            )
+        edges = [key for key in calibration.at_bounds if key in DEFENSIBLE_RANGES]
+        if edges:
+            parts.append(f"{', '.join(edges)} on the edge of the defensible range")
+        return "; ".join(parts)
+
+
+def free_set_study(
+    base: Parameters, free_sets: Sequence[tuple[str, ...]] = FREE_SET_STUDY, curve: Curve | None = None
+) -> list[FreeSetOutcome]:
+    """Fit each free set to ``curve`` (the experiment's by default) from ``base``."""
+    curve = curve or experiment_curve()
+    return [FreeSetOutcome(tuple(free), calibrate(base, free, curve=curve)) for free in free_sets]
+

@@ -1,0 +1,44 @@
+"""CSV files users give (sweep points, measured curves): read whole or refused with one line saying why.
+
+Spreadsheets save UTF-8 with a byte-order mark, editors without one; both are read. Any other
+encoding, a malformed file, too many rows or an over-long cell gets one line naming the file.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+from shakermill.support.limits import MAX_VALUE_LENGTH
+from shakermill.parameters.schema import ParameterError
+
+
+def read_csv_rows(path: Path, what: str, most_rows: int) -> list[list[str]]:
+    """The rows of the CSV file at ``path``: its header and at most ``most_rows`` rows after it.
+
+    ``what`` starts every error line ("points data.csv", "curve data.csv").
+    """
+    rows: list[list[str]] = []
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as stream:
+            reader = csv.reader(stream)
+            for row in reader:
+                _check_cells(row, what, reader.line_num)
+                rows.append(row)
+                if len(rows) > most_rows + 1:
+                    raise ParameterError(f"{what}: more than {most_rows:,} rows after the header; allowed at most {most_rows:,}")
+    except UnicodeDecodeError:
+        raise ParameterError(f"{what}: not UTF-8 text; save it as UTF-8 (with or without a byte-order mark)") from None
+    except csv.Error as exc:
+        raise ParameterError(f"{what}: malformed CSV at line {reader.line_num} ({exc})") from None
+    except OSError as exc:
+        raise ParameterError(f"{what}: cannot read the file ({exc.strerror or exc})") from None
+    return rows
+
+
+def _check_cells(row: list[str], what: str, line: int) -> None:
+    for cell in row:
+        if len(cell) > MAX_VALUE_LENGTH:
+            raise ParameterError(
+                f"{what} line {line}: a cell of {len(cell):,} characters; allowed at most {MAX_VALUE_LENGTH}"
+            )
