@@ -23,20 +23,17 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, NoReturn, Sequence
 
 import typer
-from typer.core import TyperGroup
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
+from typer.core import TyperGroup
 
 # Only light modules here: `shakermill --help` and the listing commands must not wait for NumPy, Numba,
 # pandas, xarray, SciPy or Matplotlib. Each command imports what it uses.
-from shakermill.support.version import __version__
-from shakermill.support.atomic import StorageError, check_writable_place
 from shakermill.engines.budget import BudgetExceeded
 from shakermill.parameters.config import load_config
 from shakermill.parameters.defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
-from shakermill.support.limits import MAX_BIFURCATION_VALUES
 from shakermill.parameters.schema import (
     DEFAULT_PRESET,
     FIELD_NAMES,
@@ -50,13 +47,16 @@ from shakermill.parameters.schema import (
 )
 from shakermill.studies.validation import EXPERIMENT, TABLE5, TARGET_KEYS, Curve
 from shakermill.studies.validation import validate as run_validation
+from shakermill.support.atomic import StorageError, check_writable_place
+from shakermill.support.limits import MAX_BIFURCATION_VALUES
+from shakermill.support.version import __version__
 
 if TYPE_CHECKING:
     import pandas as pd
 
+    from shakermill.io.runs import RunData
     from shakermill.parameters.schema import Parameters
     from shakermill.solvers.result import Result
-    from shakermill.io.runs import RunData
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
@@ -212,8 +212,8 @@ def run(
     overwrite: OverwriteOption = False,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
-    from shakermill.solvers.result import INTERRUPTED
     from shakermill.io.runs import check_target, to_jsonable
+    from shakermill.solvers.result import INTERRUPTED
 
     overrides = settings or []
     with _user_errors():
@@ -520,8 +520,16 @@ def plot(
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG files.")] = PNG_DPI,
 ) -> None:
     """Draw the figures of a run folder (paper Figs. 4, 5a, 5b, impact statistics) or of a sweep folder (maps or lines)."""
-    from shakermill.views.figures import contour_notes, impact_figures, parse_contour, plot_figures, run_figures, sweep_context, sweep_figures
     from shakermill.studies.sweep import is_sweep_folder, load_sweep
+    from shakermill.views.figures import (
+        contour_notes,
+        impact_figures,
+        parse_contour,
+        plot_figures,
+        run_figures,
+        sweep_context,
+        sweep_figures,
+    )
 
     target = out if out is not None else folder / FIGURES_FOLDER
     if is_sweep_folder(folder):
@@ -615,8 +623,16 @@ def sweep(
     json_output: JsonOption = False,
 ) -> None:
     """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
-    from shakermill.studies.sweep import TABLE_CSV, TABLE_PARQUET, SweepFailed, failed_points, is_sweep_folder, plan_sweep, sweep_parameters
+    from shakermill.studies.sweep import (
+        TABLE_CSV,
+        TABLE_PARQUET,
+        SweepFailed,
+        failed_points,
+        is_sweep_folder,
+        plan_sweep,
+    )
     from shakermill.studies.sweep import sweep as run_sweep
+    from shakermill.studies.sweep import sweep_parameters
 
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
@@ -710,11 +726,12 @@ def bifurcation(
     overwrite: OverwriteOption = False,
 ) -> None:
     """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
-    from shakermill.views.figures import bifurcation_figure, plot_figures, sweep_context
-    from shakermill.studies.bifurcation import bifurcation as regime_scan
-    from shakermill.studies.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
     from shakermill.io.runs import check_target, write_folder
+    from shakermill.studies.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER
+    from shakermill.studies.bifurcation import bifurcation as regime_scan
+    from shakermill.studies.bifurcation import write_bifurcation
     from shakermill.studies.sweep import parse_grid, sweep_parameters
+    from shakermill.views.figures import bifurcation_figure, plot_figures, sweep_context
 
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
@@ -799,8 +816,8 @@ def validate(
 ) -> None:
     """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
     calibrated parameters, and which free sets of a calibration can follow the curve."""
-    from shakermill.studies.calibrate import free_set_study
     from shakermill.io.runs import to_jsonable
+    from shakermill.studies.calibrate import free_set_study
 
     if solver not in ("full", "averaged"):
         _fail(f"solver: {solver!r} is not allowed; allowed: one of 'full', 'averaged'")
@@ -922,9 +939,9 @@ def calibrate(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
 ) -> None:
     """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
+    from shakermill.io.runs import to_jsonable
     from shakermill.studies.calibrate import calibrate as fit_parameters
     from shakermill.studies.calibrate import parse_free, parse_targets, write_preset
-    from shakermill.io.runs import to_jsonable
 
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])

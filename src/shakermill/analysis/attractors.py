@@ -27,12 +27,22 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from shakermill.engines.one_d import model
+from shakermill.analysis.regime import (
+    MAX_PERIOD,
+    MIN_REPEATS,
+    NO_IMPACTS,
+    PHASE_TOLERANCE,
+    Signature,
+    classify_impacts,
+    impact_phases,
+    period_signatures,
+    signatures_match,
+)
 from shakermill.engines.budget import RunBudget
+from shakermill.engines.one_d import model
 from shakermill.engines.one_d.integrator import REACHED_STOP
-from shakermill.parameters.schema import Parameters
-from shakermill.analysis.regime import MAX_PERIOD, MIN_REPEATS, NO_IMPACTS, PHASE_TOLERANCE, Signature, classify_impacts, impact_phases, period_signatures, signatures_match
 from shakermill.engines.one_d.setup import ProgressCallback, impact_columns, integrator_for
+from shakermill.parameters.schema import Parameters
 
 if TYPE_CHECKING:
     import pandas as pd

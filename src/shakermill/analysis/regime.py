@@ -15,7 +15,6 @@ from typing import Any, Mapping
 
 import numpy as np
 
-
 # Impacts as columns: at least "time" (s) and "wall" ("left"/"right"); a dict of arrays or a DataFrame.
 ImpactColumns = Mapping[str, Any]
 

@@ -29,14 +29,20 @@ from typing import TYPE_CHECKING, Any, Callable, Container, Iterable, Mapping
 
 import numpy as np
 
-from shakermill.support.version import __version__
-from shakermill.support.atomic import SET_ASIDE, StorageError, check_writable_place, partial_path, remove_abandoned_writes
-from shakermill.parameters.config import load_config, write_config_toml
 from shakermill.analysis.fit import ExponentialFit
 from shakermill.engines.one_d.integrator import REACHED_STOP
-from shakermill.parameters.schema import Parameters
 from shakermill.engines.one_d.setup import IMPACT_UNITS
+from shakermill.parameters.config import load_config, write_config_toml
+from shakermill.parameters.schema import Parameters
 from shakermill.solvers.result import TIME_ATTRIBUTES, Result, StateHistory
+from shakermill.support.atomic import (
+    SET_ASIDE,
+    StorageError,
+    check_writable_place,
+    partial_path,
+    remove_abandoned_writes,
+)
+from shakermill.support.version import __version__
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -1,2 +1,2 @@
 """The parameter model: keys with units, bounds and sources, presets (data files with citations),
-configuration files and the defaults the command line shows."""
+configuration and CSV input files, and the defaults the command line shows."""

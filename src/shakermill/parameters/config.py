@@ -20,9 +20,6 @@ from typing import Any, Mapping, Sequence
 
 import tomli_w
 
-from shakermill.support.version import __version__
-from shakermill.support.atomic import write_text_atomically
-from shakermill.support.limits import MAX_CONFIG_BYTES, quoted
 from shakermill.parameters.schema import (
     DEFAULT_PRESET,
     ParameterError,
@@ -32,6 +29,9 @@ from shakermill.parameters.schema import (
     field_unit,
     preset_values,
 )
+from shakermill.support.atomic import write_text_atomically
+from shakermill.support.limits import MAX_CONFIG_BYTES, quoted
+from shakermill.support.version import __version__
 
 PRESET_KEY = "preset"
 PROVENANCE_TABLE = "provenance"

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
-import tomllib
 import math
 import numbers
+import tomllib
 import typing
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +23,7 @@ from typing import Annotated, Any, Literal, Mapping
 import annotated_types
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from shakermill.parameters.units import UnitError, to_si
 from shakermill.support.limits import (
     MAX_FULL_RESOLUTION_PERIODS,
     MAX_RECORD_WINDOWS,
@@ -31,7 +32,6 @@ from shakermill.support.limits import (
     QUOTED_LENGTH,
     quoted,
 )
-from shakermill.parameters.units import UnitError, to_si
 from shakermill.support.presenters import present
 
 PAPER = "Son 2025, Mathematics 13, 446"

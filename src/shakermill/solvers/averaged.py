@@ -31,16 +31,24 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from shakermill.engines.one_d import model
-from shakermill.solvers.result import attach
 from shakermill.analysis.attractors import find_attractors
-from shakermill.engines.budget import RunBudget
 from shakermill.analysis.fit import fit_exponential
+from shakermill.engines.budget import RunBudget
+from shakermill.engines.one_d import model
 from shakermill.engines.one_d.integrator import BUDGET_EXCEEDED, COUNTER_NAMES, REACHED_STOP, Integrator
-from shakermill.parameters.schema import Parameters
-from shakermill.solvers.result import EnergyAudit, Result, conclude, no_impact_note, state_history, summarize
 from shakermill.engines.one_d.setup import ProgressCallback, impact_columns, integrator_for, sample_times
+from shakermill.parameters.schema import Parameters
 from shakermill.solvers.full import assemble, simulate_full
+from shakermill.solvers.result import (
+    EnergyAudit,
+    MechanicsAverages,
+    Result,
+    attach,
+    conclude,
+    no_impact_note,
+    state_history,
+    summarize,
+)
 
 # The thermal time constants of the impact-heated nodes must exceed the mean time between impacts by
 # this factor, or their temperatures follow single impacts and the average is not what drives them.
@@ -50,37 +58,6 @@ THERMAL_RTOL = 1e-9
 THERMAL_ATOL = 1e-9
 
 AVERAGING_FAILED = -10
-
-
-@dataclass(frozen=True)
-class MechanicsAverages:
-    """Time averages of the settled motion, with standard errors from batch means."""
-
-    heat_power: float  # W, mean irreversible heat rate
-    heat_power_stderr: float
-    dissipated_power: float  # W
-    velocity_term: float  # mean of 0.4 Re^{1/2} + 0.06 Re^{2/3}
-    velocity_term_stderr: float
-    transient: float  # s cut from the start
-    window: float  # s averaged over
-    batches: int
-    impact_interval: float  # s, mean time between impacts in the window (inf without impacts)
-    converged: bool
-    message: str
-
-    def as_summary(self) -> dict[str, float | int | bool | str]:
-        return {
-            "averaged_heat_power_W": self.heat_power,
-            "averaged_heat_power_stderr_W": self.heat_power_stderr,
-            "averaged_dissipated_power_W": self.dissipated_power,
-            "averaged_velocity_term": self.velocity_term,
-            "averaged_velocity_term_stderr": self.velocity_term_stderr,
-            "averaging_transient_s": self.transient,
-            "averaging_window_s": self.window,
-            "averaging_batches": self.batches,
-            "averaging_converged": self.converged,
-            "averaging_message": self.message,
-        }
 
 
 @dataclass(frozen=True)

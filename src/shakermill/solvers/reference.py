@@ -17,8 +17,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from shakermill.engines.one_d import model
-from shakermill.parameters.schema import Parameters
 from shakermill.engines.one_d.setup import tolerances_for
+from shakermill.parameters.schema import Parameters
 
 # Flight segments: SciPy only sees a contact if the gap changes sign between two steps, so the step is
 # bounded to a small part of the drive period to make a grazing touch unlikely to be missed.

@@ -22,8 +22,6 @@ if TYPE_CHECKING:
     import pandas as pd
     import xarray as xr
 
-    from shakermill.solvers.averaged import MechanicsAverages
-
 INTERRUPTED = 1
 INTERRUPTED_MESSAGE = "Interrupted by the user; the results cover the time simulated so far."
 # The run finished, but a temperature left the range where the model means anything.
@@ -36,6 +34,37 @@ ENERGY_AUDIT_FAILED = -6
 # e ≤ 0.7, 5 % at e = 0.95, 9 % at rtol 0.1. A ball so light (ball_density = 1e-6) that its energies fall
 # below the temperature tolerance left 55–77 % of the heat unaccounted for.
 ENERGY_AUDIT_TOLERANCE = 1e-2
+
+
+@dataclass(frozen=True)
+class MechanicsAverages:
+    """Time averages of the settled motion, with standard errors from batch means."""
+
+    heat_power: float  # W, mean irreversible heat rate
+    heat_power_stderr: float
+    dissipated_power: float  # W
+    velocity_term: float  # mean of 0.4 Re^{1/2} + 0.06 Re^{2/3}
+    velocity_term_stderr: float
+    transient: float  # s cut from the start
+    window: float  # s averaged over
+    batches: int
+    impact_interval: float  # s, mean time between impacts in the window (inf without impacts)
+    converged: bool
+    message: str
+
+    def as_summary(self) -> dict[str, float | int | bool | str]:
+        return {
+            "averaged_heat_power_W": self.heat_power,
+            "averaged_heat_power_stderr_W": self.heat_power_stderr,
+            "averaged_dissipated_power_W": self.dissipated_power,
+            "averaged_velocity_term": self.velocity_term,
+            "averaged_velocity_term_stderr": self.velocity_term_stderr,
+            "averaging_transient_s": self.transient,
+            "averaging_window_s": self.window,
+            "averaging_batches": self.batches,
+            "averaging_converged": self.converged,
+            "averaging_message": self.message,
+        }
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ from shakermill.solvers.averaged import simulate_averaged
 from shakermill.solvers.full import simulate_full
 from shakermill.solvers.result import INTERRUPTED, Result
 
+
 def simulate(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
     """Run ``params`` with the solver it names (``params.solver``), within ``budget`` (``params``' own if None):
     see :func:`simulate_full` and :func:`shakermill.averaged.simulate_averaged`."""

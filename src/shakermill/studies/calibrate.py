@@ -30,14 +30,21 @@ import numpy as np
 import tomli_w
 from scipy.optimize import least_squares
 
-from shakermill.support.version import __version__
-from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
 from shakermill.parameters.defaults import DEFAULT_FREE
-from shakermill.support.limits import MAX_VALUE_LENGTH, quoted
 from shakermill.parameters.schema import ParameterError, Parameters, bounds, check_known_keys
 from shakermill.solvers.result import Result
 from shakermill.solvers.simulate import simulate_whole
-from shakermill.studies.validation import CURVE_TOLERANCE_K, TARGET_KEYS, Curve, check_targets, experiment_curve, target_range
+from shakermill.studies.validation import (
+    CURVE_TOLERANCE_K,
+    TARGET_KEYS,
+    Curve,
+    check_targets,
+    experiment_curve,
+    target_range,
+)
+from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
+from shakermill.support.limits import MAX_VALUE_LENGTH, quoted
+from shakermill.support.version import __version__
 
 # The free set of the shipped calibrated preset: the smallest set that follows the experiment's curve
 # within 1 K RMS with every value inside its defensible range (see README, "Against the experiment").

@@ -41,17 +41,23 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from shakermill.support.version import __version__
-from shakermill.support.atomic import check_writable_place, create_exclusively, remove_abandoned_writes, write_files_atomically, write_text_atomically
+from shakermill.io.runs import to_jsonable
 from shakermill.parameters.config import RunConfig, load_config, parse_overrides, read_config_file
-from shakermill.support.csvinput import read_csv_rows
+from shakermill.parameters.csvinput import read_csv_rows
 from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
-from shakermill.support.limits import MAX_SWEEP_POINTS, quoted
 from shakermill.parameters.schema import DEFAULT_PRESET, ParameterError, Parameters, check_known_keys, field_unit
+from shakermill.parameters.units import UnitError, to_si
 from shakermill.solvers.result import INTERRUPTED, Result
 from shakermill.solvers.simulate import simulate
-from shakermill.io.runs import to_jsonable
-from shakermill.parameters.units import UnitError, to_si
+from shakermill.support.atomic import (
+    check_writable_place,
+    create_exclusively,
+    remove_abandoned_writes,
+    write_files_atomically,
+    write_text_atomically,
+)
+from shakermill.support.limits import MAX_SWEEP_POINTS, quoted
+from shakermill.support.version import __version__
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -318,8 +324,8 @@ class PointInterrupted(Exception):
 def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = False) -> PointOutcome:
     """Run one point and build its table row; a point that cannot run records why instead of raising."""
     # Both build on simulate; imported where they are used.
-    from shakermill.solvers.result import probed
     from shakermill.analysis.regime import classify
+    from shakermill.solvers.result import probed
 
     swept = dict(values)
     try:

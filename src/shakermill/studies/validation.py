@@ -9,9 +9,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from shakermill.support.csvinput import read_csv_rows
-from shakermill.support.limits import MAX_CURVE_POINTS, quoted
+from shakermill.parameters.csvinput import read_csv_rows
 from shakermill.parameters.schema import LONGEST_RUN_S, Bounds, ParameterError, field_unit
+from shakermill.support.limits import MAX_CURVE_POINTS, quoted
 
 PAPER = "Son 2025, Mathematics 13, 446"
 EXPERIMENT = "Takacs & McHenry 2006 (J. Mater. Sci. 41, 5246), one ball, SPEX 8000"

@@ -25,11 +25,11 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from shakermill.analysis.fit import ExponentialFit
+from shakermill.parameters.defaults import FIGURE_FORMATS, PNG_DPI
+from shakermill.parameters.schema import Parameters
 from shakermill.physics import kinematics
 from shakermill.support.atomic import remove_abandoned_writes, write_files_atomically
-from shakermill.parameters.defaults import FIGURE_FORMATS, PNG_DPI
-from shakermill.analysis.fit import ExponentialFit
-from shakermill.parameters.schema import Parameters
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -20,13 +20,10 @@ import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping, Sequence
 
-from shakermill.support.version import __version__
-from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
-from shakermill.parameters.defaults import REPORT_FILE
-from shakermill.parameters.schema import DEFAULT_PRESET, PRESETS, Preset, field_description, field_unit
-from shakermill.views.figures import PAPER_FIGURES, comparison_temperature_figure, impact_figures, model_of, paper_figures, png_bytes
 from shakermill.analysis.regime import classify_impacts, settled_run_impacts
 from shakermill.io.runs import CONFIG_FILE, RunData, load_run
+from shakermill.parameters.defaults import REPORT_FILE
+from shakermill.parameters.schema import DEFAULT_PRESET, PRESETS, Preset, field_description, field_unit
 from shakermill.studies.validation import (
     EXPERIMENT,
     OPERATING_POINT_TOLERANCE,
@@ -35,6 +32,16 @@ from shakermill.studies.validation import (
     compare,
     fitted_quantities,
     operating_point_mismatches,
+)
+from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
+from shakermill.support.version import __version__
+from shakermill.views.figures import (
+    PAPER_FIGURES,
+    comparison_temperature_figure,
+    impact_figures,
+    model_of,
+    paper_figures,
+    png_bytes,
 )
 from shakermill.views.notebook import answer_sentences, esc, number
 

@@ -41,9 +41,7 @@ from typing import Callable, Iterator
 import numpy as np
 from numba import njit
 
-from shakermill.physics import kinematics
 from shakermill.engines.budget import RunBudget
-from shakermill.physics.contact import elastic_energy, hertz_contact_time, hertz_max_overlap
 from shakermill.engines.one_d.model import (
     DISSIPATED,
     HEAT_GENERATED,
@@ -52,14 +50,16 @@ from shakermill.engines.one_d.model import (
     N_STATE,
     NO_WALL,
     RIGHT_WALL,
+    WORK_VIAL,
+    Constants,
     P,
     X,
-    Constants,
     contact_forces,
-    WORK_VIAL,
     gap,
     rhs,
 )
+from shakermill.physics import kinematics
+from shakermill.physics.contact import elastic_energy, hertz_contact_time, hertz_max_overlap
 
 # Status codes of the compiled loop (negative: failure).
 REACHED_STOP = 0

@@ -30,10 +30,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from shakermill.physics import contact
-from shakermill.physics import kinematics
-from shakermill.physics import thermal
 from shakermill.parameters.schema import Parameters
+from shakermill.physics import contact, kinematics, thermal
 
 X, P, THETA_BALL, THETA_VIAL, THETA_AIR, WORK_VIAL, DISSIPATED, HEAT_GENERATED, HEAT_LOST, VELOCITY_TERM = range(10)
 N_DYNAMIC = 5

@@ -9,8 +9,8 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from shakermill.support.limits import MAX_VALUE_LENGTH
 from shakermill.parameters.schema import ParameterError
+from shakermill.support.limits import MAX_VALUE_LENGTH
 
 
 def read_csv_rows(path: Path, what: str, most_rows: int) -> list[list[str]]:

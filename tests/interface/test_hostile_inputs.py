@@ -31,7 +31,7 @@ from typer.testing import CliRunner
 
 from shakermill import cli
 
-CORPUS = Path(__file__).parent / "hostile"
+CORPUS = Path(__file__).resolve().parents[1] / "hostile"
 DEFAULT_SECONDS = 20.0
 EXIT_CODES = {"ok": 0, "stopped": 1, "refused": 2}
 
