@@ -36,7 +36,7 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Callable, Iterator
+from typing import Callable, Iterator, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -256,6 +256,50 @@ class Tolerances:
     max_overlap: float  # m
 
 
+# What a compiled call of the loop (:func:`_advance`) reads and writes, grouped as it travels from
+# :class:`Integrator`. Numba passes a NamedTuple as one argument, as it does ``Constants``; _advance
+# unpacks the arrays once per call (see there why).
+
+
+class _StepControl(NamedTuple):
+    """The step-size controller (:class:`StepController`) with the exponent of the method's error order."""
+
+    safety: float
+    min_factor: float
+    max_factor: float
+    error_exponent: float  # −1/(error order + 1)
+
+
+class _Accuracy(NamedTuple):
+    """What each step is held to (see :class:`Tolerances`), and whether contacts end with the energy projection."""
+
+    rtol: float
+    atol: np.ndarray
+    origin: np.ndarray
+    contact_step_limit: float
+    max_overlap: float
+    project_energy: bool
+
+
+class _State(NamedTuple):
+    """The integration state the compiled loop changes in place and the next call starts from."""
+
+    clock: np.ndarray  # (t, the step to try next)
+    y: np.ndarray
+    f: np.ndarray  # f(t, y): the first stage of the next step (first same as last)
+    impact: np.ndarray  # the impact in progress, laid out as _ACTIVE, _WALL, ...
+    counters: np.ndarray  # STEPS, REJECTED, ...
+    diagnostics: np.ndarray  # of the energy projection: _CORRECTION, _UNPROJECTED
+
+
+class _Recording(NamedTuple):
+    """The regular output grid with the samples written on it, and the record windows as (start, end) rows."""
+
+    sample_times: np.ndarray
+    samples: np.ndarray
+    windows: np.ndarray
+
+
 @njit(cache=True)
 def _grow(buffer: np.ndarray) -> np.ndarray:
     larger = np.empty((2 * buffer.shape[0], buffer.shape[1]))
@@ -347,7 +391,9 @@ def _hermite(theta: float, h: float, y0: np.ndarray, f0: np.ndarray, y1: np.ndar
         out[i] = h00 * y0[i] + h10 * h * f0[i] + h01 * y1[i] + h11 * h * f1[i]
 
 
-@njit(cache=True)
+# Inlined into the loop: as a call it cost a reference count for each of its seven arrays on every trial
+# step, ~1.5 % of a default run.
+@njit(cache=True, inline="always")
 def _rk_step(t: float, h: float, y: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, k: Constants,
              stages: np.ndarray, y_new: np.ndarray, work: np.ndarray) -> None:
     """One explicit FSAL step: ``stages[0]`` holds f(t, y) on entry, the last stage holds f(t+h, y_new) on exit."""
@@ -395,9 +441,9 @@ def _contact_error_scale(speed_in: float, rtol: float, k: Constants, scale: np.n
 
 
 @njit(cache=True)
-def _error_norm(h: float, stages: np.ndarray, error_weights: np.ndarray, scale: np.ndarray,
-                components: np.ndarray) -> float:
-    """RMS of the error estimate over ``components``, in units of ``scale``."""
+def _error_norm(h: float, stages: np.ndarray, error_weights: np.ndarray, scale: np.ndarray, in_contact: bool) -> float:
+    """RMS of the error estimate over the components under control, in units of ``scale``."""
+    components = _CONTACT_CONTROLLED if in_contact else _FLIGHT_CONTROLLED
     total = 0.0
     for i in components:
         estimate = 0.0
@@ -460,56 +506,239 @@ def _shortest_contact_step(speed_in: float, k: Constants) -> float:
 
 
 @njit(cache=True)
-def _separation_step_limit(t: float, y: np.ndarray, impact: np.ndarray, k: Constants) -> float:
+def _separation_step_limit(t: float, x: float, p: float, wall: int, speed_in: float, k: Constants) -> float:
     """Longest contact step that keeps the mesh graded towards the separation (see SEPARATION_GRADING)."""
-    wall = int(impact[_WALL])
     vial_velocity = kinematics.vial_velocity(t, k.amplitude, k.omega, k.phase)
-    overlap_rate = _rate_into_wall(wall, y[P] / k.ball_mass, vial_velocity)
+    overlap_rate = _rate_into_wall(wall, p / k.ball_mass, vial_velocity)
     if overlap_rate >= 0.0:
         return np.inf
-    overlap = -gap(t, y[X], wall, k)
-    return max(SEPARATION_GRADING * overlap / -overlap_rate, _shortest_contact_step(impact[_SPEED_IN], k))
+    overlap = -gap(t, x, wall, k)
+    return max(SEPARATION_GRADING * overlap / -overlap_rate, _shortest_contact_step(speed_in, k))
 
 
 @njit(cache=True)
-def _advance(
-    t_stop, clock, y, f0, a, b, error_weights, c, k, rtol, atol, origin, contact_step_limit, max_overlap,
-    safety, min_factor, max_factor, error_exponent,
-    sample_times, samples, windows, window_buffer, impact_buffer, impact, counters,
-    project_energy, diagnostics, steps_allowed,
-):
-    """Integrate from ``clock[0]`` to ``t_stop``, or for ``steps_allowed`` accepted steps (status _PAUSED)
-    if that comes first; see :meth:`Integrator.advance`. Returns (status, buffers)."""
-    n = y.shape[0]
-    stages = np.empty((c.shape[0], n))
-    y_new = np.empty(n)
-    work = np.empty(n)
-    point = np.empty(n)
-    scale = np.empty(n)
-    stack = np.empty((_STACK_ROWS, 4))
+def _work_arrays(n_stages: int, n: int) -> tuple[np.ndarray, ...]:
+    """Work arrays of one compiled call, allocated once per call rather than per step.
+
+    The stages (the last, f(t + h, y_new), also as a row of its own), the end of the step being tried, the
+    argument of a stage, a state by dense output, the error scale, and the pending intervals of the
+    contact-onset search.
+    """
+    stages = np.empty((n_stages, n))
+    return stages, stages[n_stages - 1], np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty((_STACK_ROWS, 4))
+
+
+@njit(cache=True)
+def _bound_step(t: float, h: float, t_stop: float, x: float, p: float, wall: int, speed_in: float, k: Constants,
+                contact_step_limit: float, stack: np.ndarray) -> tuple[float, int]:
+    """The step to try from (t, x, p), at most ``h`` and ending by ``t_stop``, and the wall it ends on.
+
+    In a contact with ``wall`` the step is graded towards the separation. In flight (``wall`` = NO_WALL)
+    it is shortened to the first contact onset within it, and the wall it lands on is returned: the flight
+    path is exact, so this costs no right-hand-side evaluations, and no trial step runs into a wall.
+    """
+    h = min(h, t_stop - t)
+    if wall != NO_WALL:
+        return min(h, contact_step_limit, _separation_step_limit(t, x, p, wall, speed_in, k)), wall
+    # Bound on |gap''|: the ball's path is straight, the wall's a sine of amplitude X_v.
     curvature = k.amplitude * k.omega * k.omega
-    drive_period = 2.0 * np.pi / k.omega
-    t = clock[0]
-    h = clock[1]
+    for candidate in (LEFT_WALL, RIGHT_WALL):
+        touch = _first_touch_of_wall(t, h, x, p / k.ball_mass, candidate, curvature, k, stack)
+        if touch >= 0.0 and (wall == NO_WALL or touch < h):
+            h, wall = touch, candidate
+    return h, wall
+
+
+@njit(cache=True)
+def _step_factor(error: float, rejected_last: bool, control: _StepControl) -> float:
+    """Factor on the step size after a trial step with error norm ``error``: below 1 when the step is
+    rejected (error > 1 or NaN), up to max_factor when it is accepted."""
+    if not error <= 1.0:
+        if not np.isfinite(error):
+            return control.min_factor
+        return max(control.min_factor, control.safety * error**control.error_exponent)
+    factor = control.max_factor
+    if error != 0.0:
+        factor = min(control.max_factor, control.safety * error**control.error_exponent)
+    # A step accepted right after a rejection does not grow: the larger step it replaces just failed.
+    return min(1.0, factor) if rejected_last else factor
+
+
+@njit(cache=True)
+def _project_energy(t_new: float, y_new: np.ndarray, f_new: np.ndarray, elastic_new: float, impact: np.ndarray,
+                    k: Constants, counters: np.ndarray, diagnostics: np.ndarray) -> None:
+    """Apply :func:`_project_momentum` to the end of a contact step, and evaluate the derivative there again.
+
+    Called where the ball left the wall during the step, and where a compiled call ends inside a contact,
+    so that the energy audit of every chunk closes.
+    """
+    _project_momentum(impact, y_new, elastic_new, k, diagnostics)
+    # The projected state is where the next step starts: its derivative is that step's first stage.
+    rhs(t_new, y_new, k, f_new)
+    counters[RHS_EVALUATIONS] += 1
+
+
+@njit(cache=True)
+def _all_finite(values: np.ndarray) -> bool:
+    """True when no value is NaN or infinite."""
+    for i in range(values.shape[0]):
+        if not np.isfinite(values[i]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _sample_due(t_new: float, sample_times: np.ndarray, counters: np.ndarray) -> bool:
+    """Whether a step ending at ``t_new`` reaches the next time of the regular output grid."""
+    index = counters[SAMPLES_WRITTEN]
+    return index < sample_times.shape[0] and sample_times[index] <= t_new
+
+
+@njit(cache=True)
+def _meets_a_window(t: float, t_new: float, windows: np.ndarray) -> bool:
+    """Whether the step from ``t`` to ``t_new`` meets a record window (edges included)."""
+    for w in range(windows.shape[0]):
+        if windows[w, 0] <= t_new and t <= windows[w, 1]:
+            return True
+    return False
+
+
+@njit(cache=True)
+def _record_samples(t: float, h: float, y: np.ndarray, f0: np.ndarray, y_new: np.ndarray, f_new: np.ndarray,
+                    sample_times: np.ndarray, samples: np.ndarray, counters: np.ndarray, point: np.ndarray) -> None:
+    """Write the samples of the regular output grid that fall in the accepted step (t, t + h], by dense output."""
+    t_new = t + h
+    index = counters[SAMPLES_WRITTEN]
+    while index < sample_times.shape[0] and sample_times[index] <= t_new:
+        if h > 0.0:
+            _hermite((sample_times[index] - t) / h, h, y, f0, y_new, f_new, point)
+            samples[index] = point
+        else:
+            samples[index] = y_new
+        index += 1
+    counters[SAMPLES_WRITTEN] = index
+
+
+@njit(cache=True)
+def _record_windows(t: float, h: float, y: np.ndarray, f0: np.ndarray, y_new: np.ndarray, f_new: np.ndarray,
+                    windows: np.ndarray, buffer: np.ndarray, counters: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """Append the accepted step's points inside the record windows to ``buffer``; returns it (grown when full).
+
+    Every step point inside a window is kept, and a window's edges by dense output, so that it spans
+    exactly the interval asked for even when flight steps are long.
+    """
+    t_new = t + h
+    for w in range(windows.shape[0]):
+        start, end = windows[w, 0], windows[w, 1]
+        if h > 0.0 and t < start < t_new:
+            _hermite((start - t) / h, h, y, f0, y_new, f_new, point)
+            buffer = _append_window_point(buffer, counters, start, point)
+        if start <= t_new <= end:
+            buffer = _append_window_point(buffer, counters, t_new, y_new)
+        elif h > 0.0 and t < end < t_new:
+            _hermite((end - t) / h, h, y, f0, y_new, f_new, point)
+            buffer = _append_window_point(buffer, counters, end, point)
+    return buffer
+
+
+@njit(cache=True)
+def _open_impact(t_new: float, y_new: np.ndarray, wall: int, speed_in: float, elastic_new: float, impact: np.ndarray,
+                 k: Constants) -> None:
+    """Start the impact in progress on ``wall`` at the contact onset ``t_new``, approached at ``speed_in``.
+
+    The dissipated energy, heat, mechanical energy and vial work at the onset are kept so that the
+    impact's record and the energy projection can take differences over the contact.
+    """
+    impact[_ACTIVE] = 1.0
+    impact[_WALL] = wall
+    impact[_START] = t_new
+    impact[_SPEED_IN] = speed_in
+    impact[_DISSIPATED0] = y_new[DISSIPATED]
+    impact[_HEAT0] = y_new[HEAT_GENERATED]
+    impact[_MAX_OVERLAP] = 0.0
+    impact[_PEAK_FORCE] = 0.0
+    impact[_ENERGY0] = 0.5 * y_new[P] * y_new[P] / k.ball_mass + elastic_new
+    impact[_WORK0] = y_new[WORK_VIAL]
+
+
+@njit(cache=True)
+def _follow_contact(overlap: float, overlap_rate: float, max_overlap: float, impact: np.ndarray, k: Constants) -> bool:
+    """Keep the largest overlap and contact force of the impact in progress; True when the overlap exceeds
+    ``max_overlap``, which means the materials are too soft for the impact or the step control failed."""
+    force, _ = contact_forces(overlap, overlap_rate, k)
+    impact[_MAX_OVERLAP] = max(impact[_MAX_OVERLAP], overlap)
+    impact[_PEAK_FORCE] = max(impact[_PEAK_FORCE], force)
+    return overlap > max_overlap
+
+
+@njit(cache=True)
+def _close_impact(t_new: float, y_new: np.ndarray, overlap: float, overlap_rate: float, impact: np.ndarray,
+                  impact_buffer: np.ndarray, counters: np.ndarray, k: Constants) -> np.ndarray:
+    """Write the record of the impact in progress, which ended during the step to ``t_new``, and end it.
+
+    Returns the impact buffer (grown when full).
+    """
+    wall = int(impact[_WALL])
+    # The separation lies inside the step: back-extrapolate it on the free flight.
+    separation = max(t_new - (-overlap) / max(-overlap_rate, 1e-300), impact[_START])
+    vial_at_separation = kinematics.vial_velocity(separation, k.amplitude, k.omega, k.phase)
+    row = counters[IMPACTS]
+    if row >= impact_buffer.shape[0]:
+        impact_buffer = _grow(impact_buffer)
+    impact_buffer[row, 0] = impact[_START]
+    impact_buffer[row, 1] = wall
+    impact_buffer[row, 2] = impact[_SPEED_IN]
+    impact_buffer[row, 3] = -_rate_into_wall(wall, y_new[P] / k.ball_mass, vial_at_separation)
+    impact_buffer[row, 4] = y_new[DISSIPATED] - impact[_DISSIPATED0]
+    impact_buffer[row, 5] = y_new[HEAT_GENERATED] - impact[_HEAT0]
+    impact_buffer[row, 6] = impact[_MAX_OVERLAP]
+    impact_buffer[row, 7] = impact[_PEAK_FORCE]
+    impact_buffer[row, 8] = separation - impact[_START]
+    counters[IMPACTS] = row + 1
+    impact[_ACTIVE] = 0.0
+    return impact_buffer
+
+
+@njit(cache=True)
+def _next_step_size(h: float, factor: float, landed: bool, left_wall: bool, speed_in: float, k: Constants,
+                    contact_step_limit: float) -> float:
+    """The step to try after an accepted step of ``h`` whose error allows ``factor`` times it."""
+    if landed:
+        # A contact starts with a short step: see ONSET_STEP_FRACTION.
+        return min(contact_step_limit, _shortest_contact_step(speed_in, k))
+    h = h * factor
+    if left_wall:
+        # Flight is exact for the mechanics and smooth for the temperatures, so offer a whole drive
+        # period: the onset search cuts it at the next contact.
+        h = max(h, 2.0 * np.pi / k.omega)
+    return h
+
+
+@njit(cache=True)
+def _advance(t_stop: float, steps_allowed: int, k: Constants, tableau: tuple, control: _StepControl,
+             accuracy: _Accuracy, state: _State, recording: _Recording, window_buffer: np.ndarray,
+             impact_buffer: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
+    """Integrate from ``state.clock[0]`` to ``t_stop``, or for ``steps_allowed`` accepted steps (status _PAUSED)
+    if that comes first (see :meth:`Integrator.advance`); returns (status, window buffer, impact buffer).
+
+    The arrays are unpacked once, here: every array passed to a compiled call that is not inlined costs
+    a reference count, so the helpers called on every step take few arrays, or none."""
+    a, b, error_weights, c = tableau
+    rtol, atol, origin, contact_step_limit, max_overlap, project_energy = accuracy
+    clock, y, f0, impact, counters, diagnostics = state
+    sample_times, samples, windows = recording
+    stages, f_new, y_new, work, point, scale, stack = _work_arrays(c.shape[0], y.shape[0])
+    t, h = clock[0], clock[1]
     last_step = counters[STEPS] + steps_allowed
-    rejected_last = False
+    status, rejected_last = REACHED_STOP, False
     while t < t_stop:
         in_contact = impact[_ACTIVE] != 0.0
-        h = min(h, t_stop - t)
-        landed_wall = NO_WALL
-        if in_contact:
-            h = min(h, contact_step_limit, _separation_step_limit(t, y, impact, k))
-        else:
-            # Shorten a flight step to the first contact onset: the flight path is exact, so this
-            # costs no right-hand-side evaluations and no trial step ever runs into a wall.
-            velocity = y[P] / k.ball_mass
-            for wall in (LEFT_WALL, RIGHT_WALL):
-                touch = _first_touch_of_wall(t, h, y[X], velocity, wall, curvature, k, stack)
-                if touch >= 0.0 and (landed_wall == NO_WALL or touch < h):
-                    h, landed_wall = touch, wall
-        if landed_wall == NO_WALL and h <= _TIME_RESOLUTION * max(1.0, abs(t)):
-            clock[0], clock[1] = t, h
-            return STEP_UNDERFLOW, window_buffer, impact_buffer
+        wall = int(impact[_WALL]) if in_contact else NO_WALL
+        h, wall = _bound_step(t, h, t_stop, y[X], y[P], wall, impact[_SPEED_IN], k, contact_step_limit, stack)
+        touching, landing = wall != NO_WALL, wall != NO_WALL and not in_contact
+        if not landing and h <= _TIME_RESOLUTION * max(1.0, abs(t)):
+            status = STEP_UNDERFLOW
+            break
         stages[0] = f0
         if h > 0.0:
             _rk_step(t, h, y, a, b, c, k, stages, y_new, work)
@@ -517,127 +746,55 @@ def _advance(
             _lab_error_scale(y, y_new, rtol, atol, origin, scale)
             if in_contact:
                 _contact_error_scale(impact[_SPEED_IN], rtol, k, scale)
-            components = _CONTACT_CONTROLLED if in_contact else _FLIGHT_CONTROLLED
-            error = _error_norm(h, stages, error_weights, scale, components)
-        else:
+            error = _error_norm(h, stages, error_weights, scale, in_contact)
+        else:  # a landing right where the step starts: nothing to estimate
             y_new[:] = y
-            stages[c.shape[0] - 1] = f0
+            f_new[:] = f0
             error = 0.0
-        if not error <= 1.0:  # also rejects NaN
-            counters[REJECTED] += 1
-            factor = min_factor if not np.isfinite(error) else max(min_factor, safety * error**error_exponent)
-            h *= factor
-            rejected_last = True
-            continue
-        factor = max_factor if error == 0.0 else min(max_factor, safety * error**error_exponent)
+        factor = _step_factor(error, rejected_last, control)
+        rejected_last = not error <= 1.0  # also rejects NaN
         if rejected_last:
-            factor = min(1.0, factor)
-        rejected_last = False
-
+            counters[REJECTED] += 1
+            h *= factor
+            continue
         t_new = t + h
-        touching = in_contact or landed_wall != NO_WALL
-        elastic_new = 0.0
         if touching:
-            wall = int(impact[_WALL]) if in_contact else landed_wall
             overlap = -gap(t_new, y_new[X], wall, k)
             vial_velocity = kinematics.vial_velocity(t_new, k.amplitude, k.omega, k.phase)
-            if overlap > 0.0:
-                elastic_new = elastic_energy(overlap, k.e_star, k.radius)
+            elastic_new = elastic_energy(overlap, k.e_star, k.radius) if overlap > 0.0 else 0.0
             if in_contact and project_energy and (overlap <= 0.0 or t_new >= t_stop):
-                _project_momentum(impact, y_new, elastic_new, k, diagnostics)
-                rhs(t_new, y_new, k, stages[c.shape[0] - 1])
-                counters[RHS_EVALUATIONS] += 1
-        for i in range(n):
-            if not np.isfinite(y_new[i]):
-                clock[0], clock[1] = t, h
-                return NOT_FINITE, window_buffer, impact_buffer
-        f_new = stages[c.shape[0] - 1]
-
-        # Samples on the regular output grid, by dense output.
-        index = counters[SAMPLES_WRITTEN]
-        while index < sample_times.shape[0] and sample_times[index] <= t_new:
-            if h > 0.0:
-                _hermite((sample_times[index] - t) / h, h, y, f0, y_new, f_new, point)
-                samples[index] = point
-            else:
-                samples[index] = y_new
-            index += 1
-        counters[SAMPLES_WRITTEN] = index
-
-        # Full-resolution windows: every step point inside, and the edges by dense output, so that a
-        # window spans exactly the interval asked for even when flight steps are long.
-        for w in range(windows.shape[0]):
-            start, end = windows[w, 0], windows[w, 1]
-            if h > 0.0 and t < start < t_new:
-                _hermite((start - t) / h, h, y, f0, y_new, f_new, point)
-                window_buffer = _append_window_point(window_buffer, counters, start, point)
-            if start <= t_new <= end:
-                window_buffer = _append_window_point(window_buffer, counters, t_new, y_new)
-            elif h > 0.0 and t < end < t_new:
-                _hermite((end - t) / h, h, y, f0, y_new, f_new, point)
-                window_buffer = _append_window_point(window_buffer, counters, end, point)
-
-        # Impact bookkeeping.
+                _project_energy(t_new, y_new, f_new, elastic_new, impact, k, counters, diagnostics)
+        if not _all_finite(y_new):
+            status = NOT_FINITE
+            break
+        # Most steps record nothing: the cheap tests spare them the calls, which take many arrays.
+        if _sample_due(t_new, sample_times, counters):
+            _record_samples(t, h, y, f0, y_new, f_new, sample_times, samples, counters, point)
+        if _meets_a_window(t, t_new, windows):
+            window_buffer = _record_windows(t, h, y, f0, y_new, f_new, windows, window_buffer, counters, point)
         if touching:
-            velocity_new = y_new[P] / k.ball_mass
-            overlap_rate = _rate_into_wall(wall, velocity_new, vial_velocity)
-            if landed_wall != NO_WALL:
-                impact[_ACTIVE] = 1.0
-                impact[_WALL] = landed_wall
-                impact[_START] = t_new
-                impact[_SPEED_IN] = overlap_rate
-                impact[_DISSIPATED0] = y_new[DISSIPATED]
-                impact[_HEAT0] = y_new[HEAT_GENERATED]
-                impact[_MAX_OVERLAP] = 0.0
-                impact[_PEAK_FORCE] = 0.0
-                impact[_ENERGY0] = 0.5 * y_new[P] * y_new[P] / k.ball_mass + elastic_new
-                impact[_WORK0] = y_new[WORK_VIAL]
+            overlap_rate = _rate_into_wall(wall, y_new[P] / k.ball_mass, vial_velocity)
+            if landing:
+                _open_impact(t_new, y_new, wall, overlap_rate, elastic_new, impact, k)
             elif overlap > 0.0:  # still touching; overlap <= 0 below means it left the wall
-                force, _ = contact_forces(overlap, overlap_rate, k)
-                impact[_MAX_OVERLAP] = max(impact[_MAX_OVERLAP], overlap)
-                impact[_PEAK_FORCE] = max(impact[_PEAK_FORCE], force)
-                if overlap > max_overlap:
-                    t, clock[0], clock[1] = t_new, t_new, h
-                    y[:] = y_new
-                    f0[:] = f_new
-                    return OVERLAP_TOO_LARGE, window_buffer, impact_buffer
+                if _follow_contact(overlap, overlap_rate, max_overlap, impact, k):
+                    status = OVERLAP_TOO_LARGE
             else:
-                # Left the wall during this step: back-extrapolate the separation on the free flight.
-                separation = max(t_new - (-overlap) / max(-overlap_rate, 1e-300), impact[_START])
-                vial_at_separation = kinematics.vial_velocity(separation, k.amplitude, k.omega, k.phase)
-                row = counters[IMPACTS]
-                if row >= impact_buffer.shape[0]:
-                    impact_buffer = _grow(impact_buffer)
-                impact_buffer[row, 0] = impact[_START]
-                impact_buffer[row, 1] = wall
-                impact_buffer[row, 2] = impact[_SPEED_IN]
-                impact_buffer[row, 3] = -_rate_into_wall(wall, velocity_new, vial_at_separation)
-                impact_buffer[row, 4] = y_new[DISSIPATED] - impact[_DISSIPATED0]
-                impact_buffer[row, 5] = y_new[HEAT_GENERATED] - impact[_HEAT0]
-                impact_buffer[row, 6] = impact[_MAX_OVERLAP]
-                impact_buffer[row, 7] = impact[_PEAK_FORCE]
-                impact_buffer[row, 8] = separation - impact[_START]
-                counters[IMPACTS] = row + 1
-                impact[_ACTIVE] = 0.0
-
+                impact_buffer = _close_impact(t_new, y_new, overlap, overlap_rate, impact, impact_buffer, counters, k)
         t = t_new
         y[:] = y_new
         f0[:] = f_new
+        if status != REACHED_STOP:  # the overlap is too large: stop on the state that shows it
+            break
         counters[STEPS] += 1
-        if landed_wall == NO_WALL:
-            h = h * factor
-            if in_contact and impact[_ACTIVE] == 0.0:
-                # Just left the wall. Flight is exact for the mechanics and smooth for the temperatures,
-                # so offer a whole drive period: the onset search cuts it at the next contact.
-                h = max(h, drive_period)
-        else:
-            h = min(contact_step_limit, _shortest_contact_step(impact[_SPEED_IN], k))
+        left_wall = in_contact and impact[_ACTIVE] == 0.0
+        h = _next_step_size(h, factor, landing, left_wall, impact[_SPEED_IN], k, contact_step_limit)
         if counters[STEPS] == last_step:
             # After an accepted step: t, h and the state in the arrays are all the next call needs, and
             # rejected_last is False as on entry, so a pause leaves the integration bit for bit unchanged.
             break
     clock[0], clock[1] = t, h
-    return (REACHED_STOP if t >= t_stop else _PAUSED), window_buffer, impact_buffer
+    return (_PAUSED if status == REACHED_STOP and t < t_stop else status), window_buffer, impact_buffer
 
 
 @dataclass
@@ -657,7 +814,7 @@ class Integrator:
     budget: RunBudget = field(default_factory=RunBudget.unlimited)
 
     def __post_init__(self) -> None:
-        self._a, self._b, self._error_weights, self._c = self.tableau.arrays()
+        self._tableau = self.tableau.arrays()
         self.clock = np.array([self.t0, self.initial_step])
         self.y = np.array(self.y, dtype=float)
         self.f = np.empty(N_STATE)
@@ -717,14 +874,17 @@ class Integrator:
         return str(self.budget.reason) if status == BUDGET_EXCEEDED else STATUS_MESSAGES[status]
 
     def _compiled_call(self, t_stop: float, steps_allowed: int) -> int:
+        controller, tolerances = self.controller, self.tolerances
+        control = _StepControl(controller.safety, controller.min_factor, controller.max_factor,
+                               -1.0 / (self.tableau.error_order + 1))
+        accuracy = _Accuracy(tolerances.rtol, tolerances.atol, tolerances.origin, tolerances.contact_step_limit,
+                             tolerances.max_overlap, self.project_energy)
+        state = _State(self.clock, self.y, self.f, self._impact, self.counters, self.diagnostics)
+        recording = _Recording(self.sample_times, self.samples, self.windows)
         with _interrupt_after_compiled_code():
             status, self._window_buffer, self._impact_buffer = _advance(
-                t_stop, self.clock, self.y, self.f, self._a, self._b, self._error_weights, self._c, self.constants,
-                self.tolerances.rtol, self.tolerances.atol, self.tolerances.origin, self.tolerances.contact_step_limit,
-                self.tolerances.max_overlap, self.controller.safety, self.controller.min_factor,
-                self.controller.max_factor, -1.0 / (self.tableau.error_order + 1),
-                self.sample_times, self.samples, self.windows, self._window_buffer, self._impact_buffer,
-                self._impact, self.counters, self.project_energy, self.diagnostics, steps_allowed,
+                t_stop, steps_allowed, self.constants, self._tableau, control, accuracy, state, recording,
+                self._window_buffer, self._impact_buffer,
             )
         return int(status)
 
