@@ -20,7 +20,7 @@ import time
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, NoReturn, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, Mapping, NoReturn, Sequence
 
 import typer
 from rich.console import Console
@@ -57,6 +57,7 @@ if TYPE_CHECKING:
     from shakermill.io.runs import RunData
     from shakermill.parameters.schema import Parameters
     from shakermill.solvers.result import Result
+    from shakermill.studies.calibrate import Calibration
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
@@ -623,14 +624,7 @@ def sweep(
     json_output: JsonOption = False,
 ) -> None:
     """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
-    from shakermill.studies.sweep import (
-        TABLE_CSV,
-        TABLE_PARQUET,
-        SweepFailed,
-        failed_points,
-        is_sweep_folder,
-        plan_sweep,
-    )
+    from shakermill.studies.sweep import SweepFailed, is_sweep_folder, plan_sweep
     from shakermill.studies.sweep import sweep as run_sweep
     from shakermill.studies.sweep import sweep_parameters
 
@@ -654,19 +648,26 @@ def sweep(
     except OSError as exc:
         resume = f"; re-run with --out {target} to finish" if is_sweep_folder(target) else ""
         _fail(f"{target}: cannot write the sweep ({exc.strerror or exc}){resume}")
+    report_sweep(table, plan.keys, target, json_output)
+
+
+def report_sweep(table: pd.DataFrame, keys: Sequence[str], target: Path, json_output: bool) -> None:
+    """Print the sweep's table (a preview, or where it is as JSON); exit with EXIT_FAILED_RUN if a point failed."""
+    from shakermill.studies.sweep import TABLE_CSV, TABLE_PARQUET, failed_points
+
     failed = failed_points(table)
     if json_output:
         payload = {
             "output_dir": str(target.absolute()),
             "points": len(table),
             "failed": len(failed),
-            "keys": list(plan.keys),
+            "keys": list(keys),
             "table_parquet": str((target / TABLE_PARQUET).absolute()),
             "table_csv": str((target / TABLE_CSV).absolute()),
         }
         typer.echo(json.dumps(payload, sort_keys=True))
     else:
-        _stdout_console().print(sweep_preview(table, plan.keys, target))
+        _stdout_console().print(sweep_preview(table, keys, target))
     if not failed.empty:
         first = failed.iloc[0]
         typer.echo(
@@ -941,20 +942,16 @@ def calibrate(
     """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
     from shakermill.io.runs import to_jsonable
     from shakermill.studies.calibrate import calibrate as fit_parameters
-    from shakermill.studies.calibrate import parse_free, parse_targets, write_preset
+    from shakermill.studies.calibrate import parse_free, parse_targets
 
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])
         targets = parse_targets(target or [])
         free_keys = parse_free(free or [])
         measured = Curve.from_csv(curve) if curve is not None else None
-        if out is not None and out.exists() and out.is_dir():
-            raise ParameterError(f"out: {out} is a folder; give a .toml file name")
-        if out is not None and out.exists() and not overwrite:
-            # Checked before the fit, which takes a while.
-            raise ParameterError(f"out: {out} exists; choose another --out, or add --overwrite to replace it")
         if out is not None:
-            check_writable_place(out)
+            # Checked before the fit, which takes a while.
+            check_preset_target(out, overwrite)
         with _nothing_written_when_interrupted("the fit starts again from the beginning"), _nothing_written_when_a_run_is_stopped(
             "the fit"
         ), _progress_bar("fitting", "{task.completed} model evaluations", None, delay_s=PROGRESS_DELAY_S) as update:
@@ -962,49 +959,74 @@ def calibrate(
                 run_config.params, free_keys, targets, measured, full_resolution=full_resolution, progress=update
             )
     if out is not None:
-        command = "shakermill calibrate " + " ".join(sys.argv[2:])
-        fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]
-        description = (
-            f"{run_config.preset} with {', '.join(free_keys)} fitted to {', '.join(fitted_to)}; "
-            f"{', '.join(calibration.predictions)} are predictions"
-        )
-        with _writing(out, "the preset"):
-            write_preset(calibration, out, base_preset=run_config.preset, command=command, description=description)
+        write_fitted_preset(calibration, out, run_config.preset, free_keys, targets)
     if json_output:
         typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False))
     else:
-        console = _stdout_console()
-        table = Table("parameter", "start", "fitted", "std. error", "physically defensible?", title="calibration")
-        for key in free_keys:
-            _add_plain_row(
-                table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}",
-                _number(calibration.parameter_stderr[key], ".3g"), calibration.defensible[key],
-            )
-        console.print(table)
-        predictions = Table("not fitted, predicted", "value", title="what the fitted model predicts")
-        for key, value in calibration.predictions.items():
-            _add_plain_row(predictions, key, _number(value, ".4g"))
-        console.print(predictions)
-        if targets:
-            residuals = Table("target", "wanted", "achieved", "residual", *[f"∂ln/∂ln {key}" for key in free_keys])
-            for key, wanted in targets.items():
-                sensitivities = [f"{calibration.sensitivities[key][name]:+.3f}" for name in free_keys]
-                _add_plain_row(
-                    residuals, key, f"{wanted:g}", f"{calibration.achieved[key]:.6g}",
-                    f"{100 * calibration.relative_residuals[key]:+.3f} %", *sensitivities,
-                )
-            console.print(residuals)
-        if calibration.curve_rms_K is not None:
-            console.print(Text(f"curve ({calibration.curve_source}): RMS residual {calibration.curve_rms_K:.3g} K"))
-            for label, values in calibration.sensitivities.items():
-                if label not in targets:
-                    console.print(Text(f"d {label} / d ln(key), K: " + ", ".join(f"{key} {value:+.3g}" for key, value in values.items())))
-        console.print(Text(f"{calibration.evaluations} model evaluations ({calibration.solver} solver): {calibration.message}"))
-        if out is not None:
-            console.print(Text(f"preset written to {out}; use it with `shakermill run {out}`"))
+        print_calibration(calibration, free_keys, targets, out)
     if not calibration.success:
         typer.echo(f"error: calibration did not meet its targets: {calibration.message}", err=True)
         raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def check_preset_target(out: Path, overwrite: bool) -> None:
+    """Raise ParameterError when the fitted preset cannot be written to ``out``."""
+    if out.exists() and out.is_dir():
+        raise ParameterError(f"out: {out} is a folder; give a .toml file name")
+    if out.exists() and not overwrite:
+        raise ParameterError(f"out: {out} exists; choose another --out, or add --overwrite to replace it")
+    check_writable_place(out)
+
+
+def write_fitted_preset(
+    calibration: Calibration, out: Path, base_preset: str, free_keys: Sequence[str], targets: Mapping[str, float]
+) -> None:
+    """Write the fitted preset TOML, saying in it which command fitted which keys to what."""
+    from shakermill.studies.calibrate import write_preset
+
+    command = "shakermill calibrate " + " ".join(sys.argv[2:])
+    fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]
+    description = (
+        f"{base_preset} with {', '.join(free_keys)} fitted to {', '.join(fitted_to)}; "
+        f"{', '.join(calibration.predictions)} are predictions"
+    )
+    with _writing(out, "the preset"):
+        write_preset(calibration, out, base_preset=base_preset, command=command, description=description)
+
+
+def print_calibration(
+    calibration: Calibration, free_keys: Sequence[str], targets: Mapping[str, float], out: Path | None
+) -> None:
+    """The fitted parameters, what the fitted model predicts, the residuals of the targets and of the curve."""
+    console = _stdout_console()
+    table = Table("parameter", "start", "fitted", "std. error", "physically defensible?", title="calibration")
+    for key in free_keys:
+        _add_plain_row(
+            table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}",
+            _number(calibration.parameter_stderr[key], ".3g"), calibration.defensible[key],
+        )
+    console.print(table)
+    predictions = Table("not fitted, predicted", "value", title="what the fitted model predicts")
+    for key, value in calibration.predictions.items():
+        _add_plain_row(predictions, key, _number(value, ".4g"))
+    console.print(predictions)
+    if targets:
+        residuals = Table("target", "wanted", "achieved", "residual", *[f"∂ln/∂ln {key}" for key in free_keys])
+        for key, wanted in targets.items():
+            sensitivities = [f"{calibration.sensitivities[key][name]:+.3f}" for name in free_keys]
+            _add_plain_row(
+                residuals, key, f"{wanted:g}", f"{calibration.achieved[key]:.6g}",
+                f"{100 * calibration.relative_residuals[key]:+.3f} %", *sensitivities,
+            )
+        console.print(residuals)
+    if calibration.curve_rms_K is not None:
+        console.print(Text(f"curve ({calibration.curve_source}): RMS residual {calibration.curve_rms_K:.3g} K"))
+        for label, values in calibration.sensitivities.items():
+            if label not in targets:
+                console.print(Text(f"d {label} / d ln(key), K: " + ", ".join(f"{key} {value:+.3g}" for key, value in values.items())))
+    console.print(Text(f"{calibration.evaluations} model evaluations ({calibration.solver} solver): {calibration.message}"))
+    if out is not None:
+        console.print(Text(f"preset written to {out}; use it with `shakermill run {out}`"))
 
 
 if __name__ == "__main__":

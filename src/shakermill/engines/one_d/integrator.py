@@ -597,6 +597,7 @@ def _sample_due(t_new: float, sample_times: np.ndarray, counters: np.ndarray) ->
 @njit(cache=True)
 def _meets_a_window(t: float, t_new: float, windows: np.ndarray) -> bool:
     """Whether the step from ``t`` to ``t_new`` meets a record window (edges included)."""
+    # Windows run forwards (start < end), so every step that _record_windows writes a point for passes.
     for w in range(windows.shape[0]):
         if windows[w, 0] <= t_new and t <= windows[w, 1]:
             return True
