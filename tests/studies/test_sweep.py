@@ -1032,3 +1032,13 @@ def test_a_tls_scheduler_without_tls_settings_is_one_line(tls_scheduler, tmp_pat
     assert completed.returncode == 2
     assert_one_error_line(completed.stderr, tls_scheduler, "TLS")
     assert not folder.exists()
+
+
+def test_a_point_whose_run_spent_its_budget_is_not_probed_on_a_budget_of_its_own():
+    from shakermill.studies.sweep import run_point
+
+    base = default_parameters(solver="full", duration=60.0, record_windows=(), max_steps=2000)
+    row = run_point(base, {"omega": 110.0}).row
+    assert row["status"] == -4 and row["steps"] == 2000
+    # Before, the probe ran on a fresh budget after the run had spent the point's, and filled these keys.
+    assert row.get("n_attractors") is None and row.get("heat_power_spread_W") is None

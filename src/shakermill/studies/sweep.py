@@ -325,6 +325,7 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
     """Run one point and build its table row; a point that cannot run records why instead of raising."""
     # Both build on simulate; imported where they are used.
     from shakermill.analysis.regime import classify
+    from shakermill.engines.one_d.integrator import REACHED_STOP
     from shakermill.solvers.result import probed
 
     swept = dict(values)
@@ -338,8 +339,10 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
             # Not classified: a run cut short may be too short for it, and the point is not done anyway.
             raise PointInterrupted(result.message)
         regime, period = classify(result)
-        # The averaged solver probed the other starts already; a full run has them probed here.
-        probed(result)
+        # The averaged solver probed the other starts already; a full run has them probed here, unless
+        # it stopped early: a probe would start a budget of its own after the run had spent the point's.
+        if result.status == REACHED_STOP:
+            probed(result)
     except PointInterrupted:
         raise
     except Exception as exc:  # noqa: BLE001 - one point's crash must not stop the sweep; its row says why
