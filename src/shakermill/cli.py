@@ -80,12 +80,14 @@ class OneLineUsageErrors(TyperGroup):
         try:
             outcome = super().main(arguments, *rest, standalone_mode=False, **extra)
         except typer.Abort:
-            _fail("aborted", EXIT_FAILED_RUN)
+            # Outside Click's handling now: typer.Exit (what _fail raises) would not be caught.
+            _echo_error("aborted")
+            sys.exit(EXIT_FAILED_RUN)
         except Exception as exc:
             # Click's usage errors, told by what they carry: typer vendors Click and exports none of its classes.
             if getattr(exc, "exit_code", None) != EXIT_USAGE or not hasattr(exc, "format_message"):
                 raise
-            typer.echo(f"error: {' '.join(exc.format_message().splitlines())}", err=True)
+            _echo_error(exc.format_message())
             sys.exit(EXIT_USAGE)
         sys.exit(outcome if isinstance(outcome, int) else 0)
 
@@ -136,9 +138,13 @@ def _add_plain_row(table: Table, *cells: str) -> None:
     table.add_row(*(Text(cell) for cell in cells))
 
 
-def _fail(message: str, code: int = EXIT_USAGE) -> NoReturn:
+def _echo_error(message: str) -> None:
     # typer.echo, not rich: rich would wrap a long message over several lines and read "[...]" as markup.
     typer.echo(f"error: {' '.join(message.splitlines())}", err=True)
+
+
+def _fail(message: str, code: int = EXIT_USAGE) -> NoReturn:
+    _echo_error(message)
     raise typer.Exit(code)
 
 
