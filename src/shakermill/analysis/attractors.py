@@ -92,7 +92,7 @@ class SettledStart:
     impact_rate_hz: float
     heat_power_W: float
     heat_power_stderr_W: float  # from batch means; what separates irregular motions
-    impacts: dict[str, np.ndarray]  # the settled impacts: "time" (s), "wall"
+    impacts: dict[str, np.ndarray]  # the settled impacts' columns; "time" (s) and "wall" are used
     message: str = ""
 
 
@@ -266,9 +266,7 @@ def settle(
             start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan,
             {"time": np.empty(0), "wall": np.empty(0, dtype=str)}, integrator.explain(status),
         )
-    columns = impact_columns(integrator.impacts, params.lam)
-    kept = columns["time"] >= settled_at
-    impacts = {"time": columns["time"][kept], "wall": columns["wall"][kept]}
+    impacts = impact_columns(integrator.impacts, params.lam, since=settled_at)
     regime, cycle = classify_impacts(impacts, params.omega, params.phase)
     # Whole cycles of a periodic motion, so that its heat and rate carry no part-cycle bias.
     measured = MEASURE_PERIODS - MEASURE_PERIODS % cycle if cycle else MEASURE_PERIODS

@@ -237,12 +237,6 @@ def averaged_states(params: Parameters, averages: MechanicsAverages, times: np.n
     return states
 
 
-def impacts_of_window(integrator: Integrator, lam: float, transient: float) -> dict[str, np.ndarray]:
-    columns = impact_columns(integrator.impacts, lam)
-    kept = columns["time"] >= transient
-    return {name: values[kept] for name, values in columns.items()}
-
-
 def simulate_averaged(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
     """Run ``params`` with the multiscale solver (module docstring); same :class:`Result` as a full run.
 
@@ -323,7 +317,7 @@ def _simulate_configured_start(params: Parameters, progress: ProgressCallback | 
         t_end=params.duration,
         history=state_history(thermal.t, states, constants, params),
         window_history=state_history(window_points[:, 0], window_points[:, 1:], constants, params),
-        impact_columns=impacts_of_window(integrator, params.lam, averages.transient),
+        impact_columns=impact_columns(integrator.impacts, params.lam, since=averages.transient),
         counters=counters,
         wall_time=time.perf_counter() - started,
         energy=energy,

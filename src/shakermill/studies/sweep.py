@@ -325,7 +325,6 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
     """Run one point and build its table row; a point that cannot run records why instead of raising."""
     # Both build on simulate; imported where they are used.
     from shakermill.analysis.regime import classify
-    from shakermill.engines.one_d.integrator import REACHED_STOP
     from shakermill.solvers.result import probed
 
     swept = dict(values)
@@ -341,7 +340,7 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
         regime, period = classify(result)
         # The averaged solver probed the other starts already; a full run has them probed here, unless
         # it stopped early: a probe would start a budget of its own after the run had spent the point's.
-        if result.status == REACHED_STOP:
+        if result.success:
             probed(result)
     except PointInterrupted:
         raise

@@ -66,13 +66,16 @@ def integrator_for(params: Parameters, sample_times: np.ndarray, budget: RunBudg
         budget=budget if budget is not None else RunBudget.of(params),
     )
 
-def impact_columns(records: np.ndarray, lam: float) -> dict[str, np.ndarray]:
-    """The impact records as columns with SI units (see :data:`IMPACT_UNITS`), the wall by name."""
+def impact_columns(records: np.ndarray, lam: float, since: float = -math.inf) -> dict[str, np.ndarray]:
+    """The impact records from time ``since`` (s) on as columns with SI units (see :data:`IMPACT_UNITS`),
+    the wall by name."""
+    records = records[records[:, IMPACT_COLUMNS.index("time")] >= since]
     columns = {name: records[:, index] for index, name in enumerate(IMPACT_COLUMNS)}
     columns["wall"] = np.where(columns["wall"] == model.LEFT_WALL, "left", "right")
     columns["heat_to_ball"] = lam * columns["heat_generated"]
     columns["heat_to_vial"] = (1.0 - lam) * columns["heat_generated"]
     return columns
+
 
 IMPACT_UNITS = {
     "time": "s",
