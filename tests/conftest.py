@@ -22,6 +22,11 @@ def paper_fixture() -> dict:
         return tomllib.load(handle)
 
 
+# The tightest tolerances allowed: ~30,000 steps per simulated second (an hour: ~10⁸ steps), so a run that
+# is slow while every key stays valid (budgets, Ctrl-C within a chunk).
+TIGHTEST_TOLERANCES = {"rtol": 1e-8, "atol_position": 1e-12, "atol_momentum": 1e-12, "atol_temperature": 1e-12}
+
+
 # A vial amplitude this small makes the walls effectively stationary (velocity ~1e-10 m/s) while
 # keeping the parameter valid (amplitude must be positive).
 RESTING_WALL_AMPLITUDE = 1e-12

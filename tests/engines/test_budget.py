@@ -15,11 +15,10 @@ from shakermill.solvers.result import ENERGY_AUDIT_FAILED, ENERGY_AUDIT_TOLERANC
 from shakermill.engines.one_d.setup import integrator_for, sample_times
 from shakermill.solvers.full import simulate_full
 from shakermill.solvers.simulate import simulate_whole
+from conftest import TIGHTEST_TOLERANCES
 
-# The tightest tolerances allowed: ~30,000 steps per simulated second, so a 10-s chunk is ~3·10⁵ steps.
-TINY_STEPS = {
-    "rtol": 1e-8, "atol_position": 1e-12, "atol_momentum": 1e-12, "atol_temperature": 1e-12, "record_windows": (),
-}
+# A 10-s chunk at the tightest tolerances is ~3·10⁵ steps.
+TINY_STEPS = {**TIGHTEST_TOLERANCES, "record_windows": ()}
 
 
 def test_a_step_budget_stops_the_run_exactly_and_keeps_what_it_computed() -> None:

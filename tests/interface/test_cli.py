@@ -25,6 +25,7 @@ from shakermill.parameters.schema import FIELD_NAMES
 from shakermill.solvers.result import INTERRUPTED
 from shakermill.io.runs import RUN_FILES, load_run
 from shakermill.studies.sweep import load_sweep
+from conftest import TIGHTEST_TOLERANCES
 
 # Short runs with small windows keep every invocation well under a second once Numba's cache is warm.
 SHORT = ["--set", "duration=2", "--set", "record_windows=0:0.2"]
@@ -510,11 +511,7 @@ def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up
     assert list(tmp_path.iterdir()) == []
 
 
-# The tightest tolerances allowed: ~30,000 steps per simulated second, a run of an hour 10⁸ steps.
-TINY_STEPS = [
-    "--set", "rtol=1e-8", "--set", "atol_position=1e-12", "--set", "atol_momentum=1e-12", "--set", "atol_temperature=1e-12",
-    "--set", "record_windows=",
-]
+TINY_STEPS = [*(f"--set={key}={value}" for key, value in TIGHTEST_TOLERANCES.items()), "--set", "record_windows="]
 
 
 @pytest.mark.parametrize(
