@@ -80,7 +80,7 @@ def test_initial_temperature_is_20_celsius(defaults: Parameters) -> None:
 def test_default_options(defaults: Parameters) -> None:
     assert defaults.no_tension is False
     assert defaults.heat_model == "relative"
-    assert defaults.convection_velocity == "ball"
+    assert defaults.convection_velocity == "auto" and not defaults.relative_convection
     assert defaults.ball_position == 0.0
     assert defaults.ball_momentum == 0.0
     assert defaults.rtol == pytest.approx(1e-3, rel=1e-12)

@@ -9,10 +9,13 @@ hands control back to Python, several times a second.
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Iterator
 
 if TYPE_CHECKING:
     from shakermill.parameters.schema import Parameters
@@ -66,3 +69,25 @@ class RunBudget:
                 f"elapsed). If the run is meant to take that long, raise it, e.g. --set max_wall_time={2 * self.max_wall_time:g}."
             )
         return None
+
+
+@contextmanager
+def interrupt_after_compiled_code() -> Iterator[None]:
+    """Hold a SIGINT that arrives while compiled code runs and deliver it to the previous handler afterwards.
+
+    A KeyboardInterrupt raised inside a Numba call surfaces as ``SystemError: CPUDispatcher(...) returned a
+    result with an exception set``, which no caller can tell from a crash. Only the main thread can set
+    handlers; elsewhere, and where SIGINT is ignored (sweep workers) or default, nothing changes.
+    """
+    previous = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or not callable(previous):
+        yield
+        return
+    received: list[object] = []
+    signal.signal(signal.SIGINT, lambda signum, frame: received.append(frame))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if received:
+        previous(signal.SIGINT, received[0])

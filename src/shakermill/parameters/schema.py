@@ -49,6 +49,28 @@ def _count(description: str, **bounds: int) -> Any:
     return Field(json_schema_extra={"unit": "", "description": description}, strict=True, **bounds)
 
 
+def _per_ball(scalar_key: str) -> Any:
+    return Field(
+        max_length=MAX_BALLS,
+        json_schema_extra={"unit": "", "per_ball": scalar_key, "description": f"per-ball {scalar_key} (engine = 'dem')"},
+    )
+
+
+# The most balls of the 'dem' engine and harmonics of a user-given vial motion.
+MAX_BALLS = 50
+MAX_HARMONICS = 60
+MOTION_COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
+# Translations of a vial beyond half a metre, or harmonics beyond the 20th, describe no mill.
+MAX_MOTION_TRANSLATION = 0.5
+MAX_MOTION_HARMONIC = 20
+Harmonic = tuple[
+    Literal["x", "y", "z", "roll", "pitch", "yaw"],
+    Annotated[int, annotated_types.Ge(0), annotated_types.Le(MAX_MOTION_HARMONIC)],
+    float,
+    float,
+]
+
+
 # Every key has hard bounds: a value outside them is refused with one line naming the key and its range.
 # They are wide enough for any real mill (PLAUSIBLE_RANGES warns about the merely unusual inside them)
 # and tight enough that the model and its integrator stay meaningful and finish; the comment above each
@@ -214,9 +236,57 @@ class Parameters(BaseModel):
     heat_model: Literal["relative", "paper"] = Field(
         json_schema_extra={"description": "'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed"}
     )
-    convection_velocity: Literal["ball", "relative"] = Field(
-        json_schema_extra={"description": "velocity in Re: the ball's ('ball', as the paper) or relative to the vial"}
+    convection_velocity: Literal["auto", "ball", "relative"] = Field(
+        json_schema_extra={
+            "description": "velocity in Re: the ball's ('ball', as the paper) or relative to the vial, which carries "
+            "the air ('relative'); 'auto': 'ball' for the 1-D engine, 'relative' for 'dem' (MODEL.md §12.5)"
+        }
     )
+    # Several balls in three dimensions (MODEL.md section 12): keys of the 'dem' engine; the 1-D engine ignores them
+    engine: Literal["1d", "dem"] = Field(
+        json_schema_extra={
+            "description": "'1d': one ball on the vial's axis (MODEL.md sections 1-7); 'dem': n_balls spheres in three "
+            "dimensions with friction and rotation (section 12)"
+        }
+    )
+    # 50 balls of the smallest radius still fit any vial the bounds allow; the pair search is O(N²).
+    n_balls: int = _count("number of balls (engine = 'dem'; the 1-D engine has one)", ge=1, le=MAX_BALLS)
+    # Each ball's own radius and material, in ball order; empty: every ball takes the scalar key's value.
+    ball_radii: tuple[float, ...] = _per_ball("ball_radius")
+    ball_densities: tuple[float, ...] = _per_ball("ball_density")
+    ball_youngs_moduli: tuple[float, ...] = _per_ball("ball_youngs_modulus")
+    ball_poisson_ratios: tuple[float, ...] = _per_ball("ball_poisson_ratio")
+    ball_heat_capacities: tuple[float, ...] = _per_ball("ball_heat_capacity")
+    ball_conductivities: tuple[float, ...] = _per_ball("ball_conductivity")
+    # Only the ratio of two balls' effusivities √(kρc) matters (the split of ball-ball heat, MODEL.md §12.4):
+    # from aerogel-like 0.01 to diamond's 2000 W/(m·K).
+    ball_conductivity: float = _quantity("W/(m*K)", "ball thermal conductivity k_b", ge=0.01, le=2000.0)
+    gravity: bool = Field(
+        strict=True, json_schema_extra={"description": "gravity 9.81 m/s² downward, the vial axis horizontal (engine = 'dem')"}
+    )
+    # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
+    friction: float = _quantity("", "Coulomb friction coefficient μ of every contact (engine = 'dem')", ge=0, le=5.0)
+    rolling_friction: float = _quantity("", "rolling resistance coefficient μ_r (engine = 'dem')", ge=0, le=1.0)
+    kinematics: Literal["axial", "fourier"] = Field(
+        json_schema_extra={
+            "description": "vial motion of the 'dem' engine: 'axial' (amplitude, omega, phase: the 1-D drive) or "
+            "'fourier' (the harmonics in motion)"
+        }
+    )
+    motion: tuple[Harmonic, ...] = Field(
+        max_length=MAX_HARMONICS,
+        json_schema_extra={
+            "unit": "m or rad",
+            "description": "kinematics = 'fourier': (coordinate, k, cos, sin) terms of the vial's translations x, y, z "
+            "(m) and angles roll, pitch, yaw (rad) in the harmonics k of ωt + φ",
+        },
+    )
+    # The step inside a contact as a fraction of the smallest Rayleigh time; 0.9 is the 1-D engine's bound.
+    contact_step_fraction: float = _quantity(
+        "", "contact step of the 'dem' engine as a fraction of the smallest Rayleigh time", ge=1e-3, le=0.9
+    )
+    # A free-flight step never lets a contact begin inside it; this caps it further (1 s: no cap in practice).
+    max_flight_step: float = _quantity("s", "longest step of the 'dem' engine in free flight", ge=1e-7, le=1.0)
     record_windows: tuple[Window, ...] = Field(
         max_length=MAX_RECORD_WINDOWS,
         json_schema_extra={"unit": "s", "description": "(start, length) windows stored at full resolution"},
@@ -241,6 +311,62 @@ class Parameters(BaseModel):
                 f"ball_position: the ball must start inside the vial, allowed |ball_position| < {half_gap:g} m"
             )
         return self
+
+    @model_validator(mode="after")
+    def _balls_of_the_dem_engine(self) -> "Parameters":
+        if self.engine == "1d" and self.n_balls > 1:
+            raise ValueError(
+                f"n_balls: the 1-D engine moves one ball; allowed n_balls = 1 with engine = '1d', or set engine = 'dem'"
+            )
+        for key in PER_BALL_KEYS:
+            _check_per_ball(key, getattr(self, key), self.n_balls)
+        if self.kinematics == "fourier" and not self.motion:
+            raise ValueError("motion: kinematics = 'fourier' needs at least one harmonic; allowed (coordinate, k, cos, sin) terms")
+        _check_motion(self.motion)
+        if self.engine == "dem":
+            if self.model == "ball_only":
+                raise ValueError("model: the 'dem' engine has a node per ball, the vial and the air; allowed 'three_node' with engine = 'dem'")
+            self._check_balls_fit()
+        return self
+
+    def _check_balls_fit(self) -> None:
+        radii = self.ball_values("ball_radius")
+        largest = max(radii)
+        if 2.0 * largest >= self.vial_diameter:
+            key = "ball_radii" if self.ball_radii else "ball_radius"
+            raise ValueError(
+                f"{key}: a ball of diameter {2e3 * largest:g} mm does not move in a bore of {self.vial_diameter * 1e3:g} mm; "
+                f"allowed radii < vial_diameter/2 = {self.vial_diameter / 2:g} m"
+            )
+        if self.n_balls > 1 and self.initial_positions() is None:
+            raise ValueError(
+                f"n_balls: {self.n_balls} balls (radius up to {largest * 1e3:g} mm) do not fit side by side in a vial of "
+                f"{self.vial_diameter * 1e3:g} mm x {self.vial_length * 1e3:g} mm; allowed fewer balls, smaller ones or a "
+                "larger vial_diameter"
+            )
+
+    @property
+    def relative_convection(self) -> bool:
+        """Whether Re takes the ball's speed relative to the vial (MODEL.md §§4, 12.5)."""
+        if self.convection_velocity == "auto":
+            return self.engine == "dem"
+        return self.convection_velocity == "relative"
+
+    def ball_values(self, scalar_key: str) -> tuple[float, ...]:
+        """Each ball's value of ``scalar_key`` (e.g. 'ball_radius'): its per-ball list, or the scalar for all."""
+        values = getattr(self, PER_BALL_KEY_OF[scalar_key])
+        return tuple(values) if values else (getattr(self, scalar_key),) * self.n_balls
+
+    def initial_positions(self) -> "np.ndarray | None":
+        """Ball centres (n_balls, 3) in the vial frame at t = 0 (m): one ball at ``ball_position`` on the axis,
+        several filled in from the bottom (:mod:`shakermill.parameters.packing`); None if they do not fit."""
+        import numpy as np
+
+        from shakermill.parameters.packing import placement
+
+        if self.n_balls == 1:
+            return np.array([[self.ball_position, 0.0, 0.0]])
+        return placement(np.array(self.ball_values("ball_radius")), self.vial_length, self.vial_diameter)
 
     @model_validator(mode="after")
     def _stored_data_fits_in_memory(self) -> "Parameters":
@@ -290,9 +416,10 @@ class Parameters(BaseModel):
 
     @property
     def air_mass(self) -> float:
-        """m_a = ρ_a·(π d_v²/4·l_v − 4/3·π R³) (kg), MODEL.md section 6."""
+        """m_a = ρ_a·(π d_v²/4·l_v − Σ 4/3·π R³) (kg), MODEL.md section 6 (every ball of the 'dem' engine)."""
         vial_volume = math.pi * self.vial_diameter**2 / 4.0 * self.vial_length
-        ball_volume = 4.0 / 3.0 * math.pi * self.ball_radius**3
+        radii = self.ball_values("ball_radius") if self.engine == "dem" else (self.ball_radius,)
+        ball_volume = sum(4.0 / 3.0 * math.pi * radius**3 for radius in radii)
         return self.air_density * (vial_volume - ball_volume)
 
     @property
@@ -329,6 +456,35 @@ class Parameters(BaseModel):
 
 
 FIELD_NAMES: tuple[str, ...] = tuple(Parameters.model_fields)
+# The per-ball list keys and the scalar key each one refines.
+PER_BALL_KEY_OF = {
+    str((field.json_schema_extra or {})["per_ball"]): key
+    for key, field in Parameters.model_fields.items()
+    if "per_ball" in (field.json_schema_extra or {})
+}
+PER_BALL_KEYS = tuple(PER_BALL_KEY_OF.values())
+
+
+def _check_per_ball(key: str, values: tuple[float, ...], n_balls: int) -> None:
+    if values and len(values) != n_balls:
+        raise ValueError(
+            f"{key}: {len(values)} values for n_balls = {n_balls}; allowed an empty list or exactly {n_balls} values"
+        )
+    scalar = next(name for name, per_ball in PER_BALL_KEY_OF.items() if per_ball == key)
+    for number, value in enumerate(values, start=1):
+        if not bounds(scalar).contains(value):
+            raise ValueError(f"{key}: value {number} ({value:g}) is out of range; allowed {allowed_range(scalar)}")
+
+
+def _check_motion(motion: tuple[tuple[str, int, float, float], ...]) -> None:
+    """The summed harmonic amplitudes of each coordinate stay within a metre's half and a half turn."""
+    for coordinate in MOTION_COORDINATES:
+        amplitude = sum(abs(a) + abs(b) for name, _, a, b in motion if name == coordinate)
+        limit, unit = (math.pi, "rad") if coordinate in ("roll", "pitch", "yaw") else (MAX_MOTION_TRANSLATION, "m")
+        if amplitude > limit:
+            raise ValueError(
+                f"motion: the harmonics of {coordinate} add up to {amplitude:g} {unit}; allowed at most {limit:g} {unit}"
+            )
 
 
 def field_unit(key: str) -> str:
@@ -386,6 +542,14 @@ def allowed_range(key: str) -> str:
         return (
             f"at most {MAX_RECORD_WINDOWS} (start, length) pairs in s, start in [0, {LONGEST_RUN_S:g}], length > 0, "
             f"{MAX_RECORDED_SECONDS:g} s of the run in all"
+        )
+    if key in PER_BALL_KEYS:
+        scalar = next(name for name, per_ball in PER_BALL_KEY_OF.items() if per_ball == key)
+        return f"an empty list or n_balls values, each in {allowed_range(scalar)}"
+    if key == "motion":
+        return (
+            f"at most {MAX_HARMONICS} (coordinate, k, cos, sin) terms: coordinate one of {', '.join(MOTION_COORDINATES)}, "
+            f"k in [0, {MAX_MOTION_HARMONIC}], translations in m, angles in rad"
         )
     if field.annotation is int:
         return f"a whole number in {bounds(key)}"
@@ -496,7 +660,30 @@ SPEX_8000M = Preset(
         "model": Cited("three_node", f"{PAPER}: ball, vial and inner air as three lumped reservoirs"),
         "no_tension": Cited(False, "MODEL.md section 2: the total force is not clipped by default"),
         "heat_model": Cited("relative", "MODEL.md section 3: frame-invariant dissipation c·ζ̇²"),
-        "convection_velocity": Cited("ball", f"{PAPER}, section 3.3 (Re from the ball's velocity)"),
+        "convection_velocity": Cited(
+            "auto",
+            f"{PAPER}, section 3.3 (Re from the ball's velocity) for the 1-D engine; relative to the vial for 'dem' "
+            "(MODEL.md section 12.5)",
+        ),
+        "engine": Cited("1d", f"{PAPER}: one ball on the vial's axis"),
+        "n_balls": Cited(1, f"{PAPER}: one ball"),
+        **{key: Cited((), "every ball takes the scalar key's value") for key in PER_BALL_KEYS},
+        "ball_conductivity": Cited(
+            46.6, "AISI 52100 bearing steel at room temperature (ASM data sheet); only ratios between balls matter"
+        ),
+        "gravity": Cited(True, "MODEL.md section 12.1: 9.81 m/s² downward, the vial axis horizontal (engine = 'dem')"),
+        "friction": Cited(
+            0.3,
+            "assumption: a common choice for dry steel-on-steel contacts in DEM mill studies; not measured for SPEX "
+            "media (docs/notes/dem-references.md, section 3), so results should be checked against it",
+        ),
+        "rolling_friction": Cited(0.0, "MODEL.md section 12.3: no rolling resistance by default"),
+        "kinematics": Cited("axial", f"{PAPER}: the vial moves along its axis (MODEL.md section 12.2)"),
+        "motion": Cited((), "used only with kinematics = 'fourier'"),
+        "contact_step_fraction": Cited(
+            0.1, "numerical choice: converged at this fraction (benchmarks/README.md, DEM step study)"
+        ),
+        "max_flight_step": Cited(1e-4, "numerical choice: ~1/60 of a drive period, so the wall's motion is resolved"),
         "record_windows": Cited(
             ((0.0, 1.0), (600.0, 0.1)),
             f"the windows of {PAPER} Fig. 4 (first second) and Fig. 5b (100 ms at 10 min)",
@@ -636,6 +823,10 @@ def _coerce(key: str, value: Any) -> Any:
             return _coerce_switch(key, value)
         if key == "record_windows":
             return _coerce_windows(value)
+        if key in PER_BALL_KEYS:
+            return _coerce_per_ball(key, value)
+        if key == "motion":
+            return _coerce_motion(value)
     except UnitError as exc:
         raise ParameterError(f"{exc}; allowed {allowed_range(key)}") from None
     return value  # one of a few names: the model checks it
@@ -692,6 +883,34 @@ def _window(pair: Any) -> tuple[float, float]:
         raise UnitError(f"record_windows: expected START:LENGTH (or [start, length]) in seconds, got {quoted(pair)}")
     start, length = (to_si(item, "s", key="record_windows") for item in pair)
     return start, length
+
+
+def _coerce_per_ball(key: str, value: Any) -> tuple[float, ...]:
+    """Per-ball values from "6 mm, 5 mm" (the command line; "" means none) or a list (TOML, Python)."""
+    items = [item for item in value.split(",") if item.strip()] if isinstance(value, str) else value
+    if not isinstance(items, (list, tuple)):
+        raise UnitError(f"{key}: expected a list of values, one per ball, got {quoted(value)}")
+    scalar = next(name for name, per_ball in PER_BALL_KEY_OF.items() if per_ball == key)
+    return tuple(to_si(item, field_unit(scalar), key=key) for item in items)
+
+
+def _coerce_motion(value: Any) -> tuple[tuple[str, int, float, float], ...]:
+    """Harmonics from "x:1:0:25 mm, yaw:2:0.1:0" (the command line) or (coordinate, k, cos, sin) lists (TOML)."""
+    terms: Any = [item.split(":") for item in value.split(",") if item.strip()] if isinstance(value, str) else value
+    if not isinstance(terms, (list, tuple)):
+        raise UnitError(f"motion: expected (coordinate, k, cos, sin) terms, got {quoted(value)}")
+    return tuple(_harmonic(term) for term in terms)
+
+
+def _harmonic(term: Any) -> tuple[str, int, float, float]:
+    if not isinstance(term, (list, tuple)) or len(term) != 4 or str(term[0]).strip() not in MOTION_COORDINATES:
+        raise UnitError(
+            f"motion: expected COORDINATE:K:COS:SIN with a coordinate of {', '.join(MOTION_COORDINATES)}, got {quoted(term)}"
+        )
+    coordinate = str(term[0]).strip()
+    unit = "rad" if coordinate in ("roll", "pitch", "yaw") else "m"
+    harmonic = _coerce_count("motion", term[1])
+    return coordinate, harmonic, to_si(term[2], unit, key="motion"), to_si(term[3], unit, key="motion")
 
 
 RANGE_ERRORS = frozenset({"greater_than", "greater_than_equal", "less_than", "less_than_equal"})

@@ -102,3 +102,31 @@ def hertz_max_overlap(mass: float, radius: float, e_star: float, speed: float) -
 def hertz_contact_time(mass: float, radius: float, e_star: float, speed: float) -> float:
     """Duration of an undamped Hertz impact, 2.9433·ζ_max/v, in s (Johnson 1985, §11.4)."""
     return HERTZ_DURATION_FACTOR * hertz_max_overlap(mass, radius, e_star, speed) / speed
+
+
+# Tangential contact and rolling (MODEL.md section 12.3): the Hertz–Mindlin model of DEM codes.
+
+
+@njit(cache=True)
+def effective_shear_modulus(e_1: float, nu_1: float, e_2: float, nu_2: float) -> float:
+    """G* from 1/G* = 2(2−ν₁)(1+ν₁)/E₁ + 2(2−ν₂)(1+ν₂)/E₂, in Pa (MODEL.md §12.3)."""
+    return 1.0 / (2.0 * (2.0 - nu_1) * (1.0 + nu_1) / e_1 + 2.0 * (2.0 - nu_2) * (1.0 + nu_2) / e_2)
+
+
+@njit(cache=True)
+def concave_radius(radius: float, bore_radius: float) -> float:
+    """R* of a ball inside a cylinder of radius R_c: R·R_c/(R_c − R), in m (MODEL.md §12.3)."""
+    return radius * bore_radius / (bore_radius - radius)
+
+
+@njit(cache=True)
+def tangential_stiffness(shear_modulus: float, radius: float, overlap: float) -> float:
+    """Mindlin's no-slip stiffness k_t = 8·G*·√(R*·ζ), in N/m (MODEL.md §12.3)."""
+    return 8.0 * shear_modulus * math.sqrt(radius * overlap)
+
+
+@njit(cache=True)
+def tangential_damping(beta_e: float, stiffness: float, mass: float) -> float:
+    """c_t = −2·√(5/6)·β_e·√(k_t·m*), in N·s/m, ≥ 0 for e ≤ 1 (MODEL.md §12.3)."""
+    return -2.0 * math.sqrt(5.0 / 6.0) * beta_e * math.sqrt(stiffness * mass)
+

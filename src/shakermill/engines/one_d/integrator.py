@@ -30,18 +30,15 @@ that tiny steps cannot hold off Ctrl-C, the run's budget or progress.
 
 from __future__ import annotations
 
-import signal
-import threading
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Callable, Iterator, NamedTuple
+from typing import Callable, NamedTuple
 
 import numpy as np
 from numba import njit
 
-from shakermill.engines.budget import RunBudget
+from shakermill.engines.budget import RunBudget, interrupt_after_compiled_code
 from shakermill.engines.one_d.model import (
     DISSIPATED,
     HEAT_GENERATED,
@@ -882,7 +879,7 @@ class Integrator:
                              tolerances.max_overlap, self.project_energy)
         state = _State(self.clock, self.y, self.f, self._impact, self.counters, self.diagnostics)
         recording = _Recording(self.sample_times, self.samples, self.windows)
-        with _interrupt_after_compiled_code():
+        with interrupt_after_compiled_code():
             status, self._window_buffer, self._impact_buffer = _advance(
                 t_stop, steps_allowed, self.constants, self._tableau, control, accuracy, state, recording,
                 self._window_buffer, self._impact_buffer,
@@ -908,25 +905,3 @@ def _steps_for_call_seconds(steps: int, seconds: float) -> int:
     """The steps that take about CALL_SECONDS at the rate of the last call (``steps`` in ``seconds``)."""
     rate = steps / max(seconds, 1e-9)
     return int(min(max(rate * CALL_SECONDS, 1.0), MAX_STEPS_PER_CALL))
-
-
-@contextmanager
-def _interrupt_after_compiled_code() -> Iterator[None]:
-    """Hold a SIGINT that arrives while compiled code runs and deliver it to the previous handler afterwards.
-
-    A KeyboardInterrupt raised inside a Numba call surfaces as ``SystemError: CPUDispatcher(...) returned a
-    result with an exception set``, which no caller can tell from a crash. Only the main thread can set
-    handlers; elsewhere, and where SIGINT is ignored (sweep workers) or default, nothing changes.
-    """
-    previous = signal.getsignal(signal.SIGINT)
-    if threading.current_thread() is not threading.main_thread() or not callable(previous):
-        yield
-        return
-    received: list[object] = []
-    signal.signal(signal.SIGINT, lambda signum, frame: received.append(frame))
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if received:
-        previous(signal.SIGINT, received[0])

@@ -107,7 +107,7 @@ def constants_from(params: Parameters) -> Constants:
         eta=params.eta,
         lam=params.lam,
         paper_heat=params.heat_model == "paper",
-        relative_convection=params.convection_velocity == "relative",
+        relative_convection=params.relative_convection,
         air_density=params.air_density,
         viscosity_ambient=viscosity_ambient,
         prandtl=thermal.prandtl_number(params.air_cp, viscosity_ambient, params.air_conductivity),

@@ -1,0 +1,312 @@
+"""Constants and state of the 'dem' engine, derived once from :class:`Parameters` (MODEL.md section 12).
+
+Frames: the lab frame has z up (gravity −z) and x along the vial's axis at rest; the vial frame moves
+with the vial (its axis is its x). Contacts live in slots: ball pair (i, j), i < j, in slot ``i·N + j``;
+ball i against the left end, the right end or the cylindrical side in slot ``N² + 3i + wall``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from shakermill.parameters.schema import MOTION_COORDINATES, Parameters
+from shakermill.physics import contact, thermal
+from shakermill.physics.kinematics import fourier_coordinates, rotation_matrix
+
+LEFT_END, RIGHT_END, SIDE = 0, 1, 2
+WALL_NAMES = ("left", "right", "side")
+N_WALLS = 3
+STANDARD_GRAVITY = 9.81  # m/s², MODEL.md §12.1
+
+# Running totals of a run, in J (the energy audit, MODEL.md §12.6) and s.
+(
+    WORK_VIAL,
+    WORK_GRAVITY,
+    DISSIPATED_NORMAL,
+    DISSIPATED_TANGENTIAL,
+    DISSIPATED_SLIDING,
+    DISSIPATED_ROLLING,
+    HEAT_GENERATED,
+    HEAT_LOST,
+) = range(8)
+TOTAL_NAMES = (
+    "work_vial",
+    "work_gravity",
+    "dissipated_normal",
+    "dissipated_tangential",
+    "dissipated_sliding",
+    "dissipated_rolling",
+    "heat_generated",
+    "heat_lost",
+)
+CHANNELS = ("normal", "tangential", "sliding", "rolling")
+
+
+class Constants(NamedTuple):
+    """Everything the compiled stepping needs. Per-ball arrays have length N; pair arrays are N×N."""
+
+    n_balls: int
+    radius: np.ndarray
+    mass: np.ndarray
+    inertia: np.ndarray
+    # Ball-ball contacts (symmetric N×N) and ball-wall contacts (per ball, per wall kind)
+    pair_modulus: np.ndarray  # E*, Pa
+    pair_shear_modulus: np.ndarray  # G*, Pa
+    pair_radius: np.ndarray  # R*, m
+    pair_mass: np.ndarray  # m*, kg
+    pair_heat_share: np.ndarray  # share of a pair contact's heat that goes to ball i (row), by effusivity
+    wall_modulus: np.ndarray  # E* with the vial, per ball
+    wall_shear_modulus: np.ndarray
+    wall_radius: np.ndarray  # (N, 3): R* against the left end, the right end, the side
+    beta_e: float
+    no_tension: bool
+    friction: float
+    rolling_friction: float
+    eta: float
+    lam: float
+    # The vial
+    half_length: float
+    bore_radius: float
+    omega: float
+    phase: float
+    harmonics: np.ndarray  # (6, K, 2): (cos, sin) of x, y, z, roll, pitch, yaw per harmonic k
+    wall_speed_bound: float  # m/s: no point of the vial moves faster
+    wall_acceleration_bound: float  # m/s²
+    gravity: np.ndarray  # (3,), m/s², lab frame
+    # Steps
+    contact_step: float  # s
+    max_flight_step: float  # s
+    max_overlap: float  # m: beyond it the step control failed
+    thermal_step: float  # s: the thermal network is advanced on this clock
+    # Thermal network (MODEL.md §§4–6 with a node per ball, §12.5)
+    relative_convection: bool
+    air_density: float
+    viscosity_ambient: float
+    prandtl: float
+    mu_ref: float
+    t_ref: float
+    sutherland: float
+    air_conductivity: float
+    beta: float
+    h_inner: float
+    h_outer: float
+    inner_area: float
+    outer_area: float
+    capacity_ball: np.ndarray  # J/K per ball
+    capacity_vial: float
+    capacity_air: float
+    t_ambient: float
+
+
+class State(NamedTuple):
+    """The mutable state of a run; the compiled stepping updates these arrays in place."""
+
+    clock: np.ndarray  # [t, time since the last thermal update]
+    position: np.ndarray  # (N, 3) m, lab frame
+    velocity: np.ndarray  # (N, 3) m/s
+    spin: np.ndarray  # (N, 3) rad/s, angular velocity
+    force: np.ndarray  # (N, 3) N: contact forces of the last evaluation (gravity apart)
+    torque: np.ndarray  # (N, 3) N·m
+    temperature: np.ndarray  # (N + 2,) K: the balls, the vial, the air
+    pending_heat: np.ndarray  # (N + 1,) J into balls and vial since the last thermal update
+    pending_velocity_term: np.ndarray  # (N,) s: ∫w dt since the last thermal update
+    totals: np.ndarray  # (len(TOTAL_NAMES),) J
+    heat_into: np.ndarray  # (N + 1,) J: all heat into each ball and the vial so far
+    velocity_term_integral: np.ndarray  # (N,) s: ∫w dt of each ball so far
+    contacts: "Contacts"
+
+
+class Contacts(NamedTuple):
+    """Per-slot contact memory: forces of the last evaluation (for the step's mean work), the tangential
+    spring, stored elastic energies and what the impact record of a running contact has gathered."""
+
+    active: np.ndarray  # (S,) bool
+    normal_force: np.ndarray  # (S, 3) on ball i
+    tangential_force: np.ndarray  # (S, 3) on ball i
+    lever_torque_i: np.ndarray  # (S, 3): torque of the tangential force on ball i
+    lever_torque_j: np.ndarray  # (S, 3): on ball j (zero for a wall)
+    rolling_torque: np.ndarray  # (S, 3) on ball i (−it on j or the vial)
+    wall_velocity: np.ndarray  # (S, 3): the vial's velocity at the contact point
+    spring: np.ndarray  # (S, 3) m: tangential displacement δ_t
+    elastic_energy: np.ndarray  # (S,) J: Hertz normal energy
+    spring_energy: np.ndarray  # (S,) J: ½ k_t |δ_t|²
+    sliding: np.ndarray  # (S,) bool: the contact is at the Coulomb limit in this step
+    started: np.ndarray  # (S,) s
+    normal_speed_in: np.ndarray  # (S,) m/s: closing speed at first touch
+    tangential_speed_in: np.ndarray  # (S,) m/s: sliding speed of the contact points at first touch
+    dissipated: np.ndarray  # (S, 4) J by channel so far
+    peak_force: np.ndarray  # (S,) N
+    max_overlap: np.ndarray  # (S,) m
+
+
+def slot_count(n_balls: int) -> int:
+    return n_balls * n_balls + N_WALLS * n_balls
+
+
+def harmonics_of(params: Parameters) -> np.ndarray:
+    """The vial's motion as Fourier data (MODEL.md §12.2): ``axial`` is x = X_v sin(ωt + φ)."""
+    terms = params.motion if params.kinematics == "fourier" else (("x", 1, 0.0, params.amplitude),)
+    highest = max(k for _, k, _, _ in terms)
+    harmonics = np.zeros((len(MOTION_COORDINATES), highest + 1, 2))
+    for coordinate, k, cosine, sine in terms:
+        harmonics[MOTION_COORDINATES.index(coordinate), k] += (cosine, sine)
+    return harmonics
+
+
+def _motion_bounds(harmonics: np.ndarray, omega: float, reach: float) -> tuple[float, float]:
+    """Upper bounds of the speed and acceleration of any vial point within ``reach`` of its centre.
+
+    Each coordinate's Fourier series bounds its rate by Σ kω(|a|+|b|) and its second rate by Σ (kω)²(|a|+|b|);
+    a rotating point adds |Ω|·r and (|Ω̇| + |Ω|²)·r.
+    """
+    k = np.arange(harmonics.shape[1])
+    size = np.abs(harmonics).sum(axis=2)
+    rate = size @ (k * omega)
+    second = size @ (k * omega) ** 2
+    angular_rate, angular_second = rate[3:].sum(), second[3:].sum()
+    speed = float(np.linalg.norm(rate[:3]) + angular_rate * reach)
+    acceleration = float(np.linalg.norm(second[:3]) + (angular_second + angular_rate**2) * reach)
+    return speed, acceleration
+
+
+def constants_from(params: Parameters) -> Constants:
+    n = params.n_balls
+    radius = np.array(params.ball_values("ball_radius"))
+    density = np.array(params.ball_values("ball_density"))
+    youngs = np.array(params.ball_values("ball_youngs_modulus"))
+    poisson = np.array(params.ball_values("ball_poisson_ratio"))
+    heat_capacity = np.array(params.ball_values("ball_heat_capacity"))
+    conductivity = np.array(params.ball_values("ball_conductivity"))
+    mass = density * 4.0 / 3.0 * math.pi * radius**3
+    effusivity = np.sqrt(conductivity * density * heat_capacity)
+    pair_modulus, pair_shear, pair_radius, pair_mass, share = (np.zeros((n, n)) for _ in range(5))
+    for i in range(n):
+        for j in range(n):
+            pair_modulus[i, j] = contact.effective_modulus(youngs[i], poisson[i], youngs[j], poisson[j])
+            pair_shear[i, j] = contact.effective_shear_modulus(youngs[i], poisson[i], youngs[j], poisson[j])
+            pair_radius[i, j] = radius[i] * radius[j] / (radius[i] + radius[j])
+            pair_mass[i, j] = mass[i] * mass[j] / (mass[i] + mass[j])
+            share[i, j] = effusivity[i] / (effusivity[i] + effusivity[j])
+    bore = 0.5 * params.vial_diameter
+    wall_radius = np.column_stack([radius, radius, [contact.concave_radius(r, bore) for r in radius]])
+    e_v, nu_v = params.vial_youngs_modulus, params.vial_poisson_ratio
+    harmonics = harmonics_of(params)
+    speed_bound, acceleration_bound = _motion_bounds(harmonics, params.omega, math.hypot(0.5 * params.vial_length, bore))
+    rayleigh = min(
+        contact.rayleigh_time(r, rho, e, nu) for r, rho, e, nu in zip(radius, density, youngs, poisson, strict=True)
+    )
+    viscosity_ambient = thermal.sutherland_viscosity(
+        params.ambient_temperature, params.air_viscosity_ref, params.air_reference_temperature, params.sutherland
+    )
+    fastest_node = min(value for value, _ in params.thermal_time_constants_at_rest.values())
+    return Constants(
+        n_balls=n,
+        radius=radius,
+        mass=mass,
+        inertia=0.4 * mass * radius**2,
+        pair_modulus=pair_modulus,
+        pair_shear_modulus=pair_shear,
+        pair_radius=pair_radius,
+        pair_mass=pair_mass,
+        pair_heat_share=share,
+        wall_modulus=np.array([contact.effective_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]),
+        wall_shear_modulus=np.array([contact.effective_shear_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]),
+        wall_radius=wall_radius,
+        beta_e=contact.damping_ratio(params.restitution),
+        no_tension=params.no_tension,
+        friction=params.friction,
+        rolling_friction=params.rolling_friction,
+        eta=params.eta,
+        lam=params.lam,
+        half_length=0.5 * params.vial_length,
+        bore_radius=bore,
+        omega=params.omega,
+        phase=params.phase,
+        harmonics=harmonics,
+        wall_speed_bound=speed_bound,
+        wall_acceleration_bound=acceleration_bound,
+        gravity=np.array([0.0, 0.0, -STANDARD_GRAVITY if params.gravity else 0.0]),
+        contact_step=params.contact_step_fraction * rayleigh,
+        max_flight_step=params.max_flight_step,
+        max_overlap=MAX_OVERLAP_FRACTION * float(radius.min()),
+        thermal_step=min(THERMAL_STEP, THERMAL_STEP_FRACTION * fastest_node),
+        relative_convection=params.relative_convection,
+        air_density=params.air_density,
+        viscosity_ambient=viscosity_ambient,
+        prandtl=thermal.prandtl_number(params.air_cp, viscosity_ambient, params.air_conductivity),
+        mu_ref=params.air_viscosity_ref,
+        t_ref=params.air_reference_temperature,
+        sutherland=params.sutherland,
+        air_conductivity=params.air_conductivity,
+        beta=params.beta,
+        h_inner=params.h_inner,
+        h_outer=params.h_outer,
+        inner_area=params.inner_area,
+        outer_area=params.outer_area,
+        capacity_ball=mass * heat_capacity,
+        capacity_vial=params.vial_mass * params.vial_heat_capacity,
+        capacity_air=params.air_mass * params.air_heat_capacity,
+        t_ambient=params.ambient_temperature,
+    )
+
+
+# A contact overlap beyond this fraction of the smallest radius means the step control failed.
+MAX_OVERLAP_FRACTION = 0.05
+# The thermal network moves over ~0.1 s (the air) to hours (the vial): explicit Euler steps of a millisecond,
+# and never more than a tenth of the fastest node's time constant at rest, keep it stable and accurate.
+THERMAL_STEP = 1e-3
+THERMAL_STEP_FRACTION = 0.1
+
+
+def initial_state(params: Parameters, k: Constants) -> State:
+    """Balls at rest where :meth:`Parameters.initial_positions` puts them (one ball: ``ball_position`` and
+    ``ball_momentum`` along the axis, as the 1-D engine), everything at the initial temperature."""
+    n = params.n_balls
+    slots = slot_count(n)
+    centre = np.zeros(6)
+    rates = np.zeros(6)
+    fourier_coordinates(0.0, k.omega, k.phase, k.harmonics, centre, rates)
+    orientation = np.empty((3, 3))
+    rotation_matrix(centre[3], centre[4], centre[5], orientation)
+    position = centre[:3] + params.initial_positions() @ orientation.T
+    velocity = np.zeros((n, 3))
+    velocity[0, 0] = params.ball_momentum / k.mass[0] if n == 1 else 0.0
+    temperature = np.full(n + 2, params.initial_temperature)
+    if params.model == "ball_only":
+        temperature[n:] = params.ambient_temperature
+    return State(
+        clock=np.zeros(2),
+        position=position,
+        velocity=velocity,
+        spin=np.zeros((n, 3)),
+        force=np.zeros((n, 3)),
+        torque=np.zeros((n, 3)),
+        temperature=temperature,
+        pending_heat=np.zeros(n + 1),
+        pending_velocity_term=np.zeros(n),
+        totals=np.zeros(len(TOTAL_NAMES)),
+        heat_into=np.zeros(n + 1),
+        velocity_term_integral=np.zeros(n),
+        contacts=Contacts(
+            active=np.zeros(slots, dtype=np.bool_),
+            normal_force=np.zeros((slots, 3)),
+            tangential_force=np.zeros((slots, 3)),
+            lever_torque_i=np.zeros((slots, 3)),
+            lever_torque_j=np.zeros((slots, 3)),
+            rolling_torque=np.zeros((slots, 3)),
+            wall_velocity=np.zeros((slots, 3)),
+            spring=np.zeros((slots, 3)),
+            elastic_energy=np.zeros(slots),
+            spring_energy=np.zeros(slots),
+            sliding=np.zeros(slots, dtype=np.bool_),
+            started=np.zeros(slots),
+            normal_speed_in=np.zeros(slots),
+            tangential_speed_in=np.zeros(slots),
+            dissipated=np.zeros((slots, 4)),
+            peak_force=np.zeros(slots),
+            max_overlap=np.zeros(slots),
+        ),
+    )

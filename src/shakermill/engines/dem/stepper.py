@@ -1,0 +1,620 @@
+"""Compiled velocity-Verlet stepping of the 'dem' engine (MODEL.md section 12).
+
+One step: half kick with the last forces, drift, forces at the new positions (with the velocities
+predicted to the step's end), second half kick with the new forces. Inside a contact the step is
+``contact_step`` (a fraction of the smallest Rayleigh time); in free flight it is as long as no
+contact can begin inside it (each gap over its largest closing speed and acceleration), but never
+shorter than a contact step nor longer than ``max_flight_step``.
+
+The energy bookkeeping is exact per step. The second half kick makes each ball's change of kinetic
+energy dt·(F̄·v̄ + M̄·w̄), with F̄, M̄ the means of its forces and torques at the step's two ends and
+v̄, w̄ its mean velocities. Each contact's part of that work is split into the vial's work, the change
+of the contact's stored energies (Hertz normal, tangential spring) and its dissipation by channel, so
+the audit "work of vial and gravity = Δ kinetic energy + Δ stored + dissipated" closes to round-off,
+and each channel tends to its continuous formula (MODEL.md §12.4) as the step shrinks. η of the
+dissipation becomes heat in the balls and the vial; the thermal network advances on its own coarser
+clock with the heat and Whitaker velocity terms gathered meanwhile (MODEL.md §12.5).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from shakermill.engines.dem.model import (
+    DISSIPATED_NORMAL,
+    DISSIPATED_ROLLING,
+    DISSIPATED_SLIDING,
+    DISSIPATED_TANGENTIAL,
+    HEAT_GENERATED,
+    HEAT_LOST,
+    LEFT_END,
+    N_WALLS,
+    RIGHT_END,
+    WORK_GRAVITY,
+    WORK_VIAL,
+    Constants,
+    State,
+)
+from shakermill.physics import contact, kinematics, thermal
+
+REACHED_STOP = 0
+NOT_FINITE = -1
+OVERLAP_TOO_LARGE = -2
+PAUSED = 2  # the step allowance of one call is spent; call again
+RECORDS_FULL = 3  # the impact buffer is full; grow it and call again
+
+RECORD_COLUMNS = (
+    "time",
+    "ball",
+    "other",
+    "normal_speed",
+    "tangential_speed",
+    "dissipated_normal",
+    "dissipated_tangential",
+    "dissipated_sliding",
+    "dissipated_rolling",
+    "peak_force",
+    "max_overlap",
+    "duration",
+    "heat_to_ball",
+    "heat_to_other",
+)
+COUNTER_NAMES = ("steps", "contact_steps", "flight_steps", "impacts", "thermal_updates")
+STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES = range(len(COUNTER_NAMES))
+# ``other`` of a record: the other ball's index, or −1 − wall for the vial's left end, right end and side.
+
+
+class Scratch(NamedTuple):
+    """Arrays of one call, allocated once so that the compiled loop allocates nothing per step."""
+
+    coordinates: np.ndarray  # (6,) the vial's x, y, z, roll, pitch, yaw
+    rates: np.ndarray  # (6,) their time derivatives
+    orientation: np.ndarray  # (3, 3) vial frame to lab frame
+    angular: np.ndarray  # (3,) the vial's angular velocity now
+    angular_before: np.ndarray  # (3,) at the step's start
+    half_velocity: np.ndarray  # (N, 3) after the first half kick
+    half_spin: np.ndarray  # (N, 3)
+    velocity_before: np.ndarray  # (N, 3) at the step's start
+    spin_before: np.ndarray  # (N, 3)
+    normal_force: np.ndarray  # (S, 3) new forces and torques on ball i per slot
+    tangential_force: np.ndarray
+    lever_torque_i: np.ndarray
+    lever_torque_j: np.ndarray
+    rolling_torque: np.ndarray
+    wall_velocity: np.ndarray  # (S, 3) the vial's velocity at the contact point
+    elastic_energy: np.ndarray  # (S,)
+    spring_energy: np.ndarray  # (S,)
+    live: np.ndarray  # (S,) slots touching now or at the step's start
+    touching: np.ndarray  # (S,) bool: touching at the step's end
+    normal: np.ndarray  # (3,) vectors of the contact being evaluated
+    point_velocity: np.ndarray
+    other_velocity: np.ndarray
+    lever: np.ndarray
+    relative_spin: np.ndarray
+
+
+def scratch_for(n_balls: int, slots: int) -> Scratch:
+    return Scratch(
+        coordinates=np.zeros(6),
+        rates=np.zeros(6),
+        orientation=np.zeros((3, 3)),
+        angular=np.zeros(3),
+        angular_before=np.zeros(3),
+        half_velocity=np.zeros((n_balls, 3)),
+        half_spin=np.zeros((n_balls, 3)),
+        velocity_before=np.zeros((n_balls, 3)),
+        spin_before=np.zeros((n_balls, 3)),
+        normal_force=np.zeros((slots, 3)),
+        tangential_force=np.zeros((slots, 3)),
+        lever_torque_i=np.zeros((slots, 3)),
+        lever_torque_j=np.zeros((slots, 3)),
+        rolling_torque=np.zeros((slots, 3)),
+        wall_velocity=np.zeros((slots, 3)),
+        elastic_energy=np.zeros(slots),
+        spring_energy=np.zeros(slots),
+        live=np.zeros(slots, dtype=np.int64),
+        touching=np.zeros(slots, dtype=np.bool_),
+        normal=np.zeros(3),
+        point_velocity=np.zeros(3),
+        other_velocity=np.zeros(3),
+        lever=np.zeros(3),
+        relative_spin=np.zeros(3),
+    )
+
+
+@njit(cache=True)
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def _cross_into(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
+    x = a[1] * b[2] - a[2] * b[1]
+    y = a[2] * b[0] - a[0] * b[2]
+    z = a[0] * b[1] - a[1] * b[0]
+    out[0], out[1], out[2] = x, y, z
+
+
+@njit(cache=True)
+def _norm(a: np.ndarray) -> float:
+    return math.sqrt(_dot(a, a))
+
+
+@njit(cache=True)
+def _scaled_into(a: np.ndarray, scale: float, out: np.ndarray) -> None:
+    """out = scale·a, without a temporary array."""
+    for axis in range(3):
+        out[axis] = scale * a[axis]
+
+
+@njit(cache=True)
+def _difference_into(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
+    for axis in range(3):
+        out[axis] = a[axis] - b[axis]
+
+
+@njit(cache=True)
+def _distance(a: np.ndarray, b: np.ndarray) -> float:
+    dx, dy, dz = a[0] - b[0], a[1] - b[1], a[2] - b[2]
+    return math.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+@njit(cache=True, inline="always")
+def vial_frame(t: float, k: Constants, w: Scratch) -> None:
+    """The vial's pose and rates at ``t`` into ``w`` (MODEL.md §12.2)."""
+    kinematics.fourier_coordinates(t, k.omega, k.phase, k.harmonics, w.coordinates, w.rates)
+    kinematics.rotation_matrix(w.coordinates[3], w.coordinates[4], w.coordinates[5], w.orientation)
+    kinematics.angular_velocity(w.coordinates[4], w.coordinates[5], w.rates[3], w.rates[4], w.rates[5], w.angular)
+
+
+@njit(cache=True, inline="always")
+def wall_gap(position: np.ndarray, radius: float, wall: int, k: Constants, w: Scratch) -> float:
+    """Gap (m; negative: overlap) between a ball and ``wall``; ``w.normal`` gets the unit normal into the ball."""
+    q = w.orientation
+    rx = position[0] - w.coordinates[0]
+    ry = position[1] - w.coordinates[1]
+    rz = position[2] - w.coordinates[2]
+    axial = q[0, 0] * rx + q[1, 0] * ry + q[2, 0] * rz
+    if wall == LEFT_END:
+        _scaled_into(q[:, 0], 1.0, w.normal)
+        return axial + k.half_length - radius
+    if wall == RIGHT_END:
+        _scaled_into(q[:, 0], -1.0, w.normal)
+        return k.half_length - axial - radius
+    across_1 = q[0, 1] * rx + q[1, 1] * ry + q[2, 1] * rz
+    across_2 = q[0, 2] * rx + q[1, 2] * ry + q[2, 2] * rz
+    off_axis = math.hypot(across_1, across_2)
+    if off_axis > 0.0:
+        for axis in range(3):
+            w.normal[axis] = -(q[axis, 1] * across_1 + q[axis, 2] * across_2) / off_axis
+    else:
+        _scaled_into(q[:, 2], -1.0, w.normal)
+    return k.bore_radius - off_axis - radius
+
+
+@njit(cache=True, inline="always")
+def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: float, shear_modulus: float,
+              radius: float, mass: float, dt: float, k: Constants, s: State, w: Scratch) -> None:
+    """Normal, tangential and rolling response of a contact (MODEL.md §12.3) into ``w``'s arrays of ``slot``.
+
+    ``w.normal`` points into ball i; ``w.point_velocity`` is i's contact point's velocity relative to the
+    other body's. Updates the tangential spring and the running contact's record in place.
+    """
+    c = s.contacts
+    normal, relative = w.normal, w.point_velocity
+    approach = _dot(relative, normal)
+    elastic = contact.hertz_force(overlap, modulus, radius)
+    damping = contact.damping_coefficient(overlap, mass, radius, modulus, k.beta_e)
+    magnitude = contact.contact_force(elastic, damping, -approach, k.no_tension)
+    w.elastic_energy[slot] = contact.elastic_energy(overlap, modulus, radius)
+    spring = c.spring[slot]
+    length = _norm(spring)
+    along = _dot(spring, normal)
+    for axis in range(3):  # the spring turns with the tangent plane, keeping its length
+        spring[axis] -= along * normal[axis]
+    turned = _norm(spring)
+    if turned > 0.0:
+        spring *= length / turned
+    stiffness = contact.tangential_stiffness(shear_modulus, radius, overlap)
+    damping_t = contact.tangential_damping(k.beta_e, stiffness, mass)
+    pressing = max(magnitude, 0.0)
+    limit = k.friction * pressing
+    c.sliding[slot] = False
+    for axis in range(3):
+        sliding = relative[axis] - approach * normal[axis]
+        spring[axis] += sliding * dt
+        w.normal_force[slot, axis] = magnitude * normal[axis]
+        w.tangential_force[slot, axis] = -stiffness * spring[axis] - damping_t * sliding
+    size = _norm(w.tangential_force[slot])
+    if size > limit:
+        w.tangential_force[slot] *= limit / size
+        _scaled_into(w.tangential_force[slot], -1.0 / stiffness, spring)
+        c.sliding[slot] = True
+    w.spring_energy[slot] = 0.5 * stiffness * _dot(spring, spring)
+    spin = _norm(relative_spin)
+    for axis in range(3):
+        w.rolling_torque[slot, axis] = -k.rolling_friction * radius * pressing * relative_spin[axis] / spin if spin > 0 else 0.0
+    c.peak_force[slot] = max(c.peak_force[slot], abs(magnitude))
+    c.max_overlap[slot] = max(c.max_overlap[slot], overlap)
+
+
+@njit(cache=True, inline="always")
+def _touch(slot: int, t: float, s: State, w: Scratch) -> None:
+    """A contact begins in ``slot`` at ``t``: start its record from the approach velocities."""
+    c = s.contacts
+    approach = _dot(w.point_velocity, w.normal)
+    c.started[slot] = t
+    c.normal_speed_in[slot] = -approach
+    c.tangential_speed_in[slot] = math.sqrt(max(_dot(w.point_velocity, w.point_velocity) - approach * approach, 0.0))
+    c.dissipated[slot, :] = 0.0
+    c.peak_force[slot] = 0.0
+    c.max_overlap[slot] = 0.0
+    c.spring[slot, :] = 0.0
+
+
+@njit(cache=True, inline="always")
+def _release(slot: int, w: Scratch) -> None:
+    """No force in ``slot`` now (a contact that just ended)."""
+    w.touching[slot] = False
+    w.normal_force[slot, :] = 0.0
+    w.tangential_force[slot, :] = 0.0
+    w.lever_torque_i[slot, :] = 0.0
+    w.lever_torque_j[slot, :] = 0.0
+    w.rolling_torque[slot, :] = 0.0
+    w.elastic_energy[slot] = 0.0
+    w.spring_energy[slot] = 0.0
+
+
+@njit(cache=True, inline="always")
+def _contact_point_velocity(ball: int, lever_sign: float, s: State, w: Scratch, out: np.ndarray) -> None:
+    """Velocity of the point of ``ball`` at lever_sign·R·n from its centre (n = ``w.normal``)."""
+    for axis in range(3):
+        w.lever[axis] = lever_sign * w.normal[axis]
+    _cross_into(s.spin[ball], w.lever, out)
+    for axis in range(3):
+        out[axis] += s.velocity[ball, axis]
+
+
+@njit(cache=True, inline="always")
+def _pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live: int) -> tuple[int, float]:
+    """Responses of the touching ball pairs; returns the live-slot count and the deepest overlap (m)."""
+    n = k.n_balls
+    deepest = 0.0
+    for i in range(n):
+        for j in range(i + 1, n):
+            slot = i * n + j
+            distance = _distance(s.position[i], s.position[j])
+            overlap = k.radius[i] + k.radius[j] - distance
+            if overlap <= 0.0:
+                if s.contacts.active[slot]:
+                    _release(slot, w)
+                    w.live[live] = slot
+                    live += 1
+                continue
+            deepest = max(deepest, overlap)
+            for axis in range(3):
+                w.normal[axis] = (s.position[i, axis] - s.position[j, axis]) / distance
+            _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
+            _contact_point_velocity(j, k.radius[j], s, w, w.other_velocity)
+            w.point_velocity[:] -= w.other_velocity
+            if not s.contacts.active[slot]:
+                _touch(slot, t, s, w)
+            _difference_into(s.spin[i], s.spin[j], w.relative_spin)
+            _response(slot, overlap, w.relative_spin, k.pair_modulus[i, j], k.pair_shear_modulus[i, j],
+                      k.pair_radius[i, j], k.pair_mass[i, j], dt, k, s, w)
+            _scaled_into(w.normal, -k.radius[i], w.lever)
+            _cross_into(w.lever, w.tangential_force[slot], w.lever_torque_i[slot])
+            _scaled_into(w.lever_torque_i[slot], k.radius[j] / k.radius[i], w.lever_torque_j[slot])
+            w.wall_velocity[slot, :] = 0.0
+            w.touching[slot] = True
+            w.live[live] = slot
+            live += 1
+    return live, deepest
+
+
+@njit(cache=True, inline="always")
+def _wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live: int) -> tuple[int, float]:
+    """Responses of the balls touching the vial's walls; returns the live-slot count and the deepest overlap."""
+    n = k.n_balls
+    deepest = 0.0
+    for i in range(n):
+        for wall in range(N_WALLS):
+            slot = n * n + N_WALLS * i + wall
+            overlap = -wall_gap(s.position[i], k.radius[i], wall, k, w)
+            if overlap <= 0.0:
+                if s.contacts.active[slot]:
+                    _release(slot, w)
+                    w.live[live] = slot
+                    live += 1
+                continue
+            deepest = max(deepest, overlap)
+            # The vial's velocity at the contact point c = r − R·n: ṙ_v + Ω × (c − r_v).
+            for axis in range(3):
+                w.lever[axis] = s.position[i, axis] - k.radius[i] * w.normal[axis] - w.coordinates[axis]
+            _cross_into(w.angular, w.lever, w.other_velocity)
+            for axis in range(3):
+                w.wall_velocity[slot, axis] = w.rates[axis] + w.other_velocity[axis]
+            _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
+            w.point_velocity[:] -= w.wall_velocity[slot]
+            if not s.contacts.active[slot]:
+                _touch(slot, t, s, w)
+            _difference_into(s.spin[i], w.angular, w.relative_spin)
+            _response(slot, overlap, w.relative_spin, k.wall_modulus[i], k.wall_shear_modulus[i],
+                      k.wall_radius[i, wall], k.mass[i], dt, k, s, w)
+            _scaled_into(w.normal, -k.radius[i], w.lever)
+            _cross_into(w.lever, w.tangential_force[slot], w.lever_torque_i[slot])
+            w.lever_torque_j[slot, :] = 0.0
+            w.touching[slot] = True
+            w.live[live] = slot
+            live += 1
+    return live, deepest
+
+
+@njit(cache=True, inline="always")
+def _sum_forces(live: int, k: Constants, s: State, w: Scratch) -> None:
+    """The new contact forces and torques on every ball (gravity apart)."""
+    n = k.n_balls
+    s.force[:, :] = 0.0
+    s.torque[:, :] = 0.0
+    for index in range(live):
+        slot = w.live[index]
+        i = slot // n if slot < n * n else (slot - n * n) // N_WALLS
+        for axis in range(3):
+            force = w.normal_force[slot, axis] + w.tangential_force[slot, axis]
+            s.force[i, axis] += force
+            s.torque[i, axis] += w.lever_torque_i[slot, axis] + w.rolling_torque[slot, axis]
+            if slot < n * n:
+                j = slot % n
+                s.force[j, axis] -= force
+                s.torque[j, axis] += w.lever_torque_j[slot, axis] - w.rolling_torque[slot, axis]
+
+
+@njit(cache=True, inline="always")
+def _mean_work(slot: int, i: int, j: int, dt: float, s: State, w: Scratch) -> tuple[float, float, float, float]:
+    """(normal, tangential, rolling) work the contact in ``slot`` absorbed over the step, and the vial's work
+    through it (J); ``j`` < 0 for a wall. Means of the step's two ends, as the half kicks apply them."""
+    c = s.contacts
+    normal = tangential = rolling = vial = 0.0
+    for axis in range(3):
+        normal_force = 0.5 * (c.normal_force[slot, axis] + w.normal_force[slot, axis])
+        tangential_force = 0.5 * (c.tangential_force[slot, axis] + w.tangential_force[slot, axis])
+        rolling_torque = 0.5 * (c.rolling_torque[slot, axis] + w.rolling_torque[slot, axis])
+        lever_i = 0.5 * (c.lever_torque_i[slot, axis] + w.lever_torque_i[slot, axis])
+        velocity_i = 0.5 * (w.velocity_before[i, axis] + s.velocity[i, axis])
+        spin_i = 0.5 * (w.spin_before[i, axis] + s.spin[i, axis])
+        if j >= 0:
+            other_velocity = 0.5 * (w.velocity_before[j, axis] + s.velocity[j, axis])
+            other_spin = 0.5 * (w.spin_before[j, axis] + s.spin[j, axis])
+            tangential -= 0.5 * (c.lever_torque_j[slot, axis] + w.lever_torque_j[slot, axis]) * other_spin
+        else:
+            before = c.wall_velocity[slot, axis] if c.active[slot] else w.wall_velocity[slot, axis]
+            after = w.wall_velocity[slot, axis] if w.touching[slot] else before
+            other_velocity = 0.5 * (before + after)
+            other_spin = 0.5 * (w.angular_before[axis] + w.angular[axis])
+            vial += (normal_force + tangential_force) * other_velocity + rolling_torque * other_spin
+        normal -= normal_force * (velocity_i - other_velocity)
+        tangential -= tangential_force * (velocity_i - other_velocity) + lever_i * spin_i
+        rolling -= rolling_torque * (spin_i - other_spin)
+    return normal * dt, tangential * dt, rolling * dt, vial * dt
+
+
+@njit(cache=True, inline="always")
+def _settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.ndarray,
+            count: int) -> int:
+    """Book the step's work of the contact in ``slot`` by channel, turn it into heat, keep the new forces,
+    and close the contact's record if it ended. Returns the record count."""
+    n = k.n_balls
+    c = s.contacts
+    pair = slot < n * n
+    i = slot // n if pair else (slot - n * n) // N_WALLS
+    j = slot % n if pair else -1
+    normal, tangential, rolling, vial = _mean_work(slot, i, j, dt, s, w)
+    normal -= w.elastic_energy[slot] - c.elastic_energy[slot]
+    tangential -= w.spring_energy[slot] - c.spring_energy[slot]
+    # A step at the Coulomb limit dissipates its tangential work by sliding, a sticking step by damping.
+    sliding = tangential if c.sliding[slot] else 0.0
+    channels = (normal, tangential - sliding, sliding, rolling)
+    totals = (DISSIPATED_NORMAL, DISSIPATED_TANGENTIAL, DISSIPATED_SLIDING, DISSIPATED_ROLLING)
+    dissipated = 0.0
+    for channel in range(4):
+        c.dissipated[slot, channel] += channels[channel]
+        s.totals[totals[channel]] += channels[channel]
+        dissipated += channels[channel]
+    heat = k.eta * dissipated
+    share = k.pair_heat_share[i, j] if pair else k.lam
+    other = j if pair else n
+    s.totals[WORK_VIAL] += vial
+    s.totals[HEAT_GENERATED] += heat
+    for node, part in ((i, share * heat), (other, (1.0 - share) * heat)):
+        s.pending_heat[node] += part
+        s.heat_into[node] += part
+    c.normal_force[slot] = w.normal_force[slot]
+    c.tangential_force[slot] = w.tangential_force[slot]
+    c.lever_torque_i[slot] = w.lever_torque_i[slot]
+    c.lever_torque_j[slot] = w.lever_torque_j[slot]
+    c.rolling_torque[slot] = w.rolling_torque[slot]
+    c.wall_velocity[slot] = w.wall_velocity[slot]
+    c.elastic_energy[slot] = w.elastic_energy[slot]
+    c.spring_energy[slot] = w.spring_energy[slot]
+    c.active[slot] = w.touching[slot]
+    if w.touching[slot]:
+        return count
+    row = records[count]
+    row[0], row[1], row[2] = c.started[slot], i, j if pair else -1 - (slot - n * n) % N_WALLS
+    row[3], row[4] = c.normal_speed_in[slot], c.tangential_speed_in[slot]
+    row[5:9] = c.dissipated[slot]
+    row[9], row[10], row[11] = c.peak_force[slot], c.max_overlap[slot], t - c.started[slot]
+    total = k.eta * (c.dissipated[slot, 0] + c.dissipated[slot, 1] + c.dissipated[slot, 2] + c.dissipated[slot, 3])
+    row[12], row[13] = share * total, (1.0 - share) * total
+    c.spring[slot, :] = 0.0
+    return count + 1
+
+
+@njit(cache=True, inline="always")
+def _convect(dt: float, k: Constants, s: State, w: Scratch) -> None:
+    """Gather each ball's Whitaker velocity term over the step (MODEL.md §§4, 12.5) and the gravity's work."""
+    for i in range(k.n_balls):
+        speed_squared = 0.0
+        for axis in range(3):
+            mean_velocity = 0.5 * (w.velocity_before[i, axis] + s.velocity[i, axis])
+            s.totals[WORK_GRAVITY] += dt * k.mass[i] * k.gravity[axis] * mean_velocity
+            w.lever[axis] = s.position[i, axis] - w.coordinates[axis]
+        if k.relative_convection:
+            _cross_into(w.angular, w.lever, w.other_velocity)
+            for axis in range(3):
+                relative = s.velocity[i, axis] - w.rates[axis] - w.other_velocity[axis]
+                speed_squared += relative * relative
+        else:
+            speed_squared = _dot(s.velocity[i], s.velocity[i])
+        reynolds = thermal.reynolds_number(k.radius[i], k.air_density, math.sqrt(speed_squared), k.viscosity_ambient)
+        term = thermal.whitaker_velocity_term(reynolds) * dt
+        s.pending_velocity_term[i] += term
+        s.velocity_term_integral[i] += term
+
+
+@njit(cache=True)
+def advance_thermal(k: Constants, s: State) -> None:
+    """Advance the N + 2 node network (MODEL.md §§4–6, 12.5) over the time gathered since its last update,
+    with the heat and mean Whitaker terms of that time (explicit Euler: conserves energy exactly)."""
+    span = s.clock[1]
+    if span <= 0.0:
+        return
+    n = k.n_balls
+    theta = s.temperature
+    ball_to_air = 0.0
+    for i in range(n):
+        ratio = thermal.sutherland_viscosity(theta[i], k.mu_ref, k.t_ref, k.sutherland) / k.mu_ref
+        nusselt = thermal.nusselt_from_velocity_term(s.pending_velocity_term[i] / span, k.prandtl, ratio)
+        h_ball = thermal.heat_transfer_coefficient(nusselt, k.air_conductivity, k.radius[i])
+        flow = thermal.ball_air_heat_flow(k.radius[i], k.beta, h_ball, theta[i], theta[n + 1])
+        theta[i] += (s.pending_heat[i] - flow * span) / k.capacity_ball[i]
+        ball_to_air += flow
+    vial_to_air = thermal.newton_cooling(k.h_inner, k.inner_area, theta[n], theta[n + 1])
+    vial_to_outside = thermal.newton_cooling(k.h_outer, k.outer_area, theta[n], k.t_ambient)
+    theta[n] += (s.pending_heat[n] - (vial_to_air + vial_to_outside) * span) / k.capacity_vial
+    theta[n + 1] += (ball_to_air + vial_to_air) * span / k.capacity_air
+    s.totals[HEAT_LOST] += vial_to_outside * span
+    s.pending_heat[:] = 0.0
+    s.pending_velocity_term[:] = 0.0
+    s.clock[1] = 0.0
+
+
+@njit(cache=True)
+def _time_to_close(gap: float, speed: float, acceleration: float) -> float:
+    """Shortest time in which a gap (m) closing at most at ``speed`` and ``acceleration`` can close (s)."""
+    if gap <= 0.0:
+        return 0.0
+    if acceleration <= 0.0:
+        return gap / speed if speed > 0.0 else math.inf
+    return (math.sqrt(speed * speed + 2.0 * acceleration * gap) - speed) / acceleration
+
+
+@njit(cache=True, inline="always")
+def _flight_step(k: Constants, s: State, w: Scratch) -> float:
+    """The longest step in which no contact can begin (MODEL.md §12.6), within [contact_step, max_flight_step]."""
+    n = k.n_balls
+    step = k.max_flight_step
+    wall_acceleration = _norm(k.gravity) + k.wall_acceleration_bound
+    for i in range(n):
+        speed = _norm(s.velocity[i])
+        for wall in range(N_WALLS):
+            gap = wall_gap(s.position[i], k.radius[i], wall, k, w)
+            step = min(step, _time_to_close(gap, speed + k.wall_speed_bound, wall_acceleration))
+        for j in range(i + 1, n):
+            # Both balls fall alike in flight: their relative motion is uniform.
+            gap = _distance(s.position[i], s.position[j]) - k.radius[i] - k.radius[j]
+            step = min(step, _time_to_close(gap, _distance(s.velocity[i], s.velocity[j]), 0.0))
+    return max(step, k.contact_step)
+
+
+@njit(cache=True, inline="always")
+def _kick_and_drift(dt: float, k: Constants, s: State, w: Scratch) -> None:
+    """First half kick and drift; the velocities are left predicted to the step's end for the forces."""
+    for i in range(k.n_balls):
+        for axis in range(3):
+            acceleration = s.force[i, axis] / k.mass[i] + k.gravity[axis]
+            angular_acceleration = s.torque[i, axis] / k.inertia[i]
+            w.velocity_before[i, axis] = s.velocity[i, axis]
+            w.spin_before[i, axis] = s.spin[i, axis]
+            w.half_velocity[i, axis] = s.velocity[i, axis] + 0.5 * dt * acceleration
+            w.half_spin[i, axis] = s.spin[i, axis] + 0.5 * dt * angular_acceleration
+            s.position[i, axis] += dt * w.half_velocity[i, axis]
+            s.velocity[i, axis] = w.half_velocity[i, axis] + 0.5 * dt * acceleration
+            s.spin[i, axis] = w.half_spin[i, axis] + 0.5 * dt * angular_acceleration
+
+
+@njit(cache=True, inline="always")
+def _final_kick(dt: float, k: Constants, s: State, w: Scratch) -> None:
+    for i in range(k.n_balls):
+        for axis in range(3):
+            s.velocity[i, axis] = w.half_velocity[i, axis] + 0.5 * dt * (s.force[i, axis] / k.mass[i] + k.gravity[axis])
+            s.spin[i, axis] = w.half_spin[i, axis] + 0.5 * dt * s.torque[i, axis] / k.inertia[i]
+
+
+@njit(cache=True, inline="always")
+def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.ndarray,
+          count: int) -> tuple[int, int, float]:
+    """One velocity-Verlet step of length ``dt`` ending at ``t``; returns (record count, contacts touching,
+    deepest overlap)."""
+    w.angular_before[:] = w.angular
+    _kick_and_drift(dt, k, s, w)
+    vial_frame(t, k, w)
+    live, deepest_pair = _pair_contacts(t, dt, k, s, w, 0)
+    live, deepest_wall = _wall_contacts(t, dt, k, s, w, live)
+    _sum_forces(live, k, s, w)
+    _final_kick(dt, k, s, w)
+    touching = 0
+    for index in range(live):
+        slot = w.live[index]
+        count = _settle(slot, t, dt, k, s, w, records, count)
+        touching += 1 if w.touching[slot] else 0
+    _convect(dt, k, s, w)
+    s.clock[0] = t
+    s.clock[1] += dt
+    return count, touching, max(deepest_pair, deepest_wall)
+
+
+@njit(cache=True)
+def advance(t_stop: float, max_steps: int, k: Constants, s: State, w: Scratch, records: np.ndarray, count: int,
+            counters: np.ndarray) -> tuple[int, int]:
+    """Step to ``t_stop`` (s); returns (status, record count). Hands back early with PAUSED after
+    ``max_steps`` steps and with RECORDS_FULL when ``records`` may overflow; the thermal network is brought
+    up to the time reached either way."""
+    slots = s.contacts.active.size
+    vial_frame(s.clock[0], k, w)
+    touching = 0
+    for slot in range(slots):
+        touching += 1 if s.contacts.active[slot] else 0
+    status = REACHED_STOP
+    steps = 0
+    while s.clock[0] < t_stop:
+        if steps >= max_steps:
+            status = PAUSED
+            break
+        if count + slots > records.shape[0]:
+            status = RECORDS_FULL
+            break
+        dt = k.contact_step if touching else _flight_step(k, s, w)
+        remaining = t_stop - s.clock[0]
+        t = t_stop if dt >= remaining else s.clock[0] + dt
+        before = count
+        count, touching, deepest = _step(t, min(dt, remaining), k, s, w, records, count)
+        steps += 1
+        counters[STEPS] += 1
+        counters[CONTACT_STEPS if touching else FLIGHT_STEPS] += 1
+        counters[IMPACTS] += count - before
+        if deepest > k.max_overlap:
+            status = OVERLAP_TOO_LARGE
+            break
+        if not math.isfinite(s.position.sum() + s.velocity.sum() + s.spin.sum()):
+            status = NOT_FINITE
+            break
+        if s.clock[1] >= k.thermal_step:
+            advance_thermal(k, s)
+            counters[THERMAL_UPDATES] += 1
+    advance_thermal(k, s)
+    return status, count
