@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.solvers.averaged import AVERAGING_FAILED, mser_truncation
+from shakermill.analysis.batch_means import mser_truncation
+from shakermill.solvers.averaged import AVERAGING_FAILED
 
 NUDGE_SPEED = 1.0  # m/s: with amplitudes below the free gap a ball at rest is never hit
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from scipy.differentiate import jacobian
@@ -41,6 +42,7 @@ class SteadyState:
     velocity_term: float  # the mean Whitaker velocity term it was computed for
     solved: bool
     message: str
+    balls: tuple[float, ...] = ()  # each ball's steady temperature (K), for engines with several balls
 
     @property
     def slowest_time_constant(self) -> float:
@@ -54,6 +56,7 @@ class SteadyState:
             "slowest_time_constant_min": self.slowest_time_constant / 60.0,
             "steady_state_heat_power_W": self.heat_power,
             "steady_state_message": self.message,
+            **({"balls_steady_C": [value - 273.15 for value in self.balls]} if self.balls else {}),
         }
 
 
@@ -95,27 +98,46 @@ def steady_state(params: Parameters, heat_power: float, velocity_term: float) ->
     size = 1 if params.model == "ball_only" else 3
     ambient = params.ambient_temperature
     if params.model != "ball_only" and params.h_outer * params.outer_area <= 0.0 and heat_power > 0.0:
-        return _unsolved(heat_power, velocity_term, "no heat leaves the vial (h_outer = 0): the temperatures rise without bound")
-    rates = _rates(params, heat_power, velocity_term)
-    solution = root(rates, _first_guess(params, heat_power, size), method="hybr", tol=1e-12)
+        return _unsolved(heat_power, velocity_term, NO_HEAT_LEAVES)
+    solved = _solve(_rates(params, heat_power, velocity_term), _first_guess(params, heat_power, size))
+    if isinstance(solved, str):
+        return _unsolved(heat_power, velocity_term, solved)
+    theta, time_constants = solved
+    ball, vial, air = (theta[0], ambient, ambient) if size == 1 else theta
+    return SteadyState(float(ball), float(vial), float(air), time_constants, heat_power, velocity_term, True, "solved")
+
+
+def network_steady_state(
+    params: Parameters, rates: Callable[[np.ndarray], np.ndarray], heat_power: float, velocity_term: float, n_balls: int
+) -> SteadyState:
+    """Steady state and time constants of a network of ``n_balls`` ball nodes, the vial and the air, whose
+    averaged right-hand side is ``rates`` (the 'dem' engine); ``ball`` is the balls' mean."""
+    if params.h_outer * params.outer_area <= 0.0 and heat_power > 0.0:
+        return _unsolved(heat_power, velocity_term, NO_HEAT_LEAVES)
+    solved = _solve(rates, _first_guess(params, heat_power, n_balls + 2))
+    if isinstance(solved, str):
+        return _unsolved(heat_power, velocity_term, solved)
+    theta, time_constants = solved
+    balls = tuple(float(value) for value in theta[:n_balls])
+    return SteadyState(
+        float(np.mean(balls)), float(theta[n_balls]), float(theta[n_balls + 1]), time_constants, heat_power,
+        velocity_term, True, "solved", balls,
+    )
+
+
+NO_HEAT_LEAVES = "no heat leaves the vial (h_outer = 0): the temperatures rise without bound"
+
+
+def _solve(rates: Callable[[np.ndarray], np.ndarray], guess: np.ndarray) -> tuple[np.ndarray, tuple[float, ...]] | str:
+    """The root of ``rates`` and the time constants there (s, slowest first), or why it was not found."""
+    solution = root(rates, guess, method="hybr", tol=1e-12)
     residual = float(np.max(np.abs(rates(solution.x))))
     if not np.all(np.isfinite(solution.x)) or residual > ROOT_TOLERANCE:
-        return _unsolved(heat_power, velocity_term, f"the root of the thermal network was not found ({solution.message})")
-    theta = solution.x
-    derivative = jacobian(_vectorised(rates), theta, initial_step=1.0).df
+        return f"the root of the thermal network was not found ({solution.message})"
+    derivative = jacobian(_vectorised(rates), solution.x, initial_step=1.0).df
     eigenvalues = np.linalg.eigvals(np.atleast_2d(derivative))
-    time_constants = tuple(sorted((-1.0 / value.real for value in eigenvalues), reverse=True))
-    ball, vial, air = (theta[0], ambient, ambient) if size == 1 else theta
-    return SteadyState(
-        ball=float(ball),
-        vial=float(vial),
-        air=float(air),
-        time_constants=tuple(float(value) for value in time_constants),
-        heat_power=heat_power,
-        velocity_term=velocity_term,
-        solved=True,
-        message="solved",
-    )
+    time_constants = tuple(sorted((float(-1.0 / value.real) for value in eigenvalues), reverse=True))
+    return solution.x, time_constants
 
 
 def _unsolved(heat_power: float, velocity_term: float, message: str) -> SteadyState:

@@ -32,6 +32,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from shakermill.analysis.attractors import find_attractors
+from shakermill.analysis.batch_means import batch_rates, mser_truncation, normalised, relative_error, standard_error
 from shakermill.analysis.fit import fit_exponential
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.one_d import model
@@ -70,26 +71,6 @@ class MechanicsWindow:
     status: int
 
 
-def mser_truncation(batch_means: np.ndarray) -> int:
-    """Number of leading batches to discard (MSER: minimise the marginal standard error, d ≤ n/2)."""
-    n = batch_means.size
-    best, best_score = 0, math.inf
-    for cut in range(n // 2 + 1):
-        rest = batch_means[cut:]
-        score = float(np.sum((rest - rest.mean()) ** 2)) / rest.size**2
-        if score < best_score:
-            best, best_score = cut, score
-    return best
-
-
-def _batch_statistics(cumulative: np.ndarray, batch_length: float) -> np.ndarray:
-    return np.diff(cumulative) / batch_length
-
-
-def _standard_error(values: np.ndarray) -> float:
-    return float(values.std(ddof=1) / math.sqrt(values.size)) if values.size > 1 else math.inf
-
-
 def measure_mechanics(params: Parameters, integrator: Integrator, progress: ProgressCallback | None = None) -> MechanicsWindow:
     """Integrate the mechanics batch by batch until the averages converge (or the time bound is hit).
 
@@ -116,12 +97,12 @@ def measure_mechanics(params: Parameters, integrator: Integrator, progress: Prog
         heat.append(float(integrator.y[model.HEAT_GENERATED]))
         dissipated.append(float(integrator.y[model.DISSIPATED]))
         velocity_term.append(float(integrator.y[model.VELOCITY_TERM]))
-        heat_rates = _batch_statistics(np.array(heat), batch_length)
-        term_rates = _batch_statistics(np.array(velocity_term), batch_length)
+        heat_rates = batch_rates(np.array(heat), batch_length)
+        term_rates = batch_rates(np.array(velocity_term), batch_length)
         if heat_rates.size >= 2 * params.averaging_min_batches:
-            cut = max(mser_truncation(_normalised(heat_rates)), mser_truncation(_normalised(term_rates)))
+            cut = max(mser_truncation(normalised(heat_rates)), mser_truncation(normalised(term_rates)))
             kept = heat_rates.size - cut
-            if kept >= params.averaging_min_batches and _relative_error(heat_rates[cut:]) <= params.averaging_rel_error and _relative_error(term_rates[cut:]) <= params.averaging_rel_error:
+            if kept >= params.averaging_min_batches and relative_error(heat_rates[cut:]) <= params.averaging_rel_error and relative_error(term_rates[cut:]) <= params.averaging_rel_error:
                 converged = True
                 message = f"converged after {integrator.t:.3g} s of mechanics ({kept} batches of {batch_length:.3g} s)"
                 break
@@ -133,14 +114,14 @@ def measure_mechanics(params: Parameters, integrator: Integrator, progress: Prog
             break
     kept_heat, kept_term = heat_rates[cut:], term_rates[cut:]
     window = kept_heat.size * batch_length
-    dissipated_rates = _batch_statistics(np.array(dissipated), batch_length)[cut:]
+    dissipated_rates = batch_rates(np.array(dissipated), batch_length)[cut:]
     impacts_in_window = int(np.sum(integrator.impacts[:, 0] >= cut * batch_length)) if kept_heat.size else 0
     averages = MechanicsAverages(
         heat_power=float(kept_heat.mean()) if kept_heat.size else math.nan,
-        heat_power_stderr=_standard_error(kept_heat),
+        heat_power_stderr=standard_error(kept_heat),
         dissipated_power=float(dissipated_rates.mean()) if dissipated_rates.size else math.nan,
         velocity_term=float(kept_term.mean()) if kept_term.size else math.nan,
-        velocity_term_stderr=_standard_error(kept_term),
+        velocity_term_stderr=standard_error(kept_term),
         transient=cut * batch_length,
         window=window,
         batches=int(kept_heat.size),
@@ -149,19 +130,6 @@ def measure_mechanics(params: Parameters, integrator: Integrator, progress: Prog
         message=message,
     )
     return MechanicsWindow(averages, integrator, time.perf_counter() - started, status)
-
-
-def _normalised(values: np.ndarray) -> np.ndarray:
-    scale = abs(values.mean())
-    return values / scale if scale > 0 else values
-
-
-def _relative_error(values: np.ndarray) -> float:
-    mean = abs(values.mean())
-    error = _standard_error(values)
-    if mean == 0.0:
-        return 0.0 if error == 0.0 else math.inf
-    return error / mean
 
 
 def impact_heated_time_constants(params: Parameters, averages: MechanicsAverages) -> dict[str, float]:

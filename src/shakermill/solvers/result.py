@@ -94,10 +94,16 @@ class EnergyAudit:
     stored_air: float
     heat_lost_to_surroundings: float
     projection_correction: float
+    # The 'dem' engine adds the work of gravity and splits the dissipation by channel (MODEL.md §12.4).
+    work_by_gravity: float = 0.0
+    # ... and the energy its tangential springs gain by stiffening with the load (engines.dem.model.TOTAL_NAMES)
+    work_by_stiffening: float = 0.0
+    dissipated_by_channel: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def mechanical_residual(self) -> float:
-        return self.work_by_vial - self.kinetic_energy_change - self.elastic_energy_change - self.dissipated
+        supplied = self.work_by_vial + self.work_by_gravity + self.work_by_stiffening
+        return supplied - self.kinetic_energy_change - self.elastic_energy_change - self.dissipated
 
     @property
     def thermal_residual(self) -> float:
@@ -117,7 +123,8 @@ class EnergyAudit:
         return abs(self.residual) / scale if scale > 0.0 else 0.0
 
     def as_dict(self) -> dict[str, float]:
-        values = dict(self.__dict__)
+        values = {key: value for key, value in self.__dict__.items() if key != "dissipated_by_channel"}
+        values.update({f"dissipated_{channel}": value for channel, value in self.dissipated_by_channel.items()})
         values.update(
             mechanical_residual=self.mechanical_residual,
             thermal_residual=self.thermal_residual,
@@ -183,14 +190,14 @@ class Result:
     def _repr_html_(self) -> str:
         return present("result html", self)
 
-def conclude(result: Result, heat_power: float, velocity_term: float) -> Result:
+def conclude(result: Result, heat_power: float, velocity_term: float, steady: SteadyState | None = None) -> Result:
     """Steady state, physical bounds, energy audit and warnings of a finished run of either solver, then its summary.
 
     ``heat_power`` (W) and ``velocity_term`` are the means of the settled motion that drive the
-    thermal network (MODEL.md §11).
+    thermal network (MODEL.md §11); an engine with its own network passes its ``steady`` state.
     """
     params = result.params
-    result.steady = steady_state(params, heat_power, velocity_term)
+    result.steady = steady if steady is not None else steady_state(params, heat_power, velocity_term)
     result.warnings.extend(unit_slip_warnings(params))
     lines = (run_length_warning(result.t_end, result.steady), steady_state_bound_warning(result), fit_warning(result))
     for line in lines:
@@ -207,7 +214,7 @@ def conclude(result: Result, heat_power: float, velocity_term: float) -> Result:
 def physical_bounds_problem(result: Result) -> str | None:
     """Why the temperatures of a run cannot be physical, or None."""
     series = result.history
-    hottest_ball = float(np.nanmax(series["theta_ball"]))
+    hottest_ball = float(np.nanmax(series[BALL_TEMPERATURES if BALL_TEMPERATURES in series.variables else "theta_ball"]))
     limit = result.params.ball_temperature_limit
     if hottest_ball > limit:
         return (
@@ -289,9 +296,14 @@ CELSIUS_VARIABLES = ("theta_ball", "theta_vial", "theta_air")
 
 TIME_ATTRIBUTES = {"units": "s", "long_name": "simulated time"}
 
+# The 'dem' engine's variable of every ball's temperature (K), over (time, ball).
+BALL_TEMPERATURES = "theta_balls"
+
+
 @dataclass(frozen=True)
 class StateHistory:
     """A state history as NumPy arrays over ``times`` (s), each variable with its attributes (units, long_name).
+    A variable is over ``time`` alone unless ``dimensions`` names its dimensions (e.g. time, ball, axis).
 
     Run files are written from it directly, and :meth:`dataset` is the xarray view: a run that only
     writes its files never imports xarray, whose first Dataset imports dask and pint (half a second).
@@ -299,6 +311,10 @@ class StateHistory:
 
     times: np.ndarray
     variables: dict[str, tuple[np.ndarray, dict[str, str]]]
+    dimensions: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+
+    def dims(self, name: str) -> tuple[str, ...]:
+        return self.dimensions.get(name, ("time",))
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.variables[name][0]
@@ -308,12 +324,14 @@ class StateHistory:
         variables = {
             name: (values, {**attributes, **extra.get(name, {})}) for name, (values, attributes) in self.variables.items()
         }
-        return StateHistory(self.times, variables)
+        return StateHistory(self.times, variables, self.dimensions)
 
     def dataset(self) -> xr.Dataset:
         import xarray as xr
 
-        data_vars = {name: ("time", values, dict(attributes)) for name, (values, attributes) in self.variables.items()}
+        data_vars = {
+            name: (self.dims(name), values, dict(attributes)) for name, (values, attributes) in self.variables.items()
+        }
         return xr.Dataset(data_vars, coords={"time": ("time", self.times, dict(TIME_ATTRIBUTES))})
 
 def state_history(times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters) -> StateHistory:
@@ -388,8 +406,8 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         "max_impact_speed_m_s": float(impacts["impact_speed"].max()) if count else math.nan,
         "mean_dissipated_per_impact_J": float(impacts["dissipated_energy"].mean()) if count else math.nan,
         "steps": result.counters["steps"],
-        "rejected_steps": result.counters["rejected_steps"],
-        "rhs_evaluations": result.counters["rhs_evaluations"],
+        "rejected_steps": result.counters.get("rejected_steps", 0),
+        "rhs_evaluations": result.counters.get("rhs_evaluations", result.counters["steps"]),
         "wall_time_s": result.wall_time,
         "energy_audit_residual": result.energy.relative_residual,
         "energy_projection_relative": (
@@ -397,6 +415,7 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         ),
     }
     summary.update(understood_inputs(params))
+    summary.update(several_ball_summary(result))
     if result.steady is not None:
         summary.update(result.steady.as_summary())
     if result.averages is not None:
@@ -405,6 +424,33 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         summary.update(result.attractors.as_summary())
     summary["warnings"] = list(result.warnings)
     return summary
+
+
+def several_ball_summary(result: Result) -> dict[str, Any]:
+    """The 'dem' engine's keys: impacts by kind, each ball's temperature and the heat by channel (empty for 1-D)."""
+    if result.params.engine != "dem":
+        return {}
+    impacts = result.impact_columns
+    duration = max(result.t_end, 1e-300)
+    window = result.impact_window if result.impact_window else duration
+    scale = duration / window if window > 0 else math.nan
+    wall = int(np.sum(impacts["target"] != "ball"))
+    temperatures = result.history[BALL_TEMPERATURES][-1]
+    keys: dict[str, Any] = {
+        "engine": "dem",
+        "n_balls": result.params.n_balls,
+        "wall_impacts": int(round(wall * scale)),
+        "ball_ball_impacts": int(round((result.impact_count - wall) * scale)),
+        "ball_temperatures_C": [kelvin_to_celsius(float(value)) for value in temperatures],
+        "hottest_ball_C": kelvin_to_celsius(float(np.nanmax(temperatures))),
+        "work_gravity_J": result.energy.work_by_gravity,
+        "work_stiffening_J": result.energy.work_by_stiffening,
+    }
+    eta = result.params.eta
+    for channel, dissipated in result.energy.dissipated_by_channel.items():
+        keys[f"dissipated_{channel}_W"] = dissipated / duration
+        keys[f"heat_{channel}_W"] = eta * dissipated / duration
+    return keys
 
 
 def probed(result: Result) -> AttractorScan:

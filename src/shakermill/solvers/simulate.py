@@ -7,13 +7,17 @@ from shakermill.engines.one_d.integrator import BUDGET_EXCEEDED
 from shakermill.engines.one_d.setup import ProgressCallback
 from shakermill.parameters.schema import Parameters
 from shakermill.solvers.averaged import simulate_averaged
+from shakermill.solvers.dem import simulate_dem
 from shakermill.solvers.full import simulate_full
 from shakermill.solvers.result import INTERRUPTED, Result
 
 
 def simulate(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
-    """Run ``params`` with the solver it names (``params.solver``), within ``budget`` (``params``' own if None):
-    see :func:`simulate_full` and :func:`shakermill.averaged.simulate_averaged`."""
+    """Run ``params`` with the engine and solver it names (``params.engine``, ``params.solver``), within ``budget``
+    (``params``' own if None): see :func:`simulate_full`, :func:`shakermill.solvers.averaged.simulate_averaged`
+    and :func:`shakermill.solvers.dem.simulate_dem`."""
+    if params.engine == "dem":
+        return simulate_dem(params, progress, budget)
     if params.solver == "averaged":
         return simulate_averaged(params, progress, budget)
     return simulate_full(params, progress, budget)

@@ -35,10 +35,12 @@ from shakermill.engines.dem.model import (
     N_WALLS,
     RIGHT_END,
     WORK_GRAVITY,
+    WORK_STIFFENING,
     WORK_VIAL,
     Constants,
     State,
 )
+from shakermill.engines.dem import network
 from shakermill.physics import contact, kinematics, thermal
 
 REACHED_STOP = 0
@@ -64,7 +66,7 @@ RECORD_COLUMNS = (
     "heat_to_other",
 )
 COUNTER_NAMES = ("steps", "contact_steps", "flight_steps", "impacts", "thermal_updates")
-STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES = range(len(COUNTER_NAMES))
+STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES, ROWS_WRITTEN = range(len(COUNTER_NAMES) + 1)
 # ``other`` of a record: the other ball's index, or −1 − wall for the vial's left end, right end and side.
 
 
@@ -87,7 +89,8 @@ class Scratch(NamedTuple):
     rolling_torque: np.ndarray
     wall_velocity: np.ndarray  # (S, 3) the vial's velocity at the contact point
     elastic_energy: np.ndarray  # (S,)
-    spring_energy: np.ndarray  # (S,)
+    stiffness: np.ndarray  # (S,) tangential k_t
+    stretch: np.ndarray  # (S,) |δ_t|²
     live: np.ndarray  # (S,) slots touching now or at the step's start
     touching: np.ndarray  # (S,) bool: touching at the step's end
     normal: np.ndarray  # (3,) vectors of the contact being evaluated
@@ -95,6 +98,7 @@ class Scratch(NamedTuple):
     other_velocity: np.ndarray
     lever: np.ndarray
     relative_spin: np.ndarray
+    flow: np.ndarray  # (N + 2,) heat flows of the thermal network
 
 
 def scratch_for(n_balls: int, slots: int) -> Scratch:
@@ -115,7 +119,8 @@ def scratch_for(n_balls: int, slots: int) -> Scratch:
         rolling_torque=np.zeros((slots, 3)),
         wall_velocity=np.zeros((slots, 3)),
         elastic_energy=np.zeros(slots),
-        spring_energy=np.zeros(slots),
+        stiffness=np.zeros(slots),
+        stretch=np.zeros(slots),
         live=np.zeros(slots, dtype=np.int64),
         touching=np.zeros(slots, dtype=np.bool_),
         normal=np.zeros(3),
@@ -123,6 +128,7 @@ def scratch_for(n_balls: int, slots: int) -> Scratch:
         other_velocity=np.zeros(3),
         lever=np.zeros(3),
         relative_spin=np.zeros(3),
+        flow=np.zeros(n_balls + 2),
     )
 
 
@@ -234,7 +240,8 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
         w.tangential_force[slot] *= limit / size
         _scaled_into(w.tangential_force[slot], -1.0 / stiffness, spring)
         c.sliding[slot] = True
-    w.spring_energy[slot] = 0.5 * stiffness * _dot(spring, spring)
+    w.stiffness[slot] = stiffness
+    w.stretch[slot] = _dot(spring, spring)
     spin = _norm(relative_spin)
     for axis in range(3):
         w.rolling_torque[slot, axis] = -k.rolling_friction * radius * pressing * relative_spin[axis] / spin if spin > 0 else 0.0
@@ -266,7 +273,8 @@ def _release(slot: int, w: Scratch) -> None:
     w.lever_torque_j[slot, :] = 0.0
     w.rolling_torque[slot, :] = 0.0
     w.elastic_energy[slot] = 0.0
-    w.spring_energy[slot] = 0.0
+    w.stiffness[slot] = 0.0
+    w.stretch[slot] = 0.0
 
 
 @njit(cache=True, inline="always")
@@ -414,7 +422,12 @@ def _settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, 
     j = slot % n if pair else -1
     normal, tangential, rolling, vial = _mean_work(slot, i, j, dt, s, w)
     normal -= w.elastic_energy[slot] - c.elastic_energy[slot]
-    tangential -= w.spring_energy[slot] - c.spring_energy[slot]
+    # The spring energy ½k_t|δ_t|² changes by stretching (its own work, from the tangential work) and by
+    # stiffening with the overlap (a supply of the model's own, booked apart: model.TOTAL_NAMES).
+    mean_stiffness = 0.5 * (w.stiffness[slot] + c.stiffness[slot])
+    mean_stretch = 0.5 * (w.stretch[slot] + c.stretch[slot])
+    tangential -= 0.5 * mean_stiffness * (w.stretch[slot] - c.stretch[slot])
+    s.totals[WORK_STIFFENING] += 0.5 * mean_stretch * (w.stiffness[slot] - c.stiffness[slot])
     # A step at the Coulomb limit dissipates its tangential work by sliding, a sticking step by damping.
     sliding = tangential if c.sliding[slot] else 0.0
     channels = (normal, tangential - sliding, sliding, rolling)
@@ -439,7 +452,8 @@ def _settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, 
     c.rolling_torque[slot] = w.rolling_torque[slot]
     c.wall_velocity[slot] = w.wall_velocity[slot]
     c.elastic_energy[slot] = w.elastic_energy[slot]
-    c.spring_energy[slot] = w.spring_energy[slot]
+    c.stiffness[slot] = w.stiffness[slot]
+    c.stretch[slot] = w.stretch[slot]
     c.active[slot] = w.touching[slot]
     if w.touching[slot]:
         return count
@@ -477,27 +491,23 @@ def _convect(dt: float, k: Constants, s: State, w: Scratch) -> None:
 
 
 @njit(cache=True)
-def advance_thermal(k: Constants, s: State) -> None:
-    """Advance the N + 2 node network (MODEL.md §§4–6, 12.5) over the time gathered since its last update,
-    with the heat and mean Whitaker terms of that time (explicit Euler: conserves energy exactly)."""
+def advance_thermal(k: Constants, s: State, flow: np.ndarray) -> None:
+    """Advance the N + 2 node network (:mod:`network`) over the time gathered since its last update, with
+    the heat and mean Whitaker terms of that time (explicit Euler, which conserves energy exactly)."""
     span = s.clock[1]
     if span <= 0.0:
         return
     n = k.n_balls
     theta = s.temperature
-    ball_to_air = 0.0
     for i in range(n):
-        ratio = thermal.sutherland_viscosity(theta[i], k.mu_ref, k.t_ref, k.sutherland) / k.mu_ref
-        nusselt = thermal.nusselt_from_velocity_term(s.pending_velocity_term[i] / span, k.prandtl, ratio)
-        h_ball = thermal.heat_transfer_coefficient(nusselt, k.air_conductivity, k.radius[i])
-        flow = thermal.ball_air_heat_flow(k.radius[i], k.beta, h_ball, theta[i], theta[n + 1])
-        theta[i] += (s.pending_heat[i] - flow * span) / k.capacity_ball[i]
-        ball_to_air += flow
-    vial_to_air = thermal.newton_cooling(k.h_inner, k.inner_area, theta[n], theta[n + 1])
-    vial_to_outside = thermal.newton_cooling(k.h_outer, k.outer_area, theta[n], k.t_ambient)
-    theta[n] += (s.pending_heat[n] - (vial_to_air + vial_to_outside) * span) / k.capacity_vial
-    theta[n + 1] += (ball_to_air + vial_to_air) * span / k.capacity_air
-    s.totals[HEAT_LOST] += vial_to_outside * span
+        s.pending_velocity_term[i] /= span
+    network.flows(theta, s.pending_velocity_term, k, flow)
+    for i in range(n):
+        theta[i] += (s.pending_heat[i] - flow[i] * span) / k.capacity_ball[i]
+        theta[n + 1] += flow[i] * span / k.capacity_air
+    theta[n + 1] += flow[n] * span / k.capacity_air
+    theta[n] += (s.pending_heat[n] - (flow[n] + flow[n + 1]) * span) / k.capacity_vial
+    s.totals[HEAT_LOST] += flow[n + 1] * span
     s.pending_heat[:] = 0.0
     s.pending_velocity_term[:] = 0.0
     s.clock[1] = 0.0
@@ -579,11 +589,25 @@ def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.n
 
 
 @njit(cache=True)
+def write_row(k: Constants, s: State, w: Scratch, row: np.ndarray) -> None:
+    """The state now as a row laid out as :func:`model.row_fields` says (the thermal network brought up to now)."""
+    advance_thermal(k, s, w.flow)
+    vial_frame(s.clock[0], k, w)
+    row[0] = s.clock[0]
+    offset = 1
+    for block in (s.position.ravel(), s.velocity.ravel(), s.spin.ravel(), s.temperature, s.totals, s.heat_into,
+                  s.velocity_term_integral, w.coordinates):
+        row[offset : offset + block.size] = block
+        offset += block.size
+
+
+@njit(cache=True)
 def advance(t_stop: float, max_steps: int, k: Constants, s: State, w: Scratch, records: np.ndarray, count: int,
-            counters: np.ndarray) -> tuple[int, int]:
-    """Step to ``t_stop`` (s); returns (status, record count). Hands back early with PAUSED after
-    ``max_steps`` steps and with RECORDS_FULL when ``records`` may overflow; the thermal network is brought
-    up to the time reached either way."""
+            counters: np.ndarray, marks: np.ndarray, rows: np.ndarray) -> tuple[int, int]:
+    """Step to ``t_stop`` (s); returns (status, record count). Steps end on each time in ``marks`` (sorted),
+    where the state is written into the next row of ``rows``. Hands back early with PAUSED after ``max_steps``
+    steps and with RECORDS_FULL when ``records`` may overflow; the thermal network is brought up to the time
+    reached either way."""
     slots = s.contacts.active.size
     vial_frame(s.clock[0], k, w)
     touching = 0
@@ -599,8 +623,10 @@ def advance(t_stop: float, max_steps: int, k: Constants, s: State, w: Scratch, r
             status = RECORDS_FULL
             break
         dt = k.contact_step if touching else _flight_step(k, s, w)
-        remaining = t_stop - s.clock[0]
-        t = t_stop if dt >= remaining else s.clock[0] + dt
+        mark = counters[ROWS_WRITTEN]
+        end = min(t_stop, marks[mark]) if mark < marks.size else t_stop
+        remaining = end - s.clock[0]
+        t = end if dt >= remaining else s.clock[0] + dt
         before = count
         count, touching, deepest = _step(t, min(dt, remaining), k, s, w, records, count)
         steps += 1
@@ -614,7 +640,10 @@ def advance(t_stop: float, max_steps: int, k: Constants, s: State, w: Scratch, r
             status = NOT_FINITE
             break
         if s.clock[1] >= k.thermal_step:
-            advance_thermal(k, s)
+            advance_thermal(k, s, w.flow)
             counters[THERMAL_UPDATES] += 1
-    advance_thermal(k, s)
+        if mark < marks.size and t == marks[mark]:
+            write_row(k, s, w, rows[mark])
+            counters[ROWS_WRITTEN] += 1
+    advance_thermal(k, s, w.flow)
     return status, count
