@@ -1,0 +1,118 @@
+"""`shakermill impact`: one impact on its own, its JSON object, its table and its one-line errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from shakermill import cli
+
+SHAKERMILL = Path(sys.executable).parent / "shakermill"
+JSON_KEYS = [
+    "normal_restitution",
+    "tangential_velocity_out_m_s",
+    "angular_velocity_rad_s",
+    "contact_time_s",
+    "max_overlap_m",
+    "max_normal_force_N",
+    "dissipated_J",
+    "dissipated_normal_J",
+    "dissipated_tangential_J",
+    "dissipated_sliding_J",
+    "dissipated_rolling_J",
+]
+# Fine contact steps: the measured restitution is then within 4e-4 of the given one (tests/studies/test_impact.py).
+FINE = ["--set", "contact_step_fraction=0.02"]
+
+runner = CliRunner()
+
+
+def invoke(*args: str):
+    return runner.invoke(cli.app, ["impact", *args])
+
+
+def assert_one_error_line(stderr: str, *fragments: str) -> None:
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
+    assert lines[0].startswith("error: ")
+    for fragment in fragments:
+        assert fragment in lines[0], (fragment, lines[0])
+    assert "Traceback" not in stderr
+
+
+def test_json_holds_exactly_the_documented_keys():
+    result = invoke("--speed", "1", "--angle", "30", "--json", *FINE)
+    assert result.exit_code == 0, result.stderr
+    assert result.stdout.count("\n") == 1
+    outcome = json.loads(result.stdout)
+    assert list(outcome) == JSON_KEYS
+    assert outcome["normal_restitution"] == pytest.approx(0.7, abs=1e-3)  # the default preset's e
+
+
+def test_settings_reach_the_impact():
+    settings = ["--set", "restitution=0.5", "--set", "friction=0", *FINE]
+    result = invoke("--speed", "2", "--angle", "30", "--json", *settings)
+    assert result.exit_code == 0, result.stderr
+    outcome = json.loads(result.stdout)
+    assert outcome["normal_restitution"] == pytest.approx(0.5, abs=1e-3)
+    # Without friction nothing acts along the end face: the ball keeps V sin θ and gets no spin.
+    assert outcome["tangential_velocity_out_m_s"] == pytest.approx(1.0, rel=1e-12)
+    assert outcome["angular_velocity_rad_s"] == 0.0
+
+
+def test_spin_angle_and_ball_target_are_passed_on():
+    spinning = invoke("--speed", "1", "--angle", "60", "--spin", "300", "--set", "rolling_friction=0.05", "--json")
+    assert json.loads(spinning.stdout)["dissipated_rolling_J"] > 0.0
+    ball = invoke("--speed", "1", "--target", "ball", "--set", "restitution=0.9", "--json", *FINE)
+    assert json.loads(ball.stdout)["normal_restitution"] == pytest.approx(0.9, abs=1e-3)
+
+
+def test_a_ball_too_large_for_the_default_vial_is_accepted():
+    """The vial's size plays no part in a lone impact: the command makes room for any allowed ball."""
+    settings = ["--set", "ball_radius=0.1", "--set", "restitution=1", "--set", "friction=0"]
+    result = invoke("--speed", "0.2", "--json", *settings)
+    assert result.exit_code == 0, result.stderr
+    assert json.loads(result.stdout)["normal_restitution"] == pytest.approx(1.0, abs=1e-3)
+
+
+def test_without_json_a_table_with_units():
+    result = invoke("--speed", "1", "--angle", "45")
+    assert result.exit_code == 0, result.stderr
+    for fragment in ("normal restitution", "contact time", "µs", "largest overlap", "µm", "by sliding", "rad/s"):
+        assert fragment in result.stdout
+
+
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (["--speed", "0"], ("--speed", "0 < speed <= 1000 m/s")),
+        (["--speed", "1", "--angle", "90"], ("--angle", "0 <= angle < 90°")),
+        (["--speed", "1", "--target", "floor"], ("--target", "'wall', 'ball'")),
+        (["--speed", "1", "--spin", "1e9"], ("--spin",)),
+        (["--speed", "1", "--set", "restitution=2"], ("restitution", "(0, 1]")),
+        (["--angle", "10"], ("--speed",)),
+    ],
+)
+def test_bad_input_exits_2_with_one_line_naming_the_option(args, fragments):
+    result = invoke(*args)
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, *fragments)
+
+
+def test_an_impact_the_engine_cannot_resolve_exits_2_naming_the_cause():
+    result = invoke("--speed", "30", "--set", "ball_youngs_modulus=1e8")
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, "overlap exceeded 5 %", "contact_step_fraction")
+
+
+def test_installed_command_refuses_a_negative_speed_in_one_line():
+    command = [str(SHAKERMILL), "impact", "--speed", "-1"]
+    completed = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert completed.returncode == 2
+    assert completed.stdout == ""
+    assert completed.stderr == "error: --speed: -1 m/s is out of range; allowed 0 < speed <= 1000 m/s\n"
