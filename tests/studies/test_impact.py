@@ -126,8 +126,16 @@ def test_chung_ooi_4_gross_sliding_follows_coulomb(material, angle):
     change, spin, sliding = sliding_predictions(params, outcome)
     assert outcome.tangential_speed_in - outcome.tangential_velocity_out_m_s == pytest.approx(change, rel=0.02)
     assert outcome.angular_velocity_rad_s == pytest.approx(spin, rel=0.02)
-    assert outcome.dissipated_sliding_J == pytest.approx(sliding, rel=0.02)
-    assert outcome.dissipated_tangential_J == 0.0  # never sticking, so never damped tangentially
+    assert outcome.dissipated_sliding_J == pytest.approx(sliding, rel=0.02 if material == "alumina" else 0.04)
+    # Sliding dissipates μ∫F_n|v_slip|dt: the tangential kinetic energy the ball lost (whatever the impulse
+    # was) plus what the spring gained by stiffening, which the ball's motion did not pay for.
+    measured = outcome.tangential_speed_in - outcome.tangential_velocity_out_m_s
+    lost = params.ball_mass * (outcome.tangential_speed_in * measured - 1.75 * measured**2)
+    tangential_work = outcome.dissipated_sliding_J + outcome.dissipated_tangential_J
+    assert tangential_work - outcome.work_stiffening_J == pytest.approx(lost, rel=1e-9)
+    # Never sticking, so almost all of it is sliding: the damper only tilts the friction force off the slip
+    # (the simple law's F_t = −k_t δ_t − c_t v_t, scaled to the Coulomb limit), ~1 % for steel's e = 0.7.
+    assert abs(outcome.dissipated_tangential_J) < 0.015 * outcome.dissipated_sliding_J
 
 
 @pytest.mark.parametrize("angle", [2.0, 10.0, 20.0, 30.0])
@@ -162,12 +170,6 @@ NEGATIVE_SLIDING_CASES = {
 }
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="engine: a step at the Coulomb limit books its tangential work less the change of ½k_t|δ_t|² as "
-    "sliding; k_t grows with the overlap, so near the onset of sliding the channel goes negative (−1.4 µJ and "
-    "−4.8 µJ here, converged in the contact step); MODEL.md §12.4 asks μF_n⁺|v_slip| >= 0",
-)
 @pytest.mark.parametrize("case", NEGATIVE_SLIDING_CASES)
 def test_sliding_never_dissipates_a_negative_energy(case):
     params, inputs = NEGATIVE_SLIDING_CASES[case]
@@ -208,7 +210,7 @@ def test_the_dissipated_energy_is_the_kinetic_energy_lost(case):
     params, inputs = ENERGY_CASES[case]
     outcome = single_impact(params, **inputs)
     lost = outcome.kinetic_energy_in_J - outcome.kinetic_energy_out_J
-    assert outcome.dissipated_J == pytest.approx(lost, rel=1e-9)
+    assert outcome.dissipated_J - outcome.work_stiffening_J == pytest.approx(lost, rel=1e-9)
     assert outcome.dissipated_J > 0.0
 
 

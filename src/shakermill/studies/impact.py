@@ -54,6 +54,9 @@ class ImpactOutcome:
     dissipated_rolling_J: float
     kinetic_energy_in_J: float  # of both balls, translation and rotation
     kinetic_energy_out_J: float
+    # What the tangential spring gained by stiffening with the load (engines.dem.model.TOTAL_NAMES): the
+    # kinetic energy lost is dissipated_J less this.
+    work_stiffening_J: float
 
     @property
     def dissipated_J(self) -> float:
@@ -190,6 +193,7 @@ def _first_record(engine: Engine, contact_time: float) -> np.ndarray:
 def _outcome(
     engine: Engine, record: np.ndarray, incoming: int, speed: float, angle: float, kinetic_in: float
 ) -> ImpactOutcome:
+    from shakermill.engines.dem.model import WORK_STIFFENING
     from shakermill.engines.dem.stepper import RECORD_COLUMNS
 
     column = {name: float(record[index]) for index, name in enumerate(RECORD_COLUMNS)}
@@ -212,4 +216,5 @@ def _outcome(
         dissipated_rolling_J=column["dissipated_rolling"],
         kinetic_energy_in_J=kinetic_in,
         kinetic_energy_out_J=engine.kinetic_energy(),
+        work_stiffening_J=float(engine.state.totals[WORK_STIFFENING]),
     )

@@ -139,7 +139,7 @@ class Contacts(NamedTuple):
     elastic_energy: np.ndarray  # (S,) J: Hertz normal energy
     stiffness: np.ndarray  # (S,) N/m: k_t
     stretch: np.ndarray  # (S,) m²: |δ_t|²
-    sliding: np.ndarray  # (S,) bool: the contact is at the Coulomb limit in this step
+    slip_loss: np.ndarray  # (S,) J: energy the Coulomb limit took in this step, μF_n⁺·|slip|
     started: np.ndarray  # (S,) s
     normal_speed_in: np.ndarray  # (S,) m/s: closing speed at first touch
     tangential_speed_in: np.ndarray  # (S,) m/s: sliding speed of the contact points at first touch
@@ -308,7 +308,7 @@ def initial_state(params: Parameters, k: Constants) -> State:
             elastic_energy=np.zeros(slots),
             stiffness=np.zeros(slots),
             stretch=np.zeros(slots),
-            sliding=np.zeros(slots, dtype=np.bool_),
+            slip_loss=np.zeros(slots),
             started=np.zeros(slots),
             normal_speed_in=np.zeros(slots),
             tangential_speed_in=np.zeros(slots),

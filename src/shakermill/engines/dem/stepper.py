@@ -229,7 +229,7 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     damping_t = contact.tangential_damping(k.beta_e, stiffness, mass)
     pressing = max(magnitude, 0.0)
     limit = k.friction * pressing
-    c.sliding[slot] = False
+    c.slip_loss[slot] = 0.0
     for axis in range(3):
         sliding = relative[axis] - approach * normal[axis]
         spring[axis] += sliding * dt
@@ -238,8 +238,13 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     size = _norm(w.tangential_force[slot])
     if size > limit:
         w.tangential_force[slot] *= limit / size
-        _scaled_into(w.tangential_force[slot], -1.0 / stiffness, spring)
-        c.sliding[slot] = True
+        # The spring's end slips from where the trial put it to where the Coulomb force holds it: μF_n⁺|slip|.
+        slip = 0.0
+        for axis in range(3):
+            held = -w.tangential_force[slot, axis] / stiffness
+            slip += (spring[axis] - held) ** 2
+            spring[axis] = held
+        c.slip_loss[slot] = limit * math.sqrt(slip)
     w.stiffness[slot] = stiffness
     w.stretch[slot] = _dot(spring, spring)
     spin = _norm(relative_spin)
@@ -428,8 +433,8 @@ def _settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, 
     mean_stretch = 0.5 * (w.stretch[slot] + c.stretch[slot])
     tangential -= 0.5 * mean_stiffness * (w.stretch[slot] - c.stretch[slot])
     s.totals[WORK_STIFFENING] += 0.5 * mean_stretch * (w.stiffness[slot] - c.stiffness[slot])
-    # A step at the Coulomb limit dissipates its tangential work by sliding, a sticking step by damping.
-    sliding = tangential if c.sliding[slot] else 0.0
+    # Sliding dissipates μF_n⁺|slip| (MODEL.md §12.4); the rest of the tangential work, the damper's.
+    sliding = c.slip_loss[slot]
     channels = (normal, tangential - sliding, sliding, rolling)
     totals = (DISSIPATED_NORMAL, DISSIPATED_TANGENTIAL, DISSIPATED_SLIDING, DISSIPATED_ROLLING)
     dissipated = 0.0
