@@ -31,6 +31,7 @@ import numpy as np
 
 from shakermill.analysis.fit import ExponentialFit
 from shakermill.engines.one_d.integrator import REACHED_STOP
+from shakermill.engines.dem.engine import IMPACT_UNITS as DEM_IMPACT_UNITS
 from shakermill.engines.one_d.setup import IMPACT_UNITS
 from shakermill.parameters.config import load_config, write_config_toml
 from shakermill.parameters.schema import Parameters
@@ -242,7 +243,8 @@ def _covers(coverage: Mapping[str, str], part: str) -> dict[str, str]:
 
 
 def _mark_averaged_variables(history: StateHistory, coverage: Mapping[str, str]) -> StateHistory:
-    marks = {name: {COVERAGE_KEY: coverage["motion_variable"]} for name in AVERAGED_MOTION_VARIABLES}
+    motion = AVERAGED_MOTION_VARIABLES + DEM_MOTION_VARIABLES
+    marks = {name: {COVERAGE_KEY: coverage["motion_variable"]} for name in motion if name in history.variables}
     marks.update({name: {COVERAGE_KEY: coverage["flow_variable"]} for name in AVERAGED_FLOW_VARIABLES})
     return history.with_attributes(marks)
 
@@ -260,9 +262,12 @@ def netcdf_bytes(history: StateHistory, *, title: str, **attributes: Any) -> byt
     buffer = io.BytesIO()
     with h5netcdf.File(buffer, "w") as file:
         file.attrs.update(title=title, **attributes)
-        file.dimensions = {"time": history.times.size}
+        sizes = {"time": history.times.size}
+        for name, (values, _) in history.variables.items():
+            sizes.update(zip(history.dims(name), np.shape(values)))
+        file.dimensions = sizes
         for name, (values, variable_attributes) in {"time": (history.times, TIME_ATTRIBUTES), **history.variables}.items():
-            variable = file.create_variable(name, ("time",), data=values)
+            variable = file.create_variable(name, history.dims(name), data=values)
             variable.attrs.update(variable_attributes)
     return buffer.getvalue()
 
@@ -273,7 +278,7 @@ def impacts_parquet(columns: Mapping[str, np.ndarray], *, coverage: str | None =
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    units = {column: IMPACT_UNITS.get(column, "") for column in columns}
+    units = {column: {**IMPACT_UNITS, **DEM_IMPACT_UNITS}.get(column, "") for column in columns}
     metadata = {UNITS_METADATA_KEY: json.dumps(units).encode()}
     if coverage is not None:
         metadata[COVERAGE_KEY.encode()] = coverage.encode()
@@ -349,15 +354,15 @@ def load_run(path: Path | str) -> RunData:
         raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
     document = _read_part(summary_path, _summary_document)
     config = _read_part(folder / CONFIG_FILE, load_config)
-    impacts, impact_units = _read_part(folder / IMPACTS_FILE, _read_impact_table)
+    impacts, impact_units = _read_part(folder / IMPACTS_FILE, lambda path: _read_impact_table(path, config.params.engine))
     return RunData(
         path=folder,
         params=config.params,
         preset=config.preset,
         status=document["status"],
         message=document["message"],
-        timeseries=_read_part(folder / TIMESERIES_FILE, _read_history),
-        windows=_read_part(folder / WINDOWS_FILE, _read_history),
+        timeseries=_read_part(folder / TIMESERIES_FILE, lambda path: _read_history(path, config.params.engine)),
+        windows=_read_part(folder / WINDOWS_FILE, lambda path: _read_history(path, config.params.engine)),
         impacts=impacts,
         impact_units=impact_units,
         summary=document["summary"],
@@ -367,8 +372,13 @@ def load_run(path: Path | str) -> RunData:
     )
 
 
-# Variables of timeseries.nc and windows.nc that plot and report read (every version wrote them).
-HISTORY_VARIABLES_READ_BACK = ("time", "x", "p", "theta_ball", "theta_vial", "theta_air")
+# Variables of timeseries.nc and windows.nc that plot and report read (every version wrote them), by engine.
+HISTORY_VARIABLES_READ_BACK = {
+    "1d": ("time", "x", "p", "theta_ball", "theta_vial", "theta_air"),
+    "dem": ("time", "position", "velocity", "theta_ball", "theta_balls", "theta_vial", "theta_air"),
+}
+# The 'dem' engine's motion, not computed by its averaged solver (NaN) outside the mechanics phase.
+DEM_MOTION_VARIABLES = ("position", "angular_velocity")
 # What summary.json must hold, and of which JSON type, for the tools that read a run folder back.
 SUMMARY_SHAPE = {
     "status": int,
@@ -390,17 +400,17 @@ def _summary_document(path: Path) -> dict[str, Any]:
     return document
 
 
-def _read_history(path: Path) -> xr.Dataset:
+def _read_history(path: Path, engine: str) -> xr.Dataset:
     import xarray as xr
 
     dataset = xr.load_dataset(path, engine=NETCDF_ENGINE)
-    _require(HISTORY_VARIABLES_READ_BACK, dataset.variables, "variable")
+    _require(HISTORY_VARIABLES_READ_BACK[engine], dataset.variables, "variable")
     return dataset
 
 
-def _read_impact_table(path: Path) -> tuple[pd.DataFrame, dict[str, str]]:
+def _read_impact_table(path: Path, engine: str) -> tuple[pd.DataFrame, dict[str, str]]:
     impacts, units = read_impacts(path)
-    _require(IMPACT_UNITS, impacts.columns, "column")
+    _require(DEM_IMPACT_UNITS if engine == "dem" else IMPACT_UNITS, impacts.columns, "column")
     return impacts, units
 
 
