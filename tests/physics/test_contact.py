@@ -285,3 +285,29 @@ def test_elastic_impact_lasts_the_hertz_contact_time(speed: float) -> None:
     ratio, duration = _single_impact(speed, 1.0)
     assert ratio == pytest.approx(1.0, rel=1e-7)
     assert duration == pytest.approx(contact.hertz_contact_time(MASS, RADIUS, E_STAR, speed), rel=1e-4)
+
+
+# Tangential contact of the dem engine (MODEL.md §12.3), against hand-computed values.
+
+
+def test_effective_shear_modulus_of_two_steels() -> None:
+    # 1/G* = 2·2·(2−0.3)(1+0.3)/200e9 = 8.84/200e9 → G* = 22.624 GPa
+    assert contact.effective_shear_modulus(200e9, 0.3, 200e9, 0.3) == pytest.approx(200e9 / 8.84, rel=1e-12)
+
+
+def test_concave_radius_of_a_ball_in_a_bore() -> None:
+    # R = 6.35 mm in a bore of radius 19 mm: 6.35·19/12.65 = 9.5375 mm (the side is flatter than the ball)
+    assert contact.concave_radius(6.35e-3, 19e-3) == pytest.approx(9.537549407e-3, rel=1e-9)
+
+
+def test_mindlin_stiffness_and_damping_hand_values() -> None:
+    # k_t = 8·G*·√(R*ζ) = 8·22.624e9·√(6.35e-3·1e-5) = 8·22.624e9·2.51992e-4 = 4.5609e7 N/m
+    stiffness = contact.tangential_stiffness(22.624e9, 6.35e-3, 1e-5)
+    assert stiffness == pytest.approx(8 * 22.624e9 * 2.519920634e-4, rel=1e-9)
+    beta = contact.damping_ratio(0.7)
+    # c_t = −2√(5/6)·β_e·√(k_t m*) ≥ 0 for e < 1, and zero for e = 1
+    assert contact.tangential_damping(beta, stiffness, 8.366e-3) == pytest.approx(
+        -2 * math.sqrt(5 / 6) * beta * math.sqrt(stiffness * 8.366e-3), rel=1e-12
+    )
+    assert contact.tangential_damping(beta, stiffness, 8.366e-3) > 0.0
+    assert contact.tangential_damping(contact.damping_ratio(1.0), stiffness, 8.366e-3) == 0.0

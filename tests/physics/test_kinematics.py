@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from shakermill.physics import kinematics as drive
 
@@ -67,3 +69,60 @@ def test_faces_are_one_vial_length_apart_and_symmetric(centre: float) -> None:
     right = drive.right_face(centre, LENGTH)
     assert right - left == pytest.approx(LENGTH, rel=1e-12)
     assert 0.5 * (left + right) == pytest.approx(centre, abs=1e-15)
+
+
+# The vial as a rigid body (MODEL.md §12.2): Fourier data for its six coordinates.
+
+
+def _harmonics(terms: dict[tuple[int, int], tuple[float, float]], highest: int = 2) -> np.ndarray:
+    harmonics = np.zeros((6, highest + 1, 2))
+    for (coordinate, k), (cosine, sine) in terms.items():
+        harmonics[coordinate, k] = (cosine, sine)
+    return harmonics
+
+
+def test_fourier_coordinates_hand_values() -> None:
+    # x = 25 mm sin θ; yaw = 0.1 cos 2θ + 0.05 (harmonic 0); θ = ωt + φ = 111·0.01 + 0.3 = 1.41 rad.
+    harmonics = _harmonics({(0, 1): (0.0, 25e-3), (5, 2): (0.1, 0.0), (5, 0): (0.05, 0.0)})
+    values, rates = np.zeros(6), np.zeros(6)
+    drive.fourier_coordinates(0.01, OMEGA, 0.3, harmonics, values, rates)
+    theta = 1.41
+    assert values[0] == pytest.approx(25e-3 * math.sin(theta), rel=1e-12)
+    assert rates[0] == pytest.approx(OMEGA * 25e-3 * math.cos(theta), rel=1e-12)
+    assert values[5] == pytest.approx(0.05 + 0.1 * math.cos(2 * theta), rel=1e-12)
+    assert rates[5] == pytest.approx(-2 * OMEGA * 0.1 * math.sin(2 * theta), rel=1e-12)
+    assert values[1:5] == pytest.approx(np.zeros(4), abs=0) and rates[1:5] == pytest.approx(np.zeros(4), abs=0)
+
+
+def test_axial_fourier_data_is_the_one_dimensional_drive() -> None:
+    harmonics = _harmonics({(0, 1): (0.0, AMPLITUDE)}, highest=1)
+    values, rates = np.zeros(6), np.zeros(6)
+    for t in (0.0, 0.0123, 0.5):
+        drive.fourier_coordinates(t, OMEGA, 0.2, harmonics, values, rates)
+        assert values[0] == drive.vial_position(t, AMPLITUDE, OMEGA, 0.2)
+        assert rates[0] == pytest.approx(drive.vial_velocity(t, AMPLITUDE, OMEGA, 0.2), rel=1e-14)
+
+
+@pytest.mark.parametrize("angles", [(0.3, -0.2, 1.1), (0.0, 0.0, 0.7), (-1.0, 0.4, 0.0)])
+def test_rotation_matrix_is_extrinsic_x_then_y_then_z(angles) -> None:
+    roll, pitch, yaw = angles
+    matrix = np.empty((3, 3))
+    drive.rotation_matrix(roll, pitch, yaw, matrix)
+    expected = Rotation.from_euler("xyz", [roll, pitch, yaw]).as_matrix()  # extrinsic: R_z·R_y·R_x
+    assert matrix == pytest.approx(expected, abs=1e-14)
+    assert matrix @ matrix.T == pytest.approx(np.eye(3), abs=1e-14)
+
+
+def test_angular_velocity_is_that_of_the_rotating_matrix() -> None:
+    """Ω× = Q̇·Qᵀ, Q̇ by central differences of the angles moving at the given rates."""
+    angles = np.array([0.3, -0.2, 1.1])
+    rates = np.array([2.0, -1.5, 0.7])
+    h = 1e-6
+    ahead, behind, now = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
+    drive.rotation_matrix(*(angles + h * rates), ahead)
+    drive.rotation_matrix(*(angles - h * rates), behind)
+    drive.rotation_matrix(*angles, now)
+    skew = (ahead - behind) / (2 * h) @ now.T
+    omega = np.empty(3)
+    drive.angular_velocity(angles[1], angles[2], *rates, omega)
+    assert omega == pytest.approx([skew[2, 1], skew[0, 2], skew[1, 0]], rel=1e-8)
