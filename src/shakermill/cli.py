@@ -799,6 +799,7 @@ def bifurcation(
 
     with _user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
+        _require_one_dimensional_engine(run_config.params, "bifurcation settles the one ball's attractors")
         key, values = parse_grid(grid, most=MAX_BIFURCATION_VALUES)
         # Checked before the scan: a value out of range would otherwise stop it midway.
         for value in (values[0], values[-1]):
@@ -828,6 +829,11 @@ def bifurcation(
     console.print(table)
     console.print(coexisting_attractors_table(scan.attractors, key, run_config.params.attractor_starts))
     console.print(Text(f"{len(list(written.iterdir()))} files written to {target}"))
+
+
+def _require_one_dimensional_engine(params: Parameters, why: str) -> None:
+    if params.engine != "1d":
+        raise ParameterError(f"engine: {why}; allowed engine = '1d' here (got {params.engine!r})")
 
 
 COEXISTING_PREVIEW_ROWS = 20
@@ -1009,6 +1015,7 @@ def calibrate(
 
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])
+        _require_one_dimensional_engine(run_config.params, "calibrate fits the one-ball model to the paper's experiment")
         targets = parse_targets(target or [])
         free_keys = parse_free(free or [])
         measured = Curve.from_csv(curve) if curve is not None else None

@@ -15,7 +15,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-# Impacts as columns: at least "time" (s) and "wall" ("left"/"right"); a dict of arrays or a DataFrame.
+# Impacts as columns: at least "time" (s) and "wall" ("left"/"right"), or the 'dem' engine's "ball" and
+# "target" (which ball hit what); a dict of arrays or a DataFrame.
 ImpactColumns = Mapping[str, Any]
 
 # Longest period searched for; motions that repeat more slowly are called irregular.
@@ -42,9 +43,16 @@ class ImpactPhases:
 def settled_impacts(impacts: ImpactColumns, solver: str, end_time: float) -> dict[str, np.ndarray]:
     """Time and wall of the impacts after the start-up transient: the second half of a full run (the
     averaged solver already cut it)."""
-    time, wall = np.asarray(impacts["time"]), np.asarray(impacts["wall"])
+    time, wall = np.asarray(impacts["time"]), _walls(impacts)
     kept = np.full(time.shape, True) if solver == "averaged" else time >= 0.5 * end_time
     return {"time": time[kept], "wall": wall[kept]}
+
+
+def _walls(impacts: ImpactColumns) -> np.ndarray:
+    """What was hit at each impact: the wall, or for several balls which ball hit what ("0:left", "1:ball")."""
+    if "wall" in impacts:
+        return np.asarray(impacts["wall"])
+    return np.char.add(np.char.add(np.asarray(impacts["ball"]).astype(str), ":"), np.asarray(impacts["target"]).astype(str))
 
 
 def settled_run_impacts(run: Any) -> dict[str, np.ndarray]:

@@ -340,7 +340,8 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
         regime, period = classify(result)
         # The averaged solver probed the other starts already; a full run has them probed here, unless
         # it stopped early: a probe would start a budget of its own after the run had spent the point's.
-        if result.success:
+        # The probe settles one ball on the axis: the 'dem' engine's several balls have no such starts.
+        if result.success and params.engine == "1d":
             probed(result)
     except PointInterrupted:
         raise
