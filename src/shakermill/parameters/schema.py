@@ -18,7 +18,7 @@ import tomllib
 import typing
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal, Mapping
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping
 
 import annotated_types
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -33,6 +33,9 @@ from shakermill.support.limits import (
     quoted,
 )
 from shakermill.support.presenters import present
+
+if TYPE_CHECKING:
+    import numpy
 
 PAPER = "Son 2025, Mathematics 13, 446"
 
@@ -324,7 +327,7 @@ class Parameters(BaseModel):
     def _balls_of_the_dem_engine(self) -> "Parameters":
         if self.engine == "1d" and self.n_balls > 1:
             raise ValueError(
-                f"n_balls: the 1-D engine moves one ball; allowed n_balls = 1 with engine = '1d', or set engine = 'dem'"
+                "n_balls: the 1-D engine moves one ball; allowed n_balls = 1 with engine = '1d', or set engine = 'dem'"
             )
         for key in PER_BALL_KEYS:
             _check_per_ball(key, getattr(self, key), self.n_balls)
@@ -365,7 +368,7 @@ class Parameters(BaseModel):
         values = getattr(self, PER_BALL_KEY_OF[scalar_key])
         return tuple(values) if values else (getattr(self, scalar_key),) * self.n_balls
 
-    def initial_positions(self) -> "np.ndarray | None":
+    def initial_positions(self) -> "numpy.ndarray | None":
         """Ball centres (n_balls, 3) in the vial frame at t = 0 (m): one ball at ``ball_position`` on the axis,
         several filled in from the bottom (:mod:`shakermill.parameters.packing`); None if they do not fit."""
         import numpy as np

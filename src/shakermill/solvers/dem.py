@@ -16,7 +16,7 @@ from shakermill.analysis.fit import fit_exponential
 from shakermill.analysis.steady import SteadyState, network_steady_state
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.dem import model, network, stepper
-from shakermill.engines.dem.engine import BUDGET_EXCEEDED, Engine, impact_columns
+from shakermill.engines.dem.engine import Engine, impact_columns
 from shakermill.engines.one_d.setup import ProgressCallback, sample_times
 from shakermill.parameters.schema import Parameters
 from shakermill.physics.kinematics import fourier_coordinates

@@ -283,6 +283,16 @@ def _release(slot: int, w: Scratch) -> None:
 
 
 @njit(cache=True, inline="always")
+def _release_if_touching(slot: int, s: State, w: Scratch, live: int) -> int:
+    """A slot apart now: if it touched at the step's start, it is released and live for the step's bookkeeping."""
+    if not s.contacts.active[slot]:
+        return live
+    _release(slot, w)
+    w.live[live] = slot
+    return live + 1
+
+
+@njit(cache=True, inline="always")
 def _contact_point_velocity(ball: int, lever_sign: float, s: State, w: Scratch, out: np.ndarray) -> None:
     """Velocity of the point of ``ball`` at lever_sign·R·n from its centre (n = ``w.normal``)."""
     for axis in range(3):
@@ -303,10 +313,7 @@ def _pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live
             distance = _distance(s.position[i], s.position[j])
             overlap = k.radius[i] + k.radius[j] - distance
             if overlap <= 0.0:
-                if s.contacts.active[slot]:
-                    _release(slot, w)
-                    w.live[live] = slot
-                    live += 1
+                live = _release_if_touching(slot, s, w, live)
                 continue
             deepest = max(deepest, overlap)
             for axis in range(3):
@@ -339,10 +346,7 @@ def _wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live
             slot = n * n + N_WALLS * i + wall
             overlap = -wall_gap(s.position[i], k.radius[i], wall, k, w)
             if overlap <= 0.0:
-                if s.contacts.active[slot]:
-                    _release(slot, w)
-                    w.live[live] = slot
-                    live += 1
+                live = _release_if_touching(slot, s, w, live)
                 continue
             deepest = max(deepest, overlap)
             # The vial's velocity at the contact point c = r − R·n: ṙ_v + Ω × (c − r_v).
