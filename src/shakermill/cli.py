@@ -33,7 +33,15 @@ from typer.core import TyperGroup
 # pandas, xarray, SciPy or Matplotlib. Each command imports what it uses.
 from shakermill.engines.budget import BudgetExceeded
 from shakermill.parameters.config import load_config
-from shakermill.parameters.defaults import DEFAULT_FREE, DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI, REPORT_FILE
+from shakermill.parameters.defaults import (
+    ANIMATION_FILE,
+    ANIMATION_FRAMES,
+    DEFAULT_FREE,
+    DEFAULT_SCHEDULER_TIMEOUT_S,
+    MOST_ANIMATION_FRAMES,
+    PNG_DPI,
+    REPORT_FILE,
+)
 from shakermill.parameters.schema import (
     DEFAULT_PRESET,
     FIELD_NAMES,
@@ -366,6 +374,8 @@ def summary_table(result: Result, target: Path) -> Table:
     table.add_column("value", justify="right")
     table.add_column("unit")
     fit_window = f"0–{_number(s['simulated_s'] / 60.0, '.4g')} min"
+    # The 'dem' engine's ball temperatures, steady state and fit are the balls' means; its own rows say more.
+    ball = "balls' mean" if s.get("engine") == "dem" else "ball"
     rows = [
         ("status", s["message"] if not result.success else "ok", ""),
         ("solver", s["solver"], ""),
@@ -373,16 +383,17 @@ def summary_table(result: Result, target: Path) -> Table:
         ("amplitude; ball radius", f"{_number(s['amplitude_mm'], '.4g')}; {_number(s['ball_radius_mm'], '.4g')}", "mm"),
         ("ambient; initial temperature", f"{_number(s['ambient_temperature_C'], '.4g')}; {_number(s['initial_temperature_C'], '.4g')}", "°C"),
         ("simulated time", _number(s["simulated_s"], ".6g"), "s"),
-        ("ball steady state", _number(s["ball_steady_C"], ".2f"), "°C"),
+        (f"{ball} steady state", _number(s["ball_steady_C"], ".2f"), "°C"),
         ("vial; air steady state", f"{_number(s['vial_steady_C'], '.2f')}; {_number(s['air_steady_C'], '.2f')}", "°C"),
         ("slowest time constant", _number(s["slowest_time_constant_min"], ".1f"), "min"),
-        (f"ball θ∞ of the exponential fitted over {fit_window}", _number(s["theta_inf_C"], ".2f"), "°C"),
+        (f"{ball} θ∞ of the exponential fitted over {fit_window}", _number(s["theta_inf_C"], ".2f"), "°C"),
         ("τ of that fit", _number(s["tau_min"], ".2f"), "min"),
         ("initial heating rate θ̇₀ of that fit", _number(s["rate0_C_per_min"], ".3f"), "°C/min"),
-        ("ball at the end", _number(s["ball_C"], ".2f"), "°C"),
+        (f"{ball} at the end", _number(s["ball_C"], ".2f"), "°C"),
         ("vial at the end", _number(s["vial_C"], ".2f"), "°C"),
         ("air at the end", _number(s["air_C"], ".2f"), "°C"),
         ("vial/ball increment ratio", _number(s["vial_ball_ratio"], ".3f"), ""),
+        *several_ball_rows(s),
         ("impacts", _number(s["impacts"], "d"), ""),
         ("impact rate", _number(s["impact_rate_hz"], ".2f"), "Hz"),
         ("mean impact speed", _number(s["mean_impact_speed_m_s"], ".3f"), "m/s"),
@@ -395,6 +406,34 @@ def summary_table(result: Result, target: Path) -> Table:
     for row in rows:
         _add_plain_row(table, *row)
     return table
+
+
+# Up to this many balls the run table gives each ball's temperature; beyond, the coolest and the hottest.
+EACH_BALL_UP_TO = 6
+
+
+def several_ball_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
+    """The run table's rows of the 'dem' engine (none for 1-D): balls, their temperatures at the end and
+    steady states, impacts on the walls and between balls, heat by dissipation channel."""
+    if s.get("engine") != "dem":
+        return []
+    from shakermill.engines.dem.model import CHANNELS
+
+    rows = [("engine; balls", f"dem; {s['n_balls']}", "")]
+    for key, what in (("ball_temperatures_C", "at the end"), ("balls_steady_C", "steady state")):
+        values = [value for value in s.get(key) or () if value is not None]
+        if not values:
+            continue
+        if len(values) <= EACH_BALL_UP_TO:
+            rows.append((f"each ball {what} (ball 0; 1; …)", "; ".join(_number(value, ".2f") for value in values), "°C"))
+        else:
+            rows.append((f"balls {what}: coolest; hottest", f"{_number(min(values), '.2f')}; {_number(max(values), '.2f')}", "°C"))
+    rows.append(("impacts on the walls; between balls", f"{s['wall_impacts']}; {s['ball_ball_impacts']}", ""))
+    heat = [s.get(f"heat_{channel}_W") for channel in CHANNELS]
+    if any(value is not None for value in heat):
+        # The averaged solver has no split by channel: its heat comes from the thermal network's means.
+        rows.append((f"heat by channel: {'; '.join(CHANNELS)}", "; ".join(_number(value, ".3g") for value in heat), "W"))
+    return rows
 
 
 COMPARED_QUANTITIES = (
@@ -582,38 +621,72 @@ def plot(
         typer.Option("--contour", metavar="COLUMN=VALUE", help="Sweep folder: draw this level on every map, e.g. theta_inf_C=60."),
     ] = None,
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG files.")] = PNG_DPI,
+    window: Annotated[
+        int | None,
+        typer.Option("--window", min=0, show_default="0", help="Run folder: the record window (index in record_windows, from 0) of the ball's motion, the balls' paths and the animation."),
+    ] = None,
+    animate: Annotated[
+        bool, typer.Option("--animate", help=f"Run folder of the dem engine: also write {ANIMATION_FILE}, the balls over --window in the vial's side view.")
+    ] = False,
+    frames: Annotated[
+        int, typer.Option("--frames", min=2, max=MOST_ANIMATION_FRAMES, help="Frames of the animation (24 a second).")
+    ] = ANIMATION_FRAMES,
 ) -> None:
-    """Draw the figures of a run folder (paper Figs. 4, 5a, 5b, impact statistics) or of a sweep folder (maps or lines)."""
-    from shakermill.studies.sweep import is_sweep_folder, load_sweep
-    from shakermill.views.figures import (
-        contour_notes,
-        impact_figures,
-        parse_contour,
-        plot_figures,
-        run_figures,
-        sweep_context,
-        sweep_figures,
-    )
+    """Draw the figures of a run folder (paper Figs. 4, 5a, 5b, impact statistics; for the dem engine the balls'
+    paths and heat by channel, and with --animate a GIF) or of a sweep folder (maps or lines)."""
+    from shakermill.studies.sweep import is_sweep_folder
+    from shakermill.views.figures import plot_figures
 
     target = out if out is not None else folder / FIGURES_FOLDER
     if is_sweep_folder(folder):
-        if impacts:
-            _fail("--impacts: a sweep folder has no impacts of its own; plot one run (sweep --keep-runs writes them)")
-        with _user_errors():
-            data = load_sweep(folder)
-            numeric = list(data.table.select_dtypes("number").columns)
-            levels = [parse_contour(spec, numeric) for spec in contour or []]
-            figures = sweep_figures(data.table, data.keys, levels, context=sweep_context(data.manifest, data.keys))
-        for note in contour_notes(data.table, levels):
-            typer.echo(f"note: {note}; no contour drawn", err=True)
+        for given, option in ((impacts, "--impacts"), (animate, "--animate"), (window is not None, "--window")):
+            if given:
+                _fail(f"{option}: a sweep folder has no impacts or motion of its own; plot one run (sweep --keep-runs writes them)")
+        figures = _sweep_figures(folder, contour or [])
+        with _writing(target, "the figures"):
+            paths = plot_figures(figures, target, dpi=dpi)
     else:
         if contour:
             _fail("--contour: contours are drawn on the maps of a sweep folder, not on a run")
-        run_data = _load_run_or_fail(folder)
-        figures = impact_figures(run_data) if impacts else run_figures(run_data, impacts=True)
-    with _writing(target, "the figures"):
-        paths = plot_figures(figures, target, dpi=dpi)
+        paths = _plot_run_folder(folder, target, dpi, impacts=impacts, window=window, frames=frames if animate else None)
     typer.echo(f"{len(paths)} files written to {target}")
+
+
+def _sweep_figures(folder: Path, contour: Sequence[str]) -> dict[str, Any]:
+    """The maps or lines of a sweep folder, with the ``--contour`` levels; a note for each level never reached."""
+    from shakermill.studies.sweep import load_sweep
+    from shakermill.views.figures import contour_notes, parse_contour, sweep_context, sweep_figures
+
+    with _user_errors():
+        data = load_sweep(folder)
+        numeric = list(data.table.select_dtypes("number").columns)
+        levels = [parse_contour(spec, numeric) for spec in contour]
+        figures = sweep_figures(data.table, data.keys, levels, context=sweep_context(data.manifest, data.keys))
+    for note in contour_notes(data.table, levels):
+        typer.echo(f"note: {note}; no contour drawn", err=True)
+    return figures
+
+
+def _plot_run_folder(
+    folder: Path, target: Path, dpi: int, *, impacts: bool, window: int | None, frames: int | None
+) -> list[Path]:
+    """The figures of a run folder, and its animation of ``frames`` frames unless None; the files written."""
+    from shakermill.views.figures import check_window, impact_figures, plot_figures, run_figures, write_animation
+
+    run_data = _load_run_or_fail(folder)
+    if frames is not None and run_data.params.engine != "dem":
+        _fail("--animate: the animation shows the balls of a run of the dem engine (--set engine=dem); this run is 1-D")
+    with _user_errors():
+        if window is not None:
+            check_window(run_data.params, window)
+        written = []
+        # First: a window without motion to animate is refused before any figure is written.
+        if frames is not None:
+            with _writing(target, "the animation"):
+                written.append(write_animation(run_data, target / ANIMATION_FILE, window=window or 0, frames=frames))
+        figures = impact_figures(run_data) if impacts else run_figures(run_data, impacts=True, window=window or 0)
+    with _writing(target, "the figures"):
+        return plot_figures(figures, target, dpi=dpi) + written
 
 
 @app.command()

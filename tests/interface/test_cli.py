@@ -98,6 +98,7 @@ def test_run_writes_figures_and_prints_a_human_summary(tmp_path):
     figures = sorted(path.name for path in (out / "figures").iterdir())
     names = ("ball_heating_zoom", "ball_motion", "temperatures")
     assert figures == sorted(f"{name}.{fmt}" for name in names for fmt in ("png", "svg"))
+    assert "engine; balls" not in result.stdout and "balls' mean" not in result.stdout  # rows of the dem engine only
 
 
 def test_config_file_and_set_overrides_end_up_in_the_stored_configuration(tmp_path):
@@ -415,6 +416,84 @@ def test_plot_of_a_sweep_over_the_solver_draws_every_figure(tmp_path):
     outcome = invoke("plot", str(folder), "--out", str(tmp_path / "lines"))
     assert outcome.exit_code == 0, outcome.stderr
     assert "14 files written" in outcome.stdout
+
+
+# Three balls in a vial wide enough for them side by side, for 2 s: a few seconds with the figures.
+DEM = ["--set", "engine=dem", "--set", "n_balls=3", "--set", "vial_diameter=38 mm", "--set", "duration=2",
+       "--set", "record_windows=0:0.5,1.5:0.1"]
+DEM_FIGURES = ("ball_heating_zoom", "heat_by_channel", "temperatures", "trajectories")
+DEM_IMPACT_FIGURES = ("impact_energy_histogram", "impact_speed_histogram", "impacts_per_second")
+
+
+@pytest.fixture(scope="module")
+def dem_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("dem") / "run"
+    return out, invoke("run", *DEM, "--out", str(out))
+
+
+def table_rows(stdout: str) -> dict[str, tuple[str, str]]:
+    """The run table's rows as {quantity: (value, unit)}."""
+    cells = [[cell.strip() for cell in line.split("│")[1:-1]] for line in stdout.splitlines() if line.count("│") == 4]
+    return {quantity: (value, unit) for quantity, value, unit in cells}
+
+
+def test_a_dem_run_draws_its_figures_and_its_table_tells_the_balls_apart(dem_run):
+    out, outcome = dem_run
+    assert outcome.exit_code == 0, outcome.stderr
+    figures = sorted(path.name for path in (out / "figures").iterdir())
+    assert figures == sorted(f"{name}.{fmt}" for name in DEM_FIGURES for fmt in ("png", "svg"))
+    for name in DEM_FIGURES:
+        assert (out / "figures" / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    summary = load_run(out).summary
+    rows = table_rows(outcome.stdout)
+    assert rows["engine; balls"] == ("dem; 3", "")
+    each = "; ".join(f"{value:.2f}" for value in summary["ball_temperatures_C"])
+    assert rows["each ball at the end (ball 0; 1; …)"] == (each, "°C")
+    assert rows["impacts on the walls; between balls"] == (f"{summary['wall_impacts']}; {summary['ball_ball_impacts']}", "")
+    heat = "; ".join(f"{summary[f'heat_{channel}_W']:.3g}" for channel in ("normal", "tangential", "sliding", "rolling"))
+    assert rows["heat by channel: normal; tangential; sliding; rolling"] == (heat, "W")
+    assert rows["balls' mean at the end"] == (f"{summary['ball_C']:.2f}", "°C")
+    assert "ball at the end" not in rows
+
+
+def test_plot_of_a_dem_run_adds_the_impact_figures_and_the_animation(dem_run, tmp_path):
+    from PIL import Image
+
+    out, _ = dem_run
+    target = tmp_path / "figures"
+    outcome = invoke("plot", str(out), "--animate", "--frames", "10", "--out", str(target))
+    assert outcome.exit_code == 0, outcome.stderr
+    names = [f"{name}.{fmt}" for name in DEM_FIGURES + DEM_IMPACT_FIGURES for fmt in ("png", "svg")]
+    assert sorted(path.name for path in target.iterdir()) == sorted([*names, "trajectories.gif"])
+    assert f"{len(names) + 1} files written" in outcome.stdout
+    with Image.open(target / "trajectories.gif") as gif:
+        assert (gif.n_frames, gif.size) == (10, (640, 400))
+
+
+def test_report_of_a_dem_run_has_the_balls_and_their_figures(dem_run, tmp_path):
+    out, _ = dem_run
+    outcome = invoke("report", str(out), "--out", str(tmp_path / "report.html"))
+    assert outcome.exit_code == 0, outcome.stderr
+    document = (tmp_path / "report.html").read_text(encoding="utf-8")
+    assert "<h2>Balls</h2>" in document and document.count("<figure>") == len(DEM_FIGURES) + len(DEM_IMPACT_FIGURES)
+
+
+@pytest.mark.parametrize(
+    ("engine", "extra", "fragments"),
+    [
+        ("dem", ["--window", "2"], ("window 2", "allowed 0 to 1")),
+        ("1d", ["--animate"], ("--animate", "1-D")),
+    ],
+)
+def test_plot_refuses_a_window_the_run_lacks_and_an_animation_of_one_ball(dem_run, tmp_path, engine, extra, fragments):
+    folder = dem_run[0]
+    if engine == "1d":
+        folder = tmp_path / "run"
+        assert invoke("run", *SHORT, "--no-plots", "--out", str(folder)).exit_code == 0
+    outcome = invoke("plot", str(folder), *extra, "--out", str(tmp_path / "figures"))
+    assert outcome.exit_code == 2
+    assert_one_error_line(outcome.stderr, *fragments)
+    assert not (tmp_path / "figures").exists()
 
 
 def test_contour_on_a_run_folder_is_refused(tmp_path):

@@ -11,3 +11,7 @@ FIGURE_FORMATS = ("png", "svg")
 DEFAULT_SCHEDULER_TIMEOUT_S = 10.0
 # The calibration's free keys when none are given.
 DEFAULT_FREE = ("beta", "vial_mass", "h_outer", "lam")
+# The animation of a 'dem' run's balls (views/trajectories.py): a few seconds of GIF, however long the window.
+ANIMATION_FILE = "trajectories.gif"
+ANIMATION_FRAMES = 120
+MOST_ANIMATION_FRAMES = 300

@@ -8,6 +8,12 @@ each impact, convective cooling between). The impact figures are this
 package's own: histograms of impact speed and dissipated energy per impact, and
 the impacts per second at each end face.
 
+A run of the 'dem' engine (several balls in three dimensions, MODEL.md §12) has no ball on the axis to
+draw as in Fig. 4: its paths are drawn in the vial frame instead (``trajectories``,
+:mod:`shakermill.views.trajectories`), its temperature figures have a line per ball, ``heat_by_channel``
+splits the heat by dissipation channel and contact, and the impact figures tell the end faces, the side
+wall and the other balls apart.
+
 Matplotlib is imported inside the functions, so that importing :mod:`shakermill`
 stays fast. Figures are drawn on the Agg canvas directly, without pyplot: that
 needs no display and leaves the backend of an interactive session untouched.
@@ -26,21 +32,28 @@ import pandas as pd
 import xarray as xr
 
 from shakermill.analysis.fit import ExponentialFit
-from shakermill.parameters.defaults import FIGURE_FORMATS, PNG_DPI
-from shakermill.parameters.schema import Parameters
+from shakermill.engines.dem.model import CHANNELS
+from shakermill.parameters.defaults import ANIMATION_FRAMES, FIGURE_FORMATS, PNG_DPI
+from shakermill.parameters.schema import ParameterError, Parameters
 from shakermill.physics import kinematics
-from shakermill.support.atomic import remove_abandoned_writes, write_files_atomically
+from shakermill.solvers.result import BALL_TEMPERATURES
+from shakermill.support.atomic import remove_abandoned_writes, write_bytes_atomically, write_files_atomically
+from shakermill.views.trajectories import ANIMATION_DPI, animation_gif, ball_colours, trajectory_figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 # Figure names (file stems): the paper's Figs. 5a, 4, 5b, and this package's impact statistics.
 PAPER_FIGURES = ("temperatures", "ball_motion", "ball_heating_zoom")
+# The same for the 'dem' engine: Fig. 5a and 5b with a line per ball, the paths in the vial frame, the heat by channel.
+SEVERAL_BALL_FIGURES = ("temperatures", "trajectories", "heat_by_channel", "ball_heating_zoom")
 IMPACT_FIGURES = ("impact_speed_histogram", "impact_energy_histogram", "impacts_per_second", "impact_phase_histogram")
 KELVIN_OFFSET = 273.15
 # The paper's Fig. 5b zooms into the heating at 10 min; the window starting nearest to it is shown.
 HEATING_ZOOM_TIME = 600.0
 MIN_POINTS_TO_PLOT = 2
+# Columns of a legend under a figure (one entry per ball, the vial and the air).
+LEGEND_COLUMNS = 6
 DRIVE_CURVE_POINTS = 2000
 
 
@@ -71,12 +84,31 @@ def plot_run(run: RunLike, out_dir: Path | str, *, impacts: bool = False, dpi: i
     return plot_figures(run_figures(run, impacts=impacts), out_dir, dpi=dpi)
 
 
-def run_figures(run: RunLike, *, impacts: bool = False) -> dict[str, Figure]:
-    """The figures of ``run`` by name: those of :data:`PAPER_FIGURES` its data allow, then the impact figures."""
-    figures = paper_figures(run)
+def run_figures(run: RunLike, *, impacts: bool = False, window: int = 0) -> dict[str, Figure]:
+    """The figures of ``run`` by name: those of :func:`main_figure_names` its data allow, then the impact
+    figures; the motion (``ball_motion``, ``trajectories``) is drawn over record window ``window``."""
+    figures = paper_figures(run, window=window)
     if impacts:
         figures.update(impact_figures(run))
     return figures
+
+
+def several_balls(params: Parameters) -> bool:
+    """Whether a run is the 'dem' engine's (MODEL.md §12), whose figures differ from the paper's."""
+    return params.engine == "dem"
+
+
+def main_figure_names(params: Parameters) -> tuple[str, ...]:
+    """The figures a run of ``params`` gets besides the impact statistics, where its data allow them."""
+    return SEVERAL_BALL_FIGURES if several_balls(params) else PAPER_FIGURES
+
+
+def check_window(params: Parameters, window: int) -> None:
+    """:class:`ParameterError` unless ``window`` is the index of one of the run's record windows."""
+    count = len(params.record_windows)
+    if not 0 <= window < count:
+        allowed = f"0 to {count - 1}" if count else "none: the run has no record_windows"
+        raise ParameterError(f"window {window}: not one of the run's record windows; allowed {allowed}")
 
 
 def run_context(run: RunLike) -> str:
@@ -110,24 +142,52 @@ def add_context(figure: Figure, *lines: str) -> Figure:
     return figure
 
 
-def paper_figures(run: RunLike) -> dict[str, Figure]:
-    """Fig. 5a always; Fig. 4 and Fig. 5b only when their record windows hold enough points."""
-    figures = _paper_figures(run)
+def paper_figures(run: RunLike, *, window: int = 0) -> dict[str, Figure]:
+    """Fig. 5a always; Fig. 4 (over record window ``window``) and Fig. 5b only when their record windows
+    hold enough points. A 'dem' run gets :data:`SEVERAL_BALL_FIGURES` instead, by the same rules."""
+    figures = _paper_figures(run, window)
     context = run_context(run)
     return {name: add_context(figure, context) for name, figure in figures.items()}
 
 
-def _paper_figures(run: RunLike) -> dict[str, Figure]:
+def _paper_figures(run: RunLike, window: int) -> dict[str, Figure]:
+    params = run.params
+    balls = several_balls(params)
     figures = {"temperatures": temperature_figure(run)}
-    first_window = window_data(run, 0)
-    if first_window is not None:
-        figures["ball_motion"] = motion_figure(run.params, first_window, run.params.record_windows[0])
-    zoom_index = heating_zoom_window(run.params)
+    motion = window_data(run, window)
+    if motion is not None:
+        name, draw = ("trajectories", trajectory_figure) if balls else ("ball_motion", motion_figure)
+        figures[name] = draw(params, motion, params.record_windows[window])
+    if balls:
+        figures["heat_by_channel"] = heat_by_channel_figure(run)
+    zoom_index = heating_zoom_window(params)
     zoom = window_data(run, zoom_index) if zoom_index is not None else None
     if zoom is not None:
-        zoom_start = run.params.record_windows[zoom_index][0]
+        zoom_start = params.record_windows[zoom_index][0]
         figures["ball_heating_zoom"] = heating_zoom_figure(run, zoom, zoom_start)
     return figures
+
+
+def write_animation(
+    run: RunLike, target: Path | str, *, window: int = 0, frames: int = ANIMATION_FRAMES, dpi: int = ANIMATION_DPI
+) -> Path:
+    """Write the GIF of the balls of a 'dem' run over record window ``window`` (:func:`animation_gif`) to
+    ``target``, atomically; :class:`ParameterError` for a 1-D run or a window without points."""
+    params = run.params
+    if not several_balls(params):
+        raise ParameterError("animate: the animation shows the balls of a 'dem' run; this run is 1-D (engine = '1d')")
+    check_window(params, window)
+    motion = window_data(run, window)
+    if motion is None:
+        start, length = params.record_windows[window]
+        raise ParameterError(
+            f"window {window}: the record window from {start:g} s ({length:g} s long) holds no stored motion; the "
+            "run, or the averaged solver's mechanics, ended before it"
+        )
+    target = Path(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    remove_abandoned_writes(target.parent)
+    return write_bytes_atomically(target, animation_gif(params, motion, frames=frames, dpi=dpi))
 
 
 def save_figure(figure: Figure, stem: Path, *, dpi: int = PNG_DPI) -> list[Path]:
@@ -140,14 +200,15 @@ def save_figure(figure: Figure, stem: Path, *, dpi: int = PNG_DPI) -> list[Path]
     return write_files_atomically(files)
 
 
-def _new_figure(rows: int = 1, height: float = 4.5) -> tuple[Figure, list]:
+def _new_figure(rows: int = 1, height: float = 4.5, columns: int = 1, width: float = 7.5) -> tuple[Figure, list]:
+    """A figure of ``rows`` × ``columns`` axes, listed row by row; the rows of one column share their time axis."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    figure = Figure(figsize=(7.5, height), layout="constrained")
+    figure = Figure(figsize=(width, height), layout="constrained")
     FigureCanvasAgg(figure)
-    axes = figure.subplots(rows, 1, sharex=True, squeeze=False)
-    return figure, list(axes[:, 0])
+    axes = figure.subplots(rows, columns, sharex=columns == 1, squeeze=False)
+    return figure, list(axes.flat)
 
 
 def to_celsius(kelvin: np.ndarray) -> np.ndarray:
@@ -155,23 +216,25 @@ def to_celsius(kelvin: np.ndarray) -> np.ndarray:
 
 
 def temperature_figure(run: RunLike) -> Figure:
-    """Paper Fig. 5a: ball, vial and air temperatures in °C against minutes, with the ball's fitted exponential."""
+    """Paper Fig. 5a: ball (each ball of a 'dem' run), vial and air temperatures in °C against minutes, with
+    the fitted exponential of the ball (of the balls' mean) and its steady state."""
     figure, (axis,) = _new_figure()
     series = run.timeseries
     minutes = series["time"].values / 60.0
-    for name, label, colour in temperature_curves(run.params):
-        axis.plot(minutes, to_celsius(series[name].values), color=colour, label=label)
+    bodies = [
+        axis.plot(minutes, to_celsius(kelvin), color=colour, label=label)[0]
+        for kelvin, label, colour in temperature_lines(run.params, series)
+    ]
+    balls = several_balls(run.params)
     fit = run.ball_fit
     window = f"0–{minutes[-1]:.3g} min"
     if math.isfinite(fit.theta_inf) and math.isfinite(fit.tau):
-        axis.plot(
-            minutes, to_celsius(fit.evaluate(series["time"].values)), "k--", lw=1,
-            label=f"ball, exponential fitted over {window}",
-        )
+        fitted = "balls' mean, exponential fitted" if balls else f"ball, exponential fitted over {window}"
+        axis.plot(minutes, to_celsius(fit.evaluate(series["time"].values)), "k--", lw=1, label=fitted)
     steady = run.summary.get("ball_steady_C")
     if steady is not None and math.isfinite(steady):
         # The fit's θ∞ is a property of the window; the steady state is where the ball really settles.
-        axis.axhline(steady, color="tab:red", ls=":", lw=1, label=f"ball steady state {steady:.1f} °C (MODEL.md §11)")
+        axis.axhline(steady, color="tab:red", ls=":", lw=1, label=steady_label(run.summary, balls))
         low, high = axis.get_ylim()
         axis.set_ylim(low, max(high, steady + 0.05 * (steady - low)))
     axis.text(
@@ -180,10 +243,32 @@ def temperature_figure(run: RunLike) -> Figure:
     )
     axis.set_xlabel("time (min)")
     axis.set_ylabel("temperature (°C)")
-    axis.set_title("Temperatures of ball, vial and inner air (cf. paper Fig. 5a)")
-    axis.legend(loc="lower right")
+    named = f"the {run.params.n_balls} balls" if balls else "ball"
+    axis.set_title(f"Temperatures of {named}, vial and inner air (cf. paper Fig. 5a)")
+    if balls:
+        legend_below(figure, bodies)
+        lines = [line for line in axis.get_lines() if line not in bodies]
+        if lines:
+            axis.legend(handles=lines, loc="lower right", fontsize="small")
+    else:
+        axis.legend(loc="lower right")
     axis.grid(alpha=0.3)
     return figure
+
+
+def steady_label(summary: Mapping[str, Any], balls: bool) -> str:
+    """The legend of the steady-state line: the ball's, or the balls' mean with the range of the balls'."""
+    steady = summary["ball_steady_C"]
+    if not balls:
+        return f"ball steady state {steady:.1f} °C (MODEL.md §11)"
+    each = [value for value in summary.get("balls_steady_C") or () if value is not None]
+    spread = f" (each {min(each):.1f}–{max(each):.1f} °C)" if each else ""
+    return f"balls' mean steady state {steady:.1f} °C{spread}"
+
+
+def legend_below(figure: Figure, lines: Sequence[Any]) -> None:
+    """A legend of ``lines`` under the figure: a line per ball would cover the curves inside the axes."""
+    figure.legend(handles=lines, loc="outside lower center", ncols=min(len(lines), LEGEND_COLUMNS), fontsize="small")
 
 
 def model_of(params: Parameters) -> str:
@@ -197,6 +282,18 @@ def temperature_curves(params: Parameters) -> tuple[tuple[str, str, str], ...]:
     if model_of(params) == "ball_only":
         return ball, ("theta_air", "vial and air (held at ambient: ball_only model)", "tab:green")
     return ball, ("theta_vial", "vial", "tab:blue"), ("theta_air", "air", "tab:green")
+
+
+def temperature_lines(params: Parameters, series: xr.Dataset) -> list[tuple[np.ndarray, str, Any]]:
+    """(temperatures in K, legend label, colour) of each line of the temperature figure: the ball, vial and
+    air of :func:`temperature_curves`, or for a 'dem' run each ball (numbered as in the run's files), vial and air."""
+    if not several_balls(params):
+        return [(series[name].values, label, colour) for name, label, colour in temperature_curves(params)]
+    balls = series[BALL_TEMPERATURES].transpose("time", "ball").values
+    lines: list[tuple[np.ndarray, str, Any]] = [
+        (balls[:, ball], f"ball {ball}", colour) for ball, colour in enumerate(ball_colours(balls.shape[1]))
+    ]
+    return lines + [(series["theta_vial"].values, "vial", "tab:blue"), (series["theta_air"].values, "air", "tab:green")]
 
 
 def _fit_text(fit: ExponentialFit) -> str:
@@ -262,13 +359,21 @@ def motion_figure(
 
 
 def heating_zoom_figure(run: RunLike, window: xr.Dataset, start: float) -> Figure:
-    """Paper Fig. 5b: ball temperature in °C in the window starting at ``start`` (s), impacts marked.
+    """Paper Fig. 5b: ball temperature in °C (each ball's for a 'dem' run) in the window starting at
+    ``start`` (s), impacts marked.
 
     Each impact heats the ball in a few tens of microseconds; convection cools it between impacts.
     """
     figure, (axis,) = _new_figure()
     time = window["time"].values
-    axis.plot((time - start) * 1e3, to_celsius(window["theta_ball"].values), color="tab:red", lw=1.2)
+    balls = several_balls(run.params)
+    if balls:
+        temperatures = window[BALL_TEMPERATURES].transpose("time", "ball").values
+        for ball, colour in enumerate(ball_colours(temperatures.shape[1])):
+            axis.plot((time - start) * 1e3, to_celsius(temperatures[:, ball]), color=colour, lw=1.2, label=f"ball {ball}")
+        legend_below(figure, axis.get_lines())
+    else:
+        axis.plot((time - start) * 1e3, to_celsius(window["theta_ball"].values), color="tab:red", lw=1.2)
     impact_times = run.impacts["time"].to_numpy()
     inside = impact_times[(impact_times >= start) & (impact_times <= time[-1])]
     for impact_time in inside:
@@ -276,12 +381,71 @@ def heating_zoom_figure(run: RunLike, window: xr.Dataset, start: float) -> Figur
     axis.ticklabel_format(axis="y", useOffset=False)
     axis.set_xlabel(f"time after t = {start:g} s (ms)")
     axis.set_ylabel("ball temperature (°C)")
-    axis.set_title(f"Ball heating at each of {len(inside)} impacts (dotted), cooling between (cf. paper Fig. 5b)")
+    heated = "Heating of each ball" if balls else "Ball heating"
+    axis.set_title(f"{heated} at each of {len(inside)} impacts (dotted), cooling between (cf. paper Fig. 5b)")
     axis.grid(alpha=0.3)
     return figure
 
 
+def impact_span(run: RunLike) -> float:
+    """The seconds the impact table covers: the whole run, or the averaged solver's averaging window.
+
+    The summary's impact rate is the table's impacts over that span, whichever solver wrote it.
+    """
+    rate = run.summary.get("impact_rate_hz")
+    if rate is None or not rate > 0.0:
+        return float(run.summary.get("simulated_s", run.params.duration))
+    return len(run.impacts) / float(rate)
+
+
+def heat_by_channel_figure(run: RunLike) -> Figure:
+    """A 'dem' run's heat as mean power (W): made in each dissipation channel (MODEL.md §12.4), stacked by
+    what was hit (left, from the impact table), and received by each ball and the vial (right, from the
+    sampled history)."""
+    figure, (made, received) = _new_figure(height=4.2, columns=2, width=11.0)
+    impacts = run.impacts
+    kinds, categories = impact_kinds(impacts)
+    span = impact_span(run)
+    positions = np.arange(len(CHANNELS))
+    total = np.zeros(len(CHANNELS))
+    for kind, label, colour in categories:
+        hit = impacts[kinds == kind]
+        power = run.params.eta * np.array([hit[f"dissipated_{channel}"].sum() for channel in CHANNELS]) / span
+        made.bar(positions, power, bottom=total, color=colour, label=f"{label} ({power.sum():.3g} W)")
+        total += power
+    for position, value in zip(positions, total):
+        made.annotate(f"{value:.3g} W", (position, value), xytext=(0, 2), textcoords="offset points", ha="center", va="bottom")
+    made.set_xticks(positions, CHANNELS)
+    made.set_xlabel("dissipation channel")
+    made.set_ylabel("heat generated, mean power (W)")
+    covered = averaging_window_note(run)
+    made.set_title(f"made in each channel, by what was hit: {total.sum():.3g} W" + (f"\n({covered})" if covered else ""))
+    made.legend(loc="upper right", fontsize="small")
+    _heat_received(received, run)
+    figure.suptitle("Heat of the impacts, as mean power")
+    for axis in (made, received):
+        axis.set_ylim(0.0, axis.get_ylim()[1] * 1.15)  # room for the numbers on the bars
+        axis.grid(alpha=0.3, axis="y")
+    return figure
+
+
+def _heat_received(axis: object, run: RunLike) -> None:
+    """Bars of the mean heat power into each ball (numbered as in the run's files) and into the vial."""
+    series = run.timeseries
+    seconds = float(series["time"].values[-1]) or math.nan
+    balls = series["heat_into_balls"].transpose("time", "ball").values[-1] / seconds
+    powers = [*balls, float(series["heat_into_vial"].values[-1]) / seconds]
+    names = [str(ball) for ball in range(balls.size)] + ["vial"]
+    axis.bar(range(len(powers)), powers, color=[*ball_colours(balls.size), "tab:blue"])  # type: ignore[attr-defined]
+    axis.set_xticks(range(len(powers)), names)  # type: ignore[attr-defined]
+    axis.set_xlabel("ball (numbered as in the run's files), and the vial")  # type: ignore[attr-defined]
+    axis.set_ylabel("heat received, mean power (W)")  # type: ignore[attr-defined]
+    axis.set_title(f"received by each ball and the vial: {sum(powers):.3g} W")  # type: ignore[attr-defined]
+
+
 WALLS = (("left", "left end face", "tab:blue"), ("right", "right end face", "tab:orange"))
+# What a ball of the 'dem' engine hits (its impact table's column ``target``).
+TARGETS = (*WALLS, ("side", "side wall", "tab:green"), ("ball", "another ball", "tab:purple"))
 HISTOGRAM_BINS = 60
 HISTOGRAM_HEADROOM = 1.35
 # Impacts per second are counted in bins of at least a second (a few drive periods), at most this many bins.
@@ -292,30 +456,42 @@ MINUTES_AXIS_FROM_S = 300.0
 
 
 def impact_figures(run: RunLike) -> dict[str, Figure]:
-    """Histograms of impact speed and dissipated energy, and impacts per second at each wall (none without impacts)."""
+    """Histograms of impact speed and dissipated energy, impacts per second at each wall, and (1-D) the
+    impact phases; none without impacts."""
     impacts = run.impacts
     if impacts.empty:
         return {}
+    balls = several_balls(run.params)
+    speed = "normal impact speed relative to what is hit" if balls else "impact speed relative to the end face"
     figures = {
-        "impact_speed_histogram": impact_histogram_figure(
-            impacts, "impact_speed", 1.0, "impact speed relative to the end face", "m/s"
-        ),
+        "impact_speed_histogram": impact_histogram_figure(impacts, "impact_speed", 1.0, speed, "m/s"),
         "impact_energy_histogram": impact_histogram_figure(
             impacts, "dissipated_energy", 1e3, "energy dissipated per impact", "mJ"
         ),
         "impacts_per_second": impact_rate_figure(impacts),
-        "impact_phase_histogram": impact_phase_figure(run),
     }
+    if not balls:
+        # Regimes are sequences of end faces hit at fixed drive phases: a notion of one ball on the axis.
+        figures["impact_phase_histogram"] = impact_phase_figure(run)
     context, window = run_context(run), averaging_window_note(run)
     return {name: add_context(figure, context, window) for name, figure in figures.items()}
 
 
+def impact_kinds(impacts: pd.DataFrame) -> tuple[np.ndarray, tuple[tuple[str, str, str], ...]]:
+    """What each impact hit, and the kinds to tell apart as (name, label, colour): the end faces of a 1-D
+    run (column ``wall``), or the end faces, the side wall and another ball of a 'dem' run (``target``)."""
+    if "target" in impacts:
+        return impacts["target"].to_numpy(), TARGETS
+    return impacts["wall"].to_numpy(), WALLS
+
+
 def impact_histogram_figure(impacts: pd.DataFrame, column: str, scale: float, quantity: str, unit: str) -> Figure:
-    """Histogram of ``column`` × ``scale`` (in ``unit``), stacked by end face, with the mean and maximum in a box."""
+    """Histogram of ``column`` × ``scale`` (in ``unit``), stacked by what was hit (:func:`impact_kinds`), with the
+    mean and maximum in a box."""
     figure, (axis,) = _new_figure(height=4.0)
     values = impacts[column].to_numpy() * scale
     edges = np.histogram_bin_edges(values, bins=HISTOGRAM_BINS)
-    _stacked_by_wall(axis, values, impacts["wall"].to_numpy(), edges)
+    _stacked_by_kind(axis, values, *impact_kinds(impacts), edges)
     axis.text(
         0.98, 0.96, f"mean {values.mean():.3g} {unit}\nmax {values.max():.3g} {unit}",
         transform=axis.transAxes, ha="right", va="top",
@@ -331,15 +507,17 @@ def impact_histogram_figure(impacts: pd.DataFrame, column: str, scale: float, qu
     return figure
 
 
-def _stacked_by_wall(axis: object, values: np.ndarray, walls: np.ndarray, edges: np.ndarray) -> None:
-    """A histogram of ``values`` stacked by end face, each labelled with its count."""
-    per_wall = [values[walls == wall] for wall, _, _ in WALLS]
+def _stacked_by_kind(
+    axis: object, values: np.ndarray, kinds: np.ndarray, categories: Sequence[tuple[str, str, str]], edges: np.ndarray
+) -> None:
+    """A histogram of ``values`` stacked by what was hit (``categories``: :func:`impact_kinds`), each labelled with its count."""
+    parts = [values[kinds == kind] for kind, _, _ in categories]
     axis.hist(  # type: ignore[attr-defined]
-        per_wall,
+        parts,
         bins=edges,
         stacked=True,
-        color=[colour for _, _, colour in WALLS],
-        label=[f"{label} ({len(part)})" for (_, label, _), part in zip(WALLS, per_wall)],
+        color=[colour for _, _, colour in categories],
+        label=[f"{label} ({len(part)})" for (_, label, _), part in zip(categories, parts)],
     )
 
 
@@ -355,15 +533,17 @@ def rate_bin_edges(first_impact: float, last_impact: float) -> np.ndarray:
 
 
 def impact_rate_figure(impacts: pd.DataFrame) -> Figure:
-    """Impacts per second at each end face against time, counted in the bins of :func:`rate_bin_edges`."""
+    """Impacts per second on each kind of target (:func:`impact_kinds`) against time, counted in the bins of
+    :func:`rate_bin_edges`."""
     figure, (axis,) = _new_figure(height=4.0)
     times = impacts["time"].to_numpy()
     edges = rate_bin_edges(float(times.min()), float(times.max()))
     width = edges[1] - edges[0]
     in_minutes = edges[-1] >= MINUTES_AXIS_FROM_S
     time_scale = 60.0 if in_minutes else 1.0
-    for wall, label, colour in WALLS:
-        counts, _ = np.histogram(times[impacts["wall"].to_numpy() == wall], bins=edges)
+    kinds, categories = impact_kinds(impacts)
+    for kind, label, colour in categories:
+        counts, _ = np.histogram(times[kinds == kind], bins=edges)
         rates = counts / width
         legend = f"{label} (mean {rates.mean():.3g}/s)"
         # No baseline: the vertical edges down to zero at both ends would read as a drop in the rate.
@@ -371,7 +551,8 @@ def impact_rate_figure(impacts: pd.DataFrame) -> Figure:
     axis.set_ylim(bottom=0.0)
     axis.set_xlabel("time (min)" if in_minutes else "time (s)")
     axis.set_ylabel("impacts per second (1/s)")
-    axis.set_title(f"Impacts per second at each end face (bins of {width:.3g} s)")
+    where = "at each end face" if categories == WALLS else "on each wall and between balls"
+    axis.set_title(f"Impacts per second {where} (bins of {width:.3g} s)")
     axis.legend(loc="best")
     axis.grid(alpha=0.3)
     return figure
@@ -394,7 +575,7 @@ def impact_phase_figure(run: RunLike) -> Figure:
     regime, _ = classify_impacts(settled, params.omega, params.phase)
     figure, (axis,) = _new_figure(height=4.0)
     edges = np.linspace(0.0, 2 * math.pi, PHASE_BINS + 1)
-    _stacked_by_wall(axis, phases.phase, phases.wall, edges)
+    _stacked_by_kind(axis, phases.phase, phases.wall, WALLS, edges)
     _radian_ticks(axis.xaxis)
     axis.set_xlim(0.0, 2 * math.pi)
     axis.set_ylim(0.0, axis.get_ylim()[1] * HISTOGRAM_HEADROOM)

@@ -84,6 +84,9 @@ def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitt
     """
     v = {key: number(summary.get(key), spec) for key, _, _, spec in ANSWER_KEYS}
     minutes = number(_number(summary.get("simulated_s")) / 60.0, ".3g")
+    if _number(summary.get("n_balls")) > 1:
+        # The experiment had one ball: several balls are not compared with it.
+        return several_ball_sentences(summary, v, minutes)
     sentences = [
         f"After {minutes} min the ball is at {v['ball_C']} °C, the vial at {v['vial_C']} °C and the air at "
         f"{v['air_C']} °C.",
@@ -99,6 +102,27 @@ def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitt
         if comparison:
             sentences.append(comparison)
     return sentences
+
+
+def several_ball_sentences(summary: Mapping[str, Any], v: Mapping[str, str], minutes: str) -> list[str]:
+    """The answer of a 'dem' run with several balls: the range of their temperatures and their mean."""
+    walls, between = _number(summary.get("wall_impacts")), _number(summary.get("ball_ball_impacts"))
+    share = walls / (walls + between) if walls + between > 0 else math.nan
+    return [
+        f"After {minutes} min the {summary['n_balls']} balls are at {_spread(summary.get('ball_temperatures_C'))} °C "
+        f"(mean {v['ball_C']} °C), the vial at {v['vial_C']} °C and the air at {v['air_C']} °C.",
+        f"Run on, the balls would settle at {_spread(summary.get('balls_steady_C'))} °C (mean {v['ball_steady_C']} °C; "
+        f"vial {v['vial_steady_C']} °C, air {v['air_steady_C']} °C); the slowest time constant of the thermal "
+        f"network is {v['slowest_time_constant_min']} min.",
+        f"The impacts generate {v['heat_power_W']} W of heat at {v['impact_rate_hz']} impacts per second, "
+        f"{number(share * 100.0, '.0f')} % of them on the walls" + _averaging_note(summary) + ".",
+    ]
+
+
+def _spread(values: Any) -> str:
+    """"20.5–20.8": the lowest and highest of a list of temperatures in °C (nulls left out), or "n/a"."""
+    finite = [value for value in values or () if isinstance(value, (int, float)) and math.isfinite(value)]
+    return f"{min(finite):.1f}–{max(finite):.1f}" if finite else "n/a"
 
 
 def _number(value: Any) -> float:

@@ -36,12 +36,15 @@ from shakermill.studies.validation import (
 from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
 from shakermill.support.version import __version__
 from shakermill.views.figures import (
-    PAPER_FIGURES,
+    TARGETS,
     comparison_temperature_figure,
     impact_figures,
+    impact_span,
+    main_figure_names,
     model_of,
     paper_figures,
     png_bytes,
+    several_balls,
 )
 from shakermill.views.notebook import answer_sentences, esc, number
 
@@ -75,6 +78,30 @@ FIGURE_CAPTIONS = {
     ),
 }
 
+# A 'dem' run's figures (views/figures.py, SEVERAL_BALL_FIGURES) and its impact figures, where they differ.
+SEVERAL_BALL_CAPTIONS = {
+    "temperatures": (
+        "Temperature (°C) of each ball, the vial and the inner air over the run (min), with the exponential "
+        "fitted to the balls' mean temperature and the balls' mean steady state (cf. paper Fig. 5a)."
+    ),
+    "trajectories": (
+        "The ball centres (mm) over the first record window in the vial's own frame (x along its axis, z up at "
+        "rest), seen from above, from the side and along the axis, inside the vial's inner wall; discs: the "
+        "balls to scale where the window ends."
+    ),
+    "heat_by_channel": (
+        "Mean heat power (W) made in each dissipation channel (normal and tangential damping, sliding, rolling; "
+        "MODEL.md §12.4), stacked by what was hit, and the heat received by each ball and the vial."
+    ),
+    "ball_heating_zoom": (
+        "The temperature of each ball in the record window nearest 10 min: it jumps at the ball's impacts "
+        "(dotted: every impact of any ball) and falls by convection between them (cf. paper Fig. 5b)."
+    ),
+    "impact_speed_histogram": "Normal impact speed relative to what is hit: an end face, the side wall or another ball.",
+    "impact_energy_histogram": "Energy dissipated in each impact (mJ), by what was hit.",
+    "impacts_per_second": "Impacts per second on each wall and between balls over the time the impacts were resolved.",
+}
+
 # MODEL.md §9: where this implementation departs from the printed paper, on purpose.
 PAPER_DIFFERENCES = (
     "Hertz force (4/3)·E*·√R·ζ^(3/2); the printed text garbles it to a square root of the whole product.",
@@ -91,6 +118,12 @@ ENERGY_TERMS = (
     ("kinetic_energy_change", "change of the ball's kinetic energy"),
     ("elastic_energy_change", "change of the elastic contact energy"),
     ("dissipated", "dissipated in the contacts"),
+    ("dissipated_normal", "of which by normal damping"),
+    ("dissipated_tangential", "of which by tangential damping"),
+    ("dissipated_sliding", "of which by sliding"),
+    ("dissipated_rolling", "of which by rolling resistance"),
+    ("work_by_gravity", "work done by gravity"),
+    ("work_by_stiffening", "energy the tangential springs gain as they stiffen (Hertz–Mindlin)"),
     ("heat_generated", "irreversible heat generated (η × dissipated)"),
     ("heat_to_ball", "heat to the ball (λ × heat)"),
     ("heat_to_vial", "heat to the vial ((1 − λ) × heat)"),
@@ -183,6 +216,7 @@ def render_report(run: RunData, other: RunData | None = None) -> str:
     sections = [
         header_section(run, preset),
         results_section(run),
+        *([balls_section(run)] if several_balls(run.params) else []),
         table5_section(run, preset),
         paper_figures_section(run, figure_numbers),
         configuration_section(run, preset),
@@ -268,11 +302,14 @@ def figure_html(figure: Figure, caption: str, number: int) -> str:
     )
 
 
-def figures_html(figures: Mapping[str, Figure], numbers: Iterator[int]) -> str:
+def figures_html(figures: Mapping[str, Figure], numbers: Iterator[int], captions: Mapping[str, str] = FIGURE_CAPTIONS) -> str:
     """The figures in order, numbered on from ``numbers`` (one count for the whole report)."""
-    return "\n".join(
-        figure_html(figure, FIGURE_CAPTIONS.get(name, name), next(numbers)) for name, figure in figures.items()
-    )
+    return "\n".join(figure_html(figure, captions.get(name, name), next(numbers)) for name, figure in figures.items())
+
+
+def captions_of(run: RunData) -> dict[str, str]:
+    """The captions of ``run``'s figures: the paper's, or those of the 'dem' engine where they differ."""
+    return {**FIGURE_CAPTIONS, **SEVERAL_BALL_CAPTIONS} if several_balls(run.params) else FIGURE_CAPTIONS
 
 
 # ---------------------------------------------------------------- run facts
@@ -303,14 +340,18 @@ def finite_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def format_parameter(value: Any) -> str:
-    """A parameter value without its unit: '0.00635', 'true', '[0, 1], [600, 0.1]', 'three_node'."""
+    """A parameter value without its unit: '0.00635', 'true', '[0, 1], [600, 0.1]', 'three_node', and the
+    'dem' engine's lists: '0.005, 0.006' (ball_radii), '[x, 1, 0, 0.025], [yaw, 1, 0, 0.3]' (motion)."""
     if isinstance(value, bool):
         return str(value).lower()
     if isinstance(value, float):
         return f"{value:.6g}"
     if isinstance(value, (tuple, list)):
-        pairs = ", ".join("[" + ", ".join(f"{item:g}" for item in pair) + "]" for pair in value)
-        return pairs or "none"
+        items = (
+            f"[{', '.join(format_parameter(part) for part in item)}]" if isinstance(item, (tuple, list)) else format_parameter(item)
+            for item in value
+        )
+        return ", ".join(items) or "none"
     return str(value)
 
 
@@ -396,6 +437,8 @@ def table5_section(run: RunData, preset: Preset | None) -> str:
     vial = (preset or PRESETS[DEFAULT_PRESET]).values
     values = {**run.params.model_dump(), "duration": float(run.summary.get("simulated_s") or 0.0)}
     mismatches = operating_point_mismatches(values, {key: cited.value for key, cited in vial.items()})
+    if run.params.n_balls != 1:
+        mismatches.append(f"n_balls = {run.params.n_balls} (experiment: one ball)")
     if mismatches:
         reason = (
             "Left out: the experiment of Table 5 ran at ω = 111 rad/s (about 1060 rpm), 25 mm amplitude, one "
@@ -479,10 +522,12 @@ def fitted_statement(run: RunData, preset: Preset | None, rows: Sequence[Compari
 
 def paper_figures_section(run: RunData, numbers: Iterator[int]) -> str:
     figures = paper_figures(run)
-    missing = [name for name in PAPER_FIGURES if name not in figures]
-    parts = [figures_html(figures, numbers)]
+    missing = [name for name in main_figure_names(run.params) if name not in figures]
+    parts = [figures_html(figures, numbers, captions_of(run))]
     if missing:
         parts.append(paragraph(f"Not drawn, no record window with enough points: {', '.join(missing)}.", "note"))
+    if several_balls(run.params):
+        return section("Figures of the balls: temperatures, paths and heat (cf. Son 2025, section 4)", *parts)
     return section("Figures of the paper (Son 2025, section 4)", *parts)
 
 
@@ -520,11 +565,10 @@ def assumptions_section(run: RunData, preset: Preset | None) -> str:
             if cited.source.lower().startswith("assumption")
         ]
         assumed = paragraph(f"Values the paper does not print, as cited in preset {preset.name}:") + bullet_list(items)
-    options = ", ".join(
-        f"{key} = {format_parameter(params[key])}"
-        for key in ("model", "heat_model", "convection_velocity", "no_tension")
-        if key in params
-    )
+    keys = ("model", "heat_model", "convection_velocity", "no_tension")
+    if several_balls(run.params):
+        keys += ("engine", "n_balls", "kinematics", "gravity", "friction", "rolling_friction")
+    options = ", ".join(f"{key} = {format_parameter(params[key])}" for key in keys if key in params)
     return section(
         "Assumptions not in the paper",
         assumed,
@@ -544,8 +588,9 @@ def energy_section(run: RunData) -> str:
     if RELATIVE_RESIDUAL_KEY in energy:
         relative = ("relative residual: |residual| / largest flow", RELATIVE_RESIDUAL_KEY)
         rows.append((*relative, number(energy[RELATIVE_RESIDUAL_KEY], ".3e"), ""))
+    supplied = "work by the vial + by gravity + stiffening" if several_balls(run.params) else "work by the vial"
     balances = (
-        "work by the vial = Δkinetic + Δelastic + dissipated; dissipated = heat generated + not converted to heat; "
+        f"{supplied} = Δkinetic + Δelastic + dissipated; dissipated = heat generated + not converted to heat; "
         "heat generated = stored (ball + vial + air) + lost to the surroundings. The residuals are what is left "
         "of these balances."
     )
@@ -568,18 +613,11 @@ def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
     ]
     if impacts.empty:
         return rows
-    regime, _ = classify_impacts(settled_run_impacts(run), run.params.omega, run.params.phase)
-    rows.append(("regime of the settled motion", regime, ""))
-    for wall in ("left", "right"):
-        count = int((impacts["wall"] == wall).sum())
-        share = count / len(impacts)
-        # The summary's rate covers the whole run (the averaged solver's table covers only its window).
-        wall_rate = rate * share if isinstance(rate, (int, float)) else None
-        rows.append((f"impacts at the {wall} end face", f"{count} ({share:.1%})", ""))
-        rows.append((f"impact rate at the {wall} end face", number(wall_rate, ".4g"), "Hz"))
+    rows += target_rows(run) if several_balls(run.params) else wall_rows(run)
     for column, label, scale, unit, spec in (
-        ("impact_speed", "impact speed", 1.0, "m/s", ".4g"),
+        ("impact_speed", "impact speed" if "wall" in impacts else "normal impact speed", 1.0, "m/s", ".4g"),
         ("rebound_speed", "rebound speed", 1.0, "m/s", ".4g"),
+        ("tangential_speed", "tangential speed of the contact points at first touch", 1.0, "m/s", ".4g"),
         ("dissipated_energy", "dissipated energy per impact", 1e3, "mJ", ".4g"),
         ("heat_to_ball", "heat to the ball per impact", 1e3, "mJ", ".4g"),
         ("duration", "contact duration", 1e6, "µs", ".4g"),
@@ -591,6 +629,63 @@ def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
             stats = f"{values.mean():{spec}} / {values.min():{spec}} / {values.max():{spec}}"
             rows.append((f"{label}: mean / min / max", stats, unit))
     return rows
+
+
+def wall_rows(run: RunData) -> list[tuple[str, str, str]]:
+    """The regime of the settled motion and the impacts at each end face, of a 1-D run."""
+    impacts, rate = run.impacts, run.summary.get("impact_rate_hz")
+    regime, _ = classify_impacts(settled_run_impacts(run), run.params.omega, run.params.phase)
+    rows = [("regime of the settled motion", regime, "")]
+    for wall in ("left", "right"):
+        count = int((impacts["wall"] == wall).sum())
+        share = count / len(impacts)
+        # The summary's rate covers the whole run (the averaged solver's table covers only its window).
+        wall_rate = rate * share if isinstance(rate, (int, float)) else None
+        rows.append((f"impacts at the {wall} end face", f"{count} ({share:.1%})", ""))
+        rows.append((f"impact rate at the {wall} end face", number(wall_rate, ".4g"), "Hz"))
+    return rows
+
+
+def target_rows(run: RunData) -> list[tuple[str, str, str]]:
+    """The impacts on each wall and between balls, of a 'dem' run (whose several balls have no 1-D regime)."""
+    impacts, rate = run.impacts, run.summary.get("impact_rate_hz")
+    rows = []
+    for target, label, _ in TARGETS:
+        count = int((impacts["target"] == target).sum())
+        share = count / len(impacts)
+        target_rate = rate * share if isinstance(rate, (int, float)) else None
+        rows.append((f"impacts on {label}", f"{count} ({share:.1%})", ""))
+        rows.append((f"impact rate on {label}", number(target_rate, ".4g"), "Hz"))
+    return rows
+
+
+def balls_section(run: RunData) -> str:
+    """Each ball of a 'dem' run: radius, temperature at the end and steady state, impacts, heat received."""
+    summary, impacts = run.summary, run.impacts
+    at_end, steady = summary.get("ball_temperatures_C") or [], summary.get("balls_steady_C") or []
+    series = run.timeseries
+    seconds = float(series["time"].values[-1])
+    heat = series["heat_into_balls"].transpose("time", "ball").values[-1] / seconds if seconds > 0 else None
+    on_walls = impacts["target"] != "ball"
+    rows = []
+    for ball, radius in enumerate(run.params.ball_values("ball_radius")):
+        mine = impacts["ball"] == ball
+        rows.append((
+            str(ball),
+            number(radius * 1e3, ".4g"),
+            number(at_end[ball] if ball < len(at_end) else None, ".2f"),
+            number(steady[ball] if ball < len(steady) else None, ".2f"),
+            str(int((mine & on_walls).sum())),
+            str(int((~on_walls & (mine | (impacts["other_ball"] == ball))).sum())),
+            number(float(heat[ball]) if heat is not None else None, ".4g"),
+        ))
+    headers = ("ball", "radius (mm)", "at the end (°C)", "steady state (°C)", "impacts on the walls",
+               "impacts with other balls", "heat received (W)")
+    note = (
+        f"Balls are numbered as in the run's files, from 0. Impacts are those of the impact table "
+        f"({number(impact_span(run), '.4g')} s of the run); the heat received is the mean over the whole run."
+    )
+    return section("Balls", table(headers, rows, numeric=range(1, len(headers))), paragraph(note, "note"))
 
 
 def impacts_section(run: RunData, numbers: Iterator[int]) -> str:
@@ -606,7 +701,7 @@ def impacts_section(run: RunData, numbers: Iterator[int]) -> str:
                 "note",
             )
         )
-    parts.append(figures_html(impact_figures(run), numbers))
+    parts.append(figures_html(impact_figures(run), numbers, captions_of(run)))
     return section("Impacts", *parts)
 
 
