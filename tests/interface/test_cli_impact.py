@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -10,7 +11,9 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
+import shakermill as sm
 from shakermill import cli
+from shakermill.physics import contact
 
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
 JSON_KEYS = [
@@ -116,3 +119,69 @@ def test_installed_command_refuses_a_negative_speed_in_one_line():
     assert completed.returncode == 2
     assert completed.stdout == ""
     assert completed.stderr == "error: --speed: -1 m/s is out of range; allowed 0 < speed <= 1000 m/s\n"
+
+
+# The Chung & Ooi (2011) verification set through the command itself (inputs: docs/notes/dem-references.md §1;
+# the full set, with more angles and speeds, is in tests/studies/test_impact.py).
+RIGID_WALL = ["--set", "vial_youngs_modulus=1.2e12"]
+ALUMINA = ["--set", "ball_radius=2.5mm", "--set", "ball_density=4000", "--set", "ball_youngs_modulus=3.8e11",
+           "--set", "ball_poisson_ratio=0.23"]
+
+
+def impact_json(*args: str) -> dict:
+    result = invoke("--json", *args)
+    assert result.exit_code == 0, result.stderr
+    return json.loads(result.stdout)
+
+
+def hertz(mass: float, radius: float, modulus: float, speed: float) -> tuple[float, float, float]:
+    overlap = contact.hertz_max_overlap(mass, radius, modulus, speed)
+    return contact.hertz_contact_time(mass, radius, modulus, speed), overlap, contact.hertz_force(overlap, modulus, radius)
+
+
+@pytest.mark.parametrize(
+    "target, settings",
+    [
+        # Test 1: two glass balls (R = 10 mm, E = 48 GPa, ν = 0.2) meeting at 20 m/s, e = 1
+        ("ball", ["--set", "ball_radius=10mm", "--set", "ball_density=2800", "--set", "ball_youngs_modulus=4.8e10",
+                  "--set", "ball_poisson_ratio=0.2"]),
+        # Test 2: an aluminium ball (R = 0.1 m, E = 70 GPa, ν = 0.3) on a rigid plane at 0.2 m/s, e = 1
+        ("wall", ["--set", "ball_radius=0.1", "--set", "ball_density=2699", "--set", "ball_youngs_modulus=7e10",
+                  "--set", "ball_poisson_ratio=0.3", *RIGID_WALL]),
+    ],
+    ids=["test 1", "test 2"],
+)
+def test_chung_ooi_elastic_normal_impacts_follow_hertz(target, settings):
+    speed = 20.0 if target == "ball" else 0.2
+    outcome = impact_json("--speed", str(speed), "--target", target, "--set", "restitution=1", *settings, *FINE)
+    # The command makes the vial large enough for any ball; so does this, for the ball's mass and moduli.
+    params = sm.default_parameters(vial_length=1.0, vial_diameter=0.9, **dict(item.split("=", 1) for item in settings[1::2]))
+    own = (params.ball_youngs_modulus, params.ball_poisson_ratio)
+    if target == "ball":
+        mass, radius, modulus = params.ball_mass / 2, params.ball_radius / 2, contact.effective_modulus(*own, *own)
+    else:
+        other = (params.vial_youngs_modulus, params.vial_poisson_ratio)
+        mass, radius, modulus = params.ball_mass, params.ball_radius, contact.effective_modulus(*own, *other)
+    contact_time, overlap, force = hertz(mass, radius, modulus, speed)
+    assert outcome["contact_time_s"] == pytest.approx(contact_time, rel=0.01)
+    assert outcome["max_overlap_m"] == pytest.approx(overlap, rel=0.01)
+    assert outcome["max_normal_force_N"] == pytest.approx(force, rel=0.01)
+    assert outcome["normal_restitution"] == pytest.approx(1.0, abs=1e-3)
+
+
+@pytest.mark.parametrize("restitution", ["0.2", "0.6", "1.0"])
+def test_chung_ooi_3_restitution_is_the_given_one(restitution):
+    outcome = impact_json("--speed", "3.9", "--set", f"restitution={restitution}", "--set", "friction=0", *ALUMINA,
+                          *RIGID_WALL, *FINE)
+    assert outcome["normal_restitution"] == pytest.approx(float(restitution), abs=1e-3)
+
+
+def test_chung_ooi_4_gross_sliding_changes_velocity_and_spin_as_coulomb_says():
+    """Alumina, e = 0.98, μ = 0.092, 3.9 m/s at 60° from the normal: sliding throughout."""
+    outcome = impact_json("--speed", "3.9", "--angle", "60", "--set", "restitution=0.98", "--set", "friction=0.092",
+                          *ALUMINA, *RIGID_WALL, *FINE)
+    normal = 3.9 * math.cos(math.radians(60.0))
+    change = 0.092 * 1.98 * normal
+    assert 3.9 * math.sin(math.radians(60.0)) - outcome["tangential_velocity_out_m_s"] == pytest.approx(change, rel=0.02)
+    assert outcome["angular_velocity_rad_s"] == pytest.approx(2.5 * change / 2.5e-3, rel=0.02)
+    assert outcome["dissipated_sliding_J"] > 0.0
