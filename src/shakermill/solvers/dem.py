@@ -219,6 +219,8 @@ def _network_steady_state(params: Parameters, k: model.Constants, heat: np.ndarr
 
 
 AVERAGING_FAILED = -10
+# As the 1-D averaged solver: a node's thermal time constant over the time between the impacts that heat it.
+TIME_SCALE_SEPARATION = 20.0
 
 
 @dataclass(frozen=True)
@@ -307,7 +309,10 @@ def simulate_dem_averaged(params: Parameters, progress: ProgressCallback | None,
         return _stopped(params, engine, start, INTERRUPTED, INTERRUPTED_MESSAGE, started)
     if status != REACHED_STOP:
         return _stopped(params, engine, start, status, engine.explain(status), started)
-    if not means.averages.converged:
+    problem = None if not means.averages.converged else _time_scales_problem(engine, means)
+    if not means.averages.converged or problem is not None:
+        if problem is not None:
+            means = Means(means.heat, means.terms, _with_message(means.averages, problem))
         return _refuse(params, engine, start, means, progress, budget, started)
     times = sample_times(params)
     k = engine.constants
@@ -336,6 +341,33 @@ def simulate_dem_averaged(params: Parameters, progress: ProgressCallback | None,
     )
     steady = _network_steady_state(params, k, means.heat, means.terms)
     return conclude(result, steady.heat_power, steady.velocity_term, steady)
+
+
+def _time_scales_problem(engine: Engine, means: Means) -> str | None:
+    """Why averaging is not valid, or None: every ball's and the vial's thermal time constant must exceed the
+    time between the impacts that heat it by TIME_SCALE_SEPARATION, or its temperature follows single impacts."""
+    k, n = engine.constants, engine.constants.n_balls
+    window = means.averages.window
+    records = impact_columns(engine.records, since=means.averages.transient)
+    # Conductances (W/K) as the heat flows of 1 K excess of each ball over the air, at ambient temperature
+    # (Sutherland's factor changes them by a few percent only).
+    theta = np.full(n + 2, k.t_ambient)
+    theta[:n] += 1.0
+    flow = np.empty(n + 2)
+    network.flows(theta, means.terms, k, flow)
+    constants = [k.capacity_ball[ball] / flow[ball] if flow[ball] > 0 else math.inf for ball in range(n)]
+    vial_conductance = k.h_inner * k.inner_area + k.h_outer * k.outer_area
+    constants.append(k.capacity_vial / vial_conductance if vial_conductance > 0 else math.inf)
+    hits = [int(np.sum(records["ball"] == ball) + np.sum(records["other_ball"] == ball)) for ball in range(n)]
+    hits.append(int(np.sum(records["target"] != "ball")))
+    for node, (constant, count) in enumerate(zip(constants, hits, strict=True)):
+        if count and constant < TIME_SCALE_SEPARATION * window / count:
+            name = f"ball {node}" if node < n else "vial"
+            return (
+                f"the {name}'s thermal time constant ({constant:.3g} s) is not well separated from the time between "
+                f"the impacts that heat it ({window / count:.3g} s): its temperature follows single impacts"
+            )
+    return None
 
 
 def _with_message(averages: MechanicsAverages, message: str) -> MechanicsAverages:
