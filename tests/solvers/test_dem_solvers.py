@@ -29,6 +29,10 @@ def test_the_averaged_solver_heats_as_the_full_one(pair):
     for name in ("theta_ball", "theta_vial", "theta_air"):
         assert rise(averaged, name) == pytest.approx(rise(full, name), rel=0.05), name
     assert averaged.summary["heat_power_W"] == pytest.approx(full.summary["heat_power_W"], rel=0.05)
+    # The averaged run splits its heat by channel as the contacts of its averaging window did.
+    for channel in ("normal", "sliding"):
+        key = f"heat_{channel}_W"
+        assert averaged.summary[key] == pytest.approx(full.summary[key], rel=0.15), key
 
 
 def test_both_solvers_give_each_ball_its_own_temperature_and_a_steady_state(pair):

@@ -333,7 +333,7 @@ def simulate_dem_averaged(params: Parameters, progress: ProgressCallback | None,
         impact_columns=impact_columns(engine.records, since=means.averages.transient),
         counters=_counters(engine, thermal_rhs_evaluations=int(thermal.nfev)),
         wall_time=time.perf_counter() - started,
-        energy=_averaged_energy(params, k, means, thermal),
+        energy=_averaged_energy(params, k, means, thermal, impact_columns(engine.records, since=means.averages.transient)),
         ball_fit=fit_exponential(thermal.t, thermal.y[: k.n_balls].mean(axis=0), params.initial_temperature),
         solver="averaged",
         impact_window=means.averages.window,
@@ -423,11 +423,15 @@ def _averaged_fields(thermal, means: Means, k: model.Constants, params: Paramete
     }
 
 
-def _averaged_energy(params: Parameters, k: model.Constants, means: Means, thermal) -> EnergyAudit:
+def _averaged_energy(params: Parameters, k: model.Constants, means: Means, thermal, impacts: dict) -> EnergyAudit:
+    """The audit of the averaged run: mean rates times the duration; the split by channel is that of the
+    contacts of the averaging window."""
     n = k.n_balls
     heat = float(means.heat.sum() * params.duration)
     dissipated = means.averages.dissipated_power * params.duration
     warming = thermal.y[:-1, -1] - thermal.y[:-1, 0]
+    by_channel = np.array([float(np.sum(impacts[f"dissipated_{name}"])) for name in model.CHANNELS])
+    shares = by_channel / by_channel.sum() if by_channel.sum() > 0 else np.zeros(len(model.CHANNELS))
     return EnergyAudit(
         work_by_vial=dissipated,
         kinetic_energy_change=0.0,
@@ -442,6 +446,7 @@ def _averaged_energy(params: Parameters, k: model.Constants, means: Means, therm
         stored_air=float(k.capacity_air * warming[n + 1]),
         heat_lost_to_surroundings=float(thermal.y[-1, -1]),
         projection_correction=0.0,
+        dissipated_by_channel={name: float(share * dissipated) for name, share in zip(model.CHANNELS, shares)},
     )
 
 
