@@ -78,8 +78,8 @@ class Constants(NamedTuple):
     omega: float
     phase: float
     harmonics: np.ndarray  # (6, K, 2): (cos, sin) of x, y, z, roll, pitch, yaw per harmonic k
-    wall_speed_bound: float  # m/s: no point of the vial moves faster
-    wall_acceleration_bound: float  # m/s²
+    angular_speed_bound: float  # rad/s: the vial never turns faster
+    wall_acceleration_bound: float  # m/s²: no point of the vial accelerates faster
     gravity: np.ndarray  # (3,), m/s², lab frame
     # Steps
     contact_step: float  # s
@@ -163,19 +163,19 @@ def harmonics_of(params: Parameters) -> np.ndarray:
 
 
 def _motion_bounds(harmonics: np.ndarray, omega: float, reach: float) -> tuple[float, float]:
-    """Upper bounds of the speed and acceleration of any vial point within ``reach`` of its centre.
+    """Upper bounds of the vial's angular speed and of the acceleration of any vial point within ``reach``
+    of its centre.
 
     Each coordinate's Fourier series bounds its rate by Σ kω(|a|+|b|) and its second rate by Σ (kω)²(|a|+|b|);
-    a rotating point adds |Ω|·r and (|Ω̇| + |Ω|²)·r.
+    a rotating point adds (|Ω̇| + |Ω|²)·r.
     """
     k = np.arange(harmonics.shape[1])
     size = np.abs(harmonics).sum(axis=2)
     rate = size @ (k * omega)
     second = size @ (k * omega) ** 2
     angular_rate, angular_second = rate[3:].sum(), second[3:].sum()
-    speed = float(np.linalg.norm(rate[:3]) + angular_rate * reach)
     acceleration = float(np.linalg.norm(second[:3]) + (angular_second + angular_rate**2) * reach)
-    return speed, acceleration
+    return float(angular_rate), acceleration
 
 
 def constants_from(params: Parameters) -> Constants:
@@ -200,7 +200,7 @@ def constants_from(params: Parameters) -> Constants:
     wall_radius = np.column_stack([radius, radius, [contact.concave_radius(r, bore) for r in radius]])
     e_v, nu_v = params.vial_youngs_modulus, params.vial_poisson_ratio
     harmonics = harmonics_of(params)
-    speed_bound, acceleration_bound = _motion_bounds(harmonics, params.omega, math.hypot(0.5 * params.vial_length, bore))
+    angular_bound, acceleration_bound = _motion_bounds(harmonics, params.omega, math.hypot(0.5 * params.vial_length, bore))
     rayleigh = min(
         contact.rayleigh_time(r, rho, e, nu) for r, rho, e, nu in zip(radius, density, youngs, poisson, strict=True)
     )
@@ -232,7 +232,7 @@ def constants_from(params: Parameters) -> Constants:
         omega=params.omega,
         phase=params.phase,
         harmonics=harmonics,
-        wall_speed_bound=speed_bound,
+        angular_speed_bound=angular_bound,
         wall_acceleration_bound=acceleration_bound,
         gravity=np.array([0.0, 0.0, -STANDARD_GRAVITY if params.gravity else 0.0]),
         contact_step=params.contact_step_fraction * rayleigh,

@@ -34,6 +34,7 @@ from shakermill.engines.dem.model import (
     LEFT_END,
     N_WALLS,
     RIGHT_END,
+    SIDE,
     WORK_GRAVITY,
     WORK_STIFFENING,
     WORK_VIAL,
@@ -213,6 +214,9 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     c = s.contacts
     normal, relative = w.normal, w.point_velocity
     approach = _dot(relative, normal)
+    # A contact that began inside this step starts with an unstretched spring: it did not exist for the
+    # step's earlier part, which in free flight can be far longer than a contact step.
+    stretching = dt if c.active[slot] else 0.0
     elastic = contact.hertz_force(overlap, modulus, radius)
     damping = contact.damping_coefficient(overlap, mass, radius, modulus, k.beta_e)
     magnitude = contact.contact_force(elastic, damping, -approach, k.no_tension)
@@ -232,19 +236,19 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     c.slip_loss[slot] = 0.0
     for axis in range(3):
         sliding = relative[axis] - approach * normal[axis]
-        spring[axis] += sliding * dt
+        spring[axis] += sliding * stretching
         w.normal_force[slot, axis] = magnitude * normal[axis]
         w.tangential_force[slot, axis] = -stiffness * spring[axis] - damping_t * sliding
     size = _norm(w.tangential_force[slot])
     if size > limit:
-        w.tangential_force[slot] *= limit / size
-        # The spring's end slips from where the trial put it to where the Coulomb force holds it: μF_n⁺|slip|.
-        slip = 0.0
-        for axis in range(3):
-            held = -w.tangential_force[slot, axis] / stiffness
-            slip += (spring[axis] - held) ** 2
-            spring[axis] = held
-        c.slip_loss[slot] = limit * math.sqrt(slip)
+        # The force is scaled down to the Coulomb limit, and the spring with it (so that without a damper the
+        # spring alone gives the limit): its end slips by the part of the stretch it loses, and sliding
+        # dissipates μF_n⁺·|slip|. Holding the whole force in the spring instead would stretch it absurdly
+        # where k_t is tiny, in a contact's first step, when the damper gives most of the trial force.
+        ratio = limit / size
+        c.slip_loss[slot] = limit * (1.0 - ratio) * _norm(spring)
+        w.tangential_force[slot] *= ratio
+        spring *= ratio
     w.stiffness[slot] = stiffness
     w.stretch[slot] = _dot(spring, spring)
     spin = _norm(relative_spin)
@@ -432,11 +436,17 @@ def _settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, 
     normal, tangential, rolling, vial = _mean_work(slot, i, j, dt, s, w)
     normal -= w.elastic_energy[slot] - c.elastic_energy[slot]
     # The spring energy ½k_t|δ_t|² changes by stretching (its own work, from the tangential work) and by
-    # stiffening with the overlap (a supply of the model's own, booked apart: model.TOTAL_NAMES).
-    mean_stiffness = 0.5 * (w.stiffness[slot] + c.stiffness[slot])
-    mean_stretch = 0.5 * (w.stretch[slot] + c.stretch[slot])
-    tangential -= 0.5 * mean_stiffness * (w.stretch[slot] - c.stretch[slot])
-    s.totals[WORK_STIFFENING] += 0.5 * mean_stretch * (w.stiffness[slot] - c.stiffness[slot])
+    # stiffening with the overlap (a supply of the model's own, booked apart: model.TOTAL_NAMES). A step at
+    # the Coulomb limit sets the stretch from the new stiffness, the old stretch having slipped away: only
+    # the new one stiffens. (Both splits add up to the change exactly; the midpoint one, used otherwise, would
+    # book huge opposite terms where k_t jumps by orders of magnitude in a contact's first steps.)
+    if c.slip_loss[slot] > 0.0:
+        stiffened_stretch, stretching_stiffness = w.stretch[slot], c.stiffness[slot]
+    else:
+        stiffened_stretch = 0.5 * (w.stretch[slot] + c.stretch[slot])
+        stretching_stiffness = 0.5 * (w.stiffness[slot] + c.stiffness[slot])
+    tangential -= 0.5 * stretching_stiffness * (w.stretch[slot] - c.stretch[slot])
+    s.totals[WORK_STIFFENING] += 0.5 * stiffened_stretch * (w.stiffness[slot] - c.stiffness[slot])
     # Sliding dissipates μF_n⁺|slip| (MODEL.md §12.4); the rest of the tangential work, the damper's.
     sliding = c.slip_loss[slot]
     channels = (normal, tangential - sliding, sliding, rolling)
@@ -534,15 +544,29 @@ def _time_to_close(gap: float, speed: float, acceleration: float) -> float:
 
 @njit(cache=True, inline="always")
 def _flight_step(k: Constants, s: State, w: Scratch) -> float:
-    """The longest step in which no contact can begin (MODEL.md §12.6), within [contact_step, max_flight_step]."""
+    """The longest step in which no contact can begin (MODEL.md §12.6), within [contact_step, max_flight_step].
+
+    A ball's centre moves in the vial frame at its velocity relative to the vial's point under it, which can
+    change at most by gravity, the vial's acceleration and the Coriolis term within a step. Its distance from
+    an end face closes at most at the axial part of that velocity, its distance from the axis grows at most
+    at the part across the axis (a norm bound, so the bore's curvature needs no term of its own).
+    """
     n = k.n_balls
     step = k.max_flight_step
-    wall_acceleration = _norm(k.gravity) + k.wall_acceleration_bound
+    axis = w.orientation[:, 0]
     for i in range(n):
-        speed = _norm(s.velocity[i])
+        for component in range(3):
+            w.lever[component] = s.position[i, component] - w.coordinates[component]
+        _cross_into(w.angular, w.lever, w.other_velocity)
+        for component in range(3):
+            w.point_velocity[component] = s.velocity[i, component] - w.rates[component] - w.other_velocity[component]
+        along = _dot(w.point_velocity, axis)
+        across = math.sqrt(max(_dot(w.point_velocity, w.point_velocity) - along * along, 0.0))
+        acceleration = _norm(k.gravity) + k.wall_acceleration_bound + 2.0 * k.angular_speed_bound * (abs(along) + across)
         for wall in range(N_WALLS):
             gap = wall_gap(s.position[i], k.radius[i], wall, k, w)
-            step = min(step, _time_to_close(gap, speed + k.wall_speed_bound, wall_acceleration))
+            closing = across if wall == SIDE else (-along if wall == LEFT_END else along)
+            step = min(step, _time_to_close(gap, max(closing, 0.0), acceleration))
         for j in range(i + 1, n):
             # Both balls fall alike in flight: their relative motion is uniform.
             gap = _distance(s.position[i], s.position[j]) - k.radius[i] - k.radius[j]
