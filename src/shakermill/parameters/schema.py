@@ -695,7 +695,9 @@ SPEX_8000M = Preset(
         "kinematics": Cited("axial", f"{PAPER}: the vial moves along its axis (MODEL.md section 12.2)"),
         "motion": Cited((), "used only with kinematics = 'fourier'"),
         "contact_step_fraction": Cited(
-            0.05, "numerical choice: restitution within 1e-3 and heat power within 0.1 % of the converged value (benchmarks/README.md, DEM step study)"
+            0.05,
+            "numerical choice: restitution within 1e-3, the 1-D limit's heat power within 0.25 % of the converged "
+            "value, five balls' within the ~1 % their statistics resolve (benchmarks/README.md, dem engine)",
         ),
         "max_flight_step": Cited(1e-4, "numerical choice: ~1/60 of a drive period, so the wall's motion is resolved"),
         "record_windows": Cited(
