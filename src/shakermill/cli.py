@@ -366,6 +366,12 @@ def _number(value: Any, spec: str) -> str:
     return format(value, spec)
 
 
+def _radii_mm(params: Parameters) -> str:
+    """The ball radius in mm, or each ball's where they differ."""
+    radii = sorted(set(params.ball_values("ball_radius")))
+    return ", ".join(_number(radius * 1e3, ".4g") for radius in radii)
+
+
 def summary_table(result: Result, target: Path) -> Table:
     """The human summary of a run: fitted and final temperatures, impacts, power, numerics."""
     s = result.summary
@@ -380,7 +386,7 @@ def summary_table(result: Result, target: Path) -> Table:
         ("status", s["message"] if not result.success else "ok", ""),
         ("solver", s["solver"], ""),
         ("drive ω", f"{_number(s['omega_rad_s'], '.4g')} rad/s = {_number(s['omega_hz'], '.4g')} Hz = {_number(s['omega_rpm'], '.0f')}", "rpm"),
-        ("amplitude; ball radius", f"{_number(s['amplitude_mm'], '.4g')}; {_number(s['ball_radius_mm'], '.4g')}", "mm"),
+        ("amplitude; ball radius", f"{_number(s['amplitude_mm'], '.4g')}; {_radii_mm(result.params)}", "mm"),
         ("ambient; initial temperature", f"{_number(s['ambient_temperature_C'], '.4g')}; {_number(s['initial_temperature_C'], '.4g')}", "°C"),
         ("simulated time", _number(s["simulated_s"], ".6g"), "s"),
         (f"{ball} steady state", _number(s["ball_steady_C"], ".2f"), "°C"),
