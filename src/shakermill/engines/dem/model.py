@@ -12,8 +12,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from shakermill.engines.network import network_constants
 from shakermill.parameters.schema import MOTION_COORDINATES, Parameters
-from shakermill.physics import contact, thermal
+from shakermill.physics import contact
 from shakermill.physics.kinematics import fourier_coordinates, rotation_matrix
 
 LEFT_END, RIGHT_END, SIDE = 0, 1, 2
@@ -204,11 +205,9 @@ def constants_from(params: Parameters) -> Constants:
     rayleigh = min(
         contact.rayleigh_time(r, rho, e, nu) for r, rho, e, nu in zip(radius, density, youngs, poisson, strict=True)
     )
-    viscosity_ambient = thermal.sutherland_viscosity(
-        params.ambient_temperature, params.air_viscosity_ref, params.air_reference_temperature, params.sutherland
-    )
     fastest_node = min(value for value, _ in params.thermal_time_constants_at_rest.values())
     return Constants(
+        **network_constants(params),
         n_balls=n,
         radius=radius,
         mass=mass,
@@ -239,23 +238,7 @@ def constants_from(params: Parameters) -> Constants:
         max_flight_step=params.max_flight_step,
         max_overlap=MAX_OVERLAP_FRACTION * float(radius.min()),
         thermal_step=min(THERMAL_STEP, THERMAL_STEP_FRACTION * fastest_node),
-        relative_convection=params.relative_convection,
-        air_density=params.air_density,
-        viscosity_ambient=viscosity_ambient,
-        prandtl=thermal.prandtl_number(params.air_cp, viscosity_ambient, params.air_conductivity),
-        mu_ref=params.air_viscosity_ref,
-        t_ref=params.air_reference_temperature,
-        sutherland=params.sutherland,
-        air_conductivity=params.air_conductivity,
-        beta=params.beta,
-        h_inner=params.h_inner,
-        h_outer=params.h_outer,
-        inner_area=params.inner_area,
-        outer_area=params.outer_area,
         capacity_ball=mass * heat_capacity,
-        capacity_vial=params.vial_mass * params.vial_heat_capacity,
-        capacity_air=params.air_mass * params.air_heat_capacity,
-        t_ambient=params.ambient_temperature,
     )
 
 

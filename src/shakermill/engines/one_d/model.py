@@ -30,6 +30,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from shakermill.engines.network import network_constants
 from shakermill.parameters.schema import Parameters
 from shakermill.physics import contact, kinematics, thermal
 
@@ -91,10 +92,8 @@ def constants_from(params: Parameters) -> Constants:
     e_star = contact.effective_modulus(
         params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus, params.vial_poisson_ratio
     )
-    viscosity_ambient = thermal.sutherland_viscosity(
-        params.ambient_temperature, params.air_viscosity_ref, params.air_reference_temperature, params.sutherland
-    )
     return Constants(
+        **network_constants(params),
         ball_mass=params.ball_mass,
         radius=params.ball_radius,
         half_length=0.5 * params.vial_length,
@@ -107,23 +106,7 @@ def constants_from(params: Parameters) -> Constants:
         eta=params.eta,
         lam=params.lam,
         paper_heat=params.heat_model == "paper",
-        relative_convection=params.relative_convection,
-        air_density=params.air_density,
-        viscosity_ambient=viscosity_ambient,
-        prandtl=thermal.prandtl_number(params.air_cp, viscosity_ambient, params.air_conductivity),
-        mu_ref=params.air_viscosity_ref,
-        t_ref=params.air_reference_temperature,
-        sutherland=params.sutherland,
-        air_conductivity=params.air_conductivity,
-        beta=params.beta,
-        h_inner=params.h_inner,
-        h_outer=params.h_outer,
-        inner_area=params.inner_area,
-        outer_area=params.outer_area,
         capacity_ball=params.ball_mass * params.ball_heat_capacity,
-        capacity_vial=params.vial_mass * params.vial_heat_capacity,
-        capacity_air=params.air_mass * params.air_heat_capacity,
-        t_ambient=params.ambient_temperature,
         ball_only=params.model == "ball_only",
     )
 
