@@ -18,6 +18,7 @@ from shakermill.engines.budget import RunBudget
 from shakermill.engines.dem import model, network, stepper
 from shakermill.engines.dem.engine import Engine, impact_columns
 from shakermill.engines.one_d.setup import ProgressCallback, sample_times
+from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.schema import Parameters
 from shakermill.physics.kinematics import fourier_coordinates
 from shakermill.solvers.result import (
@@ -33,7 +34,6 @@ from shakermill.solvers.result import (
     kelvin_to_celsius,
 )
 
-REACHED_STOP = stepper.REACHED_STOP
 # The record windows hold the motion at this interval (10 kHz): a drive period in ~570 points.
 WINDOW_INTERVAL = 1e-4
 # Simulated seconds between progress reports (tiny steps hand back control sooner: engine.CALL_SECONDS).

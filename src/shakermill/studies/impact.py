@@ -176,7 +176,7 @@ def _launch(engine: Engine, target: str, speed: float, angle: float, spin: float
 
 def _first_record(engine: Engine, contact_time: float) -> np.ndarray:
     """Advance ``engine`` a Hertz contact time at a time until its first contact has ended; its record row."""
-    from shakermill.engines.dem.stepper import REACHED_STOP
+    from shakermill.engines.status import REACHED_STOP
 
     for _ in range(MAX_CHUNKS):
         status = engine.advance(engine.t + contact_time)

@@ -10,13 +10,13 @@ import numpy as np
 
 from shakermill.engines.budget import RunBudget, interrupt_after_compiled_code
 from shakermill.engines.dem import model, stepper
+from shakermill.engines.status import BUDGET_EXCEEDED, NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.parameters.schema import Parameters
 
-BUDGET_EXCEEDED = -4
 STATUS_MESSAGES = {
-    stepper.REACHED_STOP: "The engine reached the end of the integration interval.",
-    stepper.NOT_FINITE: "The state became NaN or infinite.",
-    stepper.OVERLAP_TOO_LARGE: (
+    REACHED_STOP: "The engine reached the end of the integration interval.",
+    NOT_FINITE: "The state became NaN or infinite.",
+    OVERLAP_TOO_LARGE: (
         "A contact overlap exceeded 5 % of the smallest ball radius: the materials are too soft for these impact "
         "speeds, or contact_step_fraction is too large."
     ),

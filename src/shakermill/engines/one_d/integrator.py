@@ -55,17 +55,13 @@ from shakermill.engines.one_d.model import (
     gap,
     rhs,
 )
+from shakermill.engines.status import BUDGET_EXCEEDED, NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.physics import kinematics
 from shakermill.physics.contact import elastic_energy, hertz_contact_time, hertz_max_overlap
 
 # Status codes of the compiled loop (negative: failure).
-REACHED_STOP = 0
-NOT_FINITE = -1
-OVERLAP_TOO_LARGE = -2
 STEP_UNDERFLOW = -3
-# Checked between compiled calls (Integrator.advance), not in the loop: the run's budget (RunBudget.reason
-# says which limit) and the size of the record windows.
-BUDGET_EXCEEDED = -4
+# Checked between compiled calls (Integrator.advance), not in the loop: the size of the record windows.
 WINDOWS_FULL = -7
 # Every step inside a record window is kept: ~1000 rows a simulated second at the defaults (35 min of
 # windows fit, 4 min at rtol 1e-6), but tiny steps would fill memory and disk (a vacuum vial,
