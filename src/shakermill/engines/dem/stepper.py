@@ -24,6 +24,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from shakermill.engines.dem import network
 from shakermill.engines.dem.model import (
     DISSIPATED_NORMAL,
     DISSIPATED_ROLLING,
@@ -41,12 +42,9 @@ from shakermill.engines.dem.model import (
     Constants,
     State,
 )
-from shakermill.engines.dem import network
+from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.physics import contact, kinematics, thermal
 
-REACHED_STOP = 0
-NOT_FINITE = -1
-OVERLAP_TOO_LARGE = -2
 PAUSED = 2  # the step allowance of one call is spent; call again
 RECORDS_FULL = 3  # the impact buffer is full; grow it and call again
 
@@ -307,6 +305,21 @@ def _contact_point_velocity(ball: int, lever_sign: float, s: State, w: Scratch, 
 
 
 @njit(cache=True, inline="always")
+def _engage(slot: int, t: float, overlap: float, modulus: float, shear_modulus: float, radius: float, mass: float,
+            ball_radius: float, dt: float, k: Constants, s: State, w: Scratch, live: int) -> int:
+    """A touching slot (ball pair or wall): start its record if it is new, its response with these effective
+    values, the tangential force's torque on ball i (of radius ``ball_radius``); returns the live-slot count."""
+    if not s.contacts.active[slot]:
+        _touch(slot, t, s, w)
+    _response(slot, overlap, w.relative_spin, modulus, shear_modulus, radius, mass, dt, k, s, w)
+    _scaled_into(w.normal, -ball_radius, w.lever)
+    _cross_into(w.lever, w.tangential_force[slot], w.lever_torque_i[slot])
+    w.touching[slot] = True
+    w.live[live] = slot
+    return live + 1
+
+
+@njit(cache=True, inline="always")
 def _pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live: int) -> tuple[int, float]:
     """Responses of the touching ball pairs; returns the live-slot count and the deepest overlap (m)."""
     n = k.n_balls
@@ -325,18 +338,11 @@ def _pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live
             _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
             _contact_point_velocity(j, k.radius[j], s, w, w.other_velocity)
             w.point_velocity[:] -= w.other_velocity
-            if not s.contacts.active[slot]:
-                _touch(slot, t, s, w)
             _difference_into(s.spin[i], s.spin[j], w.relative_spin)
-            _response(slot, overlap, w.relative_spin, k.pair_modulus[i, j], k.pair_shear_modulus[i, j],
-                      k.pair_radius[i, j], k.pair_mass[i, j], dt, k, s, w)
-            _scaled_into(w.normal, -k.radius[i], w.lever)
-            _cross_into(w.lever, w.tangential_force[slot], w.lever_torque_i[slot])
+            live = _engage(slot, t, overlap, k.pair_modulus[i, j], k.pair_shear_modulus[i, j], k.pair_radius[i, j],
+                           k.pair_mass[i, j], k.radius[i], dt, k, s, w, live)
             _scaled_into(w.lever_torque_i[slot], k.radius[j] / k.radius[i], w.lever_torque_j[slot])
             w.wall_velocity[slot, :] = 0.0
-            w.touching[slot] = True
-            w.live[live] = slot
-            live += 1
     return live, deepest
 
 
@@ -361,17 +367,10 @@ def _wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live
                 w.wall_velocity[slot, axis] = w.rates[axis] + w.other_velocity[axis]
             _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
             w.point_velocity[:] -= w.wall_velocity[slot]
-            if not s.contacts.active[slot]:
-                _touch(slot, t, s, w)
             _difference_into(s.spin[i], w.angular, w.relative_spin)
-            _response(slot, overlap, w.relative_spin, k.wall_modulus[i], k.wall_shear_modulus[i],
-                      k.wall_radius[i, wall], k.mass[i], dt, k, s, w)
-            _scaled_into(w.normal, -k.radius[i], w.lever)
-            _cross_into(w.lever, w.tangential_force[slot], w.lever_torque_i[slot])
+            live = _engage(slot, t, overlap, k.wall_modulus[i], k.wall_shear_modulus[i], k.wall_radius[i, wall],
+                           k.mass[i], k.radius[i], dt, k, s, w, live)
             w.lever_torque_j[slot, :] = 0.0
-            w.touching[slot] = True
-            w.live[live] = slot
-            live += 1
     return live, deepest
 
 
