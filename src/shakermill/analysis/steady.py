@@ -145,19 +145,24 @@ def _unsolved(heat_power: float, velocity_term: float, message: str) -> SteadySt
 
 
 def settled_means(times: np.ndarray, heat_generated: np.ndarray, velocity_term_integral: np.ndarray) -> tuple[float, float]:
-    """Mean heat rate (W) and Whitaker velocity term over the second half of a run (its settled motion).
+    """Mean heat rate (W) and Whitaker velocity term over the second half of a run (its settled motion)."""
+    return float(settled_rates(times, heat_generated)), float(settled_rates(times, velocity_term_integral))
+
+
+def settled_rates(times: np.ndarray, cumulative: np.ndarray) -> np.ndarray:
+    """Mean rates over the second half of a run (its settled motion) of a cumulative series over
+    (time, ...): one rate per column, zero for a run of no length.
 
     The same convention as the regime classification: the start-up transient lasts seconds, so the
     second half of any run worth averaging is settled.
     """
     end = times[-1]
     middle = 0.5 * end
+    columns = np.asarray(cumulative, dtype=float).reshape(times.size, -1)
     if end <= 0.0:
-        return 0.0, 0.0
-    heat_middle = float(np.interp(middle, times, heat_generated))
-    term_middle = float(np.interp(middle, times, velocity_term_integral))
-    span = end - middle
-    return (float(heat_generated[-1]) - heat_middle) / span, (float(velocity_term_integral[-1]) - term_middle) / span
+        return np.zeros(columns.shape[1:]).reshape(np.shape(cumulative)[1:])
+    halfway = np.array([np.interp(middle, times, column) for column in columns.T])
+    return ((columns[-1] - halfway) / (end - middle)).reshape(np.shape(cumulative)[1:])
 
 
 def run_length_warning(duration: float, steady: SteadyState) -> str | None:

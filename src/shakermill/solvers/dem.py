@@ -13,7 +13,7 @@ from scipy.integrate import solve_ivp
 
 from shakermill.analysis.batch_means import batch_rates, mser_truncation, normalised, relative_error, standard_error
 from shakermill.analysis.fit import fit_exponential
-from shakermill.analysis.steady import SteadyState, network_steady_state
+from shakermill.analysis.steady import SteadyState, network_steady_state, settled_rates
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.dem import model, network, stepper
 from shakermill.engines.dem.engine import Engine, impact_columns
@@ -198,18 +198,8 @@ def _attributes(units: str, long_name: str) -> dict[str, str]:
 def _settled_steady_state(params: Parameters, k: model.Constants, history: StateHistory) -> SteadyState:
     """The steady state (MODEL.md §11) for the means of the run's second half: its settled motion."""
     times = history.times
-    middle = 0.5 * times[-1]
-    span = times[-1] - middle
-
-    def rate(values: np.ndarray) -> np.ndarray:
-        if span <= 0.0:
-            return np.zeros(values.shape[1:])
-        halfway = np.array([np.interp(middle, times, column) for column in values.reshape(times.size, -1).T])
-        return (values[-1].reshape(-1) - halfway) / span
-
-    heat = np.append(rate(history["heat_into_balls"]), rate(history["heat_into_vial"]))
-    terms = rate(history["velocity_term_integrals"])
-    return _network_steady_state(params, k, heat, terms)
+    heat = np.append(settled_rates(times, history["heat_into_balls"]), settled_rates(times, history["heat_into_vial"]))
+    return _network_steady_state(params, k, heat, settled_rates(times, history["velocity_term_integrals"]))
 
 
 def _network_steady_state(params: Parameters, k: model.Constants, heat: np.ndarray, terms: np.ndarray) -> SteadyState:
