@@ -62,3 +62,13 @@ def single_impact_fixture():
 def default_run_20s() -> sm.Result:
     """The default preset over 20 simulated seconds (shared by several tests)."""
     return sm.simulate(sm.default_parameters(duration=20.0))
+
+
+def assert_one_error_line(stderr: str, *fragments: str) -> None:
+    """A command refused its input as the brief asks: one ``error:`` line naming every fragment, no traceback."""
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
+    assert lines[0].startswith("error: ")
+    for fragment in fragments:
+        assert fragment in lines[0], (fragment, lines[0])
+    assert "Traceback" not in stderr

@@ -14,18 +14,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import TIGHTEST_TOLERANCES, assert_one_error_line
 from rich.console import Console
 from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
-from shakermill.studies.calibrate import DEFAULT_FREE
+from shakermill.io.runs import RUN_FILES, load_run
 from shakermill.parameters.config import load_config
 from shakermill.parameters.schema import FIELD_NAMES
 from shakermill.solvers.result import INTERRUPTED
-from shakermill.io.runs import RUN_FILES, load_run
+from shakermill.studies.calibrate import DEFAULT_FREE
 from shakermill.studies.sweep import load_sweep
-from conftest import TIGHTEST_TOLERANCES
 
 # Short runs with small windows keep every invocation well under a second once Numba's cache is warm.
 SHORT = ["--set", "duration=2", "--set", "record_windows=0:0.2"]
@@ -58,15 +58,6 @@ runner = CliRunner()
 
 def invoke(*args: str):
     return runner.invoke(cli.app, list(args))
-
-
-def assert_one_error_line(stderr: str, *fragments: str) -> None:
-    lines = stderr.strip().splitlines()
-    assert len(lines) == 1, stderr
-    assert lines[0].startswith("error: ")
-    for fragment in fragments:
-        assert fragment in lines[0], (fragment, lines[0])
-    assert "Traceback" not in stderr
 
 
 def test_run_json_prints_exactly_one_object_matching_the_stored_summary(tmp_path):

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import assert_one_error_line
 from typer.testing import CliRunner
 
 import shakermill as sm
@@ -37,15 +38,6 @@ runner = CliRunner()
 
 def invoke(*args: str):
     return runner.invoke(cli.app, ["impact", *args])
-
-
-def assert_one_error_line(stderr: str, *fragments: str) -> None:
-    lines = stderr.strip().splitlines()
-    assert len(lines) == 1, stderr
-    assert lines[0].startswith("error: ")
-    for fragment in fragments:
-        assert fragment in lines[0], (fragment, lines[0])
-    assert "Traceback" not in stderr
 
 
 def test_json_holds_exactly_the_documented_keys():
