@@ -38,6 +38,7 @@ from shakermill.parameters.defaults import (
     ANIMATION_FRAMES,
     DEFAULT_FREE,
     DEFAULT_SCHEDULER_TIMEOUT_S,
+    DEM_DEFAULT_FREE,
     MOST_ANIMATION_FRAMES,
     PNG_DPI,
     REPORT_FILE,
@@ -961,10 +962,19 @@ def validate(
     study: Annotated[
         bool, typer.Option(help="Also fit several free sets to the experiment's curve and say which follow it (~15 s).")
     ] = True,
+    three_d: Annotated[
+        bool,
+        typer.Option(
+            "--three-d/--no-three-d",
+            help="Also the held-out five-ball prediction of the calibrated 3-D preset, the one-ball comparison of "
+            "the engines and the sensitivity to the assumed SPEX kinematics (averaged solver, a few minutes).",
+        ),
+    ] = True,
     json_output: JsonOption = False,
 ) -> None:
     """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
-    calibrated parameters, and which free sets of a calibration can follow the curve."""
+    calibrated parameters, which free sets of a calibration can follow the curve, and (3-D) the five-ball
+    experiment that no fit has seen."""
     from shakermill.io.runs import to_jsonable
     from shakermill.studies.calibrate import free_set_study
 
@@ -972,8 +982,10 @@ def validate(
         _fail(f"solver: {solver!r} is not allowed; allowed: one of 'full', 'averaged'")
     runs = run_validation(solver)
     outcomes = free_set_study(preset_parameters(DEFAULT_PRESET)) if study else []
+    held_out = _held_out_studies() if three_d else None
     if json_output:
-        typer.echo(json.dumps(to_jsonable(validation_payload(runs, outcomes, solver)), sort_keys=True, allow_nan=False))
+        payload = {**validation_payload(runs, outcomes, solver), **(held_out_payload(*held_out) if held_out else {})}
+        typer.echo(json.dumps(to_jsonable(payload), sort_keys=True, allow_nan=False))
         return
     console = _stdout_console()
     console.print(validation_table(runs))
@@ -982,6 +994,72 @@ def validate(
     console.print(Text(f"The experiment's ratio is for five balls: {TABLE5[-1].experiment_note}."))
     if outcomes:
         console.print(free_set_table(outcomes))
+    if held_out:
+        print_held_out(console, *held_out)
+
+
+def _held_out_studies() -> tuple[Any, Any, Any]:
+    """The five-ball prediction, the engines on one ball and the kinematic sensitivity, with one progress bar."""
+    from shakermill.studies.held_out import ENGINE_CASES, engine_comparison, five_ball_prediction
+    from shakermill.studies.kinematics import kinematic_sensitivity, sensitivity_base
+
+    with _progress_bar("3-D validation", "{task.completed}/{task.total} runs", None) as update:
+        base = sensitivity_base()
+        steps = [0]
+
+        def step(*_: Any) -> None:
+            steps[0] += 1
+            if update is not None:
+                update(steps[0])
+
+        prediction = five_ball_prediction()
+        step()
+        comparison = engine_comparison(ENGINE_CASES, progress=step)
+        sensitivity = kinematic_sensitivity(base, progress=step)
+    return prediction, comparison, sensitivity
+
+
+def held_out_payload(prediction: Any, comparison: Any, sensitivity: Any) -> dict[str, Any]:
+    from shakermill.studies.held_out import COMPARED_KEYS, FIVE_BALL_SOURCE
+
+    return {
+        "five_balls": {
+            "preset": prediction.preset,
+            "source": FIVE_BALL_SOURCE,
+            "fitted_parameters": list(prediction.fitted),
+            "fitted_to": prediction.fitted_to,
+            "statement": prediction.statement,
+            "rows": {
+                row.key: {"label": row.label, "unit": row.unit, "experiment": row.experiment, "predicted": row.predicted,
+                          "relative_error": row.relative_error}
+                for row in prediction.rows
+            },
+        },
+        "engine_comparison": {
+            "units": {key: unit for key, _, unit in COMPARED_KEYS},
+            "cases": [{"label": case.label, **values} for case, values in zip(comparison.cases, comparison.values)],
+        },
+        "kinematic_sensitivity": sensitivity.as_dict(),
+    }
+
+
+def print_held_out(console: Console, prediction: Any, comparison: Any, sensitivity: Any) -> None:
+    from shakermill.studies.held_out import COMPARED_KEYS, FIVE_BALL_SOURCE
+
+    table = Table("quantity", "unit", "experiment", "predicted", "error", title=f"Held out: five balls ({FIVE_BALL_SOURCE})")
+    for row in prediction.rows:
+        _add_plain_row(table, row.label, row.unit, f"{row.experiment:g}", f"{row.predicted:.3g}", f"{100 * row.relative_error:+.0f} %")
+    console.print(table)
+    console.print(Text(prediction.statement))
+    table = Table("one ball", *(f"{label} [{unit}]" for _, label, unit in COMPARED_KEYS), title="One ball: what the third dimension, gravity and friction change")
+    for index, case in enumerate(comparison.cases):
+        cells = [
+            f"{values:.3g}" + ("" if index == 0 else f" ({100 * comparison.change(key, index):+.0f} %)")
+            for key, values in ((key, comparison.values[index][key]) for key, _, _ in COMPARED_KEYS)
+        ]
+        _add_plain_row(table, case.label, *cells)
+    console.print(table)
+    console.print(sensitivity_table(sensitivity))
 
 
 def preset_parameters(name: str) -> Parameters:
@@ -1080,7 +1158,7 @@ def calibrate(
     ] = None,
     free: Annotated[
         list[str] | None,
-        typer.Option("--free", "-f", metavar="KEY[,KEY]", help=f"Keys to fit (default: {','.join(DEFAULT_FREE)})."),
+        typer.Option("--free", "-f", metavar="KEY[,KEY]", help=f"Keys to fit (default: {','.join(DEFAULT_FREE)}; engine = 'dem': {','.join(DEM_DEFAULT_FREE)})."),
     ] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
     full_resolution: FullResolutionOption = False,
@@ -1090,13 +1168,12 @@ def calibrate(
     """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
     from shakermill.io.runs import to_jsonable
     from shakermill.studies.calibrate import calibrate as fit_parameters
-    from shakermill.studies.calibrate import parse_free, parse_targets
+    from shakermill.studies.calibrate import default_free, parse_free, parse_targets
 
     with _user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])
-        _require_one_dimensional_engine(run_config.params, "calibrate fits the one-ball model to the paper's experiment")
         targets = parse_targets(target or [])
-        free_keys = parse_free(free or [])
+        free_keys = parse_free(free or [], default_free(run_config.params))
         measured = Curve.from_csv(curve) if curve is not None else None
         if out is not None:
             # Checked before the fit, which takes a while.

@@ -11,6 +11,9 @@ FIGURE_FORMATS = ("png", "svg")
 DEFAULT_SCHEDULER_TIMEOUT_S = 10.0
 # The calibration's free keys when none are given.
 DEFAULT_FREE = ("beta", "vial_mass", "h_outer", "lam")
+# The 'dem' engine's: λ splits each contact's heat inside the stepper, so freeing it would re-run the
+# three-dimensional mechanics at every evaluation; these three move only the thermal network.
+DEM_DEFAULT_FREE = ("beta", "vial_mass", "h_outer")
 # The animation of a 'dem' run's balls (views/trajectories.py): a few seconds of GIF, however long the window.
 ANIMATION_FILE = "trajectories.gif"
 ANIMATION_FRAMES = 120

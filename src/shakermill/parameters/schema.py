@@ -732,9 +732,25 @@ def load_preset_file(path: Path, known: Mapping[str, Preset]) -> Preset:
     )
 
 
-PRESETS: dict[str, Preset] = {SPEX_8000M.name: SPEX_8000M}
-for _preset_file in sorted(PRESET_FOLDER.glob("*.toml")):
-    PRESETS[_preset_file.stem] = load_preset_file(_preset_file, PRESETS)
+def load_presets(folder: Path, built_in: Preset) -> dict[str, Preset]:
+    """The built-in preset and every TOML file of ``folder``, each loaded after the preset it builds on."""
+    presets = {built_in.name: built_in}
+    waiting = {path.stem: path for path in sorted(folder.glob("*.toml"))}
+    while waiting:
+        ready = [name for name, path in waiting.items() if _base_of(path) in presets]
+        if not ready:
+            raise ValueError(f"presets {', '.join(sorted(waiting))} build on presets that do not exist or on each other")
+        for name in ready:
+            presets[name] = load_preset_file(waiting.pop(name), presets)
+    return presets
+
+
+def _base_of(path: Path) -> str:
+    with path.open("rb") as handle:
+        return str(tomllib.load(handle).get("preset", ""))
+
+
+PRESETS: dict[str, Preset] = load_presets(PRESET_FOLDER, SPEX_8000M)
 DEFAULT_PRESET = SPEX_8000M.name
 
 

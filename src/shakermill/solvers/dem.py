@@ -287,32 +287,77 @@ def _means(rates: np.ndarray, n: int, transient: float, batch: float, engine: En
     return Means(heat, terms, averages)
 
 
-def simulate_dem_averaged(params: Parameters, progress: ProgressCallback | None, budget: RunBudget) -> Result:
-    """Mechanics until the per-ball means converge, then the N + 2 node network for the whole duration."""
-    started = time.perf_counter()
+# Keys that enter only the thermal network, never a force or the heat a contact makes (λ, η and the
+# balls' effusivities split that heat inside the stepper, and the air's properties set the Whitaker term):
+# runs that differ in these alone share their mechanics, so a fit of the vial's heat loss measures it once.
+THERMAL_ONLY_KEYS = (
+    "h_inner", "h_outer", "inner_area", "outer_area", "vial_mass", "vial_heat_capacity", "beta",
+    "ambient_temperature", "initial_temperature", "duration", "output_interval",
+)
+
+
+@dataclass(frozen=True)
+class Mechanics:
+    """The mechanics phase of an averaged run: the engine after it, its first row, which recorded rows lie in
+    a record window, the means, and the engine's status. Reusable by runs that differ in THERMAL_ONLY_KEYS."""
+
+    params: Parameters
+    engine: Engine
+    start: np.ndarray
+    in_window: np.ndarray
+    means: Means | None  # None when the mechanics stopped early
+    status: int
+
+    @property
+    def explanation(self) -> str:
+        return INTERRUPTED_MESSAGE if self.status == INTERRUPTED else self.engine.explain(self.status)
+
+    def serves(self, params: Parameters) -> bool:
+        return params.replace(**{key: getattr(self.params, key) for key in THERMAL_ONLY_KEYS}) == self.params
+
+
+def settle_mechanics(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Mechanics:
+    """Run the mechanics until the per-ball means converge; Ctrl-C ends it with the status INTERRUPTED and
+    keeps the engine, so that what it integrated can still be returned."""
     marks, _, in_window = _marks(params, np.zeros(1), params.averaging_max_time)
+    budget = budget if budget is not None else RunBudget.of(params)
     engine = Engine(params, budget, marks[1:] if marks.size and marks[0] == 0.0 else marks)
     start = engine.row_now()
     try:
         means, status = measure_means(params, engine, progress)
     except KeyboardInterrupt:
-        return _stopped(params, engine, start, INTERRUPTED, INTERRUPTED_MESSAGE, started)
-    if status != REACHED_STOP:
-        return _stopped(params, engine, start, status, engine.explain(status), started)
-    problem = None if not means.averages.converged else _time_scales_problem(engine, means)
+        means, status = None, INTERRUPTED
+    return Mechanics(params, engine, start, in_window, means, status)
+
+
+def simulate_dem_averaged(params: Parameters, progress: ProgressCallback | None, budget: RunBudget,
+                          mechanics: Mechanics | None = None) -> Result:
+    """Mechanics until the per-ball means converge (or ``mechanics`` measured before, for parameters that
+    differ in THERMAL_ONLY_KEYS alone), then the N + 2 node network for the whole duration."""
+    started = time.perf_counter()
+    if mechanics is None:
+        mechanics = settle_mechanics(params, progress, budget)
+    elif not mechanics.serves(params):
+        raise ValueError("mechanics: measured for parameters that differ in more than the thermal-only keys")
+    if mechanics.status != REACHED_STOP or mechanics.means is None:
+        return _stopped(params, mechanics, mechanics.status, mechanics.explanation, started)
+    engine, start, means = mechanics.engine, mechanics.start, mechanics.means
+    k = model.constants_from(params)
+    problem = None if not means.averages.converged else _time_scales_problem(engine, k, means)
     if not means.averages.converged or problem is not None:
         if problem is not None:
             means = Means(means.heat, means.terms, _with_message(means.averages, problem))
-        return _refuse(params, engine, start, means, progress, budget, started)
+        return _refuse(params, mechanics, means, progress, budget, started)
     times = sample_times(params)
-    k = engine.constants
     thermal = _integrate_network(params, k, means, times)
     if progress is not None:
         progress(params.duration, params.duration)
     if not thermal.success:
         means = Means(means.heat, means.terms, _with_message(means.averages, f"the thermal network solver failed: {thermal.message}"))
-        return _refuse(params, engine, start, means, progress, budget, started)
+        return _refuse(params, mechanics, means, progress, budget, started)
+    in_window = mechanics.in_window
     windows = np.vstack([start, engine.rows])[in_window[: len(engine.rows) + 1]] if in_window.size else start[:0]
+    impacts = impact_columns(engine.records, since=means.averages.transient)
     result = Result(
         params=params,
         status=REACHED_STOP,
@@ -320,10 +365,10 @@ def simulate_dem_averaged(params: Parameters, progress: ProgressCallback | None,
         t_end=params.duration,
         history=history_of(thermal.t, _averaged_fields(thermal, means, k, params), k),
         window_history=dem_history(windows, k),
-        impact_columns=impact_columns(engine.records, since=means.averages.transient),
+        impact_columns=impacts,
         counters=_counters(engine, thermal_rhs_evaluations=int(thermal.nfev)),
         wall_time=time.perf_counter() - started,
-        energy=_averaged_energy(params, k, means, thermal, impact_columns(engine.records, since=means.averages.transient)),
+        energy=_averaged_energy(params, k, means, thermal, impacts),
         ball_fit=fit_exponential(thermal.t, thermal.y[: k.n_balls].mean(axis=0), params.initial_temperature),
         solver="averaged",
         impact_window=means.averages.window,
@@ -333,10 +378,11 @@ def simulate_dem_averaged(params: Parameters, progress: ProgressCallback | None,
     return conclude(result, steady.heat_power, steady.velocity_term, steady)
 
 
-def _time_scales_problem(engine: Engine, means: Means) -> str | None:
-    """Why averaging is not valid, or None: every ball's and the vial's thermal time constant must exceed the
-    time between the impacts that heat it by TIME_SCALE_SEPARATION, or its temperature follows single impacts."""
-    k, n = engine.constants, engine.constants.n_balls
+def _time_scales_problem(engine: Engine, k: model.Constants, means: Means) -> str | None:
+    """Why averaging is not valid, or None: every ball's and the vial's thermal time constant (``k``'s) must
+    exceed the time between the impacts that heat it by TIME_SCALE_SEPARATION, or its temperature follows
+    single impacts."""
+    n = k.n_balls
     window = means.averages.window
     records = impact_columns(engine.records, since=means.averages.transient)
     # Conductances (W/K) as the heat flows of 1 K excess of each ball over the air, at ambient temperature
@@ -440,8 +486,10 @@ def _averaged_energy(params: Parameters, k: model.Constants, means: Means, therm
     )
 
 
-def _stopped(params: Parameters, engine: Engine, start: np.ndarray, status: int, message: str, started: float) -> Result:
-    """The mechanics phase ended early (Ctrl-C, budget, engine failure): what it integrated, as a full run of that stretch."""
+def _stopped(params: Parameters, mechanics: Mechanics, status: int, message: str, started: float) -> Result:
+    """The mechanics phase ended early (Ctrl-C, budget, engine failure) or averaging is refused: what it
+    integrated, as a full run of that stretch."""
+    engine, start = mechanics.engine, mechanics.start
     samples = np.vstack([start, engine.row_now()])
     message = f"{message} Stopped in the averaged solver's mechanics phase at t = {engine.t:.6g} s; the motion and impacts up to then are kept."
     result = _result(params, engine, start, samples, start[:0], status, message, time.perf_counter() - started, solver="averaged")
@@ -449,13 +497,13 @@ def _stopped(params: Parameters, engine: Engine, start: np.ndarray, status: int,
     return conclude(result, steady.heat_power, steady.velocity_term, steady)
 
 
-def _refuse(params: Parameters, engine: Engine, start: np.ndarray, means: Means, progress: ProgressCallback | None,
+def _refuse(params: Parameters, mechanics: Mechanics, means: Means, progress: ProgressCallback | None,
             budget: RunBudget, started: float) -> Result:
     """Averaging is not valid: fall back to full resolution, or fail, as ``averaging_fallback`` says."""
     problem = means.averages.message
     if params.averaging_fallback == "fail":
         reason = f"Averaging is not valid: {problem}. Set averaging_fallback = 'full' to run at full resolution."
-        result = _stopped(params, engine, start, AVERAGING_FAILED, reason, started)
+        result = _stopped(params, mechanics, AVERAGING_FAILED, reason, started)
         result.message, result.averages = reason, means.averages
         return result
     result = simulate_dem_full(params, progress, budget)

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from typing import Callable
+
 from shakermill.engines.budget import BudgetExceeded, RunBudget
 from shakermill.engines.one_d.integrator import BUDGET_EXCEEDED
 from shakermill.engines.one_d.setup import ProgressCallback
 from shakermill.parameters.schema import Parameters
 from shakermill.solvers.averaged import simulate_averaged
-from shakermill.solvers.dem import simulate_dem
+from shakermill.solvers.dem import settle_mechanics, simulate_dem, simulate_dem_averaged
 from shakermill.solvers.full import simulate_full
 from shakermill.solvers.result import INTERRUPTED, Result
 
@@ -27,9 +29,30 @@ def simulate_whole(params: Parameters) -> Result:
     and a spent budget :class:`~shakermill.budget.BudgetExceeded` (saying which limit) instead of
     returning a partial result they would use as if it were whole."""
     budget = RunBudget.of(params)
-    result = simulate(params, budget=budget)
+    return _whole(simulate(params, budget=budget), budget)
+
+
+def _whole(result: Result, budget: RunBudget) -> Result:
     if result.status == INTERRUPTED:
         raise KeyboardInterrupt
     if result.status == BUDGET_EXCEEDED:
         raise BudgetExceeded(str(budget.reason))
     return result
+
+
+def thermal_variants(params: Parameters) -> Callable[[Parameters], Result]:
+    """:func:`simulate_whole` for runs that differ from ``params`` in ``THERMAL_ONLY_KEYS`` alone (a fit of
+    the vial's heat loss). The averaged ``dem`` solver measures the mechanics once, here, and each run then
+    integrates only its network: a three-dimensional run's means take tens of seconds, its network milliseconds."""
+    if params.engine != "dem" or params.solver != "averaged":
+        return simulate_whole
+    budget = RunBudget.of(params)
+    mechanics = settle_mechanics(params, budget=budget)
+    if mechanics.status in (INTERRUPTED, BUDGET_EXCEEDED):
+        _whole(simulate_dem_averaged(params, None, budget, mechanics), budget)
+
+    def run(variant: Parameters) -> Result:
+        variant_budget = RunBudget.of(variant)
+        return _whole(simulate_dem_averaged(variant, None, variant_budget, mechanics), variant_budget)
+
+    return run

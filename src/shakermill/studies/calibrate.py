@@ -30,10 +30,11 @@ import numpy as np
 import tomli_w
 from scipy.optimize import least_squares
 
-from shakermill.parameters.defaults import DEFAULT_FREE
+from shakermill.parameters.defaults import DEFAULT_FREE, DEM_DEFAULT_FREE
 from shakermill.parameters.schema import ParameterError, Parameters, bounds, check_known_keys
+from shakermill.solvers.dem import THERMAL_ONLY_KEYS
 from shakermill.solvers.result import Result
-from shakermill.solvers.simulate import simulate_whole
+from shakermill.solvers.simulate import thermal_variants
 from shakermill.studies.validation import (
     CURVE_TOLERANCE_K,
     TARGET_KEYS,
@@ -153,9 +154,14 @@ def _plain_number(text: str) -> float | None:
         return None
 
 
-def parse_free(items: Sequence[str]) -> tuple[str, ...]:
-    """``["beta,vial_mass", "eta"]`` -> ``("beta", "vial_mass", "eta")``; only positive float keys."""
-    keys = tuple(key.strip() for item in items for key in item.split(",") if key.strip()) or DEFAULT_FREE
+def default_free(params: Parameters) -> tuple[str, ...]:
+    """The free set a calibration of ``params`` fits when none is given: the engine's."""
+    return DEM_DEFAULT_FREE if params.engine == "dem" else DEFAULT_FREE
+
+
+def parse_free(items: Sequence[str], default: tuple[str, ...] = DEFAULT_FREE) -> tuple[str, ...]:
+    """``["beta,vial_mass", "eta"]`` -> ``("beta", "vial_mass", "eta")``, ``default`` for none; only float keys."""
+    keys = tuple(key.strip() for item in items for key in item.split(",") if key.strip()) or default
     check_known_keys(list(keys))
     for key in keys:
         if Parameters.model_fields[key].annotation is not float:
@@ -250,6 +256,7 @@ def calibrate(
     if not targets and curve is None:
         curve = experiment_curve()
     free = tuple(free)
+    _check_free_for_engine(base, free)
     for key in free:
         if getattr(base, key) <= 0:
             raise ParameterError(f"free: {key} must start positive to be fitted in log space, got {getattr(base, key)}")
@@ -261,12 +268,13 @@ def calibrate(
     longest = float(curve.times.max()) if curve is not None else 0.0
     fitting = base.replace(solver=solver, attractor_starts=1, duration=max(base.duration, longest))
     cache: dict[tuple[float, ...], tuple[np.ndarray, Result]] = {}
+    model = thermal_variants(fitting)
 
     def evaluate(x: np.ndarray) -> tuple[np.ndarray, Result]:
         key = tuple(np.round(x, 14))
         if key not in cache:
             params = fitting.replace(**{name: float(math.exp(v)) for name, v in zip(free, x)})
-            result = simulate_whole(params)
+            result = model(params)
             cache[key] = (_residuals(result, targets, curve), result)
             if progress is not None:
                 progress(len(cache))
@@ -305,6 +313,16 @@ def calibrate(
         curve_source=curve.source if curve is not None else "",
         result=result,
     )
+
+
+def _check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
+    """The 'dem' engine's calibration measures the mechanics once: only keys of the thermal network may move."""
+    moving = [key for key in free if key not in THERMAL_ONLY_KEYS]
+    if base.engine == "dem" and moving:
+        raise ParameterError(
+            f"free: {', '.join(moving)} would change the dem engine's mechanics, which a calibration measures once; "
+            f"allowed for engine = 'dem': {', '.join(THERMAL_ONLY_KEYS)}"
+        )
 
 
 def _outcome(

@@ -1,0 +1,125 @@
+"""Predictions held against what was not fitted (MODEL.md §10, §12): the five-ball experiment, and what the
+third dimension, gravity and friction change on the one-ball case.
+
+The calibrated three-dimensional preset was fitted to the one-ball curve only. The five-ball experiment of
+Takacs & McHenry (2006), as Son (2025, section 4) quotes it, is the first number the model meets that no
+fit has seen: the ball's and the vial's temperature rise after one hour, and their ratio.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping
+
+from shakermill.parameters.schema import default_parameters
+from shakermill.solvers.simulate import simulate_whole
+from shakermill.studies.validation import relative_error
+
+HELD_OUT_PRESET = "spex8000m-3d-calibrated"
+FIVE_BALLS = 5
+FIVE_BALL_SOURCE = "Takacs & McHenry 2006 (J. Mater. Sci. 41, 5246) as quoted by Son 2025, section 4: five balls, one hour"
+
+
+@dataclass(frozen=True)
+class HeldOutRow:
+    key: str
+    label: str
+    unit: str
+    experiment: float
+    predicted: float
+
+    @property
+    def relative_error(self) -> float:
+        return relative_error(self.predicted, self.experiment)
+
+
+@dataclass(frozen=True)
+class HeldOutPrediction:
+    """The calibrated preset with five balls, nothing refitted, against the five-ball experiment."""
+
+    preset: str
+    fitted: tuple[str, ...]
+    fitted_to: str
+    rows: tuple[HeldOutRow, ...]
+    summary: Mapping[str, Any]
+
+    @property
+    def statement(self) -> str:
+        errors = "; ".join(f"{row.label} off by {100 * row.relative_error:+.0f} %" for row in self.rows)
+        return (
+            f"{self.preset}: {', '.join(self.fitted)} fitted to {self.fitted_to} (one ball) only; with {FIVE_BALLS} balls "
+            f"nothing was refitted, so every number here is a prediction: {errors}."
+        )
+
+
+def five_ball_rows(summary: Mapping[str, Any]) -> tuple[HeldOutRow, ...]:
+    """The rises after one hour of the balls' mean and of the vial, and their ratio, beside the experiment."""
+    start = float(summary["initial_temperature_C"])
+    return (
+        HeldOutRow("ball_rise_C", "ball temperature rise after 1 h", "K", 46.0, float(summary["ball_C"]) - start),
+        HeldOutRow("vial_rise_C", "vial temperature rise after 1 h", "K", 21.0, float(summary["vial_C"]) - start),
+        HeldOutRow("vial_ball_ratio", "vial/ball rise ratio after 1 h", "", 0.46, float(summary["vial_ball_ratio"])),
+    )
+
+
+def five_ball_prediction(overrides: Mapping[str, Any] | None = None) -> HeldOutPrediction:
+    """Run :data:`HELD_OUT_PRESET` with five balls for the experiment's hour (averaged solver unless
+    ``overrides`` say otherwise) and compare with the experiment."""
+    from shakermill.parameters.schema import PRESETS
+
+    preset = PRESETS[HELD_OUT_PRESET]
+    settings = {"solver": "averaged", "record_windows": (), **(overrides or {}), "n_balls": FIVE_BALLS}
+    result = simulate_whole(default_parameters(HELD_OUT_PRESET, **settings))
+    fitted_to = str(preset.provenance.get("curve", "the one-ball experiment"))
+    return HeldOutPrediction(HELD_OUT_PRESET, preset.fitted, fitted_to, five_ball_rows(result.summary), result.summary)
+
+
+# The one-ball case, from the paper's model to the real mill, one change at a time.
+@dataclass(frozen=True)
+class EngineCase:
+    label: str
+    preset: str
+    settings: Mapping[str, Any] = field(default_factory=dict)
+
+
+ENGINE_CASES: tuple[EngineCase, ...] = (
+    EngineCase("1-D (the paper's model)", "spex8000m"),
+    EngineCase("3-D, its 1-D limit (axial, no gravity, no friction, Ø19 mm)", "spex8000m", {"engine": "dem", "gravity": False, "friction": 0.0}),
+    EngineCase("3-D, axial, gravity and friction, Ø19 mm", "spex8000m", {"engine": "dem"}),
+    EngineCase("3-D, axial, gravity and friction, Ø38 mm vial", "spex8000m-3d", {"kinematics": "axial"}),
+    EngineCase("3-D, SPEX figure-eight, Ø38 mm vial", "spex8000m-3d"),
+)
+COMPARED_KEYS: tuple[tuple[str, str, str], ...] = (
+    ("heat_power_W", "heat power", "W"),
+    ("hit_rate_hz", "hits (≥ 0.1 m/s)", "1/s"),
+    ("mean_hit_speed_m_s", "mean hit speed", "m/s"),
+    ("max_impact_speed_m_s", "fastest impact", "m/s"),
+    ("impact_rate_hz", "contacts, chatter included", "1/s"),
+)
+
+
+@dataclass(frozen=True)
+class EngineComparison:
+    cases: tuple[EngineCase, ...]
+    values: tuple[dict[str, float], ...]  # per case, COMPARED_KEYS' values
+
+    def change(self, key: str, case: int) -> float:
+        """Relative change of ``key`` in ``case`` against the 1-D model."""
+        return relative_error(self.values[case][key], self.values[0][key])
+
+
+def engine_comparison(
+    cases: tuple[EngineCase, ...] = ENGINE_CASES,
+    overrides: Mapping[str, Any] | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> EngineComparison:
+    """Heat power, hit rate and impact speeds of one ball for each case, with the averaged solver's means of
+    the settled motion (``overrides`` apply to every case)."""
+    values = []
+    for index, case in enumerate(cases):
+        settings = {"solver": "averaged", "record_windows": (), **case.settings, **(overrides or {})}
+        summary = simulate_whole(default_parameters(case.preset, **settings)).summary
+        values.append({key: float(summary[key]) for key, _, _ in COMPARED_KEYS})
+        if progress is not None:
+            progress(index + 1)
+    return EngineComparison(cases, tuple(values))

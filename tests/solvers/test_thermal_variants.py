@@ -1,0 +1,59 @@
+"""Runs that differ in the thermal network alone share the 'dem' engine's mechanics (solvers.simulate.thermal_variants)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import shakermill as sm
+from shakermill.parameters.schema import ParameterError
+from shakermill.solvers.dem import settle_mechanics, simulate_dem_averaged
+from shakermill.solvers.result import HIT_SPEED
+from shakermill.solvers.simulate import thermal_variants
+from shakermill.studies.calibrate import calibrate
+
+# Five balls knock each other off the bottom of a wide bore (the cheapest several-ball case) and their means
+# settle to ±3 % in a few seconds of mechanics.
+BALLS = {"engine": "dem", "n_balls": 5, "vial_diameter": "38 mm", "record_windows": (), "solver": "averaged",
+         "dem_averaging_rel_error": 0.03, "duration": 600.0}
+VARIANT = {"h_outer": 20.0, "vial_mass": 0.3, "beta": 1.5, "outer_area": 0.01}
+
+
+@pytest.fixture(name="base", scope="module")
+def base_fixture():
+    return sm.default_parameters(**BALLS)
+
+
+def test_a_thermal_variant_is_the_run_it_would_be_on_its_own(base):
+    variant = base.replace(**VARIANT)
+    run = thermal_variants(base)
+    shared = run(variant)
+    alone = sm.simulate(variant)
+    assert shared.success and alone.success and shared.averages.converged
+    # The mechanics are deterministic, so the reused means are the very numbers a fresh run measures.
+    assert shared.summary["heat_power_W"] == alone.summary["heat_power_W"]
+    for name in ("theta_ball", "theta_vial", "theta_air"):
+        np.testing.assert_allclose(shared.history[name], alone.history[name], rtol=1e-12)
+    assert shared.summary["vial_C"] != run(base).summary["vial_C"]  # the variant did change the network
+
+
+def test_mechanics_measured_for_other_mechanical_keys_are_refused(base):
+    mechanics = settle_mechanics(base.replace(averaging_max_time=0.2))
+    measured = mechanics.params
+    assert mechanics.serves(measured.replace(h_outer=10.0)) and not mechanics.serves(measured.replace(lam=0.5))
+    with pytest.raises(ValueError, match="thermal-only keys"):
+        simulate_dem_averaged(measured.replace(restitution=0.8), None, None, mechanics)
+
+
+def test_a_dem_calibration_frees_only_thermal_keys(base):
+    with pytest.raises(ParameterError, match=r"^free: lam would change the dem engine's mechanics.*allowed for engine = 'dem': h_inner"):
+        calibrate(base, ("beta", "lam"))
+
+
+def test_hits_leave_out_contacts_slower_than_the_hit_speed(base):
+    result = sm.simulate(base.replace(solver="full", duration=2.0))
+    speeds = np.asarray(result.impact_columns["impact_speed"])
+    hits = speeds[speeds >= HIT_SPEED]
+    assert 0 < hits.size < speeds.size  # resting balls chatter; flying ones hit
+    assert result.summary["hit_rate_hz"] == pytest.approx(hits.size / 2.0)
+    assert result.summary["mean_hit_speed_m_s"] == pytest.approx(hits.mean())
