@@ -14,6 +14,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from shakermill.support.limits import quoted
+
 LIBRARY_FILE = Path(__file__).parent / "materials.toml"
 
 # Each property's SI unit, as the library file must write it, and what it is.
@@ -23,8 +25,8 @@ PROPERTIES: dict[str, tuple[str, str]] = {
     "poisson_ratio": ("", "Poisson ratio ν"),
     "heat_capacity": ("J/(kg*K)", "specific heat c"),
     "conductivity": ("W/(m*K)", "thermal conductivity k"),
-    "restitution": ("", "restitution e, ball on the same material (range; shown, not applied)"),
-    "friction": ("", "friction μ, ball on the same material (range; shown, not applied)"),
+    "restitution": ("", "restitution e on the same material (shown, not applied)"),
+    "friction": ("", "friction μ on the same material (shown, not applied)"),
 }
 # The properties a material fills in: ``ball_<property>`` and ``vial_<property>`` where such a key exists.
 FILLED = ("density", "youngs_modulus", "poisson_ratio", "heat_capacity", "conductivity")
@@ -61,6 +63,14 @@ class Material:
 
     def properties(self) -> dict[str, Sourced]:
         return {name: getattr(self, name) for name in PROPERTIES}
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready: name, description, aliases and every property as {value, unit, source} (SI)."""
+        described: dict[str, object] = {"name": self.name, "description": self.description, "aliases": list(self.aliases)}
+        for key, sourced in self.properties().items():
+            value = list(sourced.value) if isinstance(sourced.value, tuple) else sourced.value
+            described[key] = {"value": value, "unit": sourced.unit, "source": sourced.source}
+        return described
 
 
 @functools.cache
@@ -108,7 +118,7 @@ def material(name: str) -> Material:
     wanted = str(name).strip().lower()
     found = library().get(_aliases().get(wanted, wanted))
     if found is None:
-        raise UnknownMaterial(f"unknown material {name!r}; allowed {allowed_names()}")
+        raise UnknownMaterial(f"unknown material {quoted(name)}; allowed {allowed_names()}")
     return found
 
 
