@@ -115,10 +115,11 @@ def _aliases() -> dict[str, str]:
 
 def material(name: str) -> Material:
     """The material ``name`` or one of its aliases (case and surrounding space ignored)."""
-    wanted = str(name).strip().lower()
+    given = str(name).strip()
+    wanted = given.lower()
     found = library().get(_aliases().get(wanted, wanted))
     if found is None:
-        raise UnknownMaterial(f"unknown material {quoted(name)}; allowed {allowed_names()}")
+        raise UnknownMaterial(f"unknown material {quoted(given)}; allowed {allowed_names()}")
     return found
 
 
