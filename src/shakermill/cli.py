@@ -593,6 +593,62 @@ def presets(
     console.print(table)
 
 
+# The library's table: property, header with its unit, scale from SI.
+MATERIAL_COLUMNS = (
+    ("density", "ρ (kg/m³)", 1.0),
+    ("youngs_modulus", "E (GPa)", 1e-9),
+    ("poisson_ratio", "ν", 1.0),
+    ("heat_capacity", "c (J/(kg·K))", 1.0),
+    ("conductivity", "k (W/(m·K))", 1.0),
+    ("restitution", "e (range, not applied)", 1.0),
+    ("friction", "μ (range, not applied)", 1.0),
+)
+
+
+@app.command("materials")
+def materials_command(
+    name: Annotated[str | None, typer.Argument(help="Show every value of this material with its unit and source.")] = None,
+    json_output: JsonOption = False,
+) -> None:
+    """List the materials library, or show one material's values, units and sources. Select one with
+    --set ball_material=NAME (or vial_material, or ball_materials per ball); its restitution and friction are
+    shown, never applied."""
+    from shakermill.parameters.materials import UnknownMaterial, library, material
+
+    try:
+        chosen = [material(name)] if name is not None else list(library().values())
+    except UnknownMaterial as exc:
+        _fail(str(exc))
+    if json_output:
+        described = [found.as_dict() for found in chosen]
+        typer.echo(json.dumps(described[0] if name is not None else {"materials": described}, allow_nan=False))
+        return
+    _stdout_console().print(material_table(chosen[0]) if name is not None else materials_table(chosen))
+
+
+def _material_value(value: float | tuple[float, float], scale: float = 1.0) -> str:
+    return f"{value[0]:g}-{value[1]:g}" if isinstance(value, tuple) else f"{value * scale:g}"
+
+
+def materials_table(chosen: Sequence[Any]) -> Table:
+    table = Table("material", *(header for _, header, _ in MATERIAL_COLUMNS), title="materials (room temperature)")
+    for found in chosen:
+        _add_plain_row(table, found.name, *(_material_value(getattr(found, key).value, scale) for key, _, scale in MATERIAL_COLUMNS))
+    table.caption = "`shakermill materials NAME`: every value's source; restitution and friction are shown, not applied"
+    return table
+
+
+def material_table(found: Any) -> Table:
+    from shakermill.parameters.materials import PROPERTIES
+
+    table = Table("property", "value", "unit (SI)", "source", title=f"{found.name}: {found.description}")
+    for key, sourced in found.properties().items():
+        _add_plain_row(table, PROPERTIES[key][1], _material_value(sourced.value), sourced.unit, sourced.source)
+    aliases = f"aliases: {', '.join(found.aliases)}; " if found.aliases else ""
+    table.caption = f"{aliases}select with --set ball_material={found.name} (or vial_material, ball_materials)"
+    return table
+
+
 @app.command()
 def keys() -> None:
     """List the canonical parameter keys with unit, allowed values, default and description."""
@@ -741,7 +797,8 @@ def sweep(
         list[str] | None,
         typer.Option(
             "--grid", "-g", metavar="KEY=START:STOP:N",
-            help="N equally spaced values of a numeric key, units allowed (amplitude=20mm:30mm:6); several grids combine as a product.",
+            help="N equally spaced values of a numeric key, units allowed (amplitude=20mm:30mm:6), or names "
+            "(ball_material=steel,zirconia); several grids combine as a product.",
         ),
     ] = None,
     points: Annotated[

@@ -28,6 +28,7 @@ from shakermill.parameters.schema import (
     field_description,
     field_unit,
     preset_values,
+    with_materials,
 )
 from shakermill.support.atomic import write_text_atomically
 from shakermill.support.limits import MAX_CONFIG_BYTES, quoted
@@ -65,8 +66,8 @@ def load_config(
         file_values = read_config_file(source)
         file_preset = _file_preset(file_values, source)
     chosen_preset = preset or file_preset or DEFAULT_PRESET
-    base = preset_values(chosen_preset)
-    base.update(file_values)
+    # Each layer completed by its own materials first: a file's material replaces the preset's values.
+    base = {**with_materials(preset_values(chosen_preset)), **with_materials(file_values)}
     params = build_parameters(base, parse_overrides(overrides))
     return RunConfig(params=params, preset=chosen_preset, source=source)
 

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping
 import annotated_types
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from shakermill.parameters import materials
 from shakermill.parameters.units import UnitError, to_si
 from shakermill.support.limits import (
     MAX_FULL_RESOLUTION_PERIODS,
@@ -50,6 +51,16 @@ def _quantity(unit: str, description: str, **bounds: float) -> Any:
 
 def _count(description: str, **bounds: int) -> Any:
     return Field(json_schema_extra={"unit": "", "description": description}, strict=True, **bounds)
+
+
+def _material_name(of: str, keys: str) -> Any:
+    return Field(
+        json_schema_extra={
+            "unit": "",
+            "description": f"material of {of} from `shakermill materials`: fills {keys} unless they are set with it or "
+            "later; '': none",
+        }
+    )
 
 
 def _per_ball(scalar_key: str) -> Any:
@@ -110,7 +121,11 @@ class Parameters(BaseModel):
     omega: float = _quantity("rad/s", "vial angular frequency ω", ge=1.0, le=1e4)
     # One turn either way: every phase has an equal one inside, and larger ones only cost precision in sin(ωt + φ).
     phase: float = _quantity("rad", "vial phase φ at t = 0", ge=-2 * math.pi, le=2 * math.pi)
-    # Materials (Table 2)
+    # Materials (Table 2). A named material fills in the keys below (with_materials); '' leaves them as they are.
+    ball_material: str = _material_name(
+        "the balls", "ball_density, ball_youngs_modulus, ball_poisson_ratio, ball_heat_capacity, ball_conductivity"
+    )
+    vial_material: str = _material_name("the vial", "vial_density, vial_youngs_modulus, vial_poisson_ratio, vial_heat_capacity")
     # 500 kg/m³: below every solid milling medium (polyethylene ~950); 25 000: above osmium (22 590), the
     # densest element. A ball of 1e-6 kg/m³ has no heat capacity and made a run take hours.
     ball_density: float = _quantity("kg/m^3", "ball density ρ_b", ge=500.0, le=25_000.0)
@@ -269,6 +284,14 @@ class Parameters(BaseModel):
     ball_poisson_ratios: tuple[float, ...] = _per_ball("ball_poisson_ratio")
     ball_heat_capacities: tuple[float, ...] = _per_ball("ball_heat_capacity")
     ball_conductivities: tuple[float, ...] = _per_ball("ball_conductivity")
+    ball_materials: tuple[str, ...] = Field(
+        max_length=MAX_BALLS,
+        json_schema_extra={
+            "unit": "",
+            "description": "per-ball material (engine = 'dem'): fills the per-ball lists of density, Young's modulus, "
+            "Poisson ratio, heat capacity and conductivity unless they are set with it or later",
+        },
+    )
     # Only the ratio of two balls' effusivities √(kρc) matters (the split of ball-ball heat, MODEL.md §12.4):
     # from aerogel-like 0.01 to diamond's 2000 W/(m·K).
     ball_conductivity: float = _quantity("W/(m*K)", "ball thermal conductivity k_b", ge=0.01, le=2000.0)
@@ -328,6 +351,12 @@ class Parameters(BaseModel):
         if self.engine == "1d" and self.n_balls > 1:
             raise ValueError(
                 "n_balls: the 1-D engine moves one ball; allowed n_balls = 1 with engine = '1d', or set engine = 'dem'"
+            )
+        # The materials first: their per-ball lists are as long as they are.
+        if self.ball_materials and len(self.ball_materials) != self.n_balls:
+            raise ValueError(
+                f"ball_materials: {len(self.ball_materials)} names for n_balls = {self.n_balls}; allowed an empty list "
+                f"or exactly {self.n_balls} names"
             )
         for key in PER_BALL_KEYS:
             _check_per_ball(key, getattr(self, key), self.n_balls)
@@ -474,6 +503,7 @@ PER_BALL_KEY_OF = {
     if "per_ball" in (field.json_schema_extra or {})
 }
 PER_BALL_KEYS = tuple(PER_BALL_KEY_OF.values())
+MATERIAL_KEYS = ("ball_material", "vial_material", "ball_materials")
 
 
 def _check_per_ball(key: str, values: tuple[float, ...], n_balls: int) -> None:
@@ -557,6 +587,10 @@ def allowed_range(key: str) -> str:
     if key in PER_BALL_KEYS:
         scalar = next(name for name, per_ball in PER_BALL_KEY_OF.items() if per_ball == key)
         return f"an empty list or n_balls values, each in {allowed_range(scalar)}"
+    if key == "ball_materials":
+        return f"an empty list or n_balls names, each {materials.allowed_names()}"
+    if key in MATERIAL_KEYS:
+        return f"'' (none) or {materials.allowed_names()}"
     if key == "motion":
         return (
             f"at most {MAX_HARMONICS} (coordinate, k, cos, sin) terms: coordinate one of {', '.join(MOTION_COORDINATES)}, "
@@ -681,6 +715,8 @@ SPEX_8000M = Preset(
         ),
         "engine": Cited("1d", f"{PAPER}: one ball on the vial's axis"),
         "n_balls": Cited(1, f"{PAPER}: one ball"),
+        **{key: Cited("", "no material: the keys' own values (the paper's steel)") for key in ("ball_material", "vial_material")},
+        "ball_materials": Cited((), "every ball takes ball_material, or the scalar keys' values"),
         **{key: Cited((), "every ball takes the scalar key's value") for key in PER_BALL_KEYS},
         "ball_conductivity": Cited(
             46.6, "AISI 52100 bearing steel at room temperature (ASM data sheet); only ratios between balls matter"
@@ -707,6 +743,70 @@ SPEX_8000M = Preset(
     },
 )
 
+def _coerce_material(key: str, value: Any) -> str | tuple[str, ...]:
+    """Canonical material names from a name or alias ('' or None: none), or for ``ball_materials`` from
+    "wc, zirconia" (the command line) or a list (TOML, Python)."""
+    if key != "ball_materials":
+        return "" if value is None or not str(value).strip() else _material_named(key, value)
+    items = [item for item in value.split(",") if item.strip()] if isinstance(value, str) else value
+    if not isinstance(items, (list, tuple)):
+        raise ParameterError(
+            f"{key}: expected a list of material names, one per ball, got {quoted(value)}; allowed {allowed_range(key)}"
+        )
+    return tuple(_material_named(key, item) for item in items)
+
+
+def _material_named(key: str, name: Any) -> str:
+    try:
+        return materials.material(name).name
+    except materials.UnknownMaterial as exc:
+        raise ParameterError(f"{key}: {exc}") from None
+
+
+def material_citations(layer: Mapping[str, Any]) -> dict[str, Cited]:
+    """The keys that the materials named in ``layer`` stand for, each with the material's value and source."""
+    cited: dict[str, Cited] = {}
+    for key, prefix in (("ball_material", "ball_"), ("vial_material", "vial_")):
+        name = _coerce_material(key, layer.get(key, ""))
+        if name:
+            found = materials.material(name)
+            for prop in materials.FILLED:
+                if prefix + prop in Parameters.model_fields:
+                    value = getattr(found, prop)
+                    cited[prefix + prop] = Cited(value.value, f"material {name}: {value.source}")
+    per_ball = [materials.material(name) for name in _coerce_material("ball_materials", layer.get("ball_materials", ()))]
+    for prop in materials.FILLED if per_ball else ():
+        sources = dict.fromkeys(f"{found.name}: {getattr(found, prop).source}" for found in per_ball)
+        values = tuple(getattr(found, prop).value for found in per_ball)
+        cited[PER_BALL_KEY_OF[f"ball_{prop}"]] = Cited(values, f"ball_materials: {'; '.join(sources)}")
+    return cited
+
+
+def with_materials(layer: Mapping[str, Any]) -> dict[str, Any]:
+    """``layer`` (a preset, a file, the ``--set`` overrides, a sweep point) with the values its materials fill in.
+
+    A key that ``layer`` sets itself wins over its material, and a later layer wins over both: each layer is
+    completed on its own before the layers are merged, so ``--set ball_material=wc`` replaces the preset's
+    steel density, while a file's ``ball_density`` beside its ``ball_material`` is kept.
+    """
+    return {**{key: cited.value for key, cited in material_citations(layer).items()}, **layer}
+
+
+def takes_names(key: str) -> bool:
+    """Whether ``key`` takes one name: a material or one of an option's choices."""
+    annotation = Parameters.model_fields[key].annotation
+    return annotation is str or typing.get_origin(annotation) is Literal
+
+
+def checked_name(key: str, value: Any) -> str:
+    """``value`` of a key that :func:`takes_names`, checked: its canonical name (a material's alias resolved)."""
+    if key in MATERIAL_KEYS:
+        return str(_coerce_material(key, value))
+    if value not in typing.get_args(Parameters.model_fields[key].annotation):
+        raise ParameterError(f"{key}: {quoted(value)} is not allowed; allowed {allowed_range(key)}")
+    return str(value)
+
+
 # Presets produced by a calibration ship as TOML files next to this module: a base preset, the fitted
 # values and a [provenance] table that records the fit (command, targets, residuals, date, version).
 PRESET_FOLDER = Path(__file__).parent / "presets"
@@ -720,7 +820,7 @@ def load_preset_file(path: Path, known: Mapping[str, Preset]) -> Preset:
     base = known[data.pop("preset")]
     fitted = tuple(provenance.get("fitted", ()))
     note = f"fitted by calibration ({path.name}, [provenance])"
-    values = dict(base.values)
+    values = {**base.values, **material_citations(data)}
     for key, value in data.items():
         values[key] = Cited(tuple(map(tuple, value)) if key == "record_windows" else value, note if key in fitted else f"set in {path.name}")
     return Preset(
@@ -859,6 +959,8 @@ def _coerce(key: str, value: Any) -> Any:
             return _coerce_per_ball(key, value)
         if key == "motion":
             return _coerce_motion(value)
+        if key in MATERIAL_KEYS:
+            return _coerce_material(key, value)
     except UnitError as exc:
         raise ParameterError(f"{exc}; allowed {allowed_range(key)}") from None
     return value  # one of a few names: the model checks it
@@ -968,12 +1070,13 @@ def _one_line(error: ValidationError) -> str:
 
 
 def build_parameters(base: Mapping[str, Any], overrides: Mapping[str, Any] | None = None) -> Parameters:
-    """Validate ``base`` updated with ``overrides`` into :class:`Parameters`.
+    """Validate ``base`` updated with ``overrides`` into :class:`Parameters`, each completed by its materials
+    first (:func:`with_materials`).
 
     Raises :class:`ParameterError` with one line that names the offending key.
     """
-    merged = dict(base)
-    merged.update(overrides or {})
+    merged = with_materials(base)
+    merged.update(with_materials(overrides or {}))
     check_known_keys(list(merged))
     missing = [key for key in FIELD_NAMES if key not in merged]
     if missing:

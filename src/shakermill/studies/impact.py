@@ -108,6 +108,7 @@ def impact_parameters(params: Parameters, target: str) -> Parameters:
     radius = params.ball_radius
     return params.replace(
         **{key: () for key in PER_BALL_KEYS},
+        ball_materials=(),
         engine="dem",
         n_balls=1 if target == "wall" else 2,
         gravity=False,

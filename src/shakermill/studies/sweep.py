@@ -45,7 +45,15 @@ from shakermill.io.runs import to_jsonable
 from shakermill.parameters.config import RunConfig, load_config, parse_overrides, read_config_file
 from shakermill.parameters.csvinput import read_csv_rows
 from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
-from shakermill.parameters.schema import DEFAULT_PRESET, ParameterError, Parameters, check_known_keys, field_unit
+from shakermill.parameters.schema import (
+    DEFAULT_PRESET,
+    ParameterError,
+    Parameters,
+    check_known_keys,
+    checked_name,
+    field_unit,
+    takes_names,
+)
 from shakermill.parameters.units import UnitError, to_si
 from shakermill.solvers.result import INTERRUPTED, Result
 from shakermill.solvers.simulate import simulate
@@ -168,6 +176,24 @@ def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray
     return key, np.linspace(low, high, int(count))
 
 
+def grid_values(spec: str) -> tuple[str, Sequence[Any]]:
+    """The values of one ``--grid``: ``KEY=START:STOP:N`` for a real-valued key (:func:`parse_grid`), or
+    ``KEY=A,B,C`` for a key that takes names (``ball_material=steel,zirconia``, ``solver=full,averaged``)."""
+    match = GRID_PATTERN.match(spec)
+    key = match["key"] if match is not None else ""
+    if key not in Parameters.model_fields or not takes_names(key):
+        return parse_grid(spec)
+    names = [item.strip() for item in match["range"].split(",") if item.strip()]
+    if not names:
+        raise ParameterError(f"grid {quoted(spec)}: expected KEY=A,B,C, for example ball_material=steel,zirconia")
+    check_point_count(len(names))
+    try:
+        # A misspelt name fails the sweep before it starts, not one point in the middle of it.
+        return key, [checked_name(key, name) for name in names]
+    except ParameterError as exc:
+        raise ParameterError(f"grid {quoted(spec)}: {exc}") from None
+
+
 def product_points(grids: Sequence[tuple[str, Sequence[Any]]], listed: int = 1) -> list[dict[str, Any]]:
     """Every combination of the grids' values; the first grid varies slowest (row-major order).
 
@@ -223,7 +249,7 @@ def _check_distinct(keys: Sequence[str], what: str) -> None:
 
 def plan_sweep(grids: Sequence[str] = (), points_file: Path | str | None = None) -> SweepPlan:
     """The points of ``--grid`` specifications and/or a ``--points`` file (each row times the grid's product)."""
-    parsed = [parse_grid(spec) for spec in grids]
+    parsed = [grid_values(spec) for spec in grids]
     listed = read_points(points_file) if points_file is not None else [{}]
     grid_points = product_points(parsed, len(listed)) if parsed else [{}]
     keys = [*listed[0], *(key for key, _ in parsed)]

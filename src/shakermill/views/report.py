@@ -23,7 +23,14 @@ from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping, Sequence
 from shakermill.analysis.regime import classify_impacts, settled_run_impacts
 from shakermill.io.runs import CONFIG_FILE, RunData, load_run
 from shakermill.parameters.defaults import REPORT_FILE
-from shakermill.parameters.schema import DEFAULT_PRESET, PRESETS, Preset, field_description, field_unit
+from shakermill.parameters.schema import (
+    DEFAULT_PRESET,
+    PRESETS,
+    Preset,
+    field_description,
+    field_unit,
+    material_citations,
+)
 from shakermill.studies.validation import (
     EXPERIMENT,
     OPERATING_POINT_TOLERANCE,
@@ -534,7 +541,9 @@ def paper_figures_section(run: RunData, numbers: Iterator[int]) -> str:
 def configuration_section(run: RunData, preset: Preset | None) -> str:
     rows = []
     differs = {}
-    for index, (key, value) in enumerate(run.params.model_dump().items()):
+    values = run.params.model_dump()
+    from_materials = material_citations(values)
+    for index, (key, value) in enumerate(values.items()):
         cited = preset.values.get(key) if preset else None
         if cited is None:
             preset_value, source = "n/a", "no preset value"
@@ -543,14 +552,17 @@ def configuration_section(run: RunData, preset: Preset | None) -> str:
         else:
             preset_value, source = format_parameter(cited.value), cited.source
             differs[index] = "differs"
+        material = from_materials.get(key)
+        if material is not None and same_value(value, material.value):
+            source = material.source
         unit = pretty_unit(field_unit(key))
         rows.append((key, format_parameter(value), unit, preset_value, source, field_description(key)))
     changed = f"highlighted: the {len(differs)} keys whose value differs" if differs else "no key differs"
     intro = (
         f"The resolved configuration of this run (SI units); {changed} from preset {run.preset}. "
-        "The source column cites the preset's value."
+        "The source column cites the value's material where a material of the library gave it, else the preset's value."
     )
-    headers = ("key", "value", "unit", "preset value", "source of the preset value", "meaning")
+    headers = ("key", "value", "unit", "preset value", "source", "meaning")
     return section("Configuration", paragraph(intro), table(headers, rows, row_classes=differs))
 
 
