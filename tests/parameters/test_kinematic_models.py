@@ -109,11 +109,12 @@ def test_every_value_a_preset_sets_names_its_source(name):
         ({"kinematics": "mixer-mill-arc", "swing_radius": 0}, ("swing_radius:", "allowed [0.001, 1] m")),
         ({"kinematics": "mixer-mill-arc", "swing_radius": "10 mm"}, ("amplitude:", "swing_radius·π/2 = 0.01571 m")),
         ({"kinematics": "figure8"}, ("kinematics:", "'spex8000m', 'mixer-mill-arc'")),
+        ({"engine": "1d", "kinematics": "spex8000m"}, ("kinematics:", "allowed 'axial' with engine = '1d'")),
     ],
 )
 def test_bad_kinematic_values_are_refused_in_one_line(overrides, fragments):
     with pytest.raises(ParameterError) as caught:
-        sm.default_parameters(engine="dem", **overrides)
+        sm.default_parameters(**{"engine": "dem", **overrides})
     message = str(caught.value)
     assert "\n" not in message
     assert all(fragment in message for fragment in fragments), message

@@ -344,6 +344,11 @@ class Parameters(BaseModel):
             raise ValueError(
                 "n_balls: the 1-D engine moves one ball; allowed n_balls = 1 with engine = '1d', or set engine = 'dem'"
             )
+        if self.engine == "1d" and self.kinematics != "axial":
+            raise ValueError(
+                f"kinematics: the 1-D engine moves the vial along its axis, not as {self.kinematics!r}; allowed 'axial' "
+                "with engine = '1d', or set engine = 'dem'"
+            )
         for key in PER_BALL_KEYS:
             _check_per_ball(key, getattr(self, key), self.n_balls)
         if self.kinematics == "fourier" and not self.motion:
