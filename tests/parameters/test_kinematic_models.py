@@ -11,7 +11,7 @@ import pytest
 import shakermill as sm
 from shakermill.engines.dem.model import harmonics_of
 from shakermill.parameters import kinematic_models as models
-from shakermill.parameters.schema import PRESETS, ParameterError, Parameters, unit_slip_warnings
+from shakermill.parameters.schema import MOTION_COORDINATES, PRESETS, ParameterError, Parameters, unit_slip_warnings
 from shakermill.physics import kinematics as drive
 
 THETAS = np.linspace(0.0, 2.0 * math.pi, 37)
@@ -50,10 +50,10 @@ def test_the_spex_motion_without_lateral_motion_and_yaw_is_axial():
 def test_the_arcs_fourier_series_is_its_closed_form(alpha):
     radius = 0.1
     terms = models.arc_terms(alpha * radius, radius)
-    assert max(k for _, k, _, _ in terms) <= models.HIGHEST_ARC_HARMONIC
-    harmonics = np.zeros((6, models.HIGHEST_ARC_HARMONIC + 1, 2))
+    assert max(k for _, k, _, _ in terms) <= models.MAX_MOTION_HARMONIC
+    harmonics = np.zeros((6, models.MAX_MOTION_HARMONIC + 1, 2))
     for coordinate, k, cosine, sine in terms:
-        harmonics[("x", "y", "z", "roll", "pitch", "yaw").index(coordinate), k] += (cosine, sine)
+        harmonics[MOTION_COORDINATES.index(coordinate), k] += (cosine, sine)
     for theta in THETAS:
         values, _ = _coordinates(harmonics, theta, 1.0, 0.0)
         swing = alpha * math.sin(theta)

@@ -23,14 +23,14 @@ from scipy.special import jv
 
 Term = tuple[str, int, float, float]
 
+# Harmonics beyond the 20th describe no mill (a user's `motion` is held to it too).
+MAX_MOTION_HARMONIC = 20
 # The arc's Bessel series: terms smaller than this fraction of the swing radius are dropped. Within the
-# widest swing allowed (MAX_SWING_ANGLE) they fall below it before the 20th harmonic (MAX_MOTION_HARMONIC
-# of parameters/schema.py, which this module sits below).
+# widest swing allowed they fall below it before MAX_MOTION_HARMONIC (2R·J_20(π/2) ≈ 6e-21 R).
 ARC_TRUNCATION = 1e-12
 # A quarter turn either way: a mixer mill swings its jars through a few degrees; beyond a right angle
 # the jar's axis would point along the arm.
 MAX_SWING_ANGLE = 0.5 * math.pi
-HIGHEST_ARC_HARMONIC = 20
 
 
 @dataclass(frozen=True)
@@ -78,7 +78,7 @@ def arc_terms(amplitude: float, swing_radius: float) -> tuple[Term, ...]:
     """
     alpha = arc_angle(amplitude, swing_radius)
     terms: list[Term] = [("y", 0, swing_radius * (1.0 - float(jv(0, alpha))), 0.0), ("yaw", 1, 0.0, alpha)]
-    for n in range(1, HIGHEST_ARC_HARMONIC + 1):
+    for n in range(1, MAX_MOTION_HARMONIC + 1):
         coefficient = 2.0 * swing_radius * float(jv(n, alpha))
         if abs(coefficient) < ARC_TRUNCATION * swing_radius:
             break

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping
 import annotated_types
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from shakermill.parameters.kinematic_models import ASSUMED_DEFAULTS, MAX_SWING_ANGLE, arc_angle
+from shakermill.parameters.kinematic_models import ASSUMED_DEFAULTS, MAX_MOTION_HARMONIC, MAX_SWING_ANGLE, arc_angle
 from shakermill.parameters.units import UnitError, to_si
 from shakermill.support.limits import (
     MAX_FULL_RESOLUTION_PERIODS,
@@ -64,9 +64,8 @@ def _per_ball(scalar_key: str) -> Any:
 MAX_BALLS = 50
 MAX_HARMONICS = 60
 MOTION_COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
-# Translations of a vial beyond half a metre, or harmonics beyond the 20th, describe no mill.
+# Translations of a vial beyond half a metre describe no mill.
 MAX_MOTION_TRANSLATION = 0.5
-MAX_MOTION_HARMONIC = 20
 Harmonic = tuple[
     Literal["x", "y", "z", "roll", "pitch", "yaw"],
     Annotated[int, annotated_types.Ge(0), annotated_types.Le(MAX_MOTION_HARMONIC)],
