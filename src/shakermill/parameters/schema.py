@@ -104,7 +104,9 @@ class Parameters(BaseModel):
     vial_diameter: float = _quantity("m", "inner diameter of the vial d_v", ge=1e-3, le=1.0)
     # Open at 0: a vanishing stroke is a resting wall, the analytic test of a single impact. 0.5 m: five
     # times the longest stroke of a shaker mill.
-    amplitude: float = _quantity("m", "vial oscillation amplitude X_v", gt=0, le=0.5)
+    amplitude: float = _quantity(
+        "m", "vial oscillation amplitude X_v (kinematics = 'mixer-mill-arc': along the arc, at the jar's centre)", gt=0, le=0.5
+    )
     # 1 rad/s (0.16 Hz): thirty times slower than any mill. 1e4 rad/s (1.6 kHz): beyond acoustic mixers
     # (60 Hz), high enough that 1060 typed for rpm is warned about, not refused; the step count grows with ω.
     omega: float = _quantity("rad/s", "vial angular frequency ω", ge=1.0, le=1e4)
