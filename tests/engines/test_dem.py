@@ -78,6 +78,17 @@ def test_the_audit_closes_in_a_rotating_vial():
     assert (result.impact_columns["target"] == "side").any()
 
 
+@pytest.mark.parametrize("preset, balls", [("spex8000m-3d", 5), ("mm400", 2)])
+def test_the_audit_closes_in_the_named_motions(preset, balls):
+    """The SPEX clamp's figure of eight and the mixer mill's arc (parameters/kinematic_models.py)."""
+    params = sm.default_parameters(preset, n_balls=balls, duration=0.3, record_windows=())
+    result = sm.simulate(params)
+    assert result.success, result.message
+    assert result.energy.relative_residual < 1e-6
+    assert abs(result.energy.thermal_residual) < 1e-9 * result.energy.heat_generated
+    assert result.impact_count > 0
+
+
 def test_the_same_configuration_gives_the_same_numbers():
     params = sm.default_parameters(**FIVE_BALLS, duration=0.5, record_windows=((0.0, 0.1),))
     first, second = sm.simulate(params), sm.simulate(params)

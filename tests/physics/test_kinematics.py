@@ -126,3 +126,42 @@ def test_angular_velocity_is_that_of_the_rotating_matrix() -> None:
     omega = np.empty(3)
     drive.angular_velocity(angles[1], angles[2], *rates, omega)
     assert omega == pytest.approx([skew[2, 1], skew[0, 2], skew[1, 0]], rel=1e-8)
+
+
+# Every named motion (parameters/kinematic_models.py): the rates the engine uses are the derivatives of
+# the positions and orientations it uses.
+NAMED_MOTIONS = {
+    "axial": {},
+    "fourier": {"motion": "x:1:0:25 mm, y:2:3 mm:1 mm, yaw:1:0.05:0.1, pitch:3:0:0.02, roll:2:0.01:0, z:0:1 mm:0"},
+    "spex8000m": {"yaw_amplitude": "10 deg"},
+    "mixer-mill-arc": {"amplitude": "10 mm", "swing_radius": "100 mm"},
+}
+
+
+def _pose(harmonics: np.ndarray, t: float, phase: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centre, orientation Q and coordinate rates of the vial at ``t``."""
+    values, rates, matrix = np.zeros(6), np.zeros(6), np.empty((3, 3))
+    drive.fourier_coordinates(t, OMEGA, phase, harmonics, values, rates)
+    drive.rotation_matrix(values[3], values[4], values[5], matrix)
+    return values, matrix, rates
+
+
+@pytest.mark.parametrize("kinematics", sorted(NAMED_MOTIONS))
+@pytest.mark.parametrize("t", [0.0, 0.0123, 0.05])
+def test_each_named_motion_moves_at_the_rates_it_prescribes(kinematics, t):
+    """Coordinates' rates against central differences, and Ω against Q̇·Qᵀ = skew(Ω)."""
+    import shakermill as sm
+    from shakermill.engines.dem.model import harmonics_of
+
+    params = sm.default_parameters(engine="dem", kinematics=kinematics, phase=0.4, **NAMED_MOTIONS[kinematics])
+    harmonics = harmonics_of(params)
+    h = 1e-7
+    ahead, q_ahead, _ = _pose(harmonics, t + h, 0.4)
+    behind, q_behind, _ = _pose(harmonics, t - h, 0.4)
+    values, q_now, rates = _pose(harmonics, t, 0.4)
+    assert rates == pytest.approx((ahead - behind) / (2 * h), rel=1e-6, abs=1e-9)
+    skew = (q_ahead - q_behind) / (2 * h) @ q_now.T
+    omega = np.empty(3)
+    drive.angular_velocity(values[4], values[5], rates[3], rates[4], rates[5], omega)
+    assert omega == pytest.approx([skew[2, 1], skew[0, 2], skew[1, 0]], rel=1e-6, abs=1e-9)
+    assert skew == pytest.approx(-skew.T, abs=1e-8)

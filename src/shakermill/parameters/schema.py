@@ -24,6 +24,7 @@ import annotated_types
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from shakermill.parameters import materials
+from shakermill.parameters.kinematic_models import ASSUMED_DEFAULTS, MAX_MOTION_HARMONIC, MAX_SWING_ANGLE, arc_angle
 from shakermill.parameters.units import UnitError, to_si
 from shakermill.support.limits import (
     MAX_FULL_RESOLUTION_PERIODS,
@@ -74,9 +75,8 @@ def _per_ball(scalar_key: str) -> Any:
 MAX_BALLS = 50
 MAX_HARMONICS = 60
 MOTION_COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
-# Translations of a vial beyond half a metre, or harmonics beyond the 20th, describe no mill.
+# Translations of a vial beyond half a metre describe no mill.
 MAX_MOTION_TRANSLATION = 0.5
-MAX_MOTION_HARMONIC = 20
 Harmonic = tuple[
     Literal["x", "y", "z", "roll", "pitch", "yaw"],
     Annotated[int, annotated_types.Ge(0), annotated_types.Le(MAX_MOTION_HARMONIC)],
@@ -115,7 +115,9 @@ class Parameters(BaseModel):
     vial_diameter: float = _quantity("m", "inner diameter of the vial d_v", ge=1e-3, le=1.0)
     # Open at 0: a vanishing stroke is a resting wall, the analytic test of a single impact. 0.5 m: five
     # times the longest stroke of a shaker mill.
-    amplitude: float = _quantity("m", "vial oscillation amplitude X_v", gt=0, le=0.5)
+    amplitude: float = _quantity(
+        "m", "vial oscillation amplitude X_v (kinematics = 'mixer-mill-arc': along the arc, at the jar's centre)", gt=0, le=0.5
+    )
     # 1 rad/s (0.16 Hz): thirty times slower than any mill. 1e4 rad/s (1.6 kHz): beyond acoustic mixers
     # (60 Hz), high enough that 1060 typed for rpm is warned about, not refused; the step count grows with ω.
     omega: float = _quantity("rad/s", "vial angular frequency ω", ge=1.0, le=1e4)
@@ -301,11 +303,25 @@ class Parameters(BaseModel):
     # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
     friction: float = _quantity("", "Coulomb friction coefficient μ of every contact (engine = 'dem')", ge=0, le=5.0)
     rolling_friction: float = _quantity("", "rolling resistance coefficient μ_r (engine = 'dem')", ge=0, le=1.0)
-    kinematics: Literal["axial", "fourier"] = Field(
+    kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc"] = Field(
         json_schema_extra={
-            "description": "vial motion of the 'dem' engine: 'axial' (amplitude, omega, phase: the 1-D drive) or "
-            "'fourier' (the harmonics in motion)"
+            "description": "vial motion of the 'dem' engine (parameters/kinematic_models.py): 'axial' (amplitude, "
+            "omega, phase: the 1-D drive), 'fourier' (the harmonics in motion), 'spex8000m' (the clamp's figure of "
+            "eight: amplitude, lateral_amplitude, yaw_amplitude) or 'mixer-mill-arc' (a jar swung on a horizontal "
+            "arc: amplitude along the arc, swing_radius)"
         }
+    )
+    # The SPEX clamp's lateral motion and yaw (kinematics = 'spex8000m'); 0 leaves either out. Half a metre,
+    # as any translation of a vial; a quarter turn, far beyond the few degrees a clamp turns.
+    lateral_amplitude: float = _quantity(
+        "m", "kinematics = 'spex8000m': lateral amplitude Y of the vial's centre, y = Y sin 2θ", ge=0, le=MAX_MOTION_TRANSLATION
+    )
+    yaw_amplitude: float = _quantity(
+        "rad", "kinematics = 'spex8000m': yaw amplitude Ψ about the vertical, yaw = Ψ sin θ", ge=0, le=0.5 * math.pi
+    )
+    # 1 mm to 1 m: from a jar turning about a pivot next to it to an arm longer than any mill.
+    swing_radius: float = _quantity(
+        "m", "kinematics = 'mixer-mill-arc': radius R of the jar centre's arc about the vertical pivot", ge=1e-3, le=1.0
     )
     motion: tuple[Harmonic, ...] = Field(
         max_length=MAX_HARMONICS,
@@ -352,6 +368,11 @@ class Parameters(BaseModel):
             raise ValueError(
                 "n_balls: the 1-D engine moves one ball; allowed n_balls = 1 with engine = '1d', or set engine = 'dem'"
             )
+        if self.engine == "1d" and self.kinematics != "axial":
+            raise ValueError(
+                f"kinematics: the 1-D engine moves the vial along its axis, not as {self.kinematics!r}; allowed 'axial' "
+                "with engine = '1d', or set engine = 'dem'"
+            )
         # The materials first: their per-ball lists are as long as they are.
         if self.ball_materials and len(self.ball_materials) != self.n_balls:
             raise ValueError(
@@ -363,6 +384,12 @@ class Parameters(BaseModel):
         if self.kinematics == "fourier" and not self.motion:
             raise ValueError("motion: kinematics = 'fourier' needs at least one harmonic; allowed (coordinate, k, cos, sin) terms")
         _check_motion(self.motion)
+        if self.kinematics == "mixer-mill-arc" and arc_angle(self.amplitude, self.swing_radius) > MAX_SWING_ANGLE:
+            raise ValueError(
+                f"amplitude: an arc of {self.amplitude * 1e3:g} mm on a swing radius of {self.swing_radius * 1e3:g} mm "
+                f"turns the jar by {arc_angle(self.amplitude, self.swing_radius):.3g} rad; allowed amplitude <= "
+                f"swing_radius·π/2 = {self.swing_radius * MAX_SWING_ANGLE:.4g} m with kinematics = 'mixer-mill-arc'"
+            )
         if self.engine == "dem":
             if self.model == "ball_only":
                 raise ValueError("model: the 'dem' engine has a node per ball, the vial and the air; allowed 'three_node' with engine = 'dem'")
@@ -730,6 +757,7 @@ SPEX_8000M = Preset(
         "rolling_friction": Cited(0.0, "MODEL.md section 12.3: no rolling resistance by default"),
         "kinematics": Cited("axial", f"{PAPER}: the vial moves along its axis (MODEL.md section 12.2)"),
         "motion": Cited((), "used only with kinematics = 'fourier'"),
+        **{key: Cited(value, source) for key, (value, source) in ASSUMED_DEFAULTS.items()},
         "contact_step_fraction": Cited(
             0.05,
             "numerical choice: restitution within 1e-3, the 1-D limit's heat power within 0.25 % of the converged "
@@ -807,8 +835,9 @@ def checked_name(key: str, value: Any) -> str:
     return str(value)
 
 
-# Presets produced by a calibration ship as TOML files next to this module: a base preset, the fitted
-# values and a [provenance] table that records the fit (command, targets, residuals, date, version).
+# Presets other than the paper's ship as TOML files next to this module: a base preset, the values that
+# differ and a [provenance] table: for a calibration, the fit (command, targets, residuals, date, version);
+# for a hand-made preset, [provenance.sources], the source of each value it sets.
 PRESET_FOLDER = Path(__file__).parent / "presets"
 
 
@@ -819,10 +848,12 @@ def load_preset_file(path: Path, known: Mapping[str, Preset]) -> Preset:
     provenance = dict(data.pop("provenance", {}))
     base = known[data.pop("preset")]
     fitted = tuple(provenance.get("fitted", ()))
+    sources = provenance.get("sources", {})
     note = f"fitted by calibration ({path.name}, [provenance])"
     values = {**base.values, **material_citations(data)}
     for key, value in data.items():
-        values[key] = Cited(tuple(map(tuple, value)) if key == "record_windows" else value, note if key in fitted else f"set in {path.name}")
+        source = note if key in fitted else sources.get(key, f"set in {path.name}")
+        values[key] = Cited(tuple(map(tuple, value)) if key == "record_windows" else value, source)
     return Preset(
         name=path.stem,
         description=str(provenance.get("description", f"{base.name} with values from {path.name}")),
@@ -889,8 +920,8 @@ class PlausibleRange:
 
 
 PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
-    # Mixer mills shake at 3-35 Hz, planetary mills turn at up to ~1100 rpm of the sun wheel.
-    "omega": PlausibleRange(30.0, 400.0, "shaker and planetary mills", ("rpm", "Hz")),
+    # Mixer mills shake at 3-35 Hz (3 Hz = 18.8 rad/s), planetary mills turn at up to ~1100 rpm of the sun wheel.
+    "omega": PlausibleRange(18.0, 400.0, "shaker and planetary mills", ("rpm", "Hz")),
     "amplitude": PlausibleRange(1e-3, 0.1, "shaker mills", ("mm",)),
     "ball_radius": PlausibleRange(2.5e-4, 0.05, "milling balls", ("mm",)),
     "vial_length": PlausibleRange(5e-3, 0.5, "milling vials", ("mm",)),

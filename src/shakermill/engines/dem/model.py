@@ -13,6 +13,7 @@ from typing import NamedTuple
 import numpy as np
 
 from shakermill.engines.network import network_constants
+from shakermill.parameters.kinematic_models import motion_terms
 from shakermill.parameters.schema import MOTION_COORDINATES, Parameters
 from shakermill.physics import contact
 from shakermill.physics.kinematics import fourier_coordinates, rotation_matrix
@@ -154,8 +155,9 @@ def slot_count(n_balls: int) -> int:
 
 
 def harmonics_of(params: Parameters) -> np.ndarray:
-    """The vial's motion as Fourier data (MODEL.md §12.2): ``axial`` is x = X_v sin(ωt + φ)."""
-    terms = params.motion if params.kinematics == "fourier" else (("x", 1, 0.0, params.amplitude),)
+    """The vial's motion as Fourier data (MODEL.md §12.2): the terms of the model ``params.kinematics``
+    names (parameters/kinematic_models.py) as ``harmonics[coordinate, k] = (cos, sin)``, m and rad."""
+    terms = motion_terms(params.kinematics, params)
     highest = max(k for _, k, _, _ in terms)
     harmonics = np.zeros((len(MOTION_COORDINATES), highest + 1, 2))
     for coordinate, k, cosine, sine in terms:
