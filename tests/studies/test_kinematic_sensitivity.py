@@ -15,7 +15,7 @@ DURATION = 0.2  # s: a few drive periods, enough for the table's shape and its d
 
 @pytest.fixture(scope="module")
 def spex():
-    params = sm.default_parameters("spex8000m-3d", n_balls=3, duration=DURATION)
+    params = sm.default_parameters("spex8000m-3d", n_balls=3, duration=DURATION, solver="full")
     calls = []
     study = kinematic_sensitivity(params, progress=lambda done, total: calls.append((done, total)))
     return params, study, calls
@@ -50,7 +50,7 @@ def test_the_same_inputs_give_the_same_table(spex):
 
 
 def test_a_factor_beyond_a_keys_bounds_is_refused():
-    params = sm.default_parameters("mm400", duration=DURATION)
+    params = sm.default_parameters("mm400", duration=DURATION, solver="full")
     with pytest.raises(ParameterError, match="amplitude"):
         kinematic_sensitivity(params, keys=("amplitude",), factors=(100.0,))
 
