@@ -3,7 +3,7 @@ is found, state each as an assumption and show how the results depend on it").
 
 Each assumed key of ``params.kinematics`` (``parameters.kinematic_models.KINEMATIC_MODELS[...].assumed``)
 is scaled by each factor in turn, the others held, and a run measures the heat power, the rate and the mean
-speed of hits (impacts of at least ``solvers.result.HIT_SPEED``, so that a resting ball's chatter does not
+speed of hits (impacts of at least ``parameters.defaults.HIT_SPEED``, so that a resting ball's chatter does not
 count) and any other summary key asked for, against the unscaled baseline. The 'dem' engine is
 deterministic, so the same inputs give the same table.
 """
