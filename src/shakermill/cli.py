@@ -1120,7 +1120,11 @@ def sensitivity_table(sensitivity: Any) -> Table:
     table = Table("assumed key × factor", "value (SI)", *measures, title=f"Sensitivity to the assumed {sensitivity.kinematics} motion (five balls)")
     _add_plain_row(table, "baseline", "", *(f"{sensitivity.baseline[name]:.4g}" for name in measures))
     for row in sensitivity.rows:
-        changes = (f"{100 * row.relative_change[name]:+.1f} %" for name in measures)
+        # A temperature's relative change depends on where its scale starts: in kelvin it says more.
+        changes = (
+            f"{row.measures[name] - sensitivity.baseline[name]:+.1f} K" if name.endswith("_C") else f"{100 * row.relative_change[name]:+.1f} %"
+            for name in measures
+        )
         _add_plain_row(table, f"{row.key} × {row.factor:g}", f"{row.value:.4g}", *changes)
     return table
 
