@@ -13,13 +13,20 @@ The preset is ``spex8000m-3d-calibrated`` where it exists, else ``spex8000m-3d``
 mechanics do not converge within ``averaging_max_time`` fails with its reason (``averaging_fallback =
 'fail'``) instead of falling back to a full-resolution hour, which would take hours for a lone ball.
 
-    .venv/bin/python benchmarks/bench_mill_study.py                   # ~25 min on 2 cores
-    .venv/bin/python benchmarks/bench_mill_study.py --rel-error 0.02  # the statistics' target, a quarter of the mechanics
+    .venv/bin/python benchmarks/bench_mill_study.py                          # all 30 points and the five-ball hour
+    .venv/bin/python benchmarks/bench_mill_study.py --rel-error 0.02         # a quarter of the mechanics per point
+    .venv/bin/python benchmarks/bench_mill_study.py --counts 4,5 --only sweep  # the cheap points alone
+    .venv/bin/python benchmarks/bench_mill_study.py --only report            # tables and figure of the folder so far
+
+Cost (2026-11-23, 2 shared cores, --rel-error 0.02): four or five balls ~130-150 s a point, three ~500 s or more,
+one or two balls far more (a ball that rolls on the bore steps at the contact step: ~10-20 wall-s per simulated
+second, and its means converge slowly). Ctrl-C keeps the finished points; the same command computes the rest.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import statistics
 import sys
@@ -30,7 +37,7 @@ import pandas as pd
 
 import shakermill as sm
 from shakermill.parameters.schema import PRESETS
-from shakermill.studies.sweep import SweepProgress
+from shakermill.studies.sweep import SweepProgress, load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURE = ROOT / "docs" / "figures" / "mill-study.png"
@@ -49,12 +56,12 @@ def study_parameters(preset: str, rel_error: float | None) -> sm.Parameters:
     return sm.default_parameters(preset, **settings)
 
 
-def grid() -> dict[str, list]:
-    """Material slowest, then diameter, then the count: the cheap many-ball points of a material come together."""
+def grid(counts: list[int]) -> dict[str, list]:
+    """Material slowest, then diameter, then the number of balls."""
     return {
         "ball_material": list(MATERIALS),
         "ball_radius": [f"{diameter / 2:g} mm" for diameter in DIAMETERS_MM],
-        "n_balls": list(BALL_COUNTS),
+        "n_balls": counts,
     }
 
 
@@ -82,7 +89,7 @@ def temperature_tables(table: pd.DataFrame) -> dict[str, pd.DataFrame]:
 
 def print_tables(tables: dict[str, pd.DataFrame]) -> None:
     for material, cells in tables.items():
-        print(f"\n{material}: the balls' mean temperature after 1 h (°C); '-': failed")
+        print(f"\n{material}: the balls' mean temperature after 1 h (°C); '-': no result (failed or not finished)")
         print("n_balls | " + " | ".join(f"Ø{diameter:g} mm".rjust(8) for diameter in cells.columns))
         print("-" * (10 + 11 * len(cells.columns)))
         for count, row in cells.iterrows():
@@ -91,12 +98,16 @@ def print_tables(tables: dict[str, pd.DataFrame]) -> None:
 
 def print_costs(table: pd.DataFrame, elapsed: float) -> None:
     times = table["wall_time_s"].dropna()
+    unfinished = table["error"].str.startswith("not finished", na=False)
+    sweep = "" if math.isnan(elapsed) else f"; the sweep {elapsed:.0f} s on {os.cpu_count()} cores"
     print(
         f"\nwall time per point: median {statistics.median(times):.1f} s (min {times.min():.1f}, max {times.max():.1f}); "
-        f"Σ points {times.sum():.0f} s; the sweep {elapsed:.0f} s on {os.cpu_count()} cores (points of an earlier "
-        "run of this folder keep their times)"
+        f"Σ points {times.sum():.0f} s over {len(times)} points{sweep} (points of an earlier run of this folder keep "
+        "their times)"
     )
-    for _, row in table[table["error"].notna()].iterrows():
+    if unfinished.any():
+        print(f"not finished: {int(unfinished.sum())} of {len(table)} points")
+    for _, row in table[table["error"].notna() & ~unfinished].iterrows():
         print(f"failed: {row['ball_material']}, {row['n_balls']} x Ø{2e3 * row['ball_radius']:g} mm: {row['error']}")
 
 
@@ -137,31 +148,51 @@ def five_balls(base: sm.Parameters, preset: str) -> None:
     )
 
 
+def run_study(base: sm.Parameters, preset: str, counts: list[int], out: Path, workers: int) -> tuple[pd.DataFrame, float]:
+    """The sweep's table and its wall time; Ctrl-C ends it with the points finished so far (a re-run goes on)."""
+    started = time.perf_counter()
+    try:
+        table = sm.sweep(base, grid(counts), out, workers=workers, progress=report_progress(started), preset=preset)
+    except KeyboardInterrupt:
+        table = load_sweep(out).table
+        print(f"\ninterrupted: the tables hold the finished points; the same command computes the others", flush=True)
+    return table, time.perf_counter() - started
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", type=Path, default=ROOT / "results" / "mill-study", help="sweep folder (resumable)")
+    parser.add_argument("--out", type=Path, help="sweep folder (resumable; default results/mill-study-<counts>-<target>)")
     parser.add_argument("--workers", type=int, default=2, help="local processes")
     parser.add_argument("--rel-error", type=float, help="dem_averaging_rel_error of the sweep (default: the preset's)")
     parser.add_argument("--figure", type=Path, default=FIGURE, help="PNG of the study")
-    parser.add_argument("--skip-five-balls", action="store_true", help="only the sweep")
+    parser.add_argument("--counts", default=",".join(map(str, BALL_COUNTS)), help="numbers of balls, comma-separated")
+    parser.add_argument(
+        "--only", choices=("sweep", "five-balls", "report"),
+        help="one part: the sweep, the five-ball hour, or the tables and figure of the sweep folder as it stands",
+    )  # fmt: skip
     args = parser.parse_args()
+    counts = [int(item) for item in args.counts.split(",")]
 
     preset = next(name for name in PRESET_CHOICES if name in PRESETS)
     base = study_parameters(preset, args.rel_error)
+    # A folder holds one sweep: another choice of counts or target gets a folder of its own.
+    out = args.out or ROOT / "results" / f"mill-study-{'-'.join(map(str, counts))}-{base.dem_averaging_rel_error:g}"
     print(
         f"preset {preset}; averaged solver, {HOUR_S:g} s, dem_averaging_rel_error {base.dem_averaging_rel_error:g}, "
-        f"averaging_max_time {base.averaging_max_time:g} s; {len(BALL_COUNTS) * len(DIAMETERS_MM) * len(MATERIALS)} "
-        f"points into {args.out}"
+        f"averaging_max_time {base.averaging_max_time:g} s; {len(counts) * len(DIAMETERS_MM) * len(MATERIALS)} "
+        f"points into {out}"
     )
-    started = time.perf_counter()
-    table = sm.sweep(base, grid(), args.out, workers=args.workers, progress=report_progress(started), preset=preset)
-    elapsed = time.perf_counter() - started
-    tables = temperature_tables(table)
-    print_tables(tables)
-    print_costs(table, elapsed)
-    draw(tables, preset, args.figure)
-    print(f"figure: {args.figure}")
-    if not args.skip_five_balls:
+    if args.only != "five-balls":
+        if args.only == "report":
+            table, elapsed = load_sweep(out).table, math.nan
+        else:
+            table, elapsed = run_study(base, preset, counts, out, args.workers)
+        tables = temperature_tables(table)
+        print_tables(tables)
+        print_costs(table, elapsed)
+        draw(tables, preset, args.figure)
+        print(f"figure: {args.figure}")
+    if args.only in (None, "five-balls"):
         five_balls(base, preset)
 
 

@@ -541,7 +541,7 @@ class Parameters(BaseModel):
     @property
     def vial_volume(self) -> float:
         """π d_v²/4·l_v: the vial's inner volume (m³)."""
-        return math.pi * self.vial_diameter**2 / 4.0 * self.vial_length
+        return _vial_volume(self.vial_length, self.vial_diameter)
 
     @property
     def balls_volume(self) -> float:
@@ -707,11 +707,15 @@ def _ball_volume(radius: float) -> float:
     return 4.0 / 3.0 * math.pi * radius**3
 
 
+def _vial_volume(vial_length: float, vial_diameter: float) -> float:
+    return math.pi * vial_diameter**2 / 4.0 * vial_length
+
+
 def balls_for_fill(fill: float, ball_radius: float, vial_length: float, vial_diameter: float) -> int:
     """How many equal balls of ``ball_radius`` (m) take ``fill`` of a vial's inner volume (m, m; fill
     dimensionless): n = max(1, round(fill·V_vial/V_ball)), V_vial = π d_v²/4·l_v, halves rounded up."""
-    volume = math.pi * vial_diameter**2 / 4.0 * vial_length
-    return max(1, math.floor(fill * volume / _ball_volume(ball_radius) + 0.5))
+    balls = fill * _vial_volume(vial_length, vial_diameter) / _ball_volume(ball_radius)
+    return max(1, math.floor(balls + 0.5))
 
 
 def layered(lower: Mapping[str, Any], upper: Mapping[str, Any]) -> dict[str, Any]:
