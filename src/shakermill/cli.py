@@ -39,6 +39,7 @@ from shakermill.parameters.defaults import (
     DEFAULT_FREE,
     DEFAULT_SCHEDULER_TIMEOUT_S,
     DEM_DEFAULT_FREE,
+    HIT_SPEED,
     MOST_ANIMATION_FRAMES,
     PNG_DPI,
     REPORT_FILE,
@@ -404,6 +405,7 @@ def summary_table(result: Result, target: Path) -> Table:
         ("impacts", _number(s["impacts"], "d"), ""),
         ("impact rate", _number(s["impact_rate_hz"], ".2f"), "Hz"),
         ("mean impact speed", _number(s["mean_impact_speed_m_s"], ".3f"), "m/s"),
+        (f"hits ≥ {HIT_SPEED:g} m/s: rate; mean speed", f"{_number(s['hit_rate_hz'], '.2f')} Hz; {_number(s['mean_hit_speed_m_s'], '.3f')}", "m/s"),
         ("heat generated", _number(s["heat_power_W"], ".3f"), "W"),
         ("steps (rejected)", f"{s['steps']} ({s['rejected_steps']})", ""),
         ("wall time", _number(s["wall_time_s"], ".2f"), "s"),
@@ -1057,22 +1059,15 @@ def validate(
 
 def _held_out_studies() -> tuple[Any, Any, Any]:
     """The five-ball prediction, the engines on one ball and the kinematic sensitivity, with one progress bar."""
-    from shakermill.studies.held_out import ENGINE_CASES, engine_comparison, five_ball_prediction
-    from shakermill.studies.kinematics import kinematic_sensitivity, sensitivity_base
+    from shakermill.studies.held_out import ENGINE_CASES, engine_comparison, five_ball_prediction, five_ball_sensitivity
 
-    with _progress_bar("3-D validation", "{task.completed}/{task.total} runs", None) as update:
-        base = sensitivity_base()
-        steps = [0]
-
-        def step(*_: Any) -> None:
-            steps[0] += 1
-            if update is not None:
-                update(steps[0])
-
+    total = 1 + len(ENGINE_CASES) + 5
+    with _progress_bar("3-D validation", "{task.completed}/{task.total} runs", total) as update:
+        show = update or (lambda done: None)
         prediction = five_ball_prediction()
-        step()
-        comparison = engine_comparison(ENGINE_CASES, progress=step)
-        sensitivity = kinematic_sensitivity(base, progress=step)
+        show(1)
+        comparison = engine_comparison(ENGINE_CASES, progress=lambda done: show(1 + done))
+        sensitivity = five_ball_sensitivity(progress=lambda done, _: show(1 + len(ENGINE_CASES) + done))
     return prediction, comparison, sensitivity
 
 
@@ -1117,6 +1112,17 @@ def print_held_out(console: Console, prediction: Any, comparison: Any, sensitivi
         _add_plain_row(table, case.label, *cells)
     console.print(table)
     console.print(sensitivity_table(sensitivity))
+
+
+def sensitivity_table(sensitivity: Any) -> Table:
+    """Each assumed amplitude halved and raised by half: the measures' relative changes against the baseline."""
+    measures = list(sensitivity.baseline)
+    table = Table("assumed key × factor", "value (SI)", *measures, title=f"Sensitivity to the assumed {sensitivity.kinematics} motion (five balls)")
+    _add_plain_row(table, "baseline", "", *(f"{sensitivity.baseline[name]:.4g}" for name in measures))
+    for row in sensitivity.rows:
+        changes = (f"{100 * row.relative_change[name]:+.1f} %" for name in measures)
+        _add_plain_row(table, f"{row.key} × {row.factor:g}", f"{row.value:.4g}", *changes)
+    return table
 
 
 def preset_parameters(name: str) -> Parameters:

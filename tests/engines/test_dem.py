@@ -81,7 +81,7 @@ def test_the_audit_closes_in_a_rotating_vial():
 @pytest.mark.parametrize("preset, balls", [("spex8000m-3d", 5), ("mm400", 2)])
 def test_the_audit_closes_in_the_named_motions(preset, balls):
     """The SPEX clamp's figure of eight and the mixer mill's arc (parameters/kinematic_models.py)."""
-    params = sm.default_parameters(preset, n_balls=balls, duration=0.3, record_windows=())
+    params = sm.default_parameters(preset, n_balls=balls, duration=0.3, record_windows=(), solver="full")
     result = sm.simulate(params)
     assert result.success, result.message
     assert result.energy.relative_residual < 1e-6

@@ -304,9 +304,10 @@ def test_compare_solvers_reports_both_solvers_and_the_speed_ratio():
 
 
 def test_validate_prints_table5_with_fitted_and_predicted_roles():
-    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--json"])
+    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-three-d", "--json"])
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
+    assert "five_balls" not in payload
     published, calibrated = payload["runs"]["spex8000m"], payload["runs"]["spex8000m-calibrated"]
     assert set(published["role"].values()) == {"predicted"}
     assert calibrated["role"]["vial_ball_ratio"] == "predicted"

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import shakermill as sm
+from shakermill.parameters.defaults import HIT_SPEED
 from shakermill.parameters.schema import ParameterError
 from shakermill.solvers.dem import settle_mechanics, simulate_dem_averaged
-from shakermill.solvers.result import HIT_SPEED
 from shakermill.solvers.simulate import thermal_variants
 from shakermill.studies.calibrate import calibrate
 

@@ -15,9 +15,9 @@ DURATION = 0.2  # s: a few drive periods, enough for the table's shape and its d
 
 @pytest.fixture(scope="module")
 def spex():
-    params = sm.default_parameters("spex8000m-3d", n_balls=3)
+    params = sm.default_parameters("spex8000m-3d", n_balls=3, duration=DURATION, solver="full")
     calls = []
-    study = kinematic_sensitivity(params, duration=DURATION, progress=lambda done, total: calls.append((done, total)))
+    study = kinematic_sensitivity(params, progress=lambda done, total: calls.append((done, total)))
     return params, study, calls
 
 
@@ -44,12 +44,20 @@ def test_the_table_has_the_baseline_first_and_a_change_per_measure(spex):
 
 def test_the_same_inputs_give_the_same_table(spex):
     params, study, _ = spex
-    again = kinematic_sensitivity(params, keys=("yaw_amplitude",), factors=(1.5,), duration=DURATION)
+    again = kinematic_sensitivity(params, keys=("yaw_amplitude",), factors=(1.5,))
     assert again.baseline == study.baseline
     assert again.rows[0] == study.rows[3]
 
 
 def test_a_factor_beyond_a_keys_bounds_is_refused():
-    params = sm.default_parameters("mm400")
+    params = sm.default_parameters("mm400", duration=DURATION, solver="full")
     with pytest.raises(ParameterError, match="amplitude"):
-        kinematic_sensitivity(params, keys=("amplitude",), factors=(100.0,), duration=DURATION)
+        kinematic_sensitivity(params, keys=("amplitude",), factors=(100.0,))
+
+
+def test_other_summary_keys_can_be_measured(spex):
+    params, study, _ = spex
+    again = kinematic_sensitivity(params, keys=("yaw_amplitude",), factors=(1.5,), measures=("ball_C", "heat_power_W"))
+    assert again.baseline["heat_power_W"] == study.baseline["heat_power_W"]
+    assert again.rows[0].relative_change["ball_C"] == pytest.approx(again.rows[0].measures["ball_C"] / again.baseline["ball_C"] - 1.0)
+    assert again.as_dict()["rows"][0]["key"] == "yaw_amplitude" and again.as_dict()["solver"] == "full"

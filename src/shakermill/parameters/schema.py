@@ -341,7 +341,8 @@ class Parameters(BaseModel):
             "(m) and angles roll, pitch, yaw (rad) in the harmonics k of ωt + φ",
         },
     )
-    # The step inside a contact as a fraction of the smallest Rayleigh time; 0.9 is the 1-D engine's bound.
+    # The step inside a contact as a fraction of the smallest Rayleigh time, or of a slow contact's own period over
+    # 9.5 where that is longer (engines/dem/model.py, RAYLEIGH_TIMES_PER_PERIOD); 0.9 is the 1-D engine's bound.
     contact_step_fraction: float = _quantity(
         "", "contact step of the 'dem' engine as a fraction of the smallest Rayleigh time", ge=1e-3, le=0.9
     )

@@ -130,3 +130,21 @@ def tangential_damping(beta_e: float, stiffness: float, mass: float) -> float:
     """c_t = −2·√(5/6)·β_e·√(k_t·m*), in N·s/m, ≥ 0 for e ≤ 1 (MODEL.md §12.3)."""
     return -2.0 * math.sqrt(5.0 / 6.0) * beta_e * math.sqrt(stiffness * mass)
 
+
+@njit(cache=True)
+def contact_period(mass: float, radius: float, e_star: float, g_star: float, overlap: float, speed: float) -> float:
+    """Shortest oscillation period of a Hertz–Mindlin contact (s), for the step inside it (MODEL.md §12.6).
+
+    Its stiffnesses are taken at ζ_e = max(ζ, ζ_max(|ζ̇|)), the overlap now or the peak an approach at the
+    normal speed now would reach, whichever is larger, so that an impact's period is known from its first step:
+    k_n = 2E*√(R*ζ_e) with the mass m*, and k_t = 8G*√(R*ζ_e) with the contact point's tangential mass 2m*/7
+    (a ball's spin, I = 2/5 mR², adds 5/(2m) to each 1/m). The tangential one is the shorter for ν < ~0.9.
+    """
+    effective = overlap
+    reach = 15.0 * mass * speed * speed / (16.0 * e_star * math.sqrt(radius))  # ζ_max^{5/2}
+    if reach > overlap * overlap * math.sqrt(overlap):  # the power only where it matters: it is slow
+        effective = reach**0.4
+    root = math.sqrt(radius * effective)
+    normal = mass / (2.0 * e_star * root)
+    tangential = 2.0 / 7.0 * mass / (8.0 * g_star * root)
+    return 2.0 * math.pi * math.sqrt(min(normal, tangential))

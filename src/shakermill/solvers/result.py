@@ -15,6 +15,7 @@ from shakermill.analysis.fit import ExponentialFit, increment_ratio
 from shakermill.analysis.steady import SteadyState, run_length_warning, steady_state
 from shakermill.engines.one_d import model
 from shakermill.engines.one_d.integrator import REACHED_STOP
+from shakermill.parameters.defaults import HIT_SPEED
 from shakermill.parameters.schema import Parameters, unit_slip_warnings
 from shakermill.support.presenters import present
 
@@ -369,12 +370,6 @@ def understood_inputs(params: Parameters) -> dict[str, float]:
         "ambient_temperature_C": kelvin_to_celsius(params.ambient_temperature),
         "initial_temperature_C": kelvin_to_celsius(params.initial_temperature),
     }
-
-# Contacts slower than this are not hits: a ball resting on the wall under gravity chatters at mm/s, ten
-# times as often as it is hit (0.1 m/s is a free fall of 0.5 mm). The 'dem' engine's impact counts include
-# that chatter, so the hit rate and speed are what compare with the 1-D model's impacts.
-HIT_SPEED = 0.1
-
 
 def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]:
     """The flat summary printed by ``run --json`` and stored as ``summary.json``."""

@@ -7,9 +7,10 @@ from typing import Callable
 from shakermill.engines.budget import BudgetExceeded, RunBudget
 from shakermill.engines.one_d.integrator import BUDGET_EXCEEDED
 from shakermill.engines.one_d.setup import ProgressCallback
+from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.schema import Parameters
 from shakermill.solvers.averaged import simulate_averaged
-from shakermill.solvers.dem import settle_mechanics, simulate_dem, simulate_dem_averaged
+from shakermill.solvers.dem import Mechanics, settle_mechanics, simulate_dem, simulate_dem_averaged
 from shakermill.solvers.full import simulate_full
 from shakermill.solvers.result import INTERRUPTED, Result
 
@@ -40,16 +41,28 @@ def _whole(result: Result, budget: RunBudget) -> Result:
     return result
 
 
+# The mechanics of the last few thermal_variants bases: the mechanics are deterministic, so a study that
+# fits several free sets to one base (validate's, the README's) measures them once.
+_SETTLED: dict[Parameters, Mechanics] = {}
+_SETTLED_KEPT = 2
+
+
 def thermal_variants(params: Parameters) -> Callable[[Parameters], Result]:
     """:func:`simulate_whole` for runs that differ from ``params`` in ``THERMAL_ONLY_KEYS`` alone (a fit of
     the vial's heat loss). The averaged ``dem`` solver measures the mechanics once, here, and each run then
     integrates only its network: a three-dimensional run's means take tens of seconds, its network milliseconds."""
     if params.engine != "dem" or params.solver != "averaged":
         return simulate_whole
-    budget = RunBudget.of(params)
-    mechanics = settle_mechanics(params, budget=budget)
-    if mechanics.status in (INTERRUPTED, BUDGET_EXCEEDED):
-        _whole(simulate_dem_averaged(params, None, budget, mechanics), budget)
+    mechanics = _SETTLED.get(params)
+    if mechanics is None:
+        budget = RunBudget.of(params)
+        mechanics = settle_mechanics(params, budget=budget)
+        if mechanics.status != REACHED_STOP:
+            _whole(simulate_dem_averaged(params, None, budget, mechanics), budget)  # raises for Ctrl-C and the budget
+        else:
+            while len(_SETTLED) >= _SETTLED_KEPT:
+                _SETTLED.pop(next(iter(_SETTLED)))
+            _SETTLED[params] = mechanics
 
     def run(variant: Parameters) -> Result:
         variant_budget = RunBudget.of(variant)

@@ -11,8 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
-from shakermill.parameters.schema import default_parameters
+from shakermill.parameters.schema import Parameters, default_parameters
 from shakermill.solvers.simulate import simulate_whole
+from shakermill.studies.kinematics import KinematicSensitivity, kinematic_sensitivity
 from shakermill.studies.validation import relative_error
 
 HELD_OUT_PRESET = "spex8000m-3d-calibrated"
@@ -62,14 +63,18 @@ def five_ball_rows(summary: Mapping[str, Any]) -> tuple[HeldOutRow, ...]:
     )
 
 
+def five_ball_parameters(overrides: Mapping[str, Any] | None = None) -> Parameters:
+    """:data:`HELD_OUT_PRESET` with five balls for the experiment's hour, averaged unless ``overrides`` say otherwise."""
+    settings = {"solver": "averaged", "record_windows": (), "duration": 3600.0, **(overrides or {}), "n_balls": FIVE_BALLS}
+    return default_parameters(HELD_OUT_PRESET, **settings)
+
+
 def five_ball_prediction(overrides: Mapping[str, Any] | None = None) -> HeldOutPrediction:
-    """Run :data:`HELD_OUT_PRESET` with five balls for the experiment's hour (averaged solver unless
-    ``overrides`` say otherwise) and compare with the experiment."""
+    """Run :func:`five_ball_parameters` and compare the rises with the experiment."""
     from shakermill.parameters.schema import PRESETS
 
     preset = PRESETS[HELD_OUT_PRESET]
-    settings = {"solver": "averaged", "record_windows": (), **(overrides or {}), "n_balls": FIVE_BALLS}
-    result = simulate_whole(default_parameters(HELD_OUT_PRESET, **settings))
+    result = simulate_whole(five_ball_parameters(overrides))
     fitted_to = str(preset.provenance.get("curve", "the one-ball experiment"))
     return HeldOutPrediction(HELD_OUT_PRESET, preset.fitted, fitted_to, five_ball_rows(result.summary), result.summary)
 
@@ -123,3 +128,14 @@ def engine_comparison(
         if progress is not None:
             progress(index + 1)
     return EngineComparison(cases, tuple(values))
+
+
+# What the five-ball prediction is made of and what it predicts, each against the assumed amplitudes.
+SENSITIVITY_MEASURES = ("heat_power_W", "hit_rate_hz", "mean_hit_speed_m_s", "ball_C", "vial_C")
+
+
+def five_ball_sensitivity(
+    overrides: Mapping[str, Any] | None = None, progress: Callable[[int, int], None] | None = None
+) -> KinematicSensitivity:
+    """How the five-ball prediction moves when each assumed amplitude of the SPEX motion is halved or raised by half."""
+    return kinematic_sensitivity(five_ball_parameters(overrides), measures=SENSITIVITY_MEASURES, progress=progress)

@@ -2,8 +2,9 @@
 is found, state each as an assumption and show how the results depend on it").
 
 Each assumed key of ``params.kinematics`` (``parameters.kinematic_models.KINEMATIC_MODELS[...].assumed``)
-is scaled by each factor in turn, the others held, and a short full-resolution mechanics run measures the
-heat power, the impact rate and the mean impact speed against the unscaled baseline. The 'dem' engine is
+is scaled by each factor in turn, the others held, and a run measures the heat power, the rate and the mean
+speed of hits (impacts of at least ``parameters.defaults.HIT_SPEED``, so that a resting ball's chatter does not
+count) and any other summary key asked for, against the unscaled baseline. The 'dem' engine is
 deterministic, so the same inputs give the same table.
 """
 
@@ -21,7 +22,7 @@ from shakermill.solvers.simulate import simulate_whole
 if TYPE_CHECKING:
     import pandas as pd
 
-MEASURES = ("heat_power_W", "impact_rate_hz", "mean_impact_speed_m_s")
+MEASURES = ("heat_power_W", "hit_rate_hz", "mean_hit_speed_m_s")
 DEFAULT_FACTORS = (0.5, 1.5)
 
 
@@ -42,8 +43,18 @@ class KinematicSensitivity:
 
     kinematics: str
     duration: float
+    solver: str
     baseline: dict[str, float]
     rows: tuple[SensitivityRow, ...]
+
+    def as_dict(self) -> dict:
+        return {
+            "kinematics": self.kinematics,
+            "duration_s": self.duration,
+            "solver": self.solver,
+            "baseline": self.baseline,
+            "rows": [row.__dict__ for row in self.rows],
+        }
 
     def table(self) -> pd.DataFrame:
         """key, factor, value, the three measures and their relative changes (``<measure>_change``), baseline first."""
@@ -66,36 +77,36 @@ def kinematic_sensitivity(
     params: Parameters,
     keys: Sequence[str] | None = None,
     factors: Sequence[float] = DEFAULT_FACTORS,
-    duration: float = 10.0,
+    measures: Sequence[str] = MEASURES,
     progress: Callable[[int, int], None] | None = None,
 ) -> KinematicSensitivity:
     """Scale each of ``keys`` (default: the assumed keys of ``params.kinematics``) by each of ``factors``.
 
-    Every run is ``params`` with ``duration`` (s), the full solver and no record windows; a value that
-    leaves a key's bounds raises :class:`~shakermill.parameters.schema.ParameterError`. ``progress(done,
-    total)`` is called after each run.
+    Every run is ``params`` as given (its solver and duration) without record windows; a value that leaves a
+    key's bounds raises :class:`~shakermill.parameters.schema.ParameterError`. ``progress(done, total)`` is
+    called after each run.
     """
     chosen = tuple(KINEMATIC_MODELS[params.kinematics].assumed if keys is None else keys)
-    short = params.replace(duration=duration, solver="full", record_windows=())
-    scaled = [(key, factor, short.replace(**{key: factor * getattr(short, key)})) for key in chosen for factor in factors]
+    base = params.replace(record_windows=())
+    scaled = [(key, factor, base.replace(**{key: factor * getattr(base, key)})) for key in chosen for factor in factors]
     total = len(scaled) + 1
-    baseline = _measure(short)
+    baseline = _measure(base, measures)
     if progress is not None:
         progress(1, total)
     rows = []
     for done, (key, factor, changed) in enumerate(scaled, start=2):
-        measures = _measure(changed)
-        rows.append(SensitivityRow(key, factor, getattr(changed, key), measures, _relative(measures, baseline)))
+        values = _measure(changed, measures)
+        rows.append(SensitivityRow(key, factor, getattr(changed, key), values, _relative(values, baseline)))
         if progress is not None:
             progress(done, total)
-    return KinematicSensitivity(params.kinematics, duration, baseline, tuple(rows))
+    return KinematicSensitivity(params.kinematics, params.duration, params.solver, baseline, tuple(rows))
 
 
-def _measure(params: Parameters) -> dict[str, float]:
+def _measure(params: Parameters, measures: Sequence[str]) -> dict[str, float]:
     summary = summarize(simulate_whole(params))
-    return {name: float(summary[name]) for name in MEASURES}  # type: ignore[arg-type]
+    return {name: float(summary[name]) for name in measures}  # type: ignore[arg-type]
 
 
-def _relative(measures: dict[str, float], baseline: dict[str, float]) -> dict[str, float]:
+def _relative(values: dict[str, float], baseline: dict[str, float]) -> dict[str, float]:
     """(value − baseline)/baseline of each measure; NaN where the baseline is 0 or undefined."""
-    return {name: (measures[name] - baseline[name]) / baseline[name] if baseline[name] else math.nan for name in MEASURES}
+    return {name: (values[name] - baseline[name]) / baseline[name] if baseline[name] else math.nan for name in values}

@@ -1,10 +1,13 @@
 """Compiled velocity-Verlet stepping of the 'dem' engine (MODEL.md section 12).
 
 One step: half kick with the last forces, drift, forces at the new positions (with the velocities
-predicted to the step's end), second half kick with the new forces. Inside a contact the step is
-``contact_step`` (a fraction of the smallest Rayleigh time); in free flight it is as long as no
-contact can begin inside it (each gap over its largest closing speed and acceleration), but never
-shorter than a contact step nor longer than ``max_flight_step``.
+predicted to the step's end), second half kick with the new forces. Inside contacts the step is
+``contact_step_fraction`` of the smallest Rayleigh time, or of the touching contacts' shortest oscillation
+period over 9.5 where that is longer (model.RAYLEIGH_TIMES_PER_PERIOD: a ball resting, rolling or hopping on
+the bore steps longer; impacts of 0.1 m/s and faster keep the Rayleigh step), never beyond 0.9 t_R. In free
+flight, and for the slots not touching when a contact's step is the longer one, it is as long as no contact
+can begin inside it (each gap over its largest closing speed and acceleration), but never shorter than the
+Rayleigh step nor longer than ``max_flight_step``.
 
 The energy bookkeeping is exact per step. The second half kick makes each ball's change of kinetic
 energy dt·(F̄·v̄ + M̄·w̄), with F̄, M̄ the means of its forces and torques at the step's two ends and
@@ -252,6 +255,7 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     spin = _norm(relative_spin)
     for axis in range(3):
         w.rolling_torque[slot, axis] = -k.rolling_friction * radius * pressing * relative_spin[axis] / spin if spin > 0 else 0.0
+    c.period[slot] = contact.contact_period(mass, radius, modulus, shear_modulus, overlap, approach)
     c.peak_force[slot] = max(c.peak_force[slot], abs(magnitude))
     c.max_overlap[slot] = max(c.max_overlap[slot], overlap)
 
@@ -546,13 +550,16 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
     """The longest step in which no contact can begin (MODEL.md §12.6), within [contact_step, max_flight_step].
 
     A ball's centre moves in the vial frame at its velocity relative to the vial's point under it, which can
-    change at most by gravity, the vial's acceleration and the Coriolis term within a step. Its distance from
-    an end face closes at most at the axial part of that velocity, its distance from the axis grows at most
-    at the part across the axis (a norm bound, so the bore's curvature needs no term of its own).
+    change at most by gravity, the vial's acceleration and the Coriolis term within a step, and by the contact
+    forces on it (taken twice their last value: they are those of slow contacts, or the step is a contact step
+    anyway; in flight they are zero). Its distance from an end face closes at most at the axial part of that
+    velocity, its distance from the axis grows at most at the part across the axis (a norm bound, so the
+    bore's curvature needs no term of its own). Touching slots are left out: their contacts have begun.
     """
     n = k.n_balls
     step = k.max_flight_step
     axis = w.orientation[:, 0]
+    active = s.contacts.active
     for i in range(n):
         for component in range(3):
             w.lever[component] = s.position[i, component] - w.coordinates[component]
@@ -561,16 +568,39 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
             w.point_velocity[component] = s.velocity[i, component] - w.rates[component] - w.other_velocity[component]
         along = _dot(w.point_velocity, axis)
         across = math.sqrt(max(_dot(w.point_velocity, w.point_velocity) - along * along, 0.0))
-        acceleration = _norm(k.gravity) + k.wall_acceleration_bound + 2.0 * k.angular_speed_bound * (abs(along) + across)
+        pushed = 2.0 * _norm(s.force[i]) / k.mass[i]
+        acceleration = (_norm(k.gravity) + k.wall_acceleration_bound + 2.0 * k.angular_speed_bound * (abs(along) + across)
+                        + pushed)
         for wall in range(N_WALLS):
+            if active[n * n + N_WALLS * i + wall]:
+                continue
             gap = wall_gap(s.position[i], k.radius[i], wall, k, w)
             closing = across if wall == SIDE else (-along if wall == LEFT_END else along)
             step = min(step, _time_to_close(gap, max(closing, 0.0), acceleration))
         for j in range(i + 1, n):
-            # Both balls fall alike in flight: their relative motion is uniform.
+            if active[i * n + j]:
+                continue
+            # Both balls fall alike in flight: their relative motion changes only by the contact forces.
             gap = _distance(s.position[i], s.position[j]) - k.radius[i] - k.radius[j]
-            step = min(step, _time_to_close(gap, _distance(s.velocity[i], s.velocity[j]), 0.0))
+            relative_acceleration = pushed + 2.0 * _norm(s.force[j]) / k.mass[j]
+            step = min(step, _time_to_close(gap, _distance(s.velocity[i], s.velocity[j]), relative_acceleration))
     return max(step, k.contact_step)
+
+
+@njit(cache=True, inline="always")
+def _step_length(touching: int, period: float, k: Constants, s: State, w: Scratch) -> float:
+    """The next step (MODEL.md §12.6). In flight, :func:`_flight_step`. Inside contacts, contact_step_fraction
+    of the longer of the smallest Rayleigh time and 1/9.5 of ``period``, the shortest period of the touching
+    contacts (:func:`contact.contact_period`, from each one's overlap and normal speed at its last evaluation),
+    so that impacts keep the Rayleigh step and slow, lasting contacts take longer ones (never beyond 0.9 t_R,
+    MODEL.md §7); a step longer than the Rayleigh one is also bounded as a flight step by the slots not
+    touching, so that no contact begins inside it."""
+    if not touching:
+        return _flight_step(k, s, w)
+    step = max(k.contact_step, min(k.period_step_fraction * period, k.longest_contact_step))
+    if step <= k.contact_step:
+        return k.contact_step
+    return min(step, _flight_step(k, s, w))
 
 
 @njit(cache=True, inline="always")
@@ -599,9 +629,9 @@ def _final_kick(dt: float, k: Constants, s: State, w: Scratch) -> None:
 
 @njit(cache=True, inline="always")
 def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.ndarray,
-          count: int) -> tuple[int, int, float]:
+          count: int) -> tuple[int, int, float, float]:
     """One velocity-Verlet step of length ``dt`` ending at ``t``; returns (record count, contacts touching,
-    deepest overlap)."""
+    deepest overlap, shortest period of the touching contacts)."""
     w.angular_before[:] = w.angular
     _kick_and_drift(dt, k, s, w)
     vial_frame(t, k, w)
@@ -610,14 +640,17 @@ def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.n
     _sum_forces(live, k, s, w)
     _final_kick(dt, k, s, w)
     touching = 0
+    period = math.inf
     for index in range(live):
         slot = w.live[index]
         count = _settle(slot, t, dt, k, s, w, records, count)
-        touching += 1 if w.touching[slot] else 0
+        if w.touching[slot]:
+            touching += 1
+            period = min(period, s.contacts.period[slot])
     _convect(dt, k, s, w)
     s.clock[0] = t
     s.clock[1] += dt
-    return count, touching, max(deepest_pair, deepest_wall)
+    return count, touching, max(deepest_pair, deepest_wall), period
 
 
 @njit(cache=True)
@@ -643,8 +676,11 @@ def advance(t_stop: float, max_steps: int, k: Constants, s: State, w: Scratch, r
     slots = s.contacts.active.size
     vial_frame(s.clock[0], k, w)
     touching = 0
+    period = math.inf
     for slot in range(slots):
-        touching += 1 if s.contacts.active[slot] else 0
+        if s.contacts.active[slot]:
+            touching += 1
+            period = min(period, s.contacts.period[slot])
     status = REACHED_STOP
     steps = 0
     while s.clock[0] < t_stop:
@@ -654,13 +690,13 @@ def advance(t_stop: float, max_steps: int, k: Constants, s: State, w: Scratch, r
         if count + slots > records.shape[0]:
             status = RECORDS_FULL
             break
-        dt = k.contact_step if touching else _flight_step(k, s, w)
+        dt = _step_length(touching, period, k, s, w)
         mark = counters[ROWS_WRITTEN]
         end = min(t_stop, marks[mark]) if mark < marks.size else t_stop
         remaining = end - s.clock[0]
         t = end if dt >= remaining else s.clock[0] + dt
         before = count
-        count, touching, deepest = _step(t, min(dt, remaining), k, s, w, records, count)
+        count, touching, deepest, period = _step(t, min(dt, remaining), k, s, w, records, count)
         steps += 1
         counters[STEPS] += 1
         counters[CONTACT_STEPS if touching else FLIGHT_STEPS] += 1

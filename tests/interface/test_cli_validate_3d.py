@@ -1,0 +1,56 @@
+"""`shakermill validate`'s three-dimensional part: the held-out five-ball prediction, the engines on one ball,
+and the sensitivity to the assumed SPEX motion, through the command (short runs stand in for the hour)."""
+
+from __future__ import annotations
+
+import functools
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from shakermill import cli
+from shakermill.studies import held_out
+
+runner = CliRunner()
+# A few drive periods at full resolution for every run: the command's shape, not its numbers.
+QUICK = {"solver": "full", "duration": 0.2}
+
+
+@pytest.fixture(name="quick_runs")
+def quick_runs_fixture(monkeypatch):
+    monkeypatch.setattr(held_out, "five_ball_prediction", functools.partial(held_out.five_ball_prediction, QUICK))
+    monkeypatch.setattr(held_out, "five_ball_sensitivity", functools.partial(held_out.five_ball_sensitivity, QUICK))
+    monkeypatch.setattr(held_out, "engine_comparison", functools.partial(held_out.engine_comparison, overrides=QUICK))
+
+
+def test_validate_prints_the_five_ball_prediction_the_engines_and_the_sensitivity(quick_runs):
+    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-study"])
+    assert outcome.exit_code == 0, outcome.output
+    text = outcome.stdout
+    assert "Held out: five balls" in text and "nothing was refitted" in text
+    for row in ("ball temperature rise after 1 h", "vial temperature rise after 1 h", "vial/ball rise ratio after 1 h"):
+        assert row in text
+    for case in held_out.ENGINE_CASES:
+        assert case.label[:30] in text
+    assert "lateral_amplitude × 0.5" in text and "yaw_amplitude × 1.5" in text
+
+
+def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_runs):
+    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-study", "--json"])
+    assert outcome.exit_code == 0, outcome.output
+    payload = json.loads(outcome.stdout)
+    five = payload["five_balls"]
+    assert five["preset"] == "spex8000m-3d-calibrated" and five["fitted_parameters"]
+    rows = five["rows"]
+    assert (rows["ball_rise_C"]["experiment"], rows["vial_rise_C"]["experiment"], rows["vial_ball_ratio"]["experiment"]) == (46.0, 21.0, 0.46)
+    for row in rows.values():
+        assert row["relative_error"] == pytest.approx(row["predicted"] / row["experiment"] - 1.0)
+    cases = payload["engine_comparison"]["cases"]
+    assert [case["label"] for case in cases] == [case.label for case in held_out.ENGINE_CASES]
+    assert payload["engine_comparison"]["units"]["heat_power_W"] == "W"
+    sensitivity = payload["kinematic_sensitivity"]
+    assert [(row["key"], row["factor"]) for row in sensitivity["rows"]] == [
+        ("lateral_amplitude", 0.5), ("lateral_amplitude", 1.5), ("yaw_amplitude", 0.5), ("yaw_amplitude", 1.5),
+    ]
+    assert set(sensitivity["baseline"]) == set(held_out.SENSITIVITY_MEASURES)
