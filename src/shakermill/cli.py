@@ -428,7 +428,7 @@ def several_ball_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
         return []
     from shakermill.engines.dem.model import CHANNELS
 
-    rows = [("engine; balls", f"dem; {s['n_balls']}", "")]
+    rows = [("engine; balls; fill of the vial", f"dem; {s['n_balls']}; {_number(s.get('fill_fraction'), '.3f')}", "")]
     for key, what in (("ball_temperatures_C", "at the end"), ("balls_steady_C", "steady state")):
         values = [value for value in s.get(key) or () if value is not None]
         if not values:

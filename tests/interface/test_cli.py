@@ -438,7 +438,7 @@ def test_a_dem_run_draws_its_figures_and_its_table_tells_the_balls_apart(dem_run
         assert (out / "figures" / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     summary = load_run(out).summary
     rows = table_rows(outcome.stdout)
-    assert rows["engine; balls"] == ("dem; 3", "")
+    assert rows["engine; balls; fill of the vial"] == (f"dem; 3; {summary['fill_fraction']:.3f}", "")
     each = "; ".join(f"{value:.2f}" for value in summary["ball_temperatures_C"])
     assert rows["each ball at the end (ball 0; 1; …)"] == (each, "°C")
     assert rows["impacts on the walls; between balls"] == (f"{summary['wall_impacts']}; {summary['ball_ball_impacts']}", "")

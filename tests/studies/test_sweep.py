@@ -121,12 +121,12 @@ def test_plan_is_the_product_with_the_first_grid_slowest():
         ("omega=90:130:²", ["N must be a whole number", "'²'"]),  # str.isdigit() is true for '²'; int() refuses it
         ("omgea=90:130:3", ["omgea", "unknown parameter", "did you mean 'omega'"]),
         ("frobnicate=1:2:3", ["frobnicate", "unknown parameter"]),
-        ("solver=1:2:3", ["solver", "grids are for real-valued parameters", "--points"]),
+        ("solver=1:2:3", ["solver", "START:STOP:N is for real-valued parameters", "solver=A,B,C"]),
         ("amplitude=23 kg:30mm:3", ["amplitude", "kg", "expected m"]),
         ("amplitude=23mm:30 s:3", ["amplitude", "expected m"]),
         ("amplitude=23 blorps:30mm:3", ["amplitude", "cannot parse"]),
         ("omega=nan:130:3", ["omega", "'nan' is not a finite number"]),
-        ("averaging_batch_periods=8:32:4", ["averaging_batch_periods", "real-valued", "--points"]),
+        ("averaging_batch_periods=8:32:4", ["averaging_batch_periods", "real-valued", "averaging_batch_periods=A,B,C"]),
     ],
 )
 def test_bad_grid_is_one_line_naming_the_problem(spec, fragments):

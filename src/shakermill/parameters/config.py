@@ -27,6 +27,7 @@ from shakermill.parameters.schema import (
     build_parameters,
     field_description,
     field_unit,
+    layered,
     preset_values,
     with_materials,
 )
@@ -67,7 +68,7 @@ def load_config(
         file_preset = _file_preset(file_values, source)
     chosen_preset = preset or file_preset or DEFAULT_PRESET
     # Each layer completed by its own materials first: a file's material replaces the preset's values.
-    base = {**with_materials(preset_values(chosen_preset)), **with_materials(file_values)}
+    base = layered(with_materials(preset_values(chosen_preset)), with_materials(file_values))
     params = build_parameters(base, parse_overrides(overrides))
     return RunConfig(params=params, preset=chosen_preset, source=source)
 
@@ -138,6 +139,10 @@ def config_toml_text(
     for key, value in params.model_dump().items():
         unit = field_unit(key)
         comment = f"# {field_description(key)}" + (f" [{unit}]" if unit else "")
+        if key == "n_balls" and params.fill > 0:
+            # Written as a value, it would contradict fill as soon as the file is run with another ball or vial.
+            entries.append(f"{comment}\n# n_balls = {value}: follows from fill\n")
+            continue
         entries.append(comment + "\n" + tomli_w.dumps({key: value}))
     entries.append(tomli_w.dumps({PROVENANCE_TABLE: _provenance(preset, extra_provenance or {})}))
     return "\n".join(entries)

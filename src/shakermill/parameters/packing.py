@@ -19,6 +19,16 @@ CLEARANCE = 0.01
 
 def placement(radii: np.ndarray, vial_length: float, vial_diameter: float) -> np.ndarray | None:
     """Centres (N, 3) in m of balls of ``radii``, bottom layer first, or None when they do not all fit."""
+    centres = packed(radii, vial_length, vial_diameter)
+    return centres if len(centres) == radii.size else None
+
+
+def packed(radii: np.ndarray, vial_length: float, vial_diameter: float) -> np.ndarray:
+    """Centres (k, 3) in m of the first k balls of ``radii`` that fit, placed one after another until one does not.
+
+    Each ball goes to the first free candidate whatever comes after it, so the first k balls of any longer list
+    lie where k balls alone would: ``len(packed(...))`` is how many of these balls the vial takes.
+    """
     step = max(GRID_STEP * float(np.max(radii)), (vial_length * vial_diameter**2 / MAX_CANDIDATES) ** (1.0 / 3.0))
     axis = _centred_grid(0.5 * vial_length, step)
     across = _centred_grid(0.5 * vial_diameter, step)
@@ -33,7 +43,7 @@ def placement(radii: np.ndarray, vial_length: float, vial_diameter: float) -> np
         padded = radius * (1.0 + CLEARANCE)
         found = np.flatnonzero(_inside(candidates, padded, vial_length, vial_diameter) & (room >= padded))
         if found.size == 0:
-            return None
+            return centres[:ball]
         centres[ball] = candidates[found[0]]
         surface = np.linalg.norm(candidates - centres[ball], axis=1) - padded
         np.minimum(room, surface, out=room)

@@ -73,6 +73,9 @@ def _per_ball(scalar_key: str) -> Any:
 
 # The most balls of the 'dem' engine and harmonics of a user-given vial motion.
 MAX_BALLS = 50
+# No packing of equal spheres fills more of space than π/√18 (Kepler's conjecture, proved by Hales), let
+# alone a vial, whose walls leave gaps: the bound of ``fill``.
+DENSEST_PACKING = math.pi / math.sqrt(18.0)
 MAX_HARMONICS = 60
 MOTION_COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
 # Translations of a vial beyond half a metre describe no mill.
@@ -279,6 +282,13 @@ class Parameters(BaseModel):
     )
     # 50 balls of the smallest radius still fit any vial the bounds allow; the pair search is O(N²).
     n_balls: int = _count("number of balls (engine = 'dem'; the 1-D engine has one)", ge=1, le=MAX_BALLS)
+    fill: float = _quantity(
+        "",
+        "fraction of the vial's inner volume the balls take (engine = 'dem'): > 0 sets n_balls = max(1, "
+        "round(fill·V_vial/V_ball)) equal balls; 0: n_balls as given",
+        ge=0,
+        le=DENSEST_PACKING,
+    )
     # Each ball's own radius and material, in ball order; empty: every ball takes the scalar key's value.
     ball_radii: tuple[float, ...] = _per_ball("ball_radius")
     ball_densities: tuple[float, ...] = _per_ball("ball_density")
@@ -364,6 +374,39 @@ class Parameters(BaseModel):
         return self
 
     @model_validator(mode="after")
+    def _fill_sets_the_balls(self) -> "Parameters":
+        """``fill`` > 0 makes n_balls equal balls (:func:`balls_for_fill`); an n_balls that says otherwise is refused.
+
+        A key, not a sweep axis of its own: a run, a configuration file and a sweep point all take it, and the
+        count it makes follows the ball and vial of that very run (a sweep over fill × ball_radius needs no
+        table of counts). It cannot disagree with n_balls unnoticed: a layer that sets fill replaces the
+        n_balls of the layers below it (:func:`layered`), and an n_balls set beside it or above it must match.
+        """
+        if self.fill == 0:
+            return self
+        if self.engine != "dem":
+            raise ValueError("fill: sets the number of balls of the 'dem' engine; allowed fill = 0 with engine = '1d', or set engine = 'dem'")
+        listed = next((key for key in ("ball_materials", *PER_BALL_KEYS) if getattr(self, key)), None)
+        if listed is not None:
+            raise ValueError(f"fill: makes equal balls, and {listed} gives each ball its own value; allowed fill = 0 with per-ball lists")
+        wanted = balls_for_fill(self.fill, self.ball_radius, self.vial_length, self.vial_diameter)
+        if wanted > MAX_BALLS:
+            raise ValueError(
+                f"fill: {self.fill:g} of this vial is {wanted} balls of radius {self.ball_radius * 1e3:g} mm; allowed fill "
+                f"< {self._fill_below(MAX_BALLS):.3g} here (at most {MAX_BALLS} balls)"
+            )
+        if self.n_balls != wanted:
+            raise ValueError(
+                f"n_balls: {self.n_balls} contradicts fill = {self.fill:g}, which makes {wanted} balls of radius "
+                f"{self.ball_radius * 1e3:g} mm in this vial; allowed n_balls = {wanted}, or fill = 0 to give n_balls alone"
+            )
+        return self
+
+    def _fill_below(self, count: int) -> float:
+        """The fill at which :func:`balls_for_fill` rounds up to ``count`` + 1 balls of ``ball_radius``."""
+        return (count + 0.5) * _ball_volume(self.ball_radius) / self.vial_volume
+
+    @model_validator(mode="after")
     def _balls_of_the_dem_engine(self) -> "Parameters":
         if self.engine == "1d" and self.n_balls > 1:
             raise ValueError(
@@ -407,11 +450,25 @@ class Parameters(BaseModel):
                 f"allowed radii < vial_diameter/2 = {self.vial_diameter / 2:g} m"
             )
         if self.n_balls > 1 and self.initial_positions() is None:
+            if self.fill > 0:
+                self._refuse_fill_that_does_not_fit()
             raise ValueError(
                 f"n_balls: {self.n_balls} balls (radius up to {largest * 1e3:g} mm) do not fit side by side in a vial of "
                 f"{self.vial_diameter * 1e3:g} mm x {self.vial_length * 1e3:g} mm; allowed fewer balls, smaller ones or a "
                 "larger vial_diameter"
             )
+
+    def _refuse_fill_that_does_not_fit(self) -> None:
+        import numpy as np
+
+        from shakermill.parameters.packing import packed
+
+        fitting = len(packed(np.full(self.n_balls, self.ball_radius), self.vial_length, self.vial_diameter))
+        raise ValueError(
+            f"fill: {self.fill:g} of the vial is {self.n_balls} balls of radius {self.ball_radius * 1e3:g} mm, and "
+            f"{fitting} fit side by side in {self.vial_diameter * 1e3:g} mm x {self.vial_length * 1e3:g} mm; allowed fill "
+            f"< {self._fill_below(fitting):.3g} for these balls and this vial"
+        )
 
     @property
     def relative_convection(self) -> bool:
@@ -483,12 +540,26 @@ class Parameters(BaseModel):
         return end_faces_area(self.vial_diameter)
 
     @property
+    def vial_volume(self) -> float:
+        """π d_v²/4·l_v: the vial's inner volume (m³)."""
+        return _vial_volume(self.vial_length, self.vial_diameter)
+
+    @property
+    def balls_volume(self) -> float:
+        """Σ 4/3·π R³ over every ball of the 'dem' engine, or the one ball of the 1-D engine (m³)."""
+        radii = self.ball_values("ball_radius") if self.engine == "dem" else (self.ball_radius,)
+        return sum(_ball_volume(radius) for radius in radii)
+
+    @property
+    def fill_fraction(self) -> float:
+        """The fraction of the vial's inner volume the balls take (dimensionless): what ``fill`` asks, as achieved
+        by a whole number of balls."""
+        return self.balls_volume / self.vial_volume
+
+    @property
     def air_mass(self) -> float:
         """m_a = ρ_a·(π d_v²/4·l_v − Σ 4/3·π R³) (kg), MODEL.md section 6 (every ball of the 'dem' engine)."""
-        vial_volume = math.pi * self.vial_diameter**2 / 4.0 * self.vial_length
-        radii = self.ball_values("ball_radius") if self.engine == "dem" else (self.ball_radius,)
-        ball_volume = sum(4.0 / 3.0 * math.pi * radius**3 for radius in radii)
-        return self.air_density * (vial_volume - ball_volume)
+        return self.air_density * (self.vial_volume - self.balls_volume)
 
     @property
     def air_heat_capacity(self) -> float:
@@ -520,7 +591,11 @@ class Parameters(BaseModel):
 
     def replace(self, **changes: Any) -> "Parameters":
         """A new validated ``Parameters`` with ``changes`` applied (values may carry units)."""
-        return build_parameters(self.model_dump(), changes)
+        current = self.model_dump()
+        if self.fill > 0 and "fill" not in changes:
+            # fill made n_balls: it makes it again for the changed ball or vial.
+            del current["n_balls"]
+        return build_parameters(current, changes)
 
 
 FIELD_NAMES: tuple[str, ...] = tuple(Parameters.model_fields)
@@ -627,6 +702,41 @@ def allowed_range(key: str) -> str:
     if field.annotation is int:
         return f"a whole number in {bounds(key)}"
     return f"{bounds(key)} {field_unit(key)}".rstrip()
+
+
+def _ball_volume(radius: float) -> float:
+    return 4.0 / 3.0 * math.pi * radius**3
+
+
+def _vial_volume(vial_length: float, vial_diameter: float) -> float:
+    return math.pi * vial_diameter**2 / 4.0 * vial_length
+
+
+def balls_for_fill(fill: float, ball_radius: float, vial_length: float, vial_diameter: float) -> int:
+    """How many equal balls of ``ball_radius`` (m) take ``fill`` of a vial's inner volume (m, m; fill
+    dimensionless): n = max(1, round(fill·V_vial/V_ball)), V_vial = π d_v²/4·l_v, halves rounded up."""
+    balls = fill * _vial_volume(vial_length, vial_diameter) / _ball_volume(ball_radius)
+    return max(1, math.floor(balls + 0.5))
+
+
+def layered(lower: Mapping[str, Any], upper: Mapping[str, Any]) -> dict[str, Any]:
+    """``upper``'s values over ``lower``'s. A fill > 0 in ``upper`` sets the number of balls itself, so it
+    replaces ``lower``'s n_balls; an n_balls in ``upper`` stays, and must agree with it."""
+    merged = {**lower, **upper}
+    if "n_balls" not in upper and "fill" in upper and _coerce("fill", upper["fill"]) > 0:
+        merged.pop("n_balls", None)
+    return merged
+
+
+def _with_balls_of_fill(values: dict[str, Any]) -> dict[str, Any]:
+    """SI ``values`` with the n_balls their fill > 0 makes, where no layer gave n_balls (:func:`layered`)."""
+    if "n_balls" in values or not values.get("fill", 0) > 0:
+        return values
+    geometry = [values.get(key) for key in ("ball_radius", "vial_length", "vial_diameter")]
+    # A missing or non-positive length gets its own error, as does a count beyond MAX_BALLS: fill's, which
+    # names fill, rather than n_balls' bounds.
+    count = balls_for_fill(values["fill"], *geometry) if all(isinstance(v, float) and v > 0 for v in geometry) else 1
+    return {**values, "n_balls": min(count, MAX_BALLS)}
 
 
 def end_faces_area(vial_diameter: float) -> float:
@@ -743,6 +853,7 @@ SPEX_8000M = Preset(
         ),
         "engine": Cited("1d", f"{PAPER}: one ball on the vial's axis"),
         "n_balls": Cited(1, f"{PAPER}: one ball"),
+        "fill": Cited(0.0, "unused: n_balls gives the number of balls"),
         **{key: Cited("", "no material: the keys' own values (the paper's steel)") for key in ("ball_material", "vial_material")},
         "ball_materials": Cited((), "every ball takes ball_material, or the scalar keys' values"),
         **{key: Cited((), "every ball takes the scalar key's value") for key in PER_BALL_KEYS},
@@ -982,7 +1093,7 @@ def _coerce(key: str, value: Any) -> Any:
         if annotation is float:
             return _coerce_quantity(key, value)
         if annotation is int:
-            return _coerce_count(key, value)
+            return whole_number(key, value)
         if annotation is bool:
             return _coerce_switch(key, value)
         if key == "record_windows":
@@ -1008,7 +1119,8 @@ def _coerce_quantity(key: str, value: Any) -> float:
     return number
 
 
-def _coerce_count(key: str, value: Any) -> int:
+def whole_number(key: str, value: Any) -> int:
+    """``value`` of a count key as an int; :class:`UnitError` for anything else."""
     # A TOML `true` is not 1, and 2.5 starts are not 2.
     if isinstance(value, bool):
         raise UnitError(f"{key}: expected a whole number, got {value!r}")
@@ -1075,7 +1187,7 @@ def _harmonic(term: Any) -> tuple[str, int, float, float]:
         )
     coordinate = str(term[0]).strip()
     unit = "rad" if coordinate in ("roll", "pitch", "yaw") else "m"
-    harmonic = _coerce_count("motion", term[1])
+    harmonic = whole_number("motion", term[1])
     return coordinate, harmonic, to_si(term[2], unit, key="motion"), to_si(term[3], unit, key="motion")
 
 
@@ -1102,18 +1214,17 @@ def _one_line(error: ValidationError) -> str:
 
 
 def build_parameters(base: Mapping[str, Any], overrides: Mapping[str, Any] | None = None) -> Parameters:
-    """Validate ``base`` updated with ``overrides`` into :class:`Parameters`, each completed by its materials
-    first (:func:`with_materials`).
+    """Validate ``base`` updated with ``overrides`` (:func:`layered`) into :class:`Parameters`, each completed
+    by its materials first (:func:`with_materials`); a fill > 0 makes n_balls where neither layer above it does.
 
     Raises :class:`ParameterError` with one line that names the offending key.
     """
-    merged = with_materials(base)
-    merged.update(with_materials(overrides or {}))
+    merged = layered(with_materials(base), with_materials(overrides or {}))
     check_known_keys(list(merged))
-    missing = [key for key in FIELD_NAMES if key not in merged]
+    coerced = _with_balls_of_fill({key: _coerce(key, value) for key, value in merged.items()})
+    missing = [key for key in FIELD_NAMES if key not in coerced]
     if missing:
         raise ParameterError(f"{missing[0]}: no value given and no preset supplies one")
-    coerced = {key: _coerce(key, value) for key, value in merged.items()}
     try:
         return Parameters(**coerced)
     except ValidationError as exc:

@@ -449,6 +449,7 @@ def several_ball_summary(result: Result) -> dict[str, Any]:
     keys: dict[str, Any] = {
         "engine": "dem",
         "n_balls": result.params.n_balls,
+        "fill_fraction": result.params.fill_fraction,
         "wall_impacts": int(round(wall * scale)),
         "ball_ball_impacts": int(round((result.impact_count - wall) * scale)),
         "ball_temperatures_C": [kelvin_to_celsius(float(value)) for value in temperatures],

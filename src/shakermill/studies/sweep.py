@@ -53,6 +53,7 @@ from shakermill.parameters.schema import (
     checked_name,
     field_unit,
     takes_names,
+    whole_number,
 )
 from shakermill.parameters.units import UnitError, to_si
 from shakermill.solvers.result import INTERRUPTED, Result
@@ -135,16 +136,20 @@ class SweepData:
 
 
 def normalize_value(key: str, value: Any) -> Any:
-    """``value`` for ``key`` as stored and hashed: SI floats for numeric keys, the value itself otherwise.
+    """``value`` for ``key`` as stored and hashed: SI floats for real keys, ints for counts, the value itself
+    otherwise (so "3" and 3 balls are one point).
 
-    Only the unit is interpreted here; whether the value is allowed is decided per point, so an
-    out-of-range value makes that point fail, not the sweep.
+    Only the unit and the type are interpreted here; whether the value is allowed is decided per point, so an
+    out-of-range value (or balls that do not fit) makes that point fail, not the sweep.
     """
-    if Parameters.model_fields[key].annotation is float:
-        try:
+    annotation = Parameters.model_fields[key].annotation
+    try:
+        if annotation is float:
             return to_si(value, field_unit(key), key=key)
-        except UnitError as exc:
-            raise ParameterError(str(exc)) from None
+        if annotation is int:
+            return whole_number(key, value)
+    except UnitError as exc:
+        raise ParameterError(str(exc)) from None
     return to_jsonable(value)
 
 
@@ -161,7 +166,7 @@ def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray
         raise ParameterError(f"grid {shown}: {exc}") from None
     if Parameters.model_fields[key].annotation is not float:
         raise ParameterError(
-            f"grid {shown}: grids are for real-valued parameters and {key} is not one; list its values with --points"
+            f"grid {shown}: START:STOP:N is for real-valued parameters and {key} is not one; list its values as {key}=A,B,C"
         )
     if len(bounds) != 3:
         raise ParameterError(f"grid {shown}: expected KEY=START:STOP:N (three fields after '='), got {len(bounds)}")
@@ -178,20 +183,27 @@ def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray
 
 def grid_values(spec: str) -> tuple[str, Sequence[Any]]:
     """The values of one ``--grid``: ``KEY=START:STOP:N`` for a real-valued key (:func:`parse_grid`), or
-    ``KEY=A,B,C`` for a key that takes names (``ball_material=steel,zirconia``, ``solver=full,averaged``)."""
+    ``KEY=A,B,C`` for a key that takes names (``ball_material=steel,zirconia``, ``solver=full,averaged``), a
+    count (``n_balls=1,2,5``) or a real value (``ball_radius=4mm,5mm,6.35mm``)."""
     match = GRID_PATTERN.match(spec)
     key = match["key"] if match is not None else ""
-    if key not in Parameters.model_fields or not takes_names(key):
+    if key not in Parameters.model_fields or not _takes_a_list(key, match["range"]):
         return parse_grid(spec)
-    names = [item.strip() for item in match["range"].split(",") if item.strip()]
-    if not names:
+    items = [item.strip() for item in match["range"].split(",") if item.strip()]
+    if not items:
         raise ParameterError(f"grid {quoted(spec)}: expected KEY=A,B,C, for example ball_material=steel,zirconia")
-    check_point_count(len(names))
+    check_point_count(len(items))
     try:
-        # A misspelt name fails the sweep before it starts, not one point in the middle of it.
-        return key, [checked_name(key, name) for name in names]
+        # A misspelt name or unit fails the sweep before it starts, not one point in the middle of it.
+        return key, [checked_name(key, item) if takes_names(key) else normalize_value(key, item) for item in items]
     except ParameterError as exc:
         raise ParameterError(f"grid {quoted(spec)}: {exc}") from None
+
+
+def _takes_a_list(key: str, values: str) -> bool:
+    """Whether ``KEY=values`` lists values: always for names, for a count or a real key unless it reads START:STOP:N
+    (which :func:`parse_grid` reads, or refuses for a count with a hint at the list)."""
+    return takes_names(key) or (Parameters.model_fields[key].annotation in (int, float) and ":" not in values)
 
 
 def product_points(grids: Sequence[tuple[str, Sequence[Any]]], listed: int = 1) -> list[dict[str, Any]]:
