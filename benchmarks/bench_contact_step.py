@@ -16,6 +16,7 @@ import numpy as np
 import shakermill as sm
 from shakermill.engines.dem import model, stepper
 from shakermill.engines.dem.engine import Engine
+from shakermill.engines.status import REACHED_STOP
 
 CASES = {
     # One ball falls onto the bore of the Ø38 vial and rests or rolls on it (axial drive, gravity on).
@@ -32,7 +33,7 @@ def run(keys: dict, seconds: int) -> dict[str, float]:
     heat, wall, cpu = [0.0], time.perf_counter(), time.process_time()
     for second in range(1, seconds + 1):
         status = engine.advance(float(second))
-        if status != stepper.REACHED_STOP:
+        if status != REACHED_STOP:
             raise RuntimeError(f"{keys}: {engine.explain(status)}")
         heat.append(float(engine.state.totals[model.HEAT_GENERATED]))
     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu

@@ -28,6 +28,7 @@ import numpy as np
 import shakermill as sm
 from shakermill.engines.dem import model, stepper
 from shakermill.engines.dem.engine import Engine
+from shakermill.engines.status import REACHED_STOP
 from shakermill.studies.impact import single_impact
 
 T = TypeVar("T")
@@ -245,7 +246,7 @@ def five_ball_batches(fraction: float, seconds: int) -> Batches:
     wall, cpu = time.perf_counter(), time.process_time()
     for second in range(1, seconds + 1):
         status = engine.advance(float(second))
-        if status != stepper.REACHED_STOP:
+        if status != REACHED_STOP:
             raise RuntimeError(f"contact_step_fraction {fraction}: {engine.explain(status)}")
         totals.append((engine.state.totals[model.HEAT_GENERATED], engine.counters[stepper.IMPACTS]))
         walls.append(time.perf_counter() - wall)

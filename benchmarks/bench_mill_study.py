@@ -9,7 +9,7 @@ temperature after 1 h in °C), the wall time per point (median) and in total, an
 into ``docs/figures/mill-study.png``. A second part runs one hour of five 12.7-mm balls at the preset's own
 settings and prints its wall time, heat power and the balls' and vial's temperatures.
 
-The preset is ``spex8000m-3d-calibrated`` where it exists, else ``spex8000m-3d`` (printed). A point whose
+The preset is ``spex8000m-3d-calibrated``, fitted to the one-ball curve only. A point whose
 mechanics do not converge within ``averaging_max_time`` fails with its reason (``averaging_fallback =
 'fail'``) instead of falling back to a full-resolution hour, which would take hours for a lone ball.
 
@@ -36,12 +36,11 @@ from pathlib import Path
 import pandas as pd
 
 import shakermill as sm
-from shakermill.parameters.schema import PRESETS
 from shakermill.studies.sweep import SweepProgress, load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURE = ROOT / "docs" / "figures" / "mill-study.png"
-PRESET_CHOICES = ("spex8000m-3d-calibrated", "spex8000m-3d")
+PRESET = "spex8000m-3d-calibrated"
 BALL_COUNTS = (1, 2, 3, 4, 5)
 DIAMETERS_MM = (8.0, 10.0, 12.7)
 MATERIALS = ("hardened-steel", "tungsten-carbide")
@@ -156,7 +155,7 @@ def run_study(base: sm.Parameters, preset: str, counts: list[int], out: Path, wo
         table = sm.sweep(base, grid(counts), out, workers=workers, progress=report_progress(started), preset=preset)
     except KeyboardInterrupt:
         table = load_sweep(out).table
-        print(f"\ninterrupted: the tables hold the finished points; the same command computes the others", flush=True)
+        print("\ninterrupted: the tables hold the finished points; the same command computes the others", flush=True)
     return table, time.perf_counter() - started
 
 
@@ -174,7 +173,7 @@ def main() -> None:
     args = parser.parse_args()
     counts = [int(item) for item in args.counts.split(",")]
 
-    preset = next(name for name in PRESET_CHOICES if name in PRESETS)
+    preset = PRESET
     base = study_parameters(preset, args.rel_error)
     # A folder holds one sweep: another choice of counts or target gets a folder of its own.
     out = args.out or ROOT / "results" / f"mill-study-{preset}-{'-'.join(map(str, counts))}-{base.dem_averaging_rel_error:g}"

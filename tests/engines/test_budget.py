@@ -6,16 +6,17 @@ import math
 
 import numpy as np
 import pytest
+from conftest import TIGHTEST_TOLERANCES
 
 import shakermill as sm
-from shakermill.engines.one_d import integrator as integrate
 from shakermill.engines.budget import BudgetExceeded
-from shakermill.engines.one_d.integrator import BUDGET_EXCEEDED, WINDOWS_FULL
-from shakermill.solvers.result import ENERGY_AUDIT_FAILED, ENERGY_AUDIT_TOLERANCE, EnergyAudit
+from shakermill.engines.one_d import integrator as integrate
+from shakermill.engines.one_d.integrator import WINDOWS_FULL
 from shakermill.engines.one_d.setup import integrator_for, sample_times
+from shakermill.engines.status import BUDGET_EXCEEDED
 from shakermill.solvers.full import simulate_full
+from shakermill.solvers.result import ENERGY_AUDIT_FAILED, ENERGY_AUDIT_TOLERANCE, EnergyAudit
 from shakermill.solvers.simulate import simulate_whole
-from conftest import TIGHTEST_TOLERANCES
 
 # A 10-s chunk at the tightest tolerances is ~3·10⁵ steps.
 TINY_STEPS = {**TIGHTEST_TOLERANCES, "record_windows": ()}

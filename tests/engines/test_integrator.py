@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.physics import contact
 from shakermill.engines.one_d import model
-from shakermill.engines.one_d.integrator import BOGACKI_SHAMPINE, OVERLAP_TOO_LARGE, ButcherTableau
+from shakermill.engines.one_d.integrator import BOGACKI_SHAMPINE, ButcherTableau
+from shakermill.engines.status import OVERLAP_TOO_LARGE
+from shakermill.physics import contact
 
 # Restitution is reproduced to ~5e-5 at rtol 1e-5, to ~3e-4 at rtol 1e-4 and to ~2e-3 at ode23's
 # default rtol 1e-3 (benchmarks/README.md has the table).

@@ -40,8 +40,8 @@ from shakermill.analysis.regime import (
 )
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.one_d import model
-from shakermill.engines.one_d.integrator import REACHED_STOP
 from shakermill.engines.one_d.setup import ProgressCallback, impact_columns, integrator_for
+from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.schema import Parameters
 
 if TYPE_CHECKING:

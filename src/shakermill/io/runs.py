@@ -30,9 +30,9 @@ from typing import TYPE_CHECKING, Any, Callable, Container, Iterable, Mapping
 import numpy as np
 
 from shakermill.analysis.fit import ExponentialFit
-from shakermill.engines.one_d.integrator import REACHED_STOP
 from shakermill.engines.dem.engine import IMPACT_UNITS as DEM_IMPACT_UNITS
 from shakermill.engines.one_d.setup import IMPACT_UNITS
+from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.config import load_config, write_config_toml
 from shakermill.parameters.schema import Parameters
 from shakermill.solvers.result import TIME_ATTRIBUTES, Result, StateHistory

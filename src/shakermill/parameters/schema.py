@@ -979,8 +979,9 @@ def load_presets(folder: Path, built_in: Preset) -> dict[str, Preset]:
     """The built-in preset and every TOML file of ``folder``, each loaded after the preset it builds on."""
     presets = {built_in.name: built_in}
     waiting = {path.stem: path for path in sorted(folder.glob("*.toml"))}
+    bases = {name: _base_of(path) for name, path in waiting.items()}
     while waiting:
-        ready = [name for name, path in waiting.items() if _base_of(path) in presets]
+        ready = [name for name in waiting if bases[name] in presets]
         if not ready:
             raise ValueError(f"presets {', '.join(sorted(waiting))} build on presets that do not exist or on each other")
         for name in ready:

@@ -36,8 +36,9 @@ from shakermill.analysis.batch_means import batch_rates, mser_truncation, normal
 from shakermill.analysis.fit import fit_exponential
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.one_d import model
-from shakermill.engines.one_d.integrator import BUDGET_EXCEEDED, COUNTER_NAMES, REACHED_STOP, Integrator
+from shakermill.engines.one_d.integrator import COUNTER_NAMES, Integrator
 from shakermill.engines.one_d.setup import ProgressCallback, impact_columns, integrator_for, sample_times
+from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.parameters.schema import Parameters
 from shakermill.solvers.full import assemble, simulate_full
 from shakermill.solvers.result import (

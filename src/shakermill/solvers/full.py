@@ -10,8 +10,9 @@ from shakermill.analysis.fit import fit_exponential
 from shakermill.analysis.steady import settled_means
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.one_d import model
-from shakermill.engines.one_d.integrator import COUNTER_NAMES, REACHED_STOP, Integrator
+from shakermill.engines.one_d.integrator import COUNTER_NAMES, Integrator
 from shakermill.engines.one_d.setup import ProgressCallback, impact_columns, integrator_for, sample_times
+from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.schema import Parameters
 from shakermill.solvers.result import (
     INTERRUPTED,

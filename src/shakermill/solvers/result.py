@@ -14,7 +14,7 @@ from shakermill.analysis.attractors import AttractorScan, find_attractors
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
 from shakermill.analysis.steady import SteadyState, run_length_warning, steady_state
 from shakermill.engines.one_d import model
-from shakermill.engines.one_d.integrator import REACHED_STOP
+from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.defaults import HIT_SPEED
 from shakermill.parameters.schema import Parameters, unit_slip_warnings
 from shakermill.support.presenters import present
@@ -429,7 +429,8 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
 
 
 def _hits(speeds: np.ndarray, window: float) -> dict[str, float]:
-    hits = np.asarray(speeds)[np.asarray(speeds) >= HIT_SPEED]
+    speeds = np.asarray(speeds)
+    hits = speeds[speeds >= HIT_SPEED]
     return {
         "hit_rate_hz": hits.size / window if window > 0 else math.nan,
         "mean_hit_speed_m_s": float(hits.mean()) if hits.size else math.nan,

@@ -5,9 +5,8 @@ from __future__ import annotations
 from typing import Callable
 
 from shakermill.engines.budget import BudgetExceeded, RunBudget
-from shakermill.engines.one_d.integrator import BUDGET_EXCEEDED
 from shakermill.engines.one_d.setup import ProgressCallback
-from shakermill.engines.status import REACHED_STOP
+from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.parameters.schema import Parameters
 from shakermill.solvers.averaged import simulate_averaged
 from shakermill.solvers.dem import Mechanics, settle_mechanics, simulate_dem, simulate_dem_averaged

@@ -14,7 +14,7 @@ from typing import Any, Callable, Mapping
 from shakermill.parameters.defaults import HIT_SPEED
 from shakermill.parameters.schema import PRESETS, Parameters, default_parameters
 from shakermill.solvers.simulate import simulate_whole
-from shakermill.studies.kinematics import KinematicSensitivity, kinematic_sensitivity
+from shakermill.studies.kinematics import KinematicSensitivity, kinematic_sensitivity, measured
 from shakermill.studies.validation import relative_error
 
 HELD_OUT_PRESET = "spex8000m-3d-calibrated"
@@ -124,8 +124,7 @@ def engine_comparison(
     values = []
     for index, case in enumerate(cases):
         settings = {"solver": "averaged", "record_windows": (), **case.settings, **(overrides or {})}
-        summary = simulate_whole(default_parameters(case.preset, **settings)).summary
-        values.append({key: float(summary[key]) for key, _, _ in COMPARED_KEYS})
+        values.append(measured(default_parameters(case.preset, **settings), [key for key, _, _ in COMPARED_KEYS]))
         if progress is not None:
             progress(index + 1)
     return EngineComparison(cases, tuple(values))

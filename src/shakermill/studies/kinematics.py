@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Callable, Sequence
 
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.parameters.schema import Parameters
-from shakermill.solvers.result import summarize
 from shakermill.solvers.simulate import simulate_whole
+from shakermill.studies.validation import relative_error
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -90,23 +90,24 @@ def kinematic_sensitivity(
     base = params.replace(record_windows=())
     scaled = [(key, factor, base.replace(**{key: factor * getattr(base, key)})) for key in chosen for factor in factors]
     total = len(scaled) + 1
-    baseline = _measure(base, measures)
+    baseline = measured(base, measures)
     if progress is not None:
         progress(1, total)
     rows = []
     for done, (key, factor, changed) in enumerate(scaled, start=2):
-        values = _measure(changed, measures)
+        values = measured(changed, measures)
         rows.append(SensitivityRow(key, factor, getattr(changed, key), values, _relative(values, baseline)))
         if progress is not None:
             progress(done, total)
     return KinematicSensitivity(params.kinematics, params.duration, params.solver, baseline, tuple(rows))
 
 
-def _measure(params: Parameters, measures: Sequence[str]) -> dict[str, float]:
-    summary = summarize(simulate_whole(params))
+def measured(params: Parameters, measures: Sequence[str]) -> dict[str, float]:
+    """The summary keys ``measures`` of a whole run of ``params``."""
+    summary = simulate_whole(params).summary
     return {name: float(summary[name]) for name in measures}  # type: ignore[arg-type]
 
 
 def _relative(values: dict[str, float], baseline: dict[str, float]) -> dict[str, float]:
-    """(value − baseline)/baseline of each measure; NaN where the baseline is 0 or undefined."""
-    return {name: (values[name] - baseline[name]) / baseline[name] if baseline[name] else math.nan for name in values}
+    """(value − baseline)/baseline of each measure; NaN where the baseline is 0."""
+    return {name: relative_error(values[name], baseline[name]) for name in values}
