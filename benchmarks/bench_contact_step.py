@@ -15,7 +15,7 @@ import numpy as np
 
 import shakermill as sm
 from shakermill.engines.dem import model, stepper
-from shakermill.engines.dem.engine import Engine
+from shakermill.engines.dem.engine import DemEngine
 from shakermill.engines.status import REACHED_STOP
 
 CASES = {
@@ -29,7 +29,7 @@ CASES = {
 
 
 def run(keys: dict, seconds: int) -> dict[str, float]:
-    engine = Engine(sm.default_parameters(**keys))
+    engine = DemEngine(sm.default_parameters(**keys))
     heat, wall, cpu = [0.0], time.perf_counter(), time.process_time()
     for second in range(1, seconds + 1):
         status = engine.advance(float(second))
@@ -38,7 +38,7 @@ def run(keys: dict, seconds: int) -> dict[str, float]:
         heat.append(float(engine.state.totals[model.HEAT_GENERATED]))
     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     batches = np.diff(heat)
-    c = engine.counters
+    c = engine.stepper_counters
     return {
         "wall": wall / seconds,
         "cpu": cpu / seconds,
@@ -54,7 +54,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--only", help="run only the cases whose name contains this text")
     args = parser.parse_args()
-    Engine(sm.default_parameters(engine="dem", n_balls=2, vial_diameter="38 mm")).advance(0.01)  # compile
+    DemEngine(sm.default_parameters(engine="dem", n_balls=2, vial_diameter="38 mm")).advance(0.01)  # compile
     header = (f"{'case':<22} {'sim s':>5} | {'wall/sim s':>10} {'CPU/sim s':>9} | {'steps/sim s':>11} "
               f"{'contact %':>9} | {'impacts/s':>9} | {'heat W':>9} {'±SE W':>8}")
     print(header + "\n" + "-" * len(header))

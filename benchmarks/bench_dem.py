@@ -27,9 +27,9 @@ import numpy as np
 
 import shakermill as sm
 from shakermill.engines.dem import model, stepper
-from shakermill.engines.dem.engine import Engine
+from shakermill.engines.dem.engine import DemEngine
 from shakermill.engines.status import REACHED_STOP
-from shakermill.studies.impact import single_impact
+from shakermill.solvers.impact import single_impact
 
 T = TypeVar("T")
 
@@ -241,14 +241,14 @@ class Batches:
 
 
 def five_ball_batches(fraction: float, seconds: int) -> Batches:
-    engine = Engine(sm.default_parameters(**FIVE_BALLS, contact_step_fraction=fraction))
+    engine = DemEngine(sm.default_parameters(**FIVE_BALLS, contact_step_fraction=fraction))
     totals, walls, cpus = [(0.0, 0)], [], []
     wall, cpu = time.perf_counter(), time.process_time()
     for second in range(1, seconds + 1):
         status = engine.advance(float(second))
         if status != REACHED_STOP:
             raise RuntimeError(f"contact_step_fraction {fraction}: {engine.explain(status)}")
-        totals.append((engine.state.totals[model.HEAT_GENERATED], engine.counters[stepper.IMPACTS]))
+        totals.append((engine.state.totals[model.HEAT_GENERATED], engine.stepper_counters[stepper.IMPACTS]))
         walls.append(time.perf_counter() - wall)
         cpus.append(time.process_time() - cpu)
     heat, impacts = np.diff(np.array(totals), axis=0).T

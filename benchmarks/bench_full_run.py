@@ -15,7 +15,7 @@ import tempfile
 import time
 
 import shakermill as sm
-from shakermill.solvers.reference import simulate_scipy
+from shakermill.engines.one_d.reference import simulate_scipy
 
 _COLD_START = """
 import time

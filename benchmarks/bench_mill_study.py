@@ -36,7 +36,8 @@ from pathlib import Path
 import pandas as pd
 
 import shakermill as sm
-from shakermill.studies.sweep import SweepProgress, load_sweep
+from shakermill.studies.sweep import SweepProgress
+from shakermill.studies.sweep_storage import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURE = ROOT / "docs" / "figures" / "mill-study.png"

@@ -21,8 +21,9 @@ import pandas as pd
 from pandas.testing import assert_frame_equal
 
 import shakermill as sm
-from shakermill.studies.sweep import comparable_columns, failed_points, plan_sweep
 from shakermill.studies.sweep import sweep as run_sweep
+from shakermill.studies.sweep_plan import plan_sweep
+from shakermill.studies.sweep_storage import comparable_columns, failed_points
 
 TARGET_S = 30.0
 

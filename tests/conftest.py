@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 import shakermill as sm
-from shakermill.parameters.schema import Parameters
+from shakermill.parameters.keys import Parameters
 
 # The paper's tables as data: a verbatim copy of ../shared/reference-data/paper.toml, kept in the
 # repository so that the tests comparing with it run in a clone with no ../shared beside it.

@@ -21,10 +21,10 @@ register_presenters()
 
 # The public names, and the modules that define them.
 _LAZY = {
-    "Parameters": "shakermill.parameters.schema",
-    "ParameterError": "shakermill.parameters.schema",
-    "build_parameters": "shakermill.parameters.schema",
-    "default_parameters": "shakermill.parameters.schema",
+    "Parameters": "shakermill.parameters.keys",
+    "ParameterError": "shakermill.parameters.errors",
+    "build_parameters": "shakermill.parameters.keys",
+    "default_parameters": "shakermill.parameters.presets",
     "Result": "shakermill.solvers.result",
     "simulate": "shakermill.solvers.simulate",
     "sweep": "shakermill.studies.sweep",

@@ -52,6 +52,7 @@ def test_random_impacts_are_irregular_and_none_is_no_impacts() -> None:
     assert classify(_fake_result([], [])) == (NO_IMPACTS, None)
 
 
+@pytest.mark.slow
 def test_default_motion_is_periodic_and_bifurcation_records_phases() -> None:
     base = sm.default_parameters(solver="averaged", duration=60.0, record_windows=())
     label, period = classify(sm.simulate(base))
@@ -64,6 +65,7 @@ def test_default_motion_is_periodic_and_bifurcation_records_phases() -> None:
     assert scan.regimes.loc[scan.regimes["omega"] == 111.0, "period"].item() == period
 
 
+@pytest.mark.slow
 def test_bifurcation_lists_every_attractor_with_basins_summing_to_one() -> None:
     # At a 23 mm stroke period-1 and period-2 coexist over the whole range (see test_attractors.py).
     base = sm.default_parameters(solver="averaged", duration=60.0, record_windows=(), amplitude=0.023)
@@ -85,6 +87,7 @@ def test_bifurcation_lists_every_attractor_with_basins_summing_to_one() -> None:
         assert sorted(set(rows["start"])) == sorted(int(start) for start in listed.split())
 
 
+@pytest.mark.slow
 def test_bifurcation_scans_any_numeric_key_and_writes_its_tables(tmp_path) -> None:
     base = sm.default_parameters(solver="averaged", duration=60.0, record_windows=())
     scan = bifurcation(base, [0.024, 0.026], key="amplitude")
@@ -106,6 +109,7 @@ def test_settled_impacts_of_a_full_run_are_its_second_half() -> None:
     assert settled_impacts(impacts, "averaged", 1.0)["time"].tolist() == [0.1, 0.4, 0.6, 0.9]
 
 
+@pytest.mark.slow
 def test_bifurcation_stops_at_ctrl_c_inside_a_run(monkeypatch) -> None:
     # simulate() turns Ctrl-C into status INTERRUPTED (a full run keeps what it computed); the scan
     # must raise it rather than go on to the next value.

@@ -8,9 +8,17 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.analysis.steady import SETTLED_TIME_CONSTANTS, run_length_warning, settled_means, steady_state
+from shakermill.analysis.steady import SETTLED_TIME_CONSTANTS, run_length_warning, settled_rates, steady_state
+from shakermill.engines.registry import engine_named
 
 
+def _steady(params, heat, term):
+    """The steady state of ``params``' engine's network with ``heat`` (W) from the impacts and the velocity term."""
+    engine = engine_named(params.engine)(params, None, np.zeros(1), 0.0)
+    return steady_state(engine.network, engine.load(np.array([heat]), np.array([term])))
+
+
+@pytest.mark.slow
 def test_steady_state_of_a_ball_at_rest_matches_the_hand_solution():
     # Re = 0 makes Nu = 2 whatever Sutherland's factor, so the network is linear and explicit:
     # all heat leaves through h_o·A_o, and the ball's share crosses ball → air → vial.
@@ -20,7 +28,7 @@ def test_steady_state_of_a_ball_at_rest_matches_the_hand_solution():
     vial = params.ambient_temperature + heat / (params.h_outer * params.outer_area)
     air = vial + params.lam * heat / (params.h_inner * params.inner_area)
     ball = air + params.lam * heat / (4 * math.pi * params.ball_radius**2 * params.beta * h_ball)
-    steady = steady_state(params, heat, 0.0)
+    steady = _steady(params, heat, 0.0)
     assert steady.solved
     assert (steady.ball, steady.vial, steady.air) == pytest.approx((ball, vial, air), abs=1e-9)
 
@@ -46,7 +54,7 @@ def test_time_constants_are_those_of_the_hand_built_linear_network():
         ]
     )
     expected = sorted(-1.0 / np.linalg.eigvals(conductances / capacities[:, None]).real, reverse=True)
-    steady = steady_state(params, 0.5, 0.0)
+    steady = _steady(params, 0.5, 0.0)
     assert steady.time_constants == pytest.approx(expected, rel=1e-6)
 
 
@@ -54,7 +62,7 @@ def test_steady_state_with_moving_ball_is_a_root_of_the_nonlinear_network():
     from shakermill.engines.one_d import model
 
     params = sm.default_parameters()
-    steady = steady_state(params, 1.2, 30.0)
+    steady = _steady(params, 1.2, 30.0)
     rates = model.thermal_network(steady.ball, steady.vial, steady.air, 1.2, 30.0, model.constants_from(params))
     assert np.max(np.abs(rates[:3])) < 1e-10
     # Every watt leaves through the outer surface.
@@ -63,7 +71,7 @@ def test_steady_state_with_moving_ball_is_a_root_of_the_nonlinear_network():
 
 def test_ball_only_model_has_vial_and_air_at_ambient():
     params = sm.default_parameters(model="ball_only")
-    steady = steady_state(params, 0.5, 0.0)
+    steady = _steady(params, 0.5, 0.0)
     h_ball = 2.0 * params.air_conductivity / (2.0 * params.ball_radius)
     expected_ball = params.ambient_temperature + params.lam * 0.5 / (4 * math.pi * params.ball_radius**2 * params.beta * h_ball)
     assert steady.vial == steady.air == params.ambient_temperature
@@ -72,19 +80,21 @@ def test_ball_only_model_has_vial_and_air_at_ambient():
 
 
 def test_no_outer_cooling_has_no_steady_state():
-    steady = steady_state(sm.default_parameters(h_outer=0.0), 1.0, 30.0)
+    steady = _steady(sm.default_parameters(h_outer=0.0), 1.0, 30.0)
     assert not steady.solved
     assert "h_outer = 0" in steady.message
     assert math.isinf(steady.ball)
 
 
-def test_settled_means_use_the_second_half_of_the_run():
+def test_settled_rates_use_the_second_half_of_the_run():
     times = np.linspace(0.0, 10.0, 11)
     heat = np.where(times < 3.0, 0.0, 2.0 * (times - 3.0))  # 2 W once settled after 3 s
     term = 5.0 * times
-    assert settled_means(times, heat, term) == pytest.approx((2.0, 5.0))
+    assert float(settled_rates(times, heat)) == pytest.approx(2.0)
+    assert settled_rates(times, np.column_stack([heat, term])) == pytest.approx([2.0, 5.0])
 
 
+@pytest.mark.slow
 def test_steady_state_is_where_a_ten_hour_averaged_run_ends():
     params = sm.default_parameters("spex8000m-calibrated", solver="averaged", duration=36000.0, record_windows=())
     result = sm.simulate(params)
@@ -96,6 +106,7 @@ def test_steady_state_is_where_a_ten_hour_averaged_run_ends():
     assert not any("slowest time constants" in line for line in result.warnings)
 
 
+@pytest.mark.slow
 def test_steady_state_is_where_a_long_full_resolution_run_ends():
     # The default preset's slowest time constant is ~20 min: three hours are nine of them.
     result = sm.simulate(sm.default_parameters(duration=3 * 3600.0, record_windows=()))
@@ -116,7 +127,7 @@ def test_an_hour_of_the_calibrated_preset_warns_that_its_fit_is_not_the_steady_s
 
 
 def test_run_length_warning_only_for_short_runs():
-    steady = steady_state(sm.default_parameters(), 1.0, 30.0)
+    steady = _steady(sm.default_parameters(), 1.0, 30.0)
     slowest = steady.slowest_time_constant
     assert run_length_warning(2.9 * slowest, steady) is not None
     assert run_length_warning(3.1 * slowest, steady) is None

@@ -11,11 +11,13 @@ from conftest import TIGHTEST_TOLERANCES
 import shakermill as sm
 from shakermill.engines.budget import BudgetExceeded
 from shakermill.engines.one_d import integrator as integrate
+from shakermill.engines.one_d.engine import OneDimensionalEngine, integrator_for
 from shakermill.engines.one_d.integrator import WINDOWS_FULL
-from shakermill.engines.one_d.setup import integrator_for, sample_times
+from shakermill.engines.records import EnergyAudit
 from shakermill.engines.status import BUDGET_EXCEEDED
+from shakermill.solvers.driver import sample_times
 from shakermill.solvers.full import simulate_full
-from shakermill.solvers.result import ENERGY_AUDIT_FAILED, ENERGY_AUDIT_TOLERANCE, EnergyAudit
+from shakermill.solvers.result import ENERGY_AUDIT_FAILED, ENERGY_AUDIT_TOLERANCE
 from shakermill.solvers.simulate import simulate_whole
 
 # A 10-s chunk at the tightest tolerances is ~3·10⁵ steps.
@@ -43,11 +45,11 @@ def test_a_wall_clock_budget_stops_a_long_run_between_chunks() -> None:
 
 def test_pauses_of_the_compiled_loop_leave_a_run_bit_for_bit_unchanged(monkeypatch) -> None:
     params = sm.default_parameters(duration=3.0, record_windows=((0.0, 0.5), (2.0, 0.3)))
-    whole = simulate_full(params)
-    monkeypatch.setattr(integrate, "FIRST_STEPS_PER_CALL", 7)
-    monkeypatch.setattr(integrate, "MAX_STEPS_PER_CALL", 7)
+    whole = simulate_full(params, OneDimensionalEngine)
+    monkeypatch.setattr(integrate.Integrator, "first_steps_per_call", 7)
+    monkeypatch.setattr(integrate.Integrator, "most_steps_per_call", 7)
     reports: list[float] = []
-    paused = simulate_full(params, progress=lambda t, _duration: reports.append(t))
+    paused = simulate_full(params, OneDimensionalEngine, progress=lambda t, _duration: reports.append(t))
     assert len(reports) > whole.counters["steps"] // 7 - 1
     assert paused.counters == whole.counters
     for name in ("x", "p", "theta_ball", "theta_vial", "theta_air", "heat_generated"):
@@ -63,7 +65,7 @@ def test_tiny_steps_hand_control_back_inside_a_chunk() -> None:
     integrator = integrator_for(params, sample_times(params))
     heartbeats: list[float] = []
     status = integrator.advance(10.0, heartbeats.append)
-    # The first call takes FIRST_STEPS_PER_CALL steps, the next the rest of the budget; then it is spent.
+    # The first call takes first_steps_per_call steps, the next the rest of the budget; then it is spent.
     assert status == BUDGET_EXCEEDED
     assert len(heartbeats) == 2 and 0.0 < heartbeats[0] < heartbeats[1] == integrator.t < 1.0
     assert int(integrator.counters[integrate.STEPS]) == 3000
@@ -97,8 +99,8 @@ def test_scans_and_fits_are_told_of_a_spent_budget_by_an_exception() -> None:
 def test_full_record_windows_stop_the_run_instead_of_filling_memory(monkeypatch) -> None:
     monkeypatch.setattr(integrate, "MAX_WINDOW_POINTS", 50)
     # The size is checked between calls: short calls make the check as fine as the test needs.
-    monkeypatch.setattr(integrate, "FIRST_STEPS_PER_CALL", 10)
-    monkeypatch.setattr(integrate, "MAX_STEPS_PER_CALL", 10)
+    monkeypatch.setattr(integrate.Integrator, "first_steps_per_call", 10)
+    monkeypatch.setattr(integrate.Integrator, "most_steps_per_call", 10)
     result = sm.simulate(sm.default_parameters(duration=20.0, record_windows=((0.0, 5.0),)))
     assert result.status == WINDOWS_FULL
     assert "Shorten record_windows" in result.message and result.t_end < 5.0

@@ -9,7 +9,7 @@ import pytest
 
 import shakermill as sm
 from shakermill.engines.dem import model
-from shakermill.engines.dem.engine import Engine
+from shakermill.engines.dem.engine import DemEngine
 from shakermill.physics import contact
 
 # The issue's 1-D limit: one ball on the axis, axial drive, no gravity, no friction, the lab-frame convection.
@@ -26,6 +26,7 @@ def heat_power_and_impact_rate(params: sm.Parameters) -> tuple[float, float]:
     return result.energy.heat_generated / result.t_end, result.impact_count / result.t_end
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("omega", [90.0, 111.0, 130.0])
 def test_one_ball_on_the_axis_is_the_one_dimensional_model(omega):
     """MODEL.md §12: heat power within 1 % and impact rate within 2 % over 20 s (the issue's limit)."""
@@ -37,6 +38,7 @@ def test_one_ball_on_the_axis_is_the_one_dimensional_model(omega):
     assert rate_dem == pytest.approx(rate_1d, rel=0.02)
 
 
+@pytest.mark.slow
 def test_one_ball_on_the_axis_heats_ball_vial_and_air_as_the_one_dimensional_model():
     one_d = sm.default_parameters(duration=20.0, record_windows=())
     first, second = sm.simulate(one_d), sm.simulate(one_d.replace(**ONE_D_LIMIT))
@@ -50,6 +52,7 @@ def test_one_ball_on_the_axis_heats_ball_vial_and_air_as_the_one_dimensional_mod
     assert second.energy.dissipated_by_channel["sliding"] == 0.0
 
 
+@pytest.mark.slow
 def test_the_energy_audit_closes_with_friction_gravity_and_rolling_resistance():
     """MODEL.md §12.6: work of vial and gravity = Δ kinetic energy + Δ stored + dissipated, to round-off."""
     params = sm.default_parameters(**FIVE_BALLS, rolling_friction=0.01, duration=2.0, record_windows=())
@@ -66,6 +69,7 @@ def test_the_energy_audit_closes_with_friction_gravity_and_rolling_resistance():
     assert energy.heat_to_ball + energy.heat_to_vial == pytest.approx(energy.heat_generated, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_the_audit_closes_in_a_rotating_vial():
     """The wall's velocity at a contact point includes Ω × r: a vial that yaws and pitches as it shakes."""
     params = sm.default_parameters(
@@ -78,6 +82,7 @@ def test_the_audit_closes_in_a_rotating_vial():
     assert (result.impact_columns["target"] == "side").any()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("preset, balls", [("spex8000m-3d", 5), ("mm400", 2)])
 def test_the_audit_closes_in_the_named_motions(preset, balls):
     """The SPEX clamp's figure of eight and the mixer mill's arc (parameters/kinematic_models.py)."""
@@ -89,6 +94,7 @@ def test_the_audit_closes_in_the_named_motions(preset, balls):
     assert result.impact_count > 0
 
 
+@pytest.mark.slow
 def test_the_same_configuration_gives_the_same_numbers():
     params = sm.default_parameters(**FIVE_BALLS, duration=0.5, record_windows=((0.0, 0.1),))
     first, second = sm.simulate(params), sm.simulate(params)
@@ -97,11 +103,12 @@ def test_the_same_configuration_gives_the_same_numbers():
     assert first.energy.as_dict() == second.energy.as_dict()
 
 
+@pytest.mark.slow
 def test_a_ball_resting_on_the_bore_sinks_in_by_the_hertz_overlap_of_the_concave_side():
     """Under gravity in a vial at rest, a ball settles on the cylinder's bottom line with the static Hertz
     overlap ζ = (3mg/(4E*√R*))^{2/3}, R* = R·R_c/(R_c − R) (MODEL.md §12.3)."""
     params = sm.default_parameters(engine="dem", **RESTING_VIAL, duration=0.3, record_windows=())
-    engine = Engine(params)
+    engine = DemEngine(params)
     engine.advance(0.3)
     k = engine.constants
     radius, bore = params.ball_radius, params.vial_diameter / 2
@@ -114,6 +121,7 @@ def test_a_ball_resting_on_the_bore_sinks_in_by_the_hertz_overlap_of_the_concave
     assert np.linalg.norm(engine.state.velocity[0]) < 1e-5
 
 
+@pytest.mark.slow
 def test_a_ball_ball_contact_splits_its_heat_by_effusivity():
     """MODEL.md §12.4: in proportion to √(kρc); here the second ball conducts four times as well."""
     params = sm.default_parameters(

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from shakermill.engines.one_d import model
-from shakermill.parameters.schema import Parameters, default_parameters
+from shakermill.parameters.keys import Parameters
+from shakermill.parameters.presets import default_parameters
 
 # The thermal state used throughout (K)
 THETA_B, THETA_V, THETA_A = 320.0, 300.0, 305.0

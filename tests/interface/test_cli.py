@@ -20,12 +20,13 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
+from shakermill.cli import common as cli_common
 from shakermill.io.runs import RUN_FILES, load_run
 from shakermill.parameters.config import load_config
-from shakermill.parameters.schema import FIELD_NAMES
+from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.solvers.result import INTERRUPTED
 from shakermill.studies.calibrate import DEFAULT_FREE
-from shakermill.studies.sweep import load_sweep
+from shakermill.studies.sweep_storage import load_sweep
 
 # Short runs with small windows keep every invocation well under a second once Numba's cache is warm.
 SHORT = ["--set", "duration=2", "--set", "record_windows=0:0.2"]
@@ -77,6 +78,7 @@ def test_run_json_prints_exactly_one_object_matching_the_stored_summary(tmp_path
     assert sorted(entry.name for entry in out.iterdir()) == sorted(RUN_FILES)  # --no-plots: no figures
 
 
+@pytest.mark.slow
 def test_run_writes_figures_and_prints_a_human_summary(tmp_path):
     out = tmp_path / "run"
     result = invoke("run", *SHORT, "--out", str(out))
@@ -167,6 +169,7 @@ def test_usage_error_from_the_parser_exits_2():
     assert "No such option" in result.stderr
 
 
+@pytest.mark.slow
 def test_numerical_failure_keeps_the_results_and_exits_1(tmp_path):
     # A soft ball and vial overlap by more than the integrator allows at the first impact.
     out = tmp_path / "run"
@@ -181,6 +184,7 @@ def test_numerical_failure_keeps_the_results_and_exits_1(tmp_path):
     assert (out / "figures" / "temperatures.png").is_file()
 
 
+@pytest.mark.slow
 def test_interruption_writes_partial_results_and_exits_130(tmp_path, monkeypatch):
     real_simulate = sm.simulate
 
@@ -209,24 +213,25 @@ def terminal_fixture(monkeypatch) -> io.StringIO:
             return real_console(file=screen, force_terminal=True, width=120)
         return real_console(**kwargs)
 
-    monkeypatch.setattr(cli, "Console", console)
+    monkeypatch.setattr(cli_common, "Console", console)
     return screen
 
 
 @pytest.mark.parametrize("solver", ["full", "averaged"])
 def test_progress_bar_is_drawn_on_a_terminal_once_a_run_takes_a_while(terminal, monkeypatch, solver):
-    monkeypatch.setattr(cli, "PROGRESS_DELAY_S", 0.0)
-    result = cli.simulate_with_progress(sm.default_parameters(solver=solver, duration=60.0, attractor_starts=2, record_windows=()))
+    monkeypatch.setattr(cli_common, "PROGRESS_DELAY_S", 0.0)
+    result = cli_common.simulate_with_progress(sm.default_parameters(solver=solver, duration=60.0, attractor_starts=2, record_windows=()))
     assert result.success
     assert "s simulated" in terminal.getvalue()
 
 
 def test_a_quick_run_draws_no_progress_bar(terminal):
-    result = cli.simulate_with_progress(sm.default_parameters(duration=2.0, record_windows=()))
+    result = cli_common.simulate_with_progress(sm.default_parameters(duration=2.0, record_windows=()))
     assert result.success
     assert terminal.getvalue() == ""
 
 
+@pytest.mark.slow
 def test_sweep_progress_bar_shows_points_done_running_and_failed(terminal, tmp_path):
     outcome = invoke(
         "sweep", *QUICK_BASE, "--grid", "restitution=0.8:1.1:3", "--workers", "1", "--out", str(tmp_path / "s")
@@ -267,6 +272,7 @@ def test_version_option():
     assert result.stdout.strip() == f"shakermill {sm.__version__}"
 
 
+@pytest.mark.slow
 def test_installed_command_reports_bad_input_without_traceback(tmp_path):
     completed = subprocess.run(
         [str(SHAKERMILL), "run", "--set", "restitution=1.5", "--out", str(tmp_path / "run")],
@@ -279,6 +285,7 @@ def test_installed_command_reports_bad_input_without_traceback(tmp_path):
     assert completed.stderr == "error: restitution: 1.5 is out of range; allowed (0, 1]\n"
 
 
+@pytest.mark.slow
 def test_installed_command_json_output_is_clean(tmp_path):
     completed = subprocess.run(
         [str(SHAKERMILL), "run", *SHORT, "--out", str(tmp_path / "run"), "--json", "--no-plots"],
@@ -292,6 +299,7 @@ def test_installed_command_json_output_is_clean(tmp_path):
     assert summary["success"] is True
 
 
+@pytest.mark.slow
 def test_compare_solvers_reports_both_solvers_and_the_speed_ratio():
     outcome = runner.invoke(cli.app, ["compare-solvers", "--set", "duration=300", "--set", "record_windows=", "--json"])
     assert outcome.exit_code == 0, outcome.output
@@ -303,6 +311,7 @@ def test_compare_solvers_reports_both_solvers_and_the_speed_ratio():
     assert averaged["heat_power_W"] == pytest.approx(full["heat_power_W"], rel=0.005)
 
 
+@pytest.mark.slow
 def test_validate_prints_table5_with_fitted_and_predicted_roles():
     outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-three-d", "--json"])
     assert outcome.exit_code == 0, outcome.output
@@ -322,6 +331,7 @@ def test_validate_prints_table5_with_fitted_and_predicted_roles():
     assert "still rising at the hour" in study[("beta", "vial_mass")]["verdict"]
 
 
+@pytest.mark.slow
 def test_calibrate_writes_a_preset_that_run_accepts(tmp_path):
     preset_file = tmp_path / "fitted.toml"
     outcome = runner.invoke(
@@ -338,6 +348,7 @@ def test_calibrate_writes_a_preset_that_run_accepts(tmp_path):
     assert json.loads(run.stdout)["theta_inf_C"] == pytest.approx(100.0, rel=0.005)
 
 
+@pytest.mark.slow
 def test_calibrate_that_cannot_meet_its_targets_exits_1(tmp_path):
     outcome = runner.invoke(cli.app, ["calibrate", "--target", "theta_inf_C=25", "--free", "vial_mass"])
     assert outcome.exit_code == 1
@@ -360,6 +371,7 @@ def sweep_folder(tmp_path_factory) -> Path:
     return folder
 
 
+@pytest.mark.slow
 def test_plot_of_a_sweep_folder_draws_maps_with_the_contour(sweep_folder, tmp_path):
     table = load_sweep(sweep_folder).table
     level = float(table["theta_inf_C"].median())
@@ -372,6 +384,7 @@ def test_plot_of_a_sweep_folder_draws_maps_with_the_contour(sweep_folder, tmp_pa
     assert "not crossed" not in outcome.stderr
 
 
+@pytest.mark.slow
 def test_plot_says_when_a_contour_level_is_never_reached(sweep_folder, tmp_path):
     table = load_sweep(sweep_folder).table
     level = float(table["theta_inf_C"].max()) + 10.0
@@ -382,6 +395,7 @@ def test_plot_says_when_a_contour_level_is_never_reached(sweep_folder, tmp_path)
     assert "14 files written" in outcome.stdout
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("extra", "fragments"),
     [
@@ -397,6 +411,7 @@ def test_plot_of_a_sweep_folder_refuses_bad_options_with_one_line(sweep_folder, 
     assert not (tmp_path / "maps").exists()
 
 
+@pytest.mark.slow
 def test_plot_of_a_sweep_over_the_solver_draws_every_figure(tmp_path):
     # The README's sweep over a string key: --points with a solver column.
     points = tmp_path / "solvers.csv"
@@ -429,6 +444,7 @@ def table_rows(stdout: str) -> dict[str, tuple[str, str]]:
     return {quantity: (value, unit) for quantity, value, unit in cells}
 
 
+@pytest.mark.slow
 def test_a_dem_run_draws_its_figures_and_its_table_tells_the_balls_apart(dem_run):
     out, outcome = dem_run
     assert outcome.exit_code == 0, outcome.stderr
@@ -448,6 +464,7 @@ def test_a_dem_run_draws_its_figures_and_its_table_tells_the_balls_apart(dem_run
     assert "ball at the end" not in rows
 
 
+@pytest.mark.slow
 def test_plot_of_a_dem_run_adds_the_impact_figures_and_the_animation(dem_run, tmp_path):
     from PIL import Image
 
@@ -462,6 +479,7 @@ def test_plot_of_a_dem_run_adds_the_impact_figures_and_the_animation(dem_run, tm
         assert (gif.n_frames, gif.size) == (10, (640, 400))
 
 
+@pytest.mark.slow
 def test_report_of_a_dem_run_has_the_balls_and_their_figures(dem_run, tmp_path):
     out, _ = dem_run
     outcome = invoke("report", str(out), "--out", str(tmp_path / "report.html"))
@@ -470,6 +488,7 @@ def test_report_of_a_dem_run_has_the_balls_and_their_figures(dem_run, tmp_path):
     assert "<h2>Balls</h2>" in document and document.count("<figure>") == len(DEM_FIGURES) + len(DEM_IMPACT_FIGURES)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("engine", "extra", "fragments"),
     [
@@ -488,6 +507,7 @@ def test_plot_refuses_a_window_the_run_lacks_and_an_animation_of_one_ball(dem_ru
     assert not (tmp_path / "figures").exists()
 
 
+@pytest.mark.slow
 def test_contour_on_a_run_folder_is_refused(tmp_path):
     assert invoke("run", *SHORT, "--no-plots", "--out", str(tmp_path / "run")).exit_code == 0
     outcome = invoke("plot", str(tmp_path / "run"), "--contour", "theta_inf_C=60")
@@ -495,6 +515,7 @@ def test_contour_on_a_run_folder_is_refused(tmp_path):
     assert_one_error_line(outcome.stderr, "--contour", "sweep folder")
 
 
+@pytest.mark.slow
 def test_bifurcation_writes_regimes_phases_and_the_diagram(tmp_path):
     folder = tmp_path / "scan"
     outcome = invoke("bifurcation", *QUICK_BASE, "--grid", "omega=100:120:3", "--out", str(folder))
@@ -556,6 +577,7 @@ def interrupt_after(command: list[str], after_s: float, exits_within_s: float = 
     return stderr
 
 
+@pytest.mark.slow
 def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path, start_up_s):
     out = tmp_path / "run"
     command = ["run", "--set", "solver=full", "--set", "duration=600 min", "--no-plots", "--out", str(out)]
@@ -567,6 +589,7 @@ def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path, sta
     assert 0 < summary["summary"]["simulated_s"] < 36000
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "command",
     [
@@ -585,6 +608,7 @@ def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up
 TINY_STEPS = [*(f"--set={key}={value}" for key, value in TIGHTEST_TOLERANCES.items()), "--set", "record_windows="]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "command, first_words",
     [
@@ -602,6 +626,7 @@ def test_real_ctrl_c_stops_a_run_stuck_on_tiny_steps_at_once(tmp_path, start_up_
     assert stderr.startswith(first_words)
 
 
+@pytest.mark.slow
 def test_a_run_that_uses_up_its_budget_keeps_its_folder_and_exits_1(tmp_path):
     out = tmp_path / "run"
     result = invoke("run", *SHORT, "--set", "max_steps=1000", "--no-plots", "--out", str(out))
@@ -613,6 +638,7 @@ def test_a_run_that_uses_up_its_budget_keeps_its_folder_and_exits_1(tmp_path):
     assert summary["status"] == -4 and summary["steps"] == 1000
 
 
+@pytest.mark.slow
 def test_run_onto_a_run_folder_is_refused_unless_overwrite(tmp_path):
     out = tmp_path / "run"
     assert invoke("run", *SHORT, "--no-plots", "--out", str(out)).exit_code == 0
@@ -634,6 +660,7 @@ def test_overwrite_never_replaces_a_folder_shakermill_did_not_write(tmp_path):
     assert [entry.name for entry in tmp_path.iterdir()] == ["thesis.tex"]
 
 
+@pytest.mark.slow
 def test_bifurcation_onto_a_non_empty_folder_is_refused_unless_overwrite(tmp_path):
     folder = tmp_path / "scan"
     folder.mkdir()
@@ -658,6 +685,7 @@ def test_bifurcation_never_writes_into_a_folder_of_the_users_own(tmp_path):
     assert (tmp_path / "bifurcation_regimes.csv").read_text() == "earlier scan"
 
 
+@pytest.mark.slow
 def test_report_onto_an_existing_file_is_refused_unless_overwrite(tmp_path):
     run_folder = tmp_path / "run"
     assert invoke("run", *SHORT, "--no-plots", "--out", str(run_folder)).exit_code == 0
@@ -672,6 +700,7 @@ def test_report_onto_an_existing_file_is_refused_unless_overwrite(tmp_path):
     assert report.read_text().lstrip().lower().startswith("<!doctype html")
 
 
+@pytest.mark.slow
 def test_calibrate_onto_an_existing_preset_file_is_refused_unless_overwrite(tmp_path, monkeypatch):
     preset_file = tmp_path / "fitted.toml"
     preset_file.write_text("# an earlier fit\n")
@@ -704,6 +733,7 @@ def test_ctrl_c_in_the_averaged_solver_says_so_in_one_line_and_writes_nothing(tm
 NOT_FOR_A_RUN_WITHOUT_FIGURES = ("xarray", "pandas", "dask", "pint", "matplotlib", "distributed")
 
 
+@pytest.mark.slow
 def test_a_run_without_figures_writes_its_files_without_the_heavy_libraries(tmp_path):
     script = (
         "import sys\n"

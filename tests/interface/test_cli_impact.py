@@ -105,6 +105,7 @@ def test_an_impact_the_engine_cannot_resolve_exits_2_naming_the_cause():
     assert_one_error_line(result.stderr, "overlap exceeded 5 %", "contact_step_fraction")
 
 
+@pytest.mark.slow
 def test_installed_command_refuses_a_negative_speed_in_one_line():
     command = [str(SHAKERMILL), "impact", "--speed", "-1"]
     completed = subprocess.run(command, capture_output=True, text=True, timeout=120)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 import json
 
 from conftest import assert_one_error_line
@@ -9,7 +11,7 @@ from typer.testing import CliRunner
 
 from shakermill import cli
 from shakermill.parameters import materials
-from shakermill.studies.sweep import load_sweep
+from shakermill.studies.sweep_storage import load_sweep
 
 runner = CliRunner()
 
@@ -61,6 +63,7 @@ def test_run_refuses_an_unknown_material_with_one_line(tmp_path):
     assert_one_error_line(outcome.stderr, "ball_material: unknown material 'gold'")
 
 
+@pytest.mark.slow
 def test_a_sweep_over_the_ball_material(tmp_path):
     folder = tmp_path / "by-material"
     outcome = invoke(

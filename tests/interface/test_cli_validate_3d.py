@@ -24,6 +24,7 @@ def quick_runs_fixture(monkeypatch):
     monkeypatch.setattr(held_out, "engine_comparison", functools.partial(held_out.engine_comparison, overrides=QUICK))
 
 
+@pytest.mark.slow
 def test_validate_prints_the_five_ball_prediction_the_engines_and_the_sensitivity(quick_runs):
     outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-study"])
     assert outcome.exit_code == 0, outcome.output
@@ -36,6 +37,7 @@ def test_validate_prints_the_five_ball_prediction_the_engines_and_the_sensitivit
     assert "lateral_amplitude × 0.5" in text and "yaw_amplitude × 1.5" in text
 
 
+@pytest.mark.slow
 def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_runs):
     outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-study", "--json"])
     assert outcome.exit_code == 0, outcome.output

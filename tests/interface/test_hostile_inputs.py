@@ -71,6 +71,7 @@ def test_the_corpus_is_large_and_its_names_unique():
     assert {case["expect"] for case in CASES} <= set(EXIT_CODES)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=[f"{case['corpus']}: {case['name']}" for case in CASES])
 def test_hostile_input_ends_cleanly_and_in_time(case, tmp_path):
     runner = CliRunner()

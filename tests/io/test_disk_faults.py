@@ -23,9 +23,9 @@ import pytest
 from typer.testing import CliRunner
 
 from shakermill import cli
-from shakermill.support.atomic import PARTIAL, create_exclusively, partial_path, remove_abandoned_writes, this_machine
 from shakermill.io.runs import load_run
-from shakermill.studies.sweep import MANIFEST_FILE, load_sweep
+from shakermill.studies.sweep_storage import MANIFEST_FILE, load_sweep
+from shakermill.support.atomic import PARTIAL, create_exclusively, partial_path, remove_abandoned_writes, this_machine
 
 # One simulated second without record windows: the run folder is ~50 kB, written in a second.
 RUN = ["run", "--set", "duration=1", "--set", "record_windows=", "--set", "attractor_starts=1", "--no-plots"]
@@ -100,6 +100,7 @@ def disk_with(monkeypatch, tmp_path):
 # Full disk, simulated in this process ---------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("budget", [0, 20_000, 45_000], ids=["no space", "full in windows.nc", "full near the end"])
 def test_a_run_onto_a_full_disk_is_one_line_and_leaves_nothing(tmp_path, disk_with, budget):
     disk_with(budget)
@@ -109,6 +110,7 @@ def test_a_run_onto_a_full_disk_is_one_line_and_leaves_nothing(tmp_path, disk_wi
     assert list(tmp_path.iterdir()) == []  # neither the run nor its hidden partial folder
 
 
+@pytest.mark.slow
 def test_a_full_disk_keeps_the_run_that_was_to_be_replaced(tmp_path, disk_with):
     out = tmp_path / "run"
     assert invoke(*RUN, "--out", str(out)).exit_code == 0
@@ -121,6 +123,7 @@ def test_a_full_disk_keeps_the_run_that_was_to_be_replaced(tmp_path, disk_with):
     assert [entry.name for entry in tmp_path.iterdir()] == ["run"]
 
 
+@pytest.mark.slow
 def test_a_sweep_whose_manifest_finds_no_space_leaves_no_folder_and_can_run_later(tmp_path, disk_with, monkeypatch):
     out = tmp_path / "sweep"
     disk_with(0)
@@ -133,6 +136,7 @@ def test_a_sweep_whose_manifest_finds_no_space_leaves_no_folder_and_can_run_late
     assert invoke(*SWEEP, "--out", str(out)).exit_code == 0
 
 
+@pytest.mark.slow
 def test_a_sweep_that_fills_the_disk_midway_is_resumed_by_the_same_command(tmp_path, disk_with, monkeypatch):
     out = tmp_path / "sweep"
     disk_with(6_000)  # the manifest, not both points
@@ -147,6 +151,7 @@ def test_a_sweep_that_fills_the_disk_midway_is_resumed_by_the_same_command(tmp_p
     assert hidden_entries(out) == []
 
 
+@pytest.mark.slow
 def test_a_sweep_keeping_its_runs_on_a_full_disk_is_one_line(tmp_path, disk_with):
     out = tmp_path / "sweep"
     disk_with(30_000)  # the manifest and part of the first run folder
@@ -157,6 +162,7 @@ def test_a_sweep_keeping_its_runs_on_a_full_disk_is_one_line(tmp_path, disk_with
     assert not list((out / "runs").iterdir())
 
 
+@pytest.mark.slow
 def test_calibrate_onto_a_full_disk_says_why_in_one_line(tmp_path, disk_with):
     preset = tmp_path / "fitted.toml"
     disk_with(0)
@@ -166,6 +172,7 @@ def test_calibrate_onto_a_full_disk_says_why_in_one_line(tmp_path, disk_with):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_report_onto_a_full_disk_keeps_the_earlier_report(tmp_path, disk_with):
     run = tmp_path / "run"
     assert invoke(*RUN, "--out", str(run)).exit_code == 0
@@ -196,6 +203,7 @@ def run_limited(args: list[str], file_size_limit: int, cwd: Path) -> subprocess.
     )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("limit", [4_000, 12_000])
 def test_a_child_whose_files_cannot_grow_exits_2_without_a_crash(tmp_path, limit):
     # Numba's cache must be warm: the child could not write it either.
@@ -256,6 +264,7 @@ def tmpfs_point(tmp_path):
     return point
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("size", ["16k", "40k"])
 def test_a_run_onto_a_full_tmpfs_exits_2_without_a_crash(tmpfs_point, size):
     code, stderr, left = on_small_tmpfs(f"size={size}", [*RUN, "--out", str(tmpfs_point / "run")], tmpfs_point)
@@ -264,6 +273,7 @@ def test_a_run_onto_a_full_tmpfs_exits_2_without_a_crash(tmpfs_point, size):
     assert left == []
 
 
+@pytest.mark.slow
 def test_a_sweep_keeping_its_runs_onto_a_full_tmpfs_exits_2_without_a_crash(tmpfs_point):
     code, stderr, left = on_small_tmpfs("size=40k", [*SWEEP, "--keep-runs", "--out", str(tmpfs_point / "sweep")], tmpfs_point)
     assert code == 2, stderr
@@ -271,6 +281,7 @@ def test_a_sweep_keeping_its_runs_onto_a_full_tmpfs_exits_2_without_a_crash(tmpf
     assert not [path for path in left if "/." in path]  # no hidden partial file or folder
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", [RUN, SWEEP, ["bifurcation", "--grid", "omega=100:110:2", *RUN[1:-1]]], ids=["run", "sweep", "bifurcation"])
 def test_a_read_only_disk_is_refused_before_the_work(tmpfs_point, command):
     code, stderr, left = on_small_tmpfs("size=1m,ro", [*command, "--out", str(tmpfs_point / "out")], tmpfs_point)
@@ -289,6 +300,7 @@ def dead_process_id() -> int:
     return child.pid
 
 
+@pytest.mark.slow
 def test_a_killed_write_leaves_a_partial_folder_that_the_next_write_removes(tmp_path):
     # The child builds a run folder's hidden partial sibling and is killed while filling it.
     script = textwrap.dedent(

@@ -13,11 +13,11 @@ import pytest
 import xarray as xr
 
 import shakermill as sm
+from shakermill.engines.one_d.description import IMPACT_UNITS
 from shakermill.io import runs as storage
-from shakermill.parameters.config import load_config
-from shakermill.parameters.schema import DEFAULT_PRESET
-from shakermill.engines.one_d.setup import IMPACT_UNITS
 from shakermill.io.runs import StorageError, load_run, to_jsonable, write_run
+from shakermill.parameters.config import load_config
+from shakermill.parameters.defaults import DEFAULT_PRESET
 
 
 @pytest.fixture(scope="module")
@@ -44,6 +44,7 @@ def test_run_folder_holds_exactly_the_documented_files(run_folder):
     assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]  # no partial or old folders left
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("file_name, attribute", [("timeseries.nc", "timeseries"), ("windows.nc", "windows")])
 def test_netcdf_files_hold_the_result_values_with_units(run_folder, short_result, file_name, attribute):
     expected: xr.Dataset = getattr(short_result, attribute)
@@ -97,6 +98,7 @@ def test_config_toml_reproduces_the_parameters_and_records_provenance(run_folder
     assert 'note = "test"' in text and f'shakermill_version = "{sm.__version__}"' in text
 
 
+@pytest.mark.slow
 def test_load_run_returns_what_was_written(run_folder, short_result):
     run = load_run(run_folder)
     assert run.params == short_result.params
@@ -144,6 +146,7 @@ def test_load_run_refuses_a_file_of_the_right_format_that_no_run_wrote(run_folde
     assert "\n" not in str(caught.value)
 
 
+@pytest.mark.slow
 def test_nan_values_are_written_as_null(tmp_path):
     # Too short to fit an exponential and without impacts: the summary holds NaNs.
     result = sm.simulate(sm.default_parameters(duration=0.001, record_windows=()))
@@ -226,6 +229,7 @@ def test_interrupted_replacement_keeps_the_previous_run(run_folder, short_result
     assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]
 
 
+@pytest.mark.slow
 def test_averaged_run_files_say_what_covers_only_the_averaging_window(tmp_path):
     result = sm.simulate(sm.default_parameters(solver="averaged", duration=600.0, attractor_starts=1))
     assert result.solver == "averaged" and result.impact_window is not None

@@ -7,9 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from shakermill.parameters import schema as params_module
+from shakermill.parameters import presets as params_module
 from shakermill.parameters.config import load_config, parse_overrides, write_config_toml
-from shakermill.parameters.schema import DEFAULT_PRESET, Cited, ParameterError, Preset, default_parameters
+from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.presets import Cited, Preset, default_parameters
 
 
 def write_toml(tmp_path: Path, text: str, name: str = "run.toml") -> Path:

@@ -7,8 +7,8 @@ import pytest
 
 import shakermill as sm
 from shakermill.parameters.config import load_config, write_config_toml
+from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.packing import placement
-from shakermill.parameters.schema import ParameterError
 
 FIVE = {"engine": "dem", "n_balls": 5, "vial_diameter": "38 mm"}
 
@@ -68,6 +68,7 @@ def test_bad_several_ball_input_is_refused_in_one_line(overrides, fragments):
     assert all(fragment in message for fragment in fragments), message
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("count, radius, diameter", [(5, 6.35e-3, 38e-3), (20, 4e-3, 38e-3), (12, 3e-3, 19e-3)])
 def test_placed_balls_lie_inside_the_vial_and_apart(count, radius, diameter):
     radii = np.full(count, radius)

@@ -11,8 +11,9 @@ from typer.testing import CliRunner
 import shakermill as sm
 from shakermill import cli
 from shakermill.parameters.config import load_config, write_config_toml
-from shakermill.parameters.schema import ParameterError, balls_for_fill
-from shakermill.studies.sweep import plan_sweep
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.geometry import balls_for_fill
+from shakermill.studies.sweep_plan import plan_sweep
 
 # The spex8000m-3d bore, Ø38 x 58 mm: π/4 · 38² · 58 mm³ = 65 779 mm³.
 VIAL_MM3 = math.pi / 4 * 38**2 * 58
@@ -81,6 +82,7 @@ def test_the_command_line_refuses_fill_beside_another_n_balls(tmp_path):
     assert_one_error_line(outcome.stderr, "n_balls: 3 contradicts fill = 0.1", "allowed n_balls = 6")
 
 
+@pytest.mark.slow
 def test_a_sweep_plan_over_fill_and_ball_size():
     plan = plan_sweep(["fill=0.05,0.1", "ball_radius=4mm,6.35mm"])
     assert plan.keys == ("fill", "ball_radius")

@@ -9,7 +9,8 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
-from shakermill.parameters.schema import ParameterError, unit_slip_warnings
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import unit_slip_warnings
 from shakermill.solvers.result import OUT_OF_PHYSICAL_BOUNDS
 
 runner = CliRunner()
@@ -81,6 +82,7 @@ def test_cli_refuses_a_bare_temperature_with_exit_2_and_one_line(tmp_path):
     assert not (tmp_path / "run").exists()
 
 
+@pytest.mark.slow
 def test_cli_warns_once_and_echoes_what_was_understood(tmp_path):
     outcome = runner.invoke(
         cli.app,

@@ -11,7 +11,10 @@ import pytest
 import shakermill as sm
 from shakermill.engines.dem.model import harmonics_of
 from shakermill.parameters import kinematic_models as models
-from shakermill.parameters.schema import MOTION_COORDINATES, PRESETS, ParameterError, Parameters, unit_slip_warnings
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import Parameters, unit_slip_warnings
+from shakermill.parameters.kinematic_models import MOTION_COORDINATES
+from shakermill.parameters.presets import PRESETS
 from shakermill.physics import kinematics as drive
 
 THETAS = np.linspace(0.0, 2.0 * math.pi, 37)

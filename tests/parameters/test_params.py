@@ -7,10 +7,13 @@ import math
 import numpy as np
 import pydantic
 import pytest
+from conftest import PAPER_TOML, SHARED_PAPER_TOML
 
 import shakermill as sm
-from conftest import PAPER_TOML, SHARED_PAPER_TOML
-from shakermill.parameters.schema import FIELD_NAMES, PRESETS, SPEX_8000M, Bounds, ParameterError, Parameters, allowed_range, bounds, build_parameters, default_parameters, preset_values
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import FIELD_NAMES, Bounds, Parameters, allowed_range, bounds, build_parameters
+from shakermill.parameters.presets import PRESETS, SPEX_8000M, default_parameters, preset_values
+
 
 @pytest.fixture(scope="module")
 def defaults() -> Parameters:

@@ -17,6 +17,7 @@ def _operating_point(omega: float, amplitude: float) -> sm.Parameters:
     return base.replace(ball_momentum=base.ball_mass * NUDGE_SPEED)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("omega, amplitude", [(111.0, 25e-3), (90.0, 30e-3), (120.0, 25e-3)])
 def test_averaged_solver_matches_full_resolution(omega: float, amplitude: float) -> None:
     params = _operating_point(omega, amplitude)
@@ -36,6 +37,7 @@ def test_averaged_solver_matches_full_resolution(omega: float, amplitude: float)
     assert 0 < a["averaged_heat_power_stderr_W"] < 1e-3 * a["averaged_heat_power_W"]
 
 
+@pytest.mark.slow
 def test_averaged_run_has_the_variables_of_a_full_run() -> None:
     params = sm.default_parameters(duration=600.0, record_windows=((0.0, 1.0),))
     full = sm.simulate(params)
@@ -51,6 +53,7 @@ def test_averaged_run_has_the_variables_of_a_full_run() -> None:
     assert averaged.summary["solver"] == "averaged"
 
 
+@pytest.mark.slow
 def test_temperatures_that_follow_single_impacts_are_refused() -> None:
     # A ball of the lowest heat capacity allowed, cooled by the strongest convection allowed, follows each
     # impact (its time constant ~0.14 s against 0.019 s between impacts): averaging is invalid.
@@ -65,6 +68,7 @@ def test_temperatures_that_follow_single_impacts_are_refused() -> None:
     assert "ball's thermal time constant" in failed.message
 
 
+@pytest.mark.slow
 def test_statistics_that_do_not_converge_are_refused() -> None:
     # A target below the round-off of the batch means: even the default's periodic motion, whose batch
     # means agree to ~1e-9, cannot reach it.

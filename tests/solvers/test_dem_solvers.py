@@ -23,6 +23,7 @@ def pair_fixture():
     return full, averaged
 
 
+@pytest.mark.slow
 def test_the_averaged_solver_heats_as_the_full_one(pair):
     full, averaged = pair
     assert full.success and averaged.success and averaged.solver == "averaged"
@@ -37,6 +38,7 @@ def test_the_averaged_solver_heats_as_the_full_one(pair):
         assert averaged.summary[key] == pytest.approx(full.summary[key], rel=0.15), key
 
 
+@pytest.mark.slow
 def test_both_solvers_give_each_ball_its_own_temperature_and_a_steady_state(pair):
     for result in pair:
         temperatures = result.history[BALL_TEMPERATURES]
@@ -47,6 +49,7 @@ def test_both_solvers_give_each_ball_its_own_temperature_and_a_steady_state(pair
         assert result.summary["ball_steady_C"] == pytest.approx(np.mean(result.summary["balls_steady_C"]))
 
 
+@pytest.mark.slow
 def test_the_averaged_solver_falls_back_when_the_means_do_not_converge():
     params = sm.default_parameters(
         **BALLS, duration=3.0, solver="averaged", dem_averaging_rel_error=1e-6, averaging_max_time=2.0
@@ -54,6 +57,7 @@ def test_the_averaged_solver_falls_back_when_the_means_do_not_converge():
     result = sm.simulate(params)
     assert result.success
     assert result.solver == "full" and result.t_end == 3.0
-    assert result.message.startswith("Averaging is not valid (the per-ball averages did not converge")
+    assert result.message.startswith("Averaging is not valid (the averages did not converge")
+    assert "(dem_averaging_rel_error)" in result.message
     failed = sm.simulate(params.replace(averaging_fallback="fail"))
     assert not failed.success and "averaging_fallback" in failed.message

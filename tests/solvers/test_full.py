@@ -72,6 +72,7 @@ def test_runs_are_deterministic() -> None:
     assert first.impacts.equals(second.impacts)
 
 
+@pytest.mark.slow
 def test_without_motion_the_temperatures_relax_to_ambient() -> None:
     params = sm.default_parameters(
         amplitude=RESTING_WALL_AMPLITUDE, initial_temperature=350.0, duration=24 * 3600.0, output_interval=60.0, rtol=1e-5,
@@ -134,6 +135,7 @@ def test_interrupted_run_keeps_what_was_computed() -> None:
     assert result.energy.relative_residual < 1e-6
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("solver", ["full", "averaged"])
 def test_ball_only_model_holds_air_and_vial_at_ambient(solver: str) -> None:
     params = sm.default_parameters(model="ball_only", solver=solver, duration=1200.0, record_windows=())

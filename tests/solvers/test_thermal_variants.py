@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 import shakermill as sm
+from shakermill.engines.dem.engine import DemEngine
 from shakermill.parameters.defaults import HIT_SPEED
-from shakermill.parameters.schema import ParameterError
-from shakermill.solvers.dem import settle_mechanics, simulate_dem_averaged
+from shakermill.parameters.errors import ParameterError
+from shakermill.solvers.averaged import settle_mechanics, simulate_averaged
 from shakermill.solvers.simulate import thermal_variants
 from shakermill.studies.calibrate import calibrate
 
@@ -24,6 +25,7 @@ def base_fixture():
     return sm.default_parameters(**BALLS)
 
 
+@pytest.mark.slow
 def test_a_thermal_variant_is_the_run_it_would_be_on_its_own(base):
     variant = base.replace(**VARIANT)
     run = thermal_variants(base)
@@ -37,12 +39,13 @@ def test_a_thermal_variant_is_the_run_it_would_be_on_its_own(base):
     assert shared.summary["vial_C"] != run(base).summary["vial_C"]  # the variant did change the network
 
 
+@pytest.mark.slow
 def test_mechanics_measured_for_other_mechanical_keys_are_refused(base):
-    mechanics = settle_mechanics(base.replace(averaging_max_time=0.2))
+    mechanics = settle_mechanics(base.replace(averaging_max_time=0.2), DemEngine)
     measured = mechanics.params
     assert mechanics.serves(measured.replace(h_outer=10.0)) and not mechanics.serves(measured.replace(lam=0.5))
     with pytest.raises(ValueError, match="thermal-only keys"):
-        simulate_dem_averaged(measured.replace(restitution=0.8), None, None, mechanics)
+        simulate_averaged(measured.replace(restitution=0.8), DemEngine, None, None, mechanics)
 
 
 def test_a_dem_calibration_frees_only_thermal_keys(base):
@@ -50,6 +53,7 @@ def test_a_dem_calibration_frees_only_thermal_keys(base):
         calibrate(base, ("beta", "lam"))
 
 
+@pytest.mark.slow
 def test_hits_leave_out_contacts_slower_than_the_hit_speed(base):
     result = sm.simulate(base.replace(solver="full", duration=2.0))
     speeds = np.asarray(result.impact_columns["impact_speed"])

@@ -6,14 +6,25 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.studies.calibrate import DEFAULT_FREE, DEFENSIBLE_RANGES, calibrate, free_set_study, log_bounds, parse_free, parse_targets, write_preset
 from shakermill.parameters.config import load_config
-from shakermill.parameters.schema import PRESETS, ParameterError
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.presets import PRESETS
+from shakermill.studies.calibrate import (
+    DEFAULT_FREE,
+    DEFENSIBLE_RANGES,
+    calibrate,
+    free_set_study,
+    log_bounds,
+    parse_free,
+    parse_targets,
+    write_preset,
+)
 from shakermill.studies.validation import CURVE_TOLERANCE_K, TABLE5, Curve, experiment_curve
 
 TABLE5_TARGETS = {entry.key: entry.experiment for entry in TABLE5 if entry.key != "vial_ball_ratio"}
 
 
+@pytest.mark.slow
 def test_recovers_known_parameters_from_a_noisy_simulated_curve() -> None:
     truth = {"beta": 0.6, "vial_mass": 0.1}
     generator = sm.default_parameters(solver="averaged", output_interval=30.0, **truth)
@@ -30,6 +41,7 @@ def test_recovers_known_parameters_from_a_noisy_simulated_curve() -> None:
     assert fit.curve_rms_K == pytest.approx(0.05, rel=0.2)
 
 
+@pytest.mark.slow
 def test_table5_calibration_meets_the_targets_and_round_trips_as_a_preset(tmp_path) -> None:
     fit = calibrate(sm.default_parameters(), ("beta", "vial_mass"), TABLE5_TARGETS)
     assert fit.success, fit.message
@@ -42,6 +54,7 @@ def test_table5_calibration_meets_the_targets_and_round_trips_as_a_preset(tmp_pa
     assert params.restitution == sm.default_parameters().restitution
 
 
+@pytest.mark.slow
 def test_shipped_calibrated_preset_follows_the_experiments_curve_at_full_resolution() -> None:
     preset = PRESETS["spex8000m-calibrated"]
     assert preset.fitted == DEFAULT_FREE
@@ -64,6 +77,7 @@ def test_experiment_curve_is_the_papers_exponential() -> None:
     assert curve.ball_C[-1] == pytest.approx(48.0 - 28.0 * np.exp(-60.0 / 16.7))
 
 
+@pytest.mark.slow
 def test_calibration_without_targets_fits_the_experiments_curve_and_reports_predictions() -> None:
     fit = calibrate(sm.default_parameters(record_windows=()), ("beta", "vial_mass", "h_outer", "lam"))
     assert fit.curve_source == experiment_curve().source
@@ -77,6 +91,7 @@ def test_calibration_without_targets_fits_the_experiments_curve_and_reports_pred
         assert key in fit.message
 
 
+@pytest.mark.slow
 def test_free_sets_that_cannot_follow_the_curve_say_why() -> None:
     (paper_knobs,) = free_set_study(sm.default_parameters(record_windows=()), [("beta", "vial_mass")])
     assert not paper_knobs.follows_curve
@@ -86,6 +101,7 @@ def test_free_sets_that_cannot_follow_the_curve_say_why() -> None:
     assert "still rising at the hour" in paper_knobs.verdict
 
 
+@pytest.mark.slow
 def test_unreachable_targets_are_reported_not_hidden() -> None:
     # vial_mass sets time constants, not temperatures: it cannot bring θ∞ down to 25 °C.
     fit = calibrate(sm.default_parameters(), ("vial_mass",), {"theta_inf_C": 25.0})

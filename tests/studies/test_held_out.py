@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from shakermill.parameters.schema import PRESETS
+from shakermill.parameters.presets import PRESETS
 from shakermill.studies.held_out import (
     ENGINE_CASES,
     FIVE_BALLS,
@@ -39,6 +39,7 @@ def test_the_held_out_preset_was_fitted_to_one_ball_and_runs_five_unrefitted():
         assert getattr(params, key) == preset.values[key].value  # nothing refitted
 
 
+@pytest.mark.slow
 def test_the_prediction_says_what_was_fitted_and_that_the_rest_is_predicted():
     prediction = five_ball_prediction(QUICK)
     assert prediction.summary["n_balls"] == FIVE_BALLS

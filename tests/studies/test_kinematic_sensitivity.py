@@ -7,7 +7,7 @@ import math
 import pytest
 
 import shakermill as sm
-from shakermill.parameters.schema import ParameterError
+from shakermill.parameters.errors import ParameterError
 from shakermill.studies.kinematics import MEASURES, kinematic_sensitivity
 
 DURATION = 0.2  # s: a few drive periods, enough for the table's shape and its determinism
@@ -21,6 +21,7 @@ def spex():
     return params, study, calls
 
 
+@pytest.mark.slow
 def test_each_assumed_amplitude_is_halved_and_raised_by_half(spex):
     params, study, calls = spex
     assert [(row.key, row.factor) for row in study.rows] == [
@@ -33,6 +34,7 @@ def test_each_assumed_amplitude_is_halved_and_raised_by_half(spex):
             assert row.relative_change[name] == pytest.approx(row.measures[name] / study.baseline[name] - 1.0, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_the_table_has_the_baseline_first_and_a_change_per_measure(spex):
     _, study, _ = spex
     table = study.table()
@@ -42,6 +44,7 @@ def test_the_table_has_the_baseline_first_and_a_change_per_measure(spex):
     assert all(math.isfinite(value) and value > 0 for value in study.baseline.values())
 
 
+@pytest.mark.slow
 def test_the_same_inputs_give_the_same_table(spex):
     params, study, _ = spex
     again = kinematic_sensitivity(params, keys=("yaw_amplitude",), factors=(1.5,))
@@ -55,6 +58,7 @@ def test_a_factor_beyond_a_keys_bounds_is_refused():
         kinematic_sensitivity(params, keys=("amplitude",), factors=(100.0,))
 
 
+@pytest.mark.slow
 def test_other_summary_keys_can_be_measured(spex):
     params, study, _ = spex
     again = kinematic_sensitivity(params, keys=("yaw_amplitude",), factors=(1.5,), measures=("ball_C", "heat_power_W"))

@@ -23,14 +23,27 @@ import pandas as pd
 import pytest
 from pandas.testing import assert_frame_equal
 
-from shakermill.parameters.schema import ParameterError, default_parameters
-from shakermill.studies.sweep import MANIFEST_FILE, POINTS_FOLDER, TABLE_CSV, TABLE_PARQUET, SweepFailed, SweepPlan, comparable_columns, connect, failed_points, load_sweep, parse_grid, plan_sweep, point_ids, read_points, sweep, sweep_parameters
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.presets import default_parameters
+from shakermill.studies.sweep import SweepFailed, sweep
+from shakermill.studies.sweep_backends import connect
+from shakermill.studies.sweep_plan import SweepPlan, parse_grid, plan_sweep, point_ids, read_points, sweep_parameters
+from shakermill.studies.sweep_storage import (
+    MANIFEST_FILE,
+    POINTS_FOLDER,
+    TABLE_CSV,
+    TABLE_PARQUET,
+    comparable_columns,
+    failed_points,
+    load_sweep,
+)
 
 DURATION = 60.0  # simulated seconds per point
 GRID = ("omega=100:120:3", "amplitude=23mm:29mm:2")  # 6 points
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
 UNREACHABLE = "tcp://127.0.0.1:1"  # port 1 on loopback: nothing listens, connections are refused
 SWEEP_MODULE = importlib.import_module("shakermill.studies.sweep")
+POINTS_MODULE = importlib.import_module("shakermill.studies.sweep_points")
 
 
 @pytest.fixture(scope="module")
@@ -200,6 +213,7 @@ def test_missing_points_file(tmp_path):
         read_points(tmp_path / "absent.csv")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("content", "fragments"),
     [
@@ -264,6 +278,7 @@ def test_an_averaged_sweep_is_not_held_to_the_full_solvers_limits():
 # Execution: in process, local pool, Dask cluster ---------------------------------------------------
 
 
+@pytest.mark.slow
 def test_in_process_table(base, in_process, tmp_path):
     plan, table, _ = in_process
     ids = point_ids(base, plan)
@@ -288,6 +303,7 @@ def test_in_process_table(base, in_process, tmp_path):
         assert table.loc[4, key] == alone[key], key
 
 
+@pytest.mark.slow
 def test_tables_on_disk_match_the_returned_table(in_process):
     _, table, folder = in_process
     data = load_sweep(folder)
@@ -314,6 +330,7 @@ def assert_csv_matches_parquet(folder: Path) -> None:
             assert [None if pd.isna(v) else str(v) for v in left] == [None if pd.isna(v) else str(v) for v in right], column
 
 
+@pytest.mark.slow
 def test_local_pool_matches_in_process_in_grid_order(base, in_process, tmp_path):
     plan, reference, _ = in_process
     table = sweep(base, plan, tmp_path / "pool", workers=2)
@@ -321,6 +338,7 @@ def test_local_pool_matches_in_process_in_grid_order(base, in_process, tmp_path)
     assert_frame_equal(comparable(load_sweep(tmp_path / "pool").table), comparable(reference))
 
 
+@pytest.mark.slow
 def test_rows_follow_the_plan_not_the_completion_order(base, tmp_path):
     # The first point runs at full resolution for 40 simulated minutes (~1.5 s), the others are
     # one simulated minute with the averaged solver (~0.03 s): with two workers the first finishes last.
@@ -354,6 +372,7 @@ def local_cluster():
         cluster.close()
 
 
+@pytest.mark.slow
 def test_dask_cluster_matches_local_pool(base, in_process, local_cluster, tmp_path):
     plan, _, _ = in_process
     pool = sweep(base, plan, tmp_path / "pool", workers=2)
@@ -373,6 +392,7 @@ def test_workers_and_scheduler_are_exclusive(base, tmp_path):
         sweep(base, plan_sweep(GRID), tmp_path / "y", workers=0)
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_is_one_line(base, tmp_path):
     started = time.monotonic()
     with pytest.raises(ParameterError) as caught:
@@ -417,6 +437,7 @@ def tcp_server():
         item.close()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("reply", "fragment"),
     [
@@ -445,6 +466,7 @@ def test_unparsable_scheduler_address_is_one_line():
 # Resume, failures, other sweeps -------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_resume_recomputes_only_missing_points(base, in_process, tmp_path):
     plan, reference, _ = in_process
     folder = tmp_path / "resume"
@@ -475,6 +497,7 @@ def test_resume_recomputes_only_missing_points(base, in_process, tmp_path):
     assert_frame_equal(comparable(third), comparable(first))
 
 
+@pytest.mark.slow
 def test_table_is_rebuilt_from_point_files_if_missing(in_process, base, tmp_path):
     plan, reference, _ = in_process
     folder = tmp_path / "rebuild"
@@ -484,6 +507,7 @@ def test_table_is_rebuilt_from_point_files_if_missing(in_process, base, tmp_path
     assert_frame_equal(comparable(rebuilt), comparable(reference))
 
 
+@pytest.mark.slow
 def test_failing_point_records_its_error_and_the_others_finish(base, tmp_path):
     # restitution is allowed in (0, 1]: the last point is out of range.
     plan = plan_sweep(["restitution=0.5:1.3:3", "amplitude=24mm:26mm:2"])
@@ -507,6 +531,7 @@ def test_failing_point_records_its_error_and_the_others_finish(base, tmp_path):
     assert_frame_equal(comparable(again), comparable(table))
 
 
+@pytest.mark.slow
 def test_points_file_with_one_out_of_range_value(base, tmp_path):
     path = tmp_path / "points.csv"
     path.write_text("omega,amplitude\n100,25 mm\n-5,25 mm\n120 rad/s,2.4 cm\n", encoding="utf-8")
@@ -517,6 +542,7 @@ def test_points_file_with_one_out_of_range_value(base, tmp_path):
     assert table.loc[2, "amplitude"] == pytest.approx(0.024)
 
 
+@pytest.mark.slow
 def test_a_folder_with_another_sweep_is_refused(base, tmp_path):
     folder = tmp_path / "taken"
     plan = plan_sweep(["omega=100:110:2"])
@@ -536,6 +562,7 @@ def test_a_folder_with_another_sweep_is_refused(base, tmp_path):
     assert sorted(path.name for path in other.iterdir()) == ["notes.txt"]
 
 
+@pytest.mark.slow
 def test_keep_runs_writes_each_point_run_folder(base, tmp_path):
     from shakermill.io.runs import load_run
 
@@ -560,6 +587,7 @@ def test_a_point_listed_twice_is_refused(base, tmp_path):
 # The command line ---------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_cli_bad_grid_exits_2_with_one_line(tmp_path):
     completed = run_cli("sweep", "--grid", "bogus", "--out", str(tmp_path / "s"))
     assert completed.returncode == 2, completed.stderr
@@ -570,6 +598,7 @@ def test_cli_bad_grid_exits_2_with_one_line(tmp_path):
     assert not (tmp_path / "s" / MANIFEST_FILE).exists()
 
 
+@pytest.mark.slow
 def test_cli_unreachable_scheduler_exits_2_with_one_line(tmp_path):
     folder = tmp_path / "s"
     completed = run_cli(
@@ -581,6 +610,7 @@ def test_cli_unreachable_scheduler_exits_2_with_one_line(tmp_path):
     assert not folder.exists()  # the connection is tried before the sweep folder is created
 
 
+@pytest.mark.slow
 def test_cli_sweep_writes_matching_csv_and_parquet(base, tmp_path):
     folder = tmp_path / "cli"
     completed = run_cli(
@@ -600,6 +630,7 @@ def test_cli_sweep_writes_matching_csv_and_parquet(base, tmp_path):
     assert_frame_equal(comparable(table), comparable(expected))
 
 
+@pytest.mark.slow
 def test_cli_some_points_failed_exits_1(tmp_path):
     folder = tmp_path / "cli"
     completed = run_cli("sweep", "--grid", "restitution=0.9:1.1:2", "--set", "duration=60", "--out", str(folder), "--workers", "1")
@@ -628,6 +659,7 @@ def _live_processes_in_group(group: int) -> list[int]:
     return live
 
 
+@pytest.mark.slow
 def test_sigkill_mid_sweep_then_resume(tmp_path):
     # 64 points of one simulated minute: ~0.03 s each, ~1 s on two workers after their start.
     grid = ["omega=90:130:8", "amplitude=23mm:30mm:8"]
@@ -687,6 +719,7 @@ def test_sigkill_mid_sweep_then_resume(tmp_path):
     assert_frame_equal(comparable(table), comparable(load_sweep(tmp_path / "uninterrupted").table))
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_the_finished_points_in_the_table_and_exits_130(tmp_path):
     # Ctrl-C in a terminal sends SIGINT to the whole foreground group: the sweep and its workers.
     folder = tmp_path / "interrupted"
@@ -725,6 +758,7 @@ print(json.dumps(table.pivot(index="amplitude", columns="omega", values="theta_i
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("guarded", [False, True], ids=["plain script", "guarded script"])
 def test_the_readme_sweep_runs_from_a_script_with_or_without_a_main_guard(tmp_path, guarded):
     source = README_SWEEP if not guarded else "if __name__ == '__main__':\n" + "".join(
@@ -748,6 +782,7 @@ def test_a_sweep_where_every_point_fails_raises_naming_the_first_failure(base, t
     assert pd.read_csv(tmp_path / "failed" / TABLE_CSV)["error"].notna().all()
 
 
+@pytest.mark.slow
 def test_cli_sweep_where_every_point_fails_exits_1_with_one_line(tmp_path):
     folder = tmp_path / "failed"
     command = [str(SHAKERMILL), "sweep", "--grid", "omega=-2:-1:2", "--set", "duration=60", "--out", str(folder), "--workers", "1"]
@@ -762,6 +797,7 @@ def test_cli_sweep_where_every_point_fails_exits_1_with_one_line(tmp_path):
 SMALL = ("omega=100:120:3",)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "damage",
     [b"", b'{"point_id": "', b"[]", b'{"row": 3}', b"\xff\xfe\x00garbage"],
@@ -786,6 +822,7 @@ def test_an_unreadable_point_file_is_computed_again(base, tmp_path, damage):
     assert {path: path.stat().st_mtime_ns for path in untouched} == untouched
 
 
+@pytest.mark.slow
 def test_cli_says_in_one_warning_line_that_it_recomputes_an_unreadable_point(tmp_path):
     folder = tmp_path / "damaged"
     command = ["sweep", "--grid", SMALL[0], "--set", f"duration={DURATION}", "--workers", "1", "--out", str(folder)]
@@ -798,6 +835,7 @@ def test_cli_says_in_one_warning_line_that_it_recomputes_an_unreadable_point(tmp
     assert load_sweep(folder).table["error"].isna().all()
 
 
+@pytest.mark.slow
 def test_two_sweeps_racing_into_one_new_folder_one_wins_the_other_is_refused(base, tmp_path, monkeypatch):
     import threading
 
@@ -805,13 +843,13 @@ def test_two_sweeps_racing_into_one_new_folder_one_wins_the_other_is_refused(bas
     plans = {"low": plan_sweep(["omega=100:105:2"]), "high": plan_sweep(["omega=110:115:2"])}
     # Both sweeps find the folder free before either creates it: the moment the race is decided.
     both_checked = threading.Barrier(len(plans), timeout=60)
-    check_folder = SWEEP_MODULE._check_folder
+    check_folder = SWEEP_MODULE.check_folder
 
     def check_then_wait_for_the_other(*args):
         check_folder(*args)
         both_checked.wait()
 
-    monkeypatch.setattr(SWEEP_MODULE, "_check_folder", check_then_wait_for_the_other)
+    monkeypatch.setattr(SWEEP_MODULE, "check_folder", check_then_wait_for_the_other)
     outcomes: dict[str, object] = {}
 
     def start(name: str) -> None:
@@ -834,6 +872,7 @@ def test_two_sweeps_racing_into_one_new_folder_one_wins_the_other_is_refused(bas
     assert list(load_sweep(folder).table["point_id"]) == winning_ids
 
 
+@pytest.mark.slow
 def test_two_sweep_processes_started_at_once_into_one_new_folder(tmp_path):
     folder = tmp_path / "race"
     grids = ["omega=100:105:2", "omega=110:115:2"]
@@ -856,6 +895,7 @@ def test_two_sweep_processes_started_at_once_into_one_new_folder(tmp_path):
     assert sorted(path.stem for path in point_files(folder)) == sorted(table["point_id"])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("crafted", ["../../outside", "/etc/hostname", "0123456789abcdef/../../../outside", "0123456789ABCDEF", 17])
 def test_a_crafted_point_id_in_the_manifest_is_refused_and_nothing_outside_is_read(base, tmp_path, crafted):
     folder = tmp_path / "crafted"
@@ -878,8 +918,6 @@ def test_a_crafted_point_id_in_the_manifest_is_refused_and_nothing_outside_is_re
 
 def _interrupted_second_point(how: str, simulate: Callable[..., Any]) -> Callable[..., Any]:
     """``simulate`` that is interrupted by Ctrl-C on its second call, the way ``how`` says."""
-    from shakermill.solvers.full import simulate_full
-
     calls = []
 
     def ctrl_c(*_progress) -> None:
@@ -890,7 +928,7 @@ def _interrupted_second_point(how: str, simulate: Callable[..., Any]) -> Callabl
         if len(calls) != 2:
             return simulate(params)
         if how == "a run cut short":
-            return simulate_full(params.replace(solver="full"), progress=ctrl_c)
+            return simulate(params.replace(solver="full"), progress=ctrl_c)
         try:
             ctrl_c()
         except KeyboardInterrupt as interrupt:
@@ -900,12 +938,13 @@ def _interrupted_second_point(how: str, simulate: Callable[..., Any]) -> Callabl
     return interrupted
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["a run cut short", "an error caused by Ctrl-C"])
 def test_an_interrupted_point_is_not_done_and_runs_again_on_resume(base, tmp_path, monkeypatch, how):
     plan = plan_sweep(SMALL)
     ids = point_ids(base, plan)
     folder = tmp_path / "interrupted"
-    monkeypatch.setattr(SWEEP_MODULE, "simulate", _interrupted_second_point(how, SWEEP_MODULE.simulate))
+    monkeypatch.setattr(POINTS_MODULE, "simulate", _interrupted_second_point(how, POINTS_MODULE.simulate))
     with pytest.raises(KeyboardInterrupt):
         sweep(base, plan, folder, workers=1)
     assert [path.stem for path in point_files(folder)] == [ids[0]]
@@ -929,6 +968,7 @@ def _live(process) -> bool:
         return False
 
 
+@pytest.mark.slow
 def test_workers_stop_when_the_sweep_is_killed_and_not_yet_reaped(tmp_path):
     import psutil
 
@@ -1006,6 +1046,7 @@ def environment_without_dask_tls() -> dict[str, str]:
     return {name: value for name, value in os.environ.items() if not name.startswith("DASK_DISTRIBUTED__COMM__TLS")}
 
 
+@pytest.mark.slow
 def test_a_tls_scheduler_runs_the_sweep_with_the_environments_tls_settings(in_process, tls_certificates, tls_scheduler, tmp_path):
     assert tls_scheduler.startswith("tls://127.0.0.1:")
     _, reference, _ = in_process
@@ -1025,6 +1066,7 @@ def test_a_tls_scheduler_runs_the_sweep_with_the_environments_tls_settings(in_pr
     assert_frame_equal(comparable(load_sweep(folder).table), comparable(reference))
 
 
+@pytest.mark.slow
 def test_a_tls_scheduler_without_tls_settings_is_one_line(tls_scheduler, tmp_path):
     folder = tmp_path / "no-tls"
     command = [str(SHAKERMILL), "sweep", "--grid", SMALL[0], "--scheduler", tls_scheduler, "--scheduler-timeout", "5", "--out", str(folder)]
@@ -1035,7 +1077,7 @@ def test_a_tls_scheduler_without_tls_settings_is_one_line(tls_scheduler, tmp_pat
 
 
 def test_a_point_whose_run_spent_its_budget_is_not_probed_on_a_budget_of_its_own():
-    from shakermill.studies.sweep import run_point
+    from shakermill.studies.sweep_points import run_point
 
     base = default_parameters(solver="full", duration=60.0, record_windows=(), max_steps=2000)
     row = run_point(base, {"omega": 110.0}).row

@@ -11,7 +11,9 @@ import json
 import pytest
 
 import shakermill as sm
-from shakermill.studies.sweep import POINTS_FOLDER, load_sweep, plan_sweep, point_ids, sweep
+from shakermill.studies.sweep import sweep
+from shakermill.studies.sweep_plan import plan_sweep, point_ids
+from shakermill.studies.sweep_storage import POINTS_FOLDER, load_sweep
 
 GRIDS = ("n_balls=1,5", "ball_radius=3mm,6.35mm")
 

@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
-import numpy as np
-
-from shakermill.studies.validation import CURVE_QUANTITIES, CURVE_TOLERANCE_K, TABLE5, Curve, compare, fitted_quantities, relative_error, validate
+from shakermill.studies.validation import (
+    CURVE_QUANTITIES,
+    CURVE_TOLERANCE_K,
+    TABLE5,
+    Curve,
+    compare,
+    fitted_quantities,
+    relative_error,
+    validate,
+)
 
 
 def test_table5_holds_the_published_numbers(paper: dict) -> None:
@@ -28,6 +36,7 @@ def test_compare_marks_fitted_and_predicted_rows() -> None:
     assert rows[0].error_vs_experiment == pytest.approx(relative_error(50.0, 48.0)) == pytest.approx(2.0 / 48.0)
 
 
+@pytest.mark.slow
 def test_validation_of_published_and_calibrated_presets() -> None:
     published, calibrated = validate(solver="averaged")
     assert all(row.role == "predicted" for row in published.rows)

@@ -9,6 +9,9 @@ import nbformat
 import pytest
 from nbclient import NotebookClient
 
+# Every test here reads a run made once for the module: make test-fast leaves them out.
+pytestmark = pytest.mark.slow
+
 NOTEBOOK = Path(__file__).resolve().parents[2] / "examples" / "quickstart.ipynb"
 # The whole notebook takes a few seconds once the compiled functions are cached; the first run compiles them.
 CELL_TIMEOUT_S = 300

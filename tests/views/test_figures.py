@@ -12,14 +12,31 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-
 from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
-from shakermill.parameters.schema import DEFAULT_PRESET
-from shakermill.views.figures import IMPACT_FIGURES, PAPER_FIGURES, SWEEP_QUANTITIES, bifurcation_figure, contour_notes, heating_zoom_figure, heating_zoom_window, impact_figures, motion_figure, parse_contour, plot_run, png_bytes, rate_bin_edges, run_figures, sweep_context, sweep_figures, temperature_figure, window_data
 from shakermill.io.runs import load_run, write_run
+from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.views.figures.common import png_bytes, window_data
+from shakermill.views.figures.impacts import IMPACT_FIGURES, impact_figures, rate_bin_edges
+from shakermill.views.figures.run import (
+    PAPER_FIGURES,
+    heating_zoom_figure,
+    heating_zoom_window,
+    motion_figure,
+    plot_run,
+    run_figures,
+    temperature_figure,
+)
+from shakermill.views.figures.sweeps import (
+    SWEEP_QUANTITIES,
+    bifurcation_figure,
+    contour_notes,
+    parse_contour,
+    sweep_context,
+    sweep_figures,
+)
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 ALL_FIGURES = ("ball_heating_zoom", "ball_motion", "temperatures")
@@ -44,6 +61,7 @@ def written_names(paths: list[Path]) -> list[str]:
     return sorted(path.name for path in paths)
 
 
+@pytest.mark.slow
 def test_plot_run_writes_png_and_svg_of_every_figure(result, tmp_path):
     paths = plot_run(result, tmp_path / "figures")
     expected = sorted(f"{name}.{fmt}" for name in ALL_FIGURES for fmt in ("png", "svg"))
@@ -59,11 +77,13 @@ def test_plot_run_writes_png_and_svg_of_every_figure(result, tmp_path):
             assert "<svg" in path.read_text(encoding="utf-8")
 
 
+@pytest.mark.slow
 def test_without_windows_only_the_temperature_figure_is_drawn(tmp_path):
     run = sm.simulate(sm.default_parameters(duration=2.0, record_windows=()))
     assert written_names(plot_run(run, tmp_path)) == ["temperatures.png", "temperatures.svg"]
 
 
+@pytest.mark.slow
 def test_figures_can_be_drawn_from_a_stored_run(result, tmp_path):
     folder = write_run(result, tmp_path / "run", preset=DEFAULT_PRESET)
     paths = plot_run(load_run(folder), tmp_path / "from_disk")
@@ -144,6 +164,7 @@ def test_figure_names_are_the_documented_ones():
     assert sorted(IMPACT_FIGURES) == sorted(IMPACT_FIGURE_NAMES)
 
 
+@pytest.mark.slow
 def test_every_axis_of_every_figure_is_labelled_with_its_unit(result):
     figures = run_figures(result, impacts=True)
     assert sorted(figures) == sorted(ALL_FIGURES + IMPACT_FIGURE_NAMES)
@@ -165,12 +186,14 @@ def test_paper_figures_say_which_figure_of_the_paper_they_are(result):
     assert "Fig. 5b" in figures["ball_heating_zoom"].axes[0].get_title()
 
 
+@pytest.mark.slow
 def test_plot_run_with_impacts_writes_the_impact_figures_too(result, tmp_path):
     paths = plot_run(result, tmp_path, impacts=True)
     expected = sorted(f"{name}.{fmt}" for name in ALL_FIGURES + IMPACT_FIGURE_NAMES for fmt in ("png", "svg"))
     assert written_names(paths) == expected
 
 
+@pytest.mark.slow
 def test_impact_histograms_count_every_impact_by_wall(result):
     figures = impact_figures(result)
     impacts = result.impacts
@@ -191,6 +214,7 @@ def test_impact_histograms_count_every_impact_by_wall(result):
     assert figures["impact_speed_histogram"].axes[0].get_xlabel() == "impact speed relative to the end face (m/s)"
 
 
+@pytest.mark.slow
 def test_impacts_per_second_integrate_to_the_impacts_at_each_wall(result):
     (axis,) = impact_figures(result)["impacts_per_second"].axes
     assert axis.get_ylabel() == "impacts per second (1/s)"
@@ -223,16 +247,18 @@ def test_ball_only_temperature_figure_draws_vial_and_air_as_one_ambient_line(res
     assert labels[2].startswith("ball, exponential fitted over 0–")
 
 
+@pytest.mark.slow
 def test_png_bytes_is_a_png(result):
     assert png_bytes(temperature_figure(result), dpi=50).startswith(PNG_SIGNATURE)
 
 
+@pytest.mark.slow
 def test_matplotlib_is_imported_lazily_and_pyplot_never():
     script = (
         "import sys\n"
         "import shakermill as sm, shakermill.cli, shakermill.views.report\n"
         "assert 'matplotlib' not in sys.modules, 'imported at package import'\n"
-        "from shakermill.views.figures import run_figures\n"
+        "from shakermill.views.figures.run import run_figures\n"
         "run = sm.simulate(sm.default_parameters(duration=0.5, record_windows='0:0.2'))\n"
         "run_figures(run, impacts=True)\n"
         "assert 'matplotlib' in sys.modules\n"
@@ -245,6 +271,7 @@ def test_matplotlib_is_imported_lazily_and_pyplot_never():
 runner = CliRunner()
 
 
+@pytest.mark.slow
 def test_plot_command_writes_every_figure_into_the_run_folder(result, tmp_path):
     folder = write_run(result, tmp_path / "run", preset=DEFAULT_PRESET)
     outcome = runner.invoke(cli.app, ["plot", str(folder)])
@@ -260,6 +287,7 @@ def test_plot_command_writes_every_figure_into_the_run_folder(result, tmp_path):
     assert str(figures) in outcome.stdout
 
 
+@pytest.mark.slow
 def test_plot_command_out_and_dpi(result, tmp_path):
     folder = write_run(result, tmp_path / "run", preset=DEFAULT_PRESET)
     outcome = runner.invoke(cli.app, ["plot", str(folder), "--out", str(tmp_path / "small"), "--dpi", "60"])
@@ -293,6 +321,7 @@ def test_plot_command_refuses_a_damaged_run_folder(result, tmp_path):
 # Impact phases, sweeps and the bifurcation diagram -------------------------------------------------
 
 
+@pytest.mark.slow
 def test_impact_phase_histogram_counts_the_settled_impacts_by_wall(result):
     (axis,) = impact_figures(result)["impact_phase_histogram"].axes
     settled = result.impacts[result.impacts["time"] >= 0.5 * result.t_end]  # a full run: its second half
@@ -304,6 +333,7 @@ def test_impact_phase_histogram_counts_the_settled_impacts_by_wall(result):
     assert f"{len(settled)} impacts" in axis.get_title()
 
 
+@pytest.mark.slow
 def test_plot_command_impacts_draws_only_the_impact_figures(result, tmp_path):
     folder = write_run(result, tmp_path / "run", preset=DEFAULT_PRESET)
     outcome = runner.invoke(cli.app, ["plot", str(folder), "--impacts", "--out", str(tmp_path / "impacts")])
@@ -326,6 +356,7 @@ def synthetic_sweep(failed_index: int | None = None) -> pd.DataFrame:
     return table
 
 
+@pytest.mark.slow
 def test_sweep_maps_fill_the_grid_and_blank_the_failed_point():
     table = synthetic_sweep(failed_index=3)
     figures = sweep_figures(table, ("omega", "amplitude"))
@@ -346,6 +377,7 @@ def test_sweep_maps_fill_the_grid_and_blank_the_failed_point():
     assert axis.get_ylim() == pytest.approx((22.0, 30.0))
 
 
+@pytest.mark.slow
 def test_sweep_contour_is_drawn_at_its_level_on_every_map():
     table = synthetic_sweep()
     figures = sweep_figures(table, ("omega", "amplitude"), [("theta_inf_C", 60.0)])
@@ -358,6 +390,7 @@ def test_sweep_contour_is_drawn_at_its_level_on_every_map():
         np.testing.assert_allclose(vertices[:, 0], 100.0 - (vertices[:, 1] / 1e3 - 0.024) * 1e3, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_a_contour_level_outside_the_values_is_said_on_every_figure_not_drawn():
     # θ∞ is 50 … 94 °C; with the failed point (omega 130, amplitude 28 mm: 94 °C) left out, 90 is the top.
     table = synthetic_sweep(failed_index=5)
@@ -396,6 +429,7 @@ def test_one_key_sweep_is_a_line_with_the_contour_crossing_marked():
     assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "ball θ∞ of the exponential fitted over the run (°C)"
 
 
+@pytest.mark.slow
 def test_regime_map_counts_each_regime_and_the_failed_points():
     figures = sweep_figures(synthetic_sweep(failed_index=0), ("omega", "amplitude"))
     (axis,) = figures["sweep_regime"].axes
@@ -427,6 +461,7 @@ def test_bad_contours_name_the_problem(spec, message):
     assert parse_contour(" theta_inf_C = 60 ", ["theta_inf_C"]) == ("theta_inf_C", 60.0)
 
 
+@pytest.mark.slow
 def test_bifurcation_figure_plots_every_phase_and_the_periods_of_every_attractor():
     phases = pd.DataFrame(
         {
@@ -504,6 +539,7 @@ def test_a_sweep_over_a_named_key_has_one_tick_per_name():
     assert axis.get_xlabel() == "solver (–)"
 
 
+@pytest.mark.slow
 def test_a_map_over_a_named_and_a_numeric_key_fills_its_grid():
     table = synthetic_sweep()
     table["model"] = table["amplitude"].map({0.024: "three_node", 0.028: "ball_only"})
@@ -517,6 +553,7 @@ def test_a_map_over_a_named_and_a_numeric_key_fills_its_grid():
     assert [tick.get_text() for tick in regime_axis.get_yticklabels()] == ["ball_only", "three_node"]
 
 
+@pytest.mark.slow
 def test_omega_axes_also_read_in_rpm():
     figures = sweep_figures(synthetic_sweep(), ("amplitude", "omega"))
     axis = figures["sweep_theta_inf_C"].axes[0]
@@ -541,6 +578,7 @@ def test_sweep_titles_carry_the_preset_and_duration():
         assert figure.axes[0].get_title().endswith("\n" + context), name
 
 
+@pytest.mark.slow
 def test_run_figures_name_the_run_and_averaged_impact_figures_their_window(tmp_path):
     params = sm.default_parameters(solver="averaged", duration=600.0)
     run = load_run(write_run(sm.simulate(params), tmp_path / "run", preset="spex8000m"))

@@ -42,6 +42,7 @@ def test_parameters_html_repr_has_the_key_inputs_and_every_key_folded_away():
     assert all(f"<td>{key}</td>" in details for key in keys)
 
 
+@pytest.mark.slow
 def test_temperatures_in_celsius_are_labelled_degc_and_stored_in_the_run_folder(default_run_20s, tmp_path):
     series = default_run_20s.timeseries
     for name in ("theta_ball", "theta_vial", "theta_air"):
@@ -55,6 +56,7 @@ def test_temperatures_in_celsius_are_labelled_degc_and_stored_in_the_run_folder(
     np.testing.assert_allclose(stored.timeseries["theta_air_C"].values, series["theta_air_C"].values)
 
 
+@pytest.mark.slow
 def test_result_plot_returns_the_paper_figures_shown_inline(default_run_20s):
     figures = default_run_20s.plot()
     assert list(figures) == ["temperatures", "ball_motion"]

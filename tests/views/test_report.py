@@ -17,12 +17,16 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
-from shakermill.parameters.schema import DEFAULT_PRESET, FIELD_NAMES, PRESETS
 from shakermill.analysis.regime import classify_impacts, settled_run_impacts
-from shakermill.views.report import REPORT_FILE, fitted_targets, number, render_report, write_report
-from shakermill.io.runs import load_run, write_run
-from shakermill.io.runs import RunData
+from shakermill.io.runs import RunData, load_run, write_run
+from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.keys import FIELD_NAMES
+from shakermill.parameters.presets import PRESETS
 from shakermill.studies.validation import TABLE5
+from shakermill.views.report import REPORT_FILE, fitted_targets, number, render_report, write_report
+
+# Every test here reads a run made once for the module: make test-fast leaves them out.
+pytestmark = pytest.mark.slow
 
 CALIBRATED_PRESET = "spex8000m-calibrated"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

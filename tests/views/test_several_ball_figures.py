@@ -14,19 +14,22 @@ from scipy.spatial.transform import Rotation
 
 import shakermill as sm
 from shakermill.io.runs import load_run, write_run
-from shakermill.parameters.schema import DEFAULT_PRESET, ParameterError
-from shakermill.views.figures import (
+from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.errors import ParameterError
+from shakermill.views.figures.common import window_data
+from shakermill.views.figures.impacts import TARGETS, impact_figures
+from shakermill.views.figures.run import (
     SEVERAL_BALL_FIGURES,
-    TARGETS,
     heat_by_channel_figure,
-    impact_figures,
     run_figures,
     temperature_figure,
-    window_data,
     write_animation,
 )
 from shakermill.views.report import render_report
 from shakermill.views.trajectories import ANIMATION_SIZE_INCHES, MOST_ANIMATION_FRAMES, animation_gif, vial_frame
+
+# Every test here reads a run made once for the module: make test-fast leaves them out.
+pytestmark = pytest.mark.slow
 
 # A vial that yaws, pitches and rolls while it strokes: a figure drawn in the lab frame, or with the rotation
 # applied the wrong way round, puts the balls millimetres outside the vial.

@@ -4,9 +4,9 @@ One run settles on one motion, but this model can hold more than one at the same
 (period-1 from some starts and period-2 from others at a 23 mm stroke, a cycle beside irregular
 motion). Which one a run reaches then depends on its start, and its regime and heat power hide the
 others. So ``attractor_starts`` deterministic initial states, the configured start first, are each
-integrated at full resolution, for the mechanics only: settled for :data:`SETTLE_PERIODS` drive
-periods, then measured over :data:`MEASURE_PERIODS` (regime from the impact phases, heat power and
-impact rate over whole cycles). The starts are grouped into attractors:
+integrated at full resolution (``solvers.attractors``), for the mechanics only: settled for
+:data:`SETTLE_PERIODS` drive periods, then measured over :data:`MEASURE_PERIODS` (regime from the impact
+phases, heat power and impact rate over whole cycles). Here they are grouped into attractors:
 
 * a periodic start defines a cycle: the walls and drive phases ωt + φ (mod 2π) of its last full
   cycle; every start whose window ends on that cycle or on its mirror image (the vial's two ends
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,16 +33,11 @@ from shakermill.analysis.regime import (
     NO_IMPACTS,
     PHASE_TOLERANCE,
     Signature,
-    classify_impacts,
     impact_phases,
     period_signatures,
     signatures_match,
 )
-from shakermill.engines.budget import RunBudget
-from shakermill.engines.one_d import model
-from shakermill.engines.one_d.setup import ProgressCallback, impact_columns, integrator_for
-from shakermill.engines.status import REACHED_STOP
-from shakermill.parameters.schema import Parameters
+from shakermill.parameters.keys import Parameters
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -241,76 +236,8 @@ def initial_states(params: Parameters, count: int) -> list[tuple[float, float]]:
 
 def settle_span(params: Parameters) -> float:
     """Simulated seconds :func:`settle` integrates: SETTLE_PERIODS and MEASURE_PERIODS drive periods."""
-    return (SETTLE_PERIODS + MEASURE_PERIODS) * 2.0 * math.pi / params.omega
+    return (SETTLE_PERIODS + MEASURE_PERIODS) * params.period
 
-
-def settle(
-    params: Parameters,
-    start: int = 0,
-    budget: RunBudget | None = None,
-    heartbeat: Callable[[float], None] | None = None,
-) -> SettledStart:
-    """Settle the mechanics of ``params`` from its initial state and measure the motion it reached.
-
-    The whole state is integrated, but only the motion is used (temperatures do not act back on it).
-    A spent ``budget`` (``params``' own if None) makes the start ``FAILED`` with the budget's message;
-    ``heartbeat(t)`` is called while steps are tiny. Ctrl-C raises ``KeyboardInterrupt``.
-    """
-    period = 2.0 * math.pi / params.omega
-    settled_at = SETTLE_PERIODS * period
-    boundaries = settled_at + period * np.arange(MEASURE_PERIODS + 1)
-    integrator = integrator_for(params.replace(record_windows=()), sample_times=boundaries, budget=budget)
-    status = integrator.advance(boundaries[-1], heartbeat)
-    if status != REACHED_STOP:
-        return SettledStart(
-            start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan,
-            {"time": np.empty(0), "wall": np.empty(0, dtype=str)}, integrator.explain(status),
-        )
-    impacts = impact_columns(integrator.impacts, params.lam, since=settled_at)
-    regime, cycle = classify_impacts(impacts, params.omega, params.phase)
-    # Whole cycles of a periodic motion, so that its heat and rate carry no part-cycle bias.
-    measured = MEASURE_PERIODS - MEASURE_PERIODS % cycle if cycle else MEASURE_PERIODS
-    heat = integrator.samples[:, model.HEAT_GENERATED]
-    span = measured * period
-    count = int(np.count_nonzero(impacts["time"] < boundaries[measured]))
-    return SettledStart(
-        start, params.ball_position, params.ball_momentum, regime, cycle, count / span,
-        (heat[measured] - heat[0]) / span, _batch_standard_error(heat, period), impacts,
-    )
-
-
-def _batch_standard_error(heat: np.ndarray, period: float) -> float:
-    """Standard error of the mean heat power from batches of BATCH_PERIODS drive periods (cumulative ``heat``)."""
-    means = np.diff(heat[::BATCH_PERIODS]) / (BATCH_PERIODS * period)
-    return float(means.std(ddof=1) / math.sqrt(means.size))
-
-
-# Attractors -------------------------------------------------------------------------------------
-
-
-
-
-
-
-def find_attractors(
-    params: Parameters, budget: RunBudget | None = None, progress: ProgressCallback | None = None
-) -> AttractorScan:
-    """Settle ``params.attractor_starts`` initial states and group them into attractors.
-
-    One ``budget`` (``params``' own if None) covers all the starts; once it is spent, the remaining
-    starts fail at once. ``progress(done, total)`` is told the simulated seconds settled, over all starts.
-    """
-    budget = budget if budget is not None else RunBudget.of(params)
-    starts = initial_states(params, params.attractor_starts)
-    span = settle_span(params)
-    total = len(starts) * span
-    settled = []
-    for index, (position, momentum) in enumerate(starts):
-        heartbeat = None if progress is None else lambda t, before=index * span: progress(before + t, total)
-        settled.append(settle(params.replace(ball_position=position, ball_momentum=momentum), index, budget, heartbeat))
-        if heartbeat is not None:
-            heartbeat(span)
-    return AttractorScan(tuple(settled), group(tuple(settled), params.omega, params.phase))
 
 
 def group(settled: tuple[SettledStart, ...], omega: float, phase: float) -> tuple[Attractor, ...]:

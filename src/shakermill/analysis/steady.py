@@ -21,8 +21,7 @@ import numpy as np
 from scipy.differentiate import jacobian
 from scipy.optimize import root
 
-from shakermill.engines.one_d import model
-from shakermill.parameters.schema import Parameters
+from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 
 # A run shorter than this many slowest time constants has not settled: its fit is not the steady state.
 SETTLED_TIME_CONSTANTS = 3.0
@@ -42,7 +41,7 @@ class SteadyState:
     velocity_term: float  # the mean Whitaker velocity term it was computed for
     solved: bool
     message: str
-    balls: tuple[float, ...] = ()  # each ball's steady temperature (K), for engines with several balls
+    balls: tuple[float, ...] = ()  # each ball's steady temperature (K)
 
     @property
     def slowest_time_constant(self) -> float:
@@ -56,33 +55,37 @@ class SteadyState:
             "slowest_time_constant_min": self.slowest_time_constant / 60.0,
             "steady_state_heat_power_W": self.heat_power,
             "steady_state_message": self.message,
-            **({"balls_steady_C": [value - 273.15 for value in self.balls]} if self.balls else {}),
         }
 
 
-def _rates(params: Parameters, heat_power: float, velocity_term: float):
-    """f(θ) of the nodes that evolve: (ball, vial, air), or the ball alone in the ``ball_only`` model."""
-    constants = model.constants_from(params)
-    ambient = params.ambient_temperature
+def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:
+    """The root of ``network`` driven by ``load`` and its time constants (MODEL.md §11). The first guess puts every
+    free node where all the heat would leave through the constant paths to the room."""
+    if network.outer_conductance() <= 0.0 and not network.arrays.held.any() and load.heat_power > 0.0:
+        return _unsolved(load, NO_HEAT_LEAVES)
+    free = network.free
 
-    def three_nodes(theta: np.ndarray) -> np.ndarray:
-        return np.array(model.thermal_network(theta[0], theta[1], theta[2], heat_power, velocity_term, constants)[:3])
+    def rates(theta: np.ndarray) -> np.ndarray:
+        return network.rates(network.with_free(theta), load.heat, load.terms)[0][free]
 
-    def ball_only(theta: np.ndarray) -> np.ndarray:
-        # The predecessor model holds vial and air at ambient: only the ball has a steady state to find.
-        return np.array(model.thermal_network(theta[0], ambient, ambient, heat_power, velocity_term, constants)[:1])
+    outer = network.outer_conductance()
+    rise = load.heat_power / outer if outer > 0 else 0.0
+    solved = _solve(rates, np.full(free.size, network.ambient + rise))
+    if isinstance(solved, str):
+        return _unsolved(load, solved)
+    theta, time_constants = solved
+    temperatures = network.with_free(theta)
+    balls = tuple(float(value) for value in temperatures[: network.n_balls])
+    return SteadyState(
+        float(np.mean(balls)), float(temperatures[network.vial]), float(temperatures[network.air]), time_constants,
+        load.heat_power, load.velocity_term, True, "solved", balls,
+    )
 
-    return ball_only if params.model == "ball_only" else three_nodes
+
+NO_HEAT_LEAVES = "no heat leaves the vial (h_outer = 0): the temperatures rise without bound"
 
 
-def _first_guess(params: Parameters, heat_power: float, size: int) -> np.ndarray:
-    """Every node at the vial's linear steady state: all heat leaves through h_o·A_o (MODEL.md §11)."""
-    outer_conductance = params.h_outer * params.outer_area
-    rise = heat_power / outer_conductance if outer_conductance > 0 else 0.0
-    return np.full(size, params.ambient_temperature + rise)
-
-
-def _vectorised(rates):
+def _vectorised(rates: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarray], np.ndarray]:
     """``rates`` for scipy.differentiate.jacobian, which evaluates many points at once (trailing axes)."""
 
     def evaluate(theta: np.ndarray) -> np.ndarray:
@@ -91,41 +94,6 @@ def _vectorised(rates):
         return values.reshape(theta.shape)
 
     return evaluate
-
-
-def steady_state(params: Parameters, heat_power: float, velocity_term: float) -> SteadyState:
-    """The root of the averaged thermal network and its time constants (MODEL.md §11)."""
-    size = 1 if params.model == "ball_only" else 3
-    ambient = params.ambient_temperature
-    if params.model != "ball_only" and params.h_outer * params.outer_area <= 0.0 and heat_power > 0.0:
-        return _unsolved(heat_power, velocity_term, NO_HEAT_LEAVES)
-    solved = _solve(_rates(params, heat_power, velocity_term), _first_guess(params, heat_power, size))
-    if isinstance(solved, str):
-        return _unsolved(heat_power, velocity_term, solved)
-    theta, time_constants = solved
-    ball, vial, air = (theta[0], ambient, ambient) if size == 1 else theta
-    return SteadyState(float(ball), float(vial), float(air), time_constants, heat_power, velocity_term, True, "solved")
-
-
-def network_steady_state(
-    params: Parameters, rates: Callable[[np.ndarray], np.ndarray], heat_power: float, velocity_term: float, n_balls: int
-) -> SteadyState:
-    """Steady state and time constants of a network of ``n_balls`` ball nodes, the vial and the air, whose
-    averaged right-hand side is ``rates`` (the 'dem' engine); ``ball`` is the balls' mean."""
-    if params.h_outer * params.outer_area <= 0.0 and heat_power > 0.0:
-        return _unsolved(heat_power, velocity_term, NO_HEAT_LEAVES)
-    solved = _solve(rates, _first_guess(params, heat_power, n_balls + 2))
-    if isinstance(solved, str):
-        return _unsolved(heat_power, velocity_term, solved)
-    theta, time_constants = solved
-    balls = tuple(float(value) for value in theta[:n_balls])
-    return SteadyState(
-        float(np.mean(balls)), float(theta[n_balls]), float(theta[n_balls + 1]), time_constants, heat_power,
-        velocity_term, True, "solved", balls,
-    )
-
-
-NO_HEAT_LEAVES = "no heat leaves the vial (h_outer = 0): the temperatures rise without bound"
 
 
 def _solve(rates: Callable[[np.ndarray], np.ndarray], guess: np.ndarray) -> tuple[np.ndarray, tuple[float, ...]] | str:
@@ -140,13 +108,8 @@ def _solve(rates: Callable[[np.ndarray], np.ndarray], guess: np.ndarray) -> tupl
     return solution.x, time_constants
 
 
-def _unsolved(heat_power: float, velocity_term: float, message: str) -> SteadyState:
-    return SteadyState(math.inf, math.inf, math.inf, (math.inf,), heat_power, velocity_term, False, message)
-
-
-def settled_means(times: np.ndarray, heat_generated: np.ndarray, velocity_term_integral: np.ndarray) -> tuple[float, float]:
-    """Mean heat rate (W) and Whitaker velocity term over the second half of a run (its settled motion)."""
-    return float(settled_rates(times, heat_generated)), float(settled_rates(times, velocity_term_integral))
+def _unsolved(load: NetworkLoad, message: str) -> SteadyState:
+    return SteadyState(math.inf, math.inf, math.inf, (math.inf,), load.heat_power, load.velocity_term, False, message)
 
 
 def settled_rates(times: np.ndarray, cumulative: np.ndarray) -> np.ndarray:

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Iterator
 
 if TYPE_CHECKING:
-    from shakermill.parameters.schema import Parameters
+    from shakermill.parameters.keys import Parameters
 
 
 class BudgetExceeded(Exception):

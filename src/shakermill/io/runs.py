@@ -30,12 +30,12 @@ from typing import TYPE_CHECKING, Any, Callable, Container, Iterable, Mapping
 import numpy as np
 
 from shakermill.analysis.fit import ExponentialFit
-from shakermill.engines.dem.engine import IMPACT_UNITS as DEM_IMPACT_UNITS
-from shakermill.engines.one_d.setup import IMPACT_UNITS
+from shakermill.engines.records import TIME_ATTRIBUTES, StateHistory
+from shakermill.engines.registry import describe
 from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.config import load_config, write_config_toml
-from shakermill.parameters.schema import Parameters
-from shakermill.solvers.result import TIME_ATTRIBUTES, Result, StateHistory
+from shakermill.parameters.keys import Parameters
+from shakermill.solvers.result import Result
 from shakermill.support.atomic import (
     SET_ASIDE,
     StorageError,
@@ -59,8 +59,8 @@ RUN_FILES = (TIMESERIES_FILE, WINDOWS_FILE, IMPACTS_FILE, SUMMARY_FILE, CONFIG_F
 UNITS_METADATA_KEY = b"units"
 # Key of what a file covers, where it is less than the whole run (averaged solver): attribute and Parquet metadata.
 COVERAGE_KEY = "coverage"
-# Variables of an averaged run's timeseries.nc: never computed, or rates of the averaging window times time.
-AVERAGED_MOTION_VARIABLES = ("x", "p", "velocity")
+# Variables of an averaged run's timeseries.nc that are the averaging window's rates times time (the motion, never
+# computed, is the engine's ``description.motion``).
 AVERAGED_FLOW_VARIABLES = ("work_vial", "dissipated", "heat_generated", "velocity_term_integral")
 # Reading goes through xarray with this engine; writing uses h5netcdf directly (:func:`netcdf_bytes`).
 NETCDF_ENGINE = "h5netcdf"
@@ -187,15 +187,17 @@ def write_run(
 
 def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenance: Mapping[str, Any]) -> None:
     attributes = _run_attributes(result, preset)
+    description = describe(result.params.engine)
     coverage = averaging_coverage(result)
-    history = _mark_averaged_variables(result.history, coverage) if coverage else result.history
+    history = _mark_averaged_variables(result.history, description.motion, coverage) if coverage else result.history
     title = "shakermill sampled state history"
     series = netcdf_bytes(history, title=title, **attributes, **_covers(coverage, "timeseries"))
     (folder / TIMESERIES_FILE).write_bytes(series)
     title = "shakermill full-resolution state in the record windows"
     windows = netcdf_bytes(result.window_history, title=title, **attributes, **_covers(coverage, "motion"))
     (folder / WINDOWS_FILE).write_bytes(windows)
-    (folder / IMPACTS_FILE).write_bytes(impacts_parquet(result.impact_columns, coverage=coverage.get("impacts")))
+    impacts = impacts_parquet(result.impact_columns, description.impact_units, coverage=coverage.get("impacts"))
+    (folder / IMPACTS_FILE).write_bytes(impacts)
     (folder / SUMMARY_FILE).write_text(summary_json(result, preset), encoding="utf-8")
     provenance = {"status": result.status, "message": result.message, "simulated_s": result.t_end, **extra_provenance}
     write_config_toml(result.params, folder / CONFIG_FILE, preset=preset, extra_provenance=provenance)
@@ -218,6 +220,7 @@ def averaging_coverage(result: Result) -> dict[str, str]:
     averages = result.averages
     if result.impact_window is None or averages is None:
         return {}
+    motion_variables = describe(result.params.engine).motion
     start, end = averages.transient, averages.transient + averages.window
     motion = (
         f"the ball's motion was integrated at full resolution only up to t = {end:.6g} s (the averaged solver's "
@@ -225,7 +228,7 @@ def averaging_coverage(result: Result) -> dict[str, str]:
     )
     return {
         "timeseries": (
-            f"averaged solver: the temperatures cover the whole run; {', '.join(AVERAGED_MOTION_VARIABLES)} are NaN "
+            f"averaged solver: the temperatures cover the whole run; {', '.join(motion_variables)} are NaN "
             f"(not computed), and {', '.join(AVERAGED_FLOW_VARIABLES)} are the averaging window's mean rates times time"
         ),
         "motion": motion,
@@ -242,8 +245,7 @@ def _covers(coverage: Mapping[str, str], part: str) -> dict[str, str]:
     return {COVERAGE_KEY: coverage[part]} if coverage else {}
 
 
-def _mark_averaged_variables(history: StateHistory, coverage: Mapping[str, str]) -> StateHistory:
-    motion = AVERAGED_MOTION_VARIABLES + DEM_MOTION_VARIABLES
+def _mark_averaged_variables(history: StateHistory, motion: tuple[str, ...], coverage: Mapping[str, str]) -> StateHistory:
     marks = {name: {COVERAGE_KEY: coverage["motion_variable"]} for name in motion if name in history.variables}
     marks.update({name: {COVERAGE_KEY: coverage["flow_variable"]} for name in AVERAGED_FLOW_VARIABLES})
     return history.with_attributes(marks)
@@ -272,13 +274,13 @@ def netcdf_bytes(history: StateHistory, *, title: str, **attributes: Any) -> byt
     return buffer.getvalue()
 
 
-def impacts_parquet(columns: Mapping[str, np.ndarray], *, coverage: str | None = None) -> memoryview:
-    """The impact columns as a Parquet file, with their units as JSON in the schema metadata, and what
+def impacts_parquet(columns: Mapping[str, np.ndarray], units: Mapping[str, str], *, coverage: str | None = None) -> memoryview:
+    """The impact columns as a Parquet file, with their ``units`` as JSON in the schema metadata, and what
     the table covers (``coverage``) where it is not the whole run."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    units = {column: {**IMPACT_UNITS, **DEM_IMPACT_UNITS}.get(column, "") for column in columns}
+    units = {column: units.get(column, "") for column in columns}
     metadata = {UNITS_METADATA_KEY: json.dumps(units).encode()}
     if coverage is not None:
         metadata[COVERAGE_KEY.encode()] = coverage.encode()
@@ -372,13 +374,6 @@ def load_run(path: Path | str) -> RunData:
     )
 
 
-# Variables of timeseries.nc and windows.nc that plot and report read (every version wrote them), by engine.
-HISTORY_VARIABLES_READ_BACK = {
-    "1d": ("time", "x", "p", "theta_ball", "theta_vial", "theta_air"),
-    "dem": ("time", "position", "velocity", "theta_ball", "theta_balls", "theta_vial", "theta_air"),
-}
-# The 'dem' engine's motion, not computed by its averaged solver (NaN) outside the mechanics phase.
-DEM_MOTION_VARIABLES = ("position", "angular_velocity")
 # What summary.json must hold, and of which JSON type, for the tools that read a run folder back.
 SUMMARY_SHAPE = {
     "status": int,
@@ -404,13 +399,14 @@ def _read_history(path: Path, engine: str) -> xr.Dataset:
     import xarray as xr
 
     dataset = xr.load_dataset(path, engine=NETCDF_ENGINE)
-    _require(HISTORY_VARIABLES_READ_BACK[engine], dataset.variables, "variable")
+    # What plot and report read (every version wrote them).
+    _require(describe(engine).read_back, dataset.variables, "variable")
     return dataset
 
 
 def _read_impact_table(path: Path, engine: str) -> tuple[pd.DataFrame, dict[str, str]]:
     impacts, units = read_impacts(path)
-    _require(DEM_IMPACT_UNITS if engine == "dem" else IMPACT_UNITS, impacts.columns, "column")
+    _require(describe(engine).impact_units, impacts.columns, "column")
     return impacts, units
 
 

@@ -20,17 +20,17 @@ from typing import Any, Mapping, Sequence
 
 import tomli_w
 
-from shakermill.parameters.schema import (
-    DEFAULT_PRESET,
-    ParameterError,
+from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import (
     Parameters,
     build_parameters,
     field_description,
     field_unit,
     layered,
-    preset_values,
     with_materials,
 )
+from shakermill.parameters.presets import preset_values
 from shakermill.support.atomic import write_text_atomically
 from shakermill.support.limits import MAX_CONFIG_BYTES, quoted
 from shakermill.support.version import __version__

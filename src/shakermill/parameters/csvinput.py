@@ -9,7 +9,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from shakermill.parameters.schema import ParameterError
+from shakermill.parameters.errors import ParameterError
 from shakermill.support.limits import MAX_VALUE_LENGTH
 
 

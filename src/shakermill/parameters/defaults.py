@@ -4,6 +4,10 @@ The modules that use them import them from here, so that ``shakermill --help`` c
 without importing NumPy, pandas, SciPy or Matplotlib.
 """
 
+# The preset of a run that names none: the paper's SPEX 8000M (parameters/presets.py).
+DEFAULT_PRESET = "spex8000m"
+# What `calibrate --target` fits: the Table 5 quantities of the experiment (studies/validation.py, TABLE5).
+TARGET_KEYS = ("theta_inf_C", "tau_min", "rate0_C_per_min", "vial_ball_ratio")
 PNG_DPI = 150
 REPORT_FILE = "report.html"
 # The files each figure is written as.

@@ -19,12 +19,14 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-from scipy.special import jv
-
 Term = tuple[str, int, float, float]
 
+# The vial's six rigid-body coordinates: translations of its centre (m) and angles about the lab's axes (rad).
+MOTION_COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
 # Harmonics beyond the 20th describe no mill (a user's `motion` is held to it too).
 MAX_MOTION_HARMONIC = 20
+# Translations of a vial beyond half a metre describe no mill.
+MAX_MOTION_TRANSLATION = 0.5
 # The arc's Bessel series: terms smaller than this fraction of the swing radius are dropped. Within the
 # widest swing allowed they fall below it before MAX_MOTION_HARMONIC (2R·J_20(π/2) ≈ 6e-21 R).
 ARC_TRUNCATION = 1e-12
@@ -76,6 +78,9 @@ def arc_terms(amplitude: float, swing_radius: float) -> tuple[Term, ...]:
     series (Jacobi–Anger): x = 2R Σ_{k≥0} J_{2k+1}(α) sin((2k+1)θ),
     y = R(1 − J_0(α)) − 2R Σ_{k≥1} J_{2k}(α) cos(2kθ), truncated where 2R|J_n(α)| < ARC_TRUNCATION·R.
     """
+    # SciPy is imported here, not at start-up: these terms are needed by a run of this motion alone.
+    from scipy.special import jv
+
     alpha = arc_angle(amplitude, swing_radius)
     terms: list[Term] = [("y", 0, swing_radius * (1.0 - float(jv(0, alpha))), 0.0), ("yaw", 1, 0.0, alpha)]
     for n in range(1, MAX_MOTION_HARMONIC + 1):

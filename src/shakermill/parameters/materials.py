@@ -2,7 +2,7 @@
 
 A material stands for the elastic and thermal keys of a ball or a vial (:data:`FILLED`): the keys
 ``ball_material``, ``vial_material`` and, per ball, ``ball_materials`` fill them in
-(:func:`shakermill.parameters.schema.with_materials`). Its restitution and friction are ranges for a ball
+(:func:`shakermill.parameters.keys.with_materials`). Its restitution and friction are ranges for a ball
 on the same material and are only shown: both belong to a pair of surfaces, vary with the impact speed,
 and the presets' ``restitution`` and ``friction`` are calibrated, so a material never changes them.
 """
@@ -13,7 +13,9 @@ import functools
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, Mapping, Sequence
 
+from shakermill.parameters.errors import ParameterError
 from shakermill.support.limits import quoted
 
 LIBRARY_FILE = Path(__file__).parent / "materials.toml"
@@ -127,3 +129,49 @@ def allowed_names() -> str:
     aliases = ", ".join(f"{alias} = {canonical}" for alias, canonical in _aliases().items())
     return f"one of {', '.join(names())} (aliases: {aliases})"
 
+
+
+def allowed_for(key: str) -> str:
+    """The values ``key`` takes: one name (``ball_material``, ``vial_material``) or a list of them (``ball_materials``)."""
+    return f"an empty list or n_balls names, each {allowed_names()}" if key == "ball_materials" else f"'' (none) or {allowed_names()}"
+
+
+def names_in(key: str, value: Any) -> str | tuple[str, ...]:
+    """Canonical material names from a name or alias ('' or None: none), or for ``ball_materials`` from
+    "wc, zirconia" (the command line) or a list (TOML, Python); :class:`ParameterError` naming ``key`` otherwise."""
+    if key != "ball_materials":
+        return "" if value is None or not str(value).strip() else _named(key, value)
+    items = [item for item in value.split(",") if item.strip()] if isinstance(value, str) else value
+    if not isinstance(items, (list, tuple)):
+        raise ParameterError(
+            f"{key}: expected a list of material names, one per ball, got {quoted(value)}; allowed {allowed_for(key)}"
+        )
+    return tuple(_named(key, item) for item in items)
+
+
+def _named(key: str, name: Any) -> str:
+    try:
+        return material(name).name
+    except UnknownMaterial as exc:
+        raise ParameterError(f"{key}: {exc}") from None
+
+
+def filled_keys(layer: Mapping[str, Any], keys: Sequence[str], per_ball_key_of: Mapping[str, str]) -> dict[str, tuple[Any, str]]:
+    """The ``keys`` that the materials named in ``layer`` fill in, each with the material's value and source: a ball's
+    or the vial's properties (``ball_material``, ``vial_material``), each ball's per-ball list (``ball_materials``,
+    its list key by ``per_ball_key_of``)."""
+    filled: dict[str, tuple[Any, str]] = {}
+    for key, prefix in (("ball_material", "ball_"), ("vial_material", "vial_")):
+        name = names_in(key, layer.get(key, ""))
+        if name:
+            found = material(name)
+            for prop in FILLED:
+                if prefix + prop in keys:
+                    value = getattr(found, prop)
+                    filled[prefix + prop] = (value.value, f"material {name}: {value.source}")
+    per_ball = [material(name) for name in names_in("ball_materials", layer.get("ball_materials", ()))]
+    for prop in FILLED if per_ball else ():
+        sources = dict.fromkeys(f"{found.name}: {getattr(found, prop).source}" for found in per_ball)
+        values = tuple(getattr(found, prop).value for found in per_ball)
+        filled[per_ball_key_of[f"ball_{prop}"]] = (values, f"ball_materials: {'; '.join(sources)}")
+    return filled

@@ -1,22 +1,30 @@
-"""What a run produced, from either solver: :class:`Result`, its energy audit, state histories and
-summary, and the conclusions every run gets (steady state, physical bounds, warnings, attractors)."""
+"""What a run produced, from any engine and solver: :class:`Result` with its state histories, impacts and energy
+audit (``engines/records.py``), its summary, and the conclusions every run gets (steady state, physical bounds,
+warnings)."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from shakermill.analysis.attractors import AttractorScan, find_attractors
+from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
-from shakermill.analysis.steady import SteadyState, run_length_warning, steady_state
-from shakermill.engines.one_d import model
+from shakermill.analysis.steady import SteadyState, run_length_warning
+from shakermill.engines.records import (
+    BALL_TEMPERATURES,
+    CELSIUS_VARIABLES,
+    EnergyAudit,
+    StateHistory,
+    kelvin_to_celsius,
+)
+from shakermill.engines.registry import describe
 from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.defaults import HIT_SPEED
-from shakermill.parameters.schema import Parameters, unit_slip_warnings
+from shakermill.parameters.keys import Parameters, unit_slip_warnings
 from shakermill.support.presenters import present
 
 if TYPE_CHECKING:
@@ -67,72 +75,6 @@ class MechanicsAverages:
             "averaging_message": self.message,
         }
 
-
-@dataclass(frozen=True)
-class EnergyAudit:
-    """Where the vial's work went, in J, over the simulated interval.
-
-    work_by_vial = Δkinetic + Δelastic + dissipated
-    dissipated   = heat_generated + not_converted_to_heat
-    heat_generated = Δstored (ball + vial + air) + heat_lost_to_surroundings
-
-    ``projection_correction`` is the total |Δ kinetic energy| the energy
-    projection applied at the end of contacts: the integrator's truncation
-    error in the contact mechanics, which the projection removes from the
-    balance above but which this field keeps visible.
-    """
-
-    work_by_vial: float
-    kinetic_energy_change: float
-    elastic_energy_change: float
-    dissipated: float
-    heat_generated: float
-    heat_to_ball: float
-    heat_to_vial: float
-    not_converted_to_heat: float
-    stored_ball: float
-    stored_vial: float
-    stored_air: float
-    heat_lost_to_surroundings: float
-    projection_correction: float
-    # The 'dem' engine adds the work of gravity and splits the dissipation by channel (MODEL.md §12.4).
-    work_by_gravity: float = 0.0
-    # ... and the energy its tangential springs gain by stiffening with the load (engines.dem.model.TOTAL_NAMES)
-    work_by_stiffening: float = 0.0
-    dissipated_by_channel: Mapping[str, float] = field(default_factory=dict)
-
-    @property
-    def mechanical_residual(self) -> float:
-        supplied = self.work_by_vial + self.work_by_gravity + self.work_by_stiffening
-        return supplied - self.kinetic_energy_change - self.elastic_energy_change - self.dissipated
-
-    @property
-    def thermal_residual(self) -> float:
-        stored = self.stored_ball + self.stored_vial + self.stored_air
-        return self.heat_generated - stored - self.heat_lost_to_surroundings
-
-    @property
-    def residual(self) -> float:
-        return self.mechanical_residual + self.thermal_residual
-
-    @property
-    def relative_residual(self) -> float:
-        """|residual| over the largest flow in the balance (0 when nothing flowed, NaN when a term is not finite)."""
-        if not math.isfinite(self.residual):
-            return math.nan
-        scale = max(abs(self.work_by_vial), abs(self.dissipated), abs(self.heat_generated))
-        return abs(self.residual) / scale if scale > 0.0 else 0.0
-
-    def as_dict(self) -> dict[str, float]:
-        values = {key: value for key, value in self.__dict__.items() if key != "dissipated_by_channel"}
-        values.update({f"dissipated_{channel}": value for channel, value in self.dissipated_by_channel.items()})
-        values.update(
-            mechanical_residual=self.mechanical_residual,
-            thermal_residual=self.thermal_residual,
-            residual=self.residual,
-            relative_residual=self.relative_residual,
-        )
-        return values
 
 @dataclass
 class Result:
@@ -191,14 +133,11 @@ class Result:
     def _repr_html_(self) -> str:
         return present("result html", self)
 
-def conclude(result: Result, heat_power: float, velocity_term: float, steady: SteadyState | None = None) -> Result:
-    """Steady state, physical bounds, energy audit and warnings of a finished run of either solver, then its summary.
-
-    ``heat_power`` (W) and ``velocity_term`` are the means of the settled motion that drive the
-    thermal network (MODEL.md §11); an engine with its own network passes its ``steady`` state.
-    """
+def conclude(result: Result, steady: SteadyState) -> Result:
+    """The ``steady`` state (MODEL.md §11), physical bounds, energy audit and warnings of a finished run, then its
+    summary."""
     params = result.params
-    result.steady = steady if steady is not None else steady_state(params, heat_power, velocity_term)
+    result.steady = steady
     result.warnings.extend(unit_slip_warnings(params))
     lines = (run_length_warning(result.t_end, result.steady), steady_state_bound_warning(result), fit_warning(result))
     for line in lines:
@@ -261,104 +200,9 @@ def steady_state_bound_warning(result: Result) -> str | None:
         f"({kelvin_to_celsius(limit):.4g} °C): a longer run would leave the model's range"
     )
 
-def no_impact_note(params: Parameters, impacts: int) -> str:
-    """A hint for the surprising case of a run without impacts, empty otherwise."""
-    if impacts:
-        return ""
-    free_gap = params.vial_length / 2.0 - params.ball_radius
-    if params.amplitude < free_gap:
-        return (
-            f" No impact happened: the amplitude ({params.amplitude * 1e3:g} mm) is smaller than the free gap "
-            f"({free_gap * 1e3:g} mm), so in one dimension a slow ball is never reached; "
-            "give it an initial ball_momentum or ball_position."
-        )
-    return " No impact happened."
-
-_VARIABLES = {
-    # name: (state index, units, long name)
-    "x": (model.X, "m", "ball centre position"),
-    "p": (model.P, "kg m s-1", "ball momentum"),
-    "theta_ball": (model.THETA_BALL, "K", "ball temperature"),
-    "theta_vial": (model.THETA_VIAL, "K", "vial temperature"),
-    "theta_air": (model.THETA_AIR, "K", "inner air temperature"),
-    "work_vial": (model.WORK_VIAL, "J", "cumulative work done by the vial on the ball"),
-    "dissipated": (model.DISSIPATED, "J", "cumulative energy dissipated in contacts"),
-    "heat_generated": (model.HEAT_GENERATED, "J", "cumulative irreversible heat generated"),
-    "heat_lost": (model.HEAT_LOST, "J", "cumulative heat lost from the vial to the surroundings"),
-    "velocity_term_integral": (
-        model.VELOCITY_TERM,
-        "s",
-        "time integral of Whitaker's velocity term 0.4 Re^(1/2) + 0.06 Re^(2/3)",
-    ),
-}
-
-# Temperatures (K) that the datasets also carry in °C, as ``<name>_C``.
-CELSIUS_VARIABLES = ("theta_ball", "theta_vial", "theta_air")
-
-TIME_ATTRIBUTES = {"units": "s", "long_name": "simulated time"}
-
-# The 'dem' engine's variable of every ball's temperature (K), over (time, ball).
-BALL_TEMPERATURES = "theta_balls"
-
-
-@dataclass(frozen=True)
-class StateHistory:
-    """A state history as NumPy arrays over ``times`` (s), each variable with its attributes (units, long_name).
-    A variable is over ``time`` alone unless ``dimensions`` names its dimensions (e.g. time, ball, axis).
-
-    Run files are written from it directly, and :meth:`dataset` is the xarray view: a run that only
-    writes its files never imports xarray, whose first Dataset imports dask and pint (half a second).
-    """
-
-    times: np.ndarray
-    variables: dict[str, tuple[np.ndarray, dict[str, str]]]
-    dimensions: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
-
-    def dims(self, name: str) -> tuple[str, ...]:
-        return self.dimensions.get(name, ("time",))
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        return self.variables[name][0]
-
-    def with_attributes(self, extra: Mapping[str, Mapping[str, str]]) -> StateHistory:
-        """The same history with ``extra[name]`` added to the attributes of variable ``name``."""
-        variables = {
-            name: (values, {**attributes, **extra.get(name, {})}) for name, (values, attributes) in self.variables.items()
-        }
-        return StateHistory(self.times, variables, self.dimensions)
-
-    def dataset(self) -> xr.Dataset:
-        import xarray as xr
-
-        data_vars = {
-            name: (self.dims(name), values, dict(attributes)) for name, (values, attributes) in self.variables.items()
-        }
-        return xr.Dataset(data_vars, coords={"time": ("time", self.times, dict(TIME_ATTRIBUTES))})
-
-def state_history(times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters) -> StateHistory:
-    """The state history with units and long names, temperatures also in °C, the ball's velocity and the vial's position."""
-    variables = {
-        name: (states[:, index], {"units": units, "long_name": long_name})
-        for name, (index, units, long_name) in _VARIABLES.items()
-    }
-    # The same temperatures in °C beside the kelvin ones: ``ds.theta_ball_C.plot()`` is then labelled with the
-    # unit of its values, which converting ``theta_ball`` by hand would not change from [K].
-    for name in CELSIUS_VARIABLES:
-        kelvin, attributes = variables[name]
-        variables[f"{name}_C"] = (kelvin_to_celsius(kelvin), {"units": "degC", "long_name": attributes["long_name"]})
-    variables["velocity"] = (states[:, model.P] / constants.ball_mass, {"units": "m s-1", "long_name": "ball velocity"})
-    variables["vial_position"] = (
-        params.amplitude * np.sin(params.omega * times + params.phase),
-        {"units": "m", "long_name": "vial centre position"},
-    )
-    return StateHistory(times, variables)
-
-def kelvin_to_celsius(kelvin: float) -> float:
-    return kelvin - 273.15
-
 def understood_inputs(params: Parameters) -> dict[str, float]:
     """The inputs people most often give in other units, echoed in those units (guards against unit slips)."""
-    cycles_per_second = params.omega / (2.0 * math.pi)
+    cycles_per_second = params.frequency
     return {
         "omega_rad_s": params.omega,
         "omega_hz": cycles_per_second,
@@ -438,17 +282,19 @@ def _hits(speeds: np.ndarray, window: float) -> dict[str, float]:
 
 
 def several_ball_summary(result: Result) -> dict[str, Any]:
-    """The 'dem' engine's keys: impacts by kind, each ball's temperature and the heat by channel (empty for 1-D)."""
-    if result.params.engine != "dem":
+    """The keys of an engine that moves several balls: impacts by kind, each ball's temperature and steady state, the
+    heat by channel (none for an engine of one ball)."""
+    description = describe(result.params.engine)
+    if not description.several_balls:
         return {}
     impacts = result.impact_columns
     duration = max(result.t_end, 1e-300)
     window = result.impact_window if result.impact_window else duration
     scale = duration / window if window > 0 else math.nan
-    wall = int(np.sum(impacts["target"] != "ball"))
+    wall = int(np.sum(impacts[description.impact_target] != "ball"))
     temperatures = result.history[BALL_TEMPERATURES][-1]
     keys: dict[str, Any] = {
-        "engine": "dem",
+        "engine": description.name,
         "n_balls": result.params.n_balls,
         "fill_fraction": result.params.fill_fraction,
         "wall_impacts": int(round(wall * scale)),
@@ -458,21 +304,10 @@ def several_ball_summary(result: Result) -> dict[str, Any]:
         "work_gravity_J": result.energy.work_by_gravity,
         "work_stiffening_J": result.energy.work_by_stiffening,
     }
+    if result.steady is not None and result.steady.balls:
+        keys["balls_steady_C"] = [kelvin_to_celsius(value) for value in result.steady.balls]
     eta = result.params.eta
     for channel, dissipated in result.energy.dissipated_by_channel.items():
         keys[f"dissipated_{channel}_W"] = dissipated / duration
         keys[f"heat_{channel}_W"] = eta * dissipated / duration
     return keys
-
-
-def probed(result: Result) -> AttractorScan:
-    """The attractors at ``result``'s parameters: those its solver probed, or found now and attached."""
-    if result.attractors is None:
-        attach(result, find_attractors(result.params))
-    return result.attractors
-
-def attach(result: Result, scan: AttractorScan) -> None:
-    """Give ``result`` the scan, its warnings, and its summary keys (``n_attractors``, ``heat_power_spread_W``, ...)."""
-    result.attractors = scan
-    result.warnings.extend(scan.warnings())
-    result.summary = summarize(result)

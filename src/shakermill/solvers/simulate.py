@@ -1,32 +1,32 @@
-"""One entry point for both solvers: ``simulate(params)`` runs the one ``params.solver`` names."""
+"""One entry point for every engine and solver: ``simulate(params)`` runs the engine ``params.engine`` names
+(``engines/registry.py``) with the solver ``params.solver`` names."""
 
 from __future__ import annotations
 
 from typing import Callable
 
 from shakermill.engines.budget import BudgetExceeded, RunBudget
-from shakermill.engines.one_d.setup import ProgressCallback
+from shakermill.engines.interface import ProgressCallback
+from shakermill.engines.registry import engine_named
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
-from shakermill.parameters.schema import Parameters
-from shakermill.solvers.averaged import simulate_averaged
-from shakermill.solvers.dem import Mechanics, settle_mechanics, simulate_dem, simulate_dem_averaged
+from shakermill.parameters.keys import Parameters
+from shakermill.solvers.averaged import Mechanics, settle_mechanics, simulate_averaged
 from shakermill.solvers.full import simulate_full
 from shakermill.solvers.result import INTERRUPTED, Result
 
 
 def simulate(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
-    """Run ``params`` with the engine and solver it names (``params.engine``, ``params.solver``), within ``budget``
-    (``params``' own if None): see :func:`simulate_full`, :func:`shakermill.solvers.averaged.simulate_averaged`
-    and :func:`shakermill.solvers.dem.simulate_dem`."""
-    if params.engine == "dem":
-        return simulate_dem(params, progress, budget)
+    """Run ``params`` with the engine and solver it names, within ``budget`` (``params``' own if None): see
+    :func:`~shakermill.solvers.full.simulate_full` and :func:`~shakermill.solvers.averaged.simulate_averaged`."""
+    engine = engine_named(params.engine)
     if params.solver == "averaged":
-        return simulate_averaged(params, progress, budget)
-    return simulate_full(params, progress, budget)
+        return simulate_averaged(params, engine, progress, budget)
+    return simulate_full(params, engine, progress, budget)
+
 
 def simulate_whole(params: Parameters) -> Result:
     """:func:`simulate` for callers built on many runs (scans, fits): Ctrl-C raises ``KeyboardInterrupt``
-    and a spent budget :class:`~shakermill.budget.BudgetExceeded` (saying which limit) instead of
+    and a spent budget :class:`~shakermill.engines.budget.BudgetExceeded` (saying which limit) instead of
     returning a partial result they would use as if it were whole."""
     budget = RunBudget.of(params)
     return _whole(simulate(params, budget=budget), budget)
@@ -47,17 +47,19 @@ _SETTLED_KEPT = 2
 
 
 def thermal_variants(params: Parameters) -> Callable[[Parameters], Result]:
-    """:func:`simulate_whole` for runs that differ from ``params`` in ``THERMAL_ONLY_KEYS`` alone (a fit of
-    the vial's heat loss). The averaged ``dem`` solver measures the mechanics once, here, and each run then
-    integrates only its network: a three-dimensional run's means take tens of seconds, its network milliseconds."""
-    if params.engine != "dem" or params.solver != "averaged":
+    """:func:`simulate_whole` for runs that differ from ``params`` in the engine's thermal-only keys alone (a fit of
+    the vial's heat loss). Where the engine has such keys and the solver averages, the mechanics is measured once,
+    here, and each run then integrates only its network: a three-dimensional run's means take tens of seconds,
+    its network milliseconds."""
+    engine = engine_named(params.engine)
+    if not engine.description.thermal_only_keys or params.solver != "averaged":
         return simulate_whole
     mechanics = _SETTLED.get(params)
     if mechanics is None:
         budget = RunBudget.of(params)
-        mechanics = settle_mechanics(params, budget=budget)
+        mechanics = settle_mechanics(params, engine, budget=budget)
         if mechanics.status != REACHED_STOP:
-            _whole(simulate_dem_averaged(params, None, budget, mechanics), budget)  # raises for Ctrl-C and the budget
+            _whole(simulate_averaged(params, engine, None, budget, mechanics), budget)  # raises for Ctrl-C and the budget
         else:
             while len(_SETTLED) >= _SETTLED_KEPT:
                 _SETTLED.pop(next(iter(_SETTLED)))
@@ -65,6 +67,6 @@ def thermal_variants(params: Parameters) -> Callable[[Parameters], Result]:
 
     def run(variant: Parameters) -> Result:
         variant_budget = RunBudget.of(variant)
-        return _whole(simulate_dem_averaged(variant, None, variant_budget, mechanics), variant_budget)
+        return _whole(simulate_averaged(variant, engine, None, variant_budget, mechanics), variant_budget)
 
     return run

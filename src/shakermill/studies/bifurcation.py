@@ -10,7 +10,8 @@ from typing import TYPE_CHECKING, Callable, Sequence
 from shakermill.analysis.regime import classify
 from shakermill.io.runs import FolderKind
 from shakermill.parameters.defaults import FIGURE_FORMATS
-from shakermill.parameters.schema import ParameterError, Parameters
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import Parameters
 from shakermill.support.limits import MAX_BIFURCATION_VALUES
 
 if TYPE_CHECKING:
@@ -44,7 +45,7 @@ def bifurcation(
     import pandas as pd
 
     from shakermill.engines.budget import BudgetExceeded
-    from shakermill.solvers.result import probed
+    from shakermill.solvers.attractors import probed
     from shakermill.solvers.simulate import simulate_whole
 
     if len(values) > MAX_BIFURCATION_VALUES:
@@ -80,7 +81,7 @@ BIFURCATION_FIGURE = "bifurcation"
 
 def write_bifurcation(scan: Bifurcation, folder: Path) -> list[Path]:
     """``bifurcation_regimes``, ``bifurcation_attractors`` and ``bifurcation_phases`` tables (Parquet and CSV) in ``folder``."""
-    from shakermill.studies.sweep import write_table
+    from shakermill.studies.sweep_storage import write_table
 
     folder.mkdir(parents=True, exist_ok=True)
     tables = dict(zip(BIFURCATION_TABLES, (scan.regimes, scan.attractors, scan.phases)))

@@ -30,9 +30,10 @@ import numpy as np
 import tomli_w
 from scipy.optimize import least_squares
 
+from shakermill.engines.registry import describe
 from shakermill.parameters.defaults import DEFAULT_FREE, DEM_DEFAULT_FREE
-from shakermill.parameters.schema import ParameterError, Parameters, bounds, check_known_keys
-from shakermill.solvers.dem import THERMAL_ONLY_KEYS
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import Parameters, bounds, check_known_keys
 from shakermill.solvers.result import Result
 from shakermill.solvers.simulate import thermal_variants
 from shakermill.studies.validation import (
@@ -155,8 +156,9 @@ def _plain_number(text: str) -> float | None:
 
 
 def default_free(params: Parameters) -> tuple[str, ...]:
-    """The free set a calibration of ``params`` fits when none is given: the engine's."""
-    return DEM_DEFAULT_FREE if params.engine == "dem" else DEFAULT_FREE
+    """The free set a calibration of ``params`` fits when none is given: DEFAULT_FREE, or for an engine whose fits
+    measure the mechanics once (the 'dem' engine: it declares thermal-only keys) those that move the network alone."""
+    return DEM_DEFAULT_FREE if describe(params.engine).thermal_only_keys else DEFAULT_FREE
 
 
 def parse_free(items: Sequence[str], default: tuple[str, ...] = DEFAULT_FREE) -> tuple[str, ...]:
@@ -316,12 +318,14 @@ def calibrate(
 
 
 def _check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
-    """The 'dem' engine's calibration measures the mechanics once: only keys of the thermal network may move."""
-    moving = [key for key in free if key not in THERMAL_ONLY_KEYS]
-    if base.engine == "dem" and moving:
+    """An engine with thermal-only keys (the 'dem' engine) has its calibration measure the mechanics once: only keys
+    of the thermal network may move."""
+    thermal_only = describe(base.engine).thermal_only_keys
+    moving = [key for key in free if key not in thermal_only]
+    if thermal_only and moving:
         raise ParameterError(
-            f"free: {', '.join(moving)} would change the dem engine's mechanics, which a calibration measures once; "
-            f"allowed for engine = 'dem': {', '.join(THERMAL_ONLY_KEYS)}"
+            f"free: {', '.join(moving)} would change the {base.engine} engine's mechanics, which a calibration measures "
+            f"once; allowed for engine = {base.engine!r}: {', '.join(thermal_only)}"
         )
 
 

@@ -12,9 +12,11 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
 from shakermill.parameters.defaults import HIT_SPEED
-from shakermill.parameters.schema import PRESETS, Parameters, default_parameters
+from shakermill.parameters.keys import Parameters
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
+from shakermill.parameters.presets import PRESETS, default_parameters
 from shakermill.solvers.simulate import simulate_whole
-from shakermill.studies.kinematics import KinematicSensitivity, kinematic_sensitivity, measured
+from shakermill.studies.kinematics import DEFAULT_FACTORS, KinematicSensitivity, kinematic_sensitivity, measured
 from shakermill.studies.validation import relative_error
 
 HELD_OUT_PRESET = "spex8000m-3d-calibrated"
@@ -139,3 +141,46 @@ def five_ball_sensitivity(
 ) -> KinematicSensitivity:
     """How the five-ball prediction moves when each assumed amplitude of the SPEX motion is halved or raised by half."""
     return kinematic_sensitivity(five_ball_parameters(overrides), measures=SENSITIVITY_MEASURES, progress=progress)
+
+
+@dataclass(frozen=True)
+class HeldOutStudies:
+    """The five-ball prediction, the engines on one ball and the sensitivity to the assumed SPEX motion."""
+
+    prediction: HeldOutPrediction
+    comparison: EngineComparison
+    sensitivity: KinematicSensitivity
+
+    def as_dict(self) -> dict[str, Any]:
+        prediction, comparison = self.prediction, self.comparison
+        return {
+            "five_balls": {
+                "preset": prediction.preset,
+                "source": FIVE_BALL_SOURCE,
+                "fitted_parameters": list(prediction.fitted),
+                "fitted_to": prediction.fitted_to,
+                "statement": prediction.statement,
+                "rows": {
+                    row.key: {"label": row.label, "unit": row.unit, "experiment": row.experiment, "predicted": row.predicted,
+                              "relative_error": row.relative_error}
+                    for row in prediction.rows
+                },
+            },
+            "engine_comparison": {
+                "units": {key: unit for key, _, unit in COMPARED_KEYS},
+                "cases": [{"label": case.label, **values} for case, values in zip(comparison.cases, comparison.values)],
+            },
+            "kinematic_sensitivity": self.sensitivity.as_dict(),
+        }
+
+
+def held_out_studies(progress: Callable[[int, int], None] | None = None) -> HeldOutStudies:
+    """All three; ``progress(done, total)`` counts their runs."""
+    assumed = KINEMATIC_MODELS[five_ball_parameters().kinematics].assumed
+    total = 1 + len(ENGINE_CASES) + 1 + len(DEFAULT_FACTORS) * len(assumed)
+    show = progress if progress is not None else (lambda done, total: None)
+    prediction = five_ball_prediction()
+    show(1, total)
+    comparison = engine_comparison(ENGINE_CASES, progress=lambda done: show(1 + done, total))
+    sensitivity = five_ball_sensitivity(progress=lambda done, _: show(1 + len(ENGINE_CASES) + done, total))
+    return HeldOutStudies(prediction, comparison, sensitivity)

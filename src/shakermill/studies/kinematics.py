@@ -14,8 +14,8 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, Sequence
 
+from shakermill.parameters.keys import Parameters
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
-from shakermill.parameters.schema import Parameters
 from shakermill.solvers.simulate import simulate_whole
 from shakermill.studies.validation import relative_error
 
@@ -83,7 +83,7 @@ def kinematic_sensitivity(
     """Scale each of ``keys`` (default: the assumed keys of ``params.kinematics``) by each of ``factors``.
 
     Every run is ``params`` as given (its solver and duration) without record windows; a value that leaves a
-    key's bounds raises :class:`~shakermill.parameters.schema.ParameterError`. ``progress(done, total)`` is
+    key's bounds raises :class:`~shakermill.parameters.errors.ParameterError`. ``progress(done, total)`` is
     called after each run.
     """
     chosen = tuple(KINEMATIC_MODELS[params.kinematics].assumed if keys is None else keys)

@@ -5,13 +5,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, Mapping
 
 from shakermill.parameters.csvinput import read_csv_rows
-from shakermill.parameters.schema import LONGEST_RUN_S, Bounds, ParameterError, field_unit
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import LONGEST_RUN_S, Bounds, field_unit
 from shakermill.support.limits import MAX_CURVE_POINTS, quoted
+
+if TYPE_CHECKING:
+    import numpy as np
 
 PAPER = "Son 2025, Mathematics 13, 446"
 EXPERIMENT = "Takacs & McHenry 2006 (J. Mater. Sci. 41, 5246), one ball, SPEX 8000"
@@ -134,14 +136,19 @@ class Curve:
                 temperatures.append(float(cells["ball_C"]))
             except (KeyError, ValueError):
                 raise ParameterError(f"{what} line {number}: needs a number in {column} and in ball_C") from None
+        import numpy as np
+
         return cls(np.array(times), np.array(temperatures), str(path))
 
     def residuals_K(self, times: np.ndarray, theta_ball_K: np.ndarray) -> np.ndarray:
         """A modelled ball temperature history (s, K) minus this curve at its times (K)."""
+        import numpy as np
+
         return np.interp(self.times, times, theta_ball_K) - 273.15 - self.ball_C
 
     def rms_K(self, times: np.ndarray, theta_ball_K: np.ndarray) -> float:
-        return float(np.sqrt(np.mean(self.residuals_K(times, theta_ball_K) ** 2)))
+        residuals = self.residuals_K(times, theta_ball_K)
+        return math.sqrt(float((residuals**2).mean()))
 
 
 def _check_point(what: str, index: int, time: float, temperature: float, previous: float | None) -> None:
@@ -158,6 +165,8 @@ def _check_point(what: str, index: int, time: float, temperature: float, previou
 
 def experiment_curve() -> Curve:
     """θ(t) = 48 − 28·exp(−t/16.7 min) at every minute of the hour: the experiment as the paper gives it."""
+    import numpy as np
+
     theta_0, theta_inf, tau = EXPERIMENT_CURVE_C
     times = np.arange(EXPERIMENT_CURVE_MINUTES + 1) * 60.0
     source = "experiment (Takacs & McHenry 2006 via Son 2025 Table 5): 48 - 28 exp(-t / 16.7 min), 0-60 min"
@@ -236,7 +245,7 @@ class ValidationRun:
 
 def validate(solver: str = "full") -> list[ValidationRun]:
     """Run the published and the calibrated preset and compare both with Table 5 and the experiment's curve."""
-    from shakermill.parameters.schema import PRESETS, default_parameters
+    from shakermill.parameters.presets import PRESETS, default_parameters
     from shakermill.solvers.simulate import simulate
 
     curve = experiment_curve()

@@ -42,3 +42,8 @@ def quoted(value: object) -> str:
     """``repr(value)``, shortened to :data:`QUOTED_LENGTH` characters so that an error stays one readable line."""
     text = repr(value)
     return text if len(text) <= QUOTED_LENGTH else f"{text[: QUOTED_LENGTH - 5]}...{text[-2:]} ({len(text)} characters)"
+
+
+def in_one_line(error: BaseException) -> str:
+    """An exception's message on one line (its type's name where it has none)."""
+    return " ".join(str(error).split()) or type(error).__name__

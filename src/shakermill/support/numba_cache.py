@@ -19,8 +19,13 @@ _COMPILED_SOURCES = tuple(
         "physics/kinematics.py",
         "physics/contact.py",
         "physics/thermal.py",
+        "engines/thermal/kernel.py",
         "engines/one_d/model.py",
+        "engines/one_d/contacts.py",
         "engines/one_d/integrator.py",
+        "engines/dem/vectors.py",
+        "engines/dem/contacts.py",
+        "engines/dem/stepper.py",
     )
 )
 # Numba keeps each module's cached code in the __pycache__ beside it.

@@ -1,8 +1,3 @@
-"""The installed package's version, recorded in every file shakermill writes."""
+"""The package's version, recorded in every file shakermill writes; ``pyproject.toml`` reads it from here."""
 
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("shakermill")
-except PackageNotFoundError:  # running from a source tree without installation
-    __version__ = "0+unknown"
+__version__ = "0.1.0"

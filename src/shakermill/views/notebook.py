@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 from shakermill.support.presenters import register
 
 if TYPE_CHECKING:
-    from shakermill.parameters.schema import Parameters
+    from shakermill.parameters.keys import Parameters
     from shakermill.solvers.result import Result
 
 # The experiment's ball temperature after the hour it lasted (Takacs & McHenry 2006 via Son 2025 Table 5).
@@ -207,7 +207,7 @@ class FigureSet(dict):
     """Figures by name; a notebook shows them, one inline PNG each, when this is a cell's value."""
 
     def _repr_html_(self) -> str:
-        from shakermill.views.figures import png_bytes
+        from shakermill.views.figures.common import png_bytes
 
         images = (
             f"<figure><img alt=\"{esc(name)}\" src=\"data:image/png;base64,"
@@ -218,7 +218,7 @@ class FigureSet(dict):
 
 
 def run_figure_set(result: Result, *, impacts: bool = False) -> FigureSet:
-    from shakermill.views.figures import run_figures
+    from shakermill.views.figures.run import run_figures
 
     return FigureSet(run_figures(result, impacts=impacts))
 

@@ -12,25 +12,17 @@ others "predicted", with the relative error against the experiment either way.
 
 from __future__ import annotations
 
-import base64
 import errno
 import itertools
 import math
 import tomllib
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping, Sequence
+from typing import Any, Iterator, Sequence
 
-from shakermill.analysis.regime import classify_impacts, settled_run_impacts
 from shakermill.io.runs import CONFIG_FILE, RunData, load_run
-from shakermill.parameters.defaults import REPORT_FILE
-from shakermill.parameters.schema import (
-    DEFAULT_PRESET,
-    PRESETS,
-    Preset,
-    field_description,
-    field_unit,
-    material_citations,
-)
+from shakermill.parameters.defaults import DEFAULT_PRESET, REPORT_FILE
+from shakermill.parameters.keys import field_description, field_unit, material_sources
+from shakermill.parameters.presets import PRESETS, Preset
 from shakermill.studies.validation import (
     EXPERIMENT,
     OPERATING_POINT_TOLERANCE,
@@ -42,72 +34,31 @@ from shakermill.studies.validation import (
 )
 from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
 from shakermill.support.version import __version__
-from shakermill.views.figures import (
-    TARGETS,
-    comparison_temperature_figure,
-    impact_figures,
-    impact_span,
-    main_figure_names,
-    model_of,
-    paper_figures,
-    png_bytes,
-    several_balls,
+from shakermill.views.figures.common import several_balls
+from shakermill.views.figures.run import comparison_temperature_figure, main_figure_names, model_of, paper_figures
+from shakermill.views.html import (
+    bullet_list,
+    figure_html,
+    figures_html,
+    paragraph,
+    percent,
+    pretty_unit,
+    section,
+    table,
 )
 from shakermill.views.notebook import answer_sentences, esc, number
+from shakermill.views.report_sections import (
+    balls_section,
+    captions_of,
+    energy_section,
+    finite_summary,
+    impacts_section,
+    numerics_section,
+)
 
-if TYPE_CHECKING:
-    from matplotlib.figure import Figure
-
-# Screen resolution: sharp enough in a browser, and keeps a report of six figures well under a megabyte.
-EMBED_DPI = 100
 # Keys that change what is stored or reported, not what is simulated: a calibration still holds when they differ.
 OUTPUT_ONLY_KEYS = frozenset({"record_windows", "output_interval", "attractor_starts"})
 
-FIGURE_CAPTIONS = {
-    "ball_motion": (
-        "Paper Fig. 4: ball centre position (mm) and momentum (kg·m/s) over the first recorded window. Grey: "
-        "the ball centre at contact with either end face. Straight flights, momentum reversed at each impact."
-    ),
-    "temperatures": (
-        "Paper Fig. 5a: ball, vial and inner-air temperatures (°C) over the run (min), with the exponential "
-        "fitted to the ball temperature (MODEL.md §8)."
-    ),
-    "ball_heating_zoom": (
-        "Paper Fig. 5b: the ball temperature in the record window nearest 10 min. It jumps at each impact "
-        "(dotted) and falls by convection between impacts."
-    ),
-    "impact_speed_histogram": "Impact speed of the ball relative to the end face it hits, by end face.",
-    "impact_energy_histogram": "Energy dissipated in each impact (mJ), by end face.",
-    "impacts_per_second": "Impacts per second at each end face over the time the impacts were resolved.",
-    "impact_phase_histogram": (
-        "Drive phase ωt + φ (mod 2π) at the impacts of the settled motion, by end face: sharp lines for a "
-        "periodic motion, a spread for an irregular one."
-    ),
-}
-
-# A 'dem' run's figures (views/figures.py, SEVERAL_BALL_FIGURES) and its impact figures, where they differ.
-SEVERAL_BALL_CAPTIONS = {
-    "temperatures": (
-        "Temperature (°C) of each ball, the vial and the inner air over the run (min), with the exponential "
-        "fitted to the balls' mean temperature and the balls' mean steady state (cf. paper Fig. 5a)."
-    ),
-    "trajectories": (
-        "The ball centres (mm) over the first record window in the vial's own frame (x along its axis, z up at "
-        "rest), seen from above, from the side and along the axis, inside the vial's inner wall; discs: the "
-        "balls to scale where the window ends."
-    ),
-    "heat_by_channel": (
-        "Mean heat power (W) made in each dissipation channel (normal and tangential damping, sliding, rolling; "
-        "MODEL.md §12.4), stacked by what was hit, and the heat received by each ball and the vial."
-    ),
-    "ball_heating_zoom": (
-        "The temperature of each ball in the record window nearest 10 min: it jumps at the ball's impacts "
-        "(dotted: every impact of any ball) and falls by convection between them (cf. paper Fig. 5b)."
-    ),
-    "impact_speed_histogram": "Normal impact speed relative to what is hit: an end face, the side wall or another ball.",
-    "impact_energy_histogram": "Energy dissipated in each impact (mJ), by what was hit.",
-    "impacts_per_second": "Impacts per second on each wall and between balls over the time the impacts were resolved.",
-}
 
 # MODEL.md §9: where this implementation departs from the printed paper, on purpose.
 PAPER_DIFFERENCES = (
@@ -120,31 +71,6 @@ PAPER_DIFFERENCES = (
     "printed in the paper; they are stated assumptions (listed above with their values).",
 )
 
-ENERGY_TERMS = (
-    ("work_by_vial", "work done by the vial on the ball"),
-    ("kinetic_energy_change", "change of the ball's kinetic energy"),
-    ("elastic_energy_change", "change of the elastic contact energy"),
-    ("dissipated", "dissipated in the contacts"),
-    ("dissipated_normal", "of which by normal damping"),
-    ("dissipated_tangential", "of which by tangential damping"),
-    ("dissipated_sliding", "of which by sliding"),
-    ("dissipated_rolling", "of which by rolling resistance"),
-    ("work_by_gravity", "work done by gravity"),
-    ("work_by_stiffening", "energy the tangential springs gain as they stiffen (Hertz–Mindlin)"),
-    ("heat_generated", "irreversible heat generated (η × dissipated)"),
-    ("heat_to_ball", "heat to the ball (λ × heat)"),
-    ("heat_to_vial", "heat to the vial ((1 − λ) × heat)"),
-    ("not_converted_to_heat", "dissipated but not turned into heat"),
-    ("stored_ball", "stored in the ball"),
-    ("stored_vial", "stored in the vial"),
-    ("stored_air", "stored in the inner air"),
-    ("heat_lost_to_surroundings", "lost to the surroundings"),
-    ("projection_correction", "total |ΔE_kin| applied by the energy projection (outside the balance)"),
-    ("mechanical_residual", "mechanical residual: work − Δkinetic − Δelastic − dissipated"),
-    ("thermal_residual", "thermal residual: heat − stored − lost"),
-    ("residual", "total residual"),
-)
-RELATIVE_RESIDUAL_KEY = "relative_residual"
 
 RESULT_QUANTITIES = (
     ("ball_steady_C", "ball steady state (root of the averaged network, MODEL.md §11)", "°C", ".2f"),
@@ -247,78 +173,6 @@ def render_report(run: RunData, other: RunData | None = None) -> str:
 # ---------------------------------------------------------------- HTML and number helpers
 
 
-def percent(fraction: float) -> str:
-    if not math.isfinite(fraction):
-        return "n/a"
-    # Adding 0.0 turns a -0.0 from rounding a tiny negative error into +0.0.
-    return f"{round(fraction * 100, 1) + 0.0:+.1f} %"
-
-
-def pretty_unit(unit: str) -> str:
-    """'kg/m^3' -> 'kg/m³', 'J/(kg*K)' -> 'J/(kg·K)'."""
-    return unit.replace("^3", "³").replace("^2", "²").replace("*", "·")
-
-
-def table(
-    headers: Sequence[str] | None,
-    rows: Iterable[Sequence[str]],
-    *,
-    numeric: Sequence[int] = (),
-    row_classes: Mapping[int, str] | None = None,
-) -> str:
-    """An HTML table of plain-text cells (escaped here); ``numeric`` columns are right-aligned.
-
-    Without ``headers`` the table has no header row (a list of facts).
-    """
-    classes = row_classes or {}
-    head = ""
-    if headers:
-        head = "<thead><tr>" + "".join(f"<th>{esc(header)}</th>" for header in headers) + "</tr></thead>\n"
-    body = []
-    for index, row in enumerate(rows):
-        cells = "".join(
-            f"<td class=\"num\">{esc(cell)}</td>" if column in numeric else f"<td>{esc(cell)}</td>"
-            for column, cell in enumerate(row)
-        )
-        css = f" class=\"{esc(classes[index])}\"" if index in classes else ""
-        body.append(f"<tr{css}>{cells}</tr>")
-    return f"<table>\n{head}<tbody>\n" + "\n".join(body) + "\n</tbody>\n</table>"
-
-
-def section(title: str, *parts: str) -> str:
-    return f"<section>\n<h2>{esc(title)}</h2>\n" + "\n".join(parts) + "\n</section>"
-
-
-def paragraph(text: str, css_class: str = "") -> str:
-    css = f" class=\"{css_class}\"" if css_class else ""
-    return f"<p{css}>{esc(text)}</p>"
-
-
-def bullet_list(items: Iterable[str], ordered: bool = False) -> str:
-    tag = "ol" if ordered else "ul"
-    return f"<{tag}>" + "".join(f"<li>{esc(item)}</li>" for item in items) + f"</{tag}>"
-
-
-def figure_html(figure: Figure, caption: str, number: int) -> str:
-    """``figure`` as an inline PNG (data URI) with its caption, numbered "Figure ``number``"."""
-    encoded = base64.b64encode(png_bytes(figure, EMBED_DPI)).decode("ascii")
-    caption = f"Figure {number}: {caption}"
-    return (
-        f"<figure><img src=\"data:image/png;base64,{encoded}\" alt=\"{esc(caption)}\">"
-        f"<figcaption>{esc(caption)}</figcaption></figure>"
-    )
-
-
-def figures_html(figures: Mapping[str, Figure], numbers: Iterator[int], captions: Mapping[str, str] = FIGURE_CAPTIONS) -> str:
-    """The figures in order, numbered on from ``numbers`` (one count for the whole report)."""
-    return "\n".join(figure_html(figure, captions.get(name, name), next(numbers)) for name, figure in figures.items())
-
-
-def captions_of(run: RunData) -> dict[str, str]:
-    """The captions of ``run``'s figures: the paper's, or those of the 'dem' engine where they differ."""
-    return {**FIGURE_CAPTIONS, **SEVERAL_BALL_CAPTIONS} if several_balls(run.params) else FIGURE_CAPTIONS
-
-
 # ---------------------------------------------------------------- run facts
 
 
@@ -339,11 +193,6 @@ def run_provenance(run: RunData) -> dict[str, Any]:
     """The ``[provenance]`` table of the run's ``config.toml``: version, creation time, command, overrides."""
     with (run.path / CONFIG_FILE).open("rb") as stream:
         return dict(tomllib.load(stream).get("provenance", {}))
-
-
-def finite_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
-    """``summary`` with the nulls of ``summary.json`` (non-finite numbers) back as NaN."""
-    return {key: math.nan if value is None else value for key, value in summary.items()}
 
 
 def format_parameter(value: Any) -> str:
@@ -542,7 +391,7 @@ def configuration_section(run: RunData, preset: Preset | None) -> str:
     rows = []
     differs = {}
     values = run.params.model_dump()
-    from_materials = material_citations(values)
+    from_materials = material_sources(values)
     for index, (key, value) in enumerate(values.items()):
         cited = preset.values.get(key) if preset else None
         if cited is None:
@@ -552,9 +401,9 @@ def configuration_section(run: RunData, preset: Preset | None) -> str:
         else:
             preset_value, source = format_parameter(cited.value), cited.source
             differs[index] = "differs"
-        material = from_materials.get(key)
-        if material is not None and same_value(value, material.value):
-            source = material.source
+        material_value, material_source = from_materials.get(key, (None, None))
+        if material_source is not None and same_value(value, material_value):
+            source = material_source
         unit = pretty_unit(field_unit(key))
         rows.append((key, format_parameter(value), unit, preset_value, source, field_description(key)))
     changed = f"highlighted: the {len(differs)} keys whose value differs" if differs else "no key differs"
@@ -588,152 +437,6 @@ def assumptions_section(run: RunData, preset: Preset | None) -> str:
         bullet_list(PAPER_DIFFERENCES, ordered=True),
         paragraph(f"Model options of this run: {options}.", "note"),
     )
-
-
-def energy_section(run: RunData) -> str:
-    energy = run.energy
-    labels = dict(ENERGY_TERMS)
-    # Terms a newer audit may add are shown too, under their own names.
-    keys = [key for key, _ in ENERGY_TERMS if key in energy]
-    keys += [key for key in energy if key not in labels and key != RELATIVE_RESIDUAL_KEY]
-    rows = [(labels.get(key, key), key, number(energy[key], ".6g"), "J") for key in keys]
-    if RELATIVE_RESIDUAL_KEY in energy:
-        relative = ("relative residual: |residual| / largest flow", RELATIVE_RESIDUAL_KEY)
-        rows.append((*relative, number(energy[RELATIVE_RESIDUAL_KEY], ".3e"), ""))
-    supplied = "work by the vial + by gravity + stiffening" if several_balls(run.params) else "work by the vial"
-    balances = (
-        f"{supplied} = Δkinetic + Δelastic + dissipated; dissipated = heat generated + not converted to heat; "
-        "heat generated = stored (ball + vial + air) + lost to the surroundings. The residuals are what is left "
-        "of these balances."
-    )
-    return section(
-        "Energy audit",
-        paragraph(balances),
-        table(("term", "key", "value", "unit"), rows, numeric=(2,)),
-    )
-
-
-def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
-    """(quantity, value, unit) rows of the impact table, with the summary's count and rate."""
-    impacts = run.impacts
-    summary = run.summary
-    rate = summary.get("impact_rate_hz")
-    rows = [
-        ("impacts in the run", number(summary.get("impacts"), "d"), ""),
-        ("impacts in the impact table", str(len(impacts)), ""),
-        ("impact rate", number(rate, ".4g"), "Hz"),
-    ]
-    if impacts.empty:
-        return rows
-    rows += target_rows(run) if several_balls(run.params) else wall_rows(run)
-    for column, label, scale, unit, spec in (
-        ("impact_speed", "impact speed" if "wall" in impacts else "normal impact speed", 1.0, "m/s", ".4g"),
-        ("rebound_speed", "rebound speed", 1.0, "m/s", ".4g"),
-        ("tangential_speed", "tangential speed of the contact points at first touch", 1.0, "m/s", ".4g"),
-        ("dissipated_energy", "dissipated energy per impact", 1e3, "mJ", ".4g"),
-        ("heat_to_ball", "heat to the ball per impact", 1e3, "mJ", ".4g"),
-        ("duration", "contact duration", 1e6, "µs", ".4g"),
-        ("max_overlap", "maximum overlap", 1e6, "µm", ".4g"),
-        ("peak_force", "peak contact force", 1.0, "N", ".5g"),
-    ):
-        if column in impacts:
-            values = impacts[column].to_numpy() * scale
-            stats = f"{values.mean():{spec}} / {values.min():{spec}} / {values.max():{spec}}"
-            rows.append((f"{label}: mean / min / max", stats, unit))
-    return rows
-
-
-def wall_rows(run: RunData) -> list[tuple[str, str, str]]:
-    """The regime of the settled motion and the impacts at each end face, of a 1-D run."""
-    impacts, rate = run.impacts, run.summary.get("impact_rate_hz")
-    regime, _ = classify_impacts(settled_run_impacts(run), run.params.omega, run.params.phase)
-    rows = [("regime of the settled motion", regime, "")]
-    for wall in ("left", "right"):
-        count = int((impacts["wall"] == wall).sum())
-        share = count / len(impacts)
-        # The summary's rate covers the whole run (the averaged solver's table covers only its window).
-        wall_rate = rate * share if isinstance(rate, (int, float)) else None
-        rows.append((f"impacts at the {wall} end face", f"{count} ({share:.1%})", ""))
-        rows.append((f"impact rate at the {wall} end face", number(wall_rate, ".4g"), "Hz"))
-    return rows
-
-
-def target_rows(run: RunData) -> list[tuple[str, str, str]]:
-    """The impacts on each wall and between balls, of a 'dem' run (whose several balls have no 1-D regime)."""
-    impacts, rate = run.impacts, run.summary.get("impact_rate_hz")
-    rows = []
-    for target, label, _ in TARGETS:
-        count = int((impacts["target"] == target).sum())
-        share = count / len(impacts)
-        target_rate = rate * share if isinstance(rate, (int, float)) else None
-        rows.append((f"impacts on {label}", f"{count} ({share:.1%})", ""))
-        rows.append((f"impact rate on {label}", number(target_rate, ".4g"), "Hz"))
-    return rows
-
-
-def balls_section(run: RunData) -> str:
-    """Each ball of a 'dem' run: radius, temperature at the end and steady state, impacts, heat received."""
-    summary, impacts = run.summary, run.impacts
-    at_end, steady = summary.get("ball_temperatures_C") or [], summary.get("balls_steady_C") or []
-    series = run.timeseries
-    seconds = float(series["time"].values[-1])
-    heat = series["heat_into_balls"].transpose("time", "ball").values[-1] / seconds if seconds > 0 else None
-    on_walls = impacts["target"] != "ball"
-    rows = []
-    for ball, radius in enumerate(run.params.ball_values("ball_radius")):
-        mine = impacts["ball"] == ball
-        rows.append((
-            str(ball),
-            number(radius * 1e3, ".4g"),
-            number(at_end[ball] if ball < len(at_end) else None, ".2f"),
-            number(steady[ball] if ball < len(steady) else None, ".2f"),
-            str(int((mine & on_walls).sum())),
-            str(int((~on_walls & (mine | (impacts["other_ball"] == ball))).sum())),
-            number(float(heat[ball]) if heat is not None else None, ".4g"),
-        ))
-    headers = ("ball", "radius (mm)", "at the end (°C)", "steady state (°C)", "impacts on the walls",
-               "impacts with other balls", "heat received (W)")
-    note = (
-        f"Balls are numbered as in the run's files, from 0. Impacts are those of the impact table "
-        f"({number(impact_span(run), '.4g')} s of the run); the heat received is the mean over the whole run."
-    )
-    return section("Balls", table(headers, rows, numeric=range(1, len(headers))), paragraph(note, "note"))
-
-
-def impacts_section(run: RunData, numbers: Iterator[int]) -> str:
-    parts = [table(("quantity", "value", "unit"), impact_statistics(run), numeric=(1,))]
-    if run.impacts.empty:
-        parts.append(paragraph("No impacts were recorded.", "note"))
-    elif run.summary.get("impacts") != len(run.impacts):
-        parts.append(
-            paragraph(
-                "The averaged solver resolves impacts only while its averages converge "
-                f"({number(run.summary.get('averaging_window_s'), '.3g')} s); the count for the whole run is the "
-                "mean rate times the duration, and the statistics are over the impacts of the table.",
-                "note",
-            )
-        )
-    parts.append(figures_html(impact_figures(run), numbers, captions_of(run)))
-    return section("Impacts", *parts)
-
-
-def numerics_section(run: RunData) -> str:
-    summary = run.summary
-    params = run.params
-    rows = [
-        ("solver", str(summary.get("solver", "n/a")), ""),
-        ("relative tolerance rtol", number(params.rtol, ".3g"), ""),
-        ("accepted steps", number(summary.get("steps"), "d"), ""),
-        ("rejected steps", number(summary.get("rejected_steps"), "d"), ""),
-        ("right-hand-side evaluations", number(summary.get("rhs_evaluations"), "d"), ""),
-        ("wall time", number(summary.get("wall_time_s"), ".3g"), "s"),
-        ("energy projection", "on" if params.energy_projection else "off", ""),
-        ("projection correction / dissipated energy", number(summary.get("energy_projection_relative"), ".3e"), ""),
-        ("energy audit relative residual", number(summary.get("energy_audit_residual"), ".3e"), ""),
-    ]
-    # The averaged solver adds its statistics (averaged_*, averaging_*) to the summary.
-    rows += [(key, number(value, ".4g"), "") for key, value in summary.items() if key.startswith("averag")]
-    return section("Numerics", table(("quantity", "value", "unit"), rows, numeric=(1,)))
 
 
 def comparison_section(run: RunData, other: RunData, numbers: Iterator[int]) -> str:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 
 from shakermill.parameters.defaults import ANIMATION_FRAMES, MOST_ANIMATION_FRAMES
-from shakermill.parameters.schema import Parameters
+from shakermill.parameters.keys import Parameters
 from shakermill.physics import kinematics
 
 if TYPE_CHECKING:
@@ -75,7 +75,7 @@ def spread_samples(samples: int, most: int) -> np.ndarray:
     return np.linspace(0, samples - 1, min(samples, most)).round().astype(np.int64)
 
 
-def _new_figure(size: tuple[float, float]) -> Figure:
+def new_figure(size: tuple[float, float]) -> Figure:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -118,7 +118,7 @@ def trajectory_figure(params: Parameters, window: xr.Dataset, record_window: tup
     radii = np.asarray(params.ball_values("ball_radius")) * MM
     colours = ball_colours(radii.size)
     length, bore = params.vial_length * MM, params.vial_diameter * MM
-    figure = _new_figure((12.0, 3.9))
+    figure = new_figure((12.0, 3.9))
     axes = figure.subplots(1, 3, width_ratios=(length, length, bore))
     for axis, (across, up, name) in zip(axes, VIEWS):
         draw_vial(axis, across, up, params)
@@ -156,7 +156,7 @@ def animation_gif(
     time = window["time"].values
     shown = spread_samples(time.size, min(max(frames, 1), MOST_ANIMATION_FRAMES))
     radii = np.asarray(params.ball_values("ball_radius")) * MM
-    figure = _new_figure(ANIMATION_SIZE_INCHES)
+    figure = new_figure(ANIMATION_SIZE_INCHES)
     figure.set_dpi(dpi)
     axis = figure.subplots()
     draw_vial(axis, "x", "z", params)

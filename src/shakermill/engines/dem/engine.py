@@ -1,100 +1,137 @@
-"""A run of the 'dem' engine driven from Python: the compiled stepping in calls of ~0.1 s, within the
-run's budget, with the impact records grown as they fill (MODEL.md section 12)."""
+"""A run of the 'dem' engine (MODEL.md section 12) behind the engine interface (``engines/interface.py``): the
+compiled stepping driven in budgeted calls, the state recorded at the output samples and inside the record
+windows, its history with units, its contact records as named columns, its energy audit and the load of its
+thermal network."""
 
 from __future__ import annotations
 
-import time
-from typing import Callable
+import math
+from typing import ClassVar, Mapping, Sequence
 
 import numpy as np
 
-from shakermill.engines.budget import RunBudget, interrupt_after_compiled_code
+from shakermill.engines.budget import RunBudget
+from shakermill.engines.calls import CALL_AGAIN, PAUSED, CompiledRun
 from shakermill.engines.dem import model, stepper
-from shakermill.engines.status import BUDGET_EXCEEDED, NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
-from shakermill.parameters.schema import Parameters
+from shakermill.engines.dem.description import CHANNELS, DESCRIPTION
+from shakermill.engines.interface import EngineDescription, Measured
+from shakermill.engines.records import (
+    BALL_TEMPERATURES,
+    CELSIUS_VARIABLES,
+    EnergyAudit,
+    StateHistory,
+    attributes,
+    with_celsius,
+)
+from shakermill.engines.status import BUDGET_EXCEEDED
+from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
+from shakermill.parameters.keys import Parameters
+from shakermill.physics.kinematics import fourier_coordinates
 
-STATUS_MESSAGES = {
-    REACHED_STOP: "The engine reached the end of the integration interval.",
-    NOT_FINITE: "The state became NaN or infinite.",
-    OVERLAP_TOO_LARGE: (
-        "A contact overlap exceeded 5 % of the smallest ball radius: the materials are too soft for these impact "
-        "speeds, or contact_step_fraction is too large."
-    ),
-}
-# Wall time (s) one compiled call aims at, so that Ctrl-C and the budget are heard several times a second.
-CALL_SECONDS = 0.1
-FIRST_STEPS_PER_CALL = 2_000
-MAX_STEPS_PER_CALL = 50_000_000
 INITIAL_RECORDS = 4096
+# The record windows hold the motion at this interval (10 kHz): a drive period in ~570 points.
+WINDOW_INTERVAL = 1e-4
+TARGETS = np.array(["left", "right", "side"])
+_PER_BALL = ("time", "ball")
+_VECTORS = ("time", "ball", "axis")
 
 
-class Engine:
+def marks(params: Parameters, samples: np.ndarray, end: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Times up to ``end`` at which the run is recorded, in order, from 0 (the start), and whether each is one of the
+    output ``samples`` and whether it lies in a record window."""
+    points = [
+        np.arange(start, min(start + length, end) + 0.5 * WINDOW_INTERVAL, WINDOW_INTERVAL)
+        for start, length in params.record_windows
+        if start < end
+    ]
+    window = np.unique(np.concatenate(points)) if points else np.empty(0)
+    times = np.union1d(np.append(0.0, samples[samples <= end]), window)
+    return times, np.isin(times, samples), np.isin(times, window)
+
+
+class DemEngine(CompiledRun):
     """The balls, the vial and the thermal network of one run, advanced by :meth:`advance`."""
 
-    def __init__(self, params: Parameters, budget: RunBudget | None = None, marks: np.ndarray | None = None) -> None:
-        """``marks``: sorted times (s) at which the state is recorded (:attr:`rows`)."""
+    description: ClassVar[EngineDescription] = DESCRIPTION
+    first_steps_per_call: ClassVar[int] = 2_000
+    most_steps_per_call: ClassVar[int] = 50_000_000
+
+    def __init__(self, params: Parameters, budget: RunBudget | None = None, samples: Sequence[float] = (0.0,),
+                 horizon: float = 0.0) -> None:
+        """See :class:`~shakermill.engines.interface.Engine`. The state is recorded as a row (:func:`model.row_fields`)
+        at each sample and every WINDOW_INTERVAL inside the record windows; the start before the first step."""
         self.params = params
+        self.budget = budget if budget is not None else RunBudget.of(params)
+        self.network = self.network_for(params)
         self.constants = model.constants_from(params)
         self.state = model.initial_state(params, self.constants)
-        self.scratch = stepper.scratch_for(params.n_balls, model.slot_count(params.n_balls))
-        self.budget = budget if budget is not None else RunBudget.of(params)
-        self.counters = np.zeros(len(stepper.COUNTER_NAMES) + 1, dtype=np.int64)
-        self.marks = np.zeros(0) if marks is None else np.asarray(marks, dtype=float)
+        self.scratch = model.scratch_for(params.n_balls, model.slot_count(params.n_balls))
+        self.stepper_counters = np.zeros(len(stepper.COUNTER_NAMES) + 1, dtype=np.int64)
+        times, self._is_sample, self._in_window = marks(params, np.asarray(samples, dtype=float), horizon)
+        self.marks = times[1:]
         self._rows = np.zeros((self.marks.size, model.row_width(params.n_balls)))
         self._records = np.zeros((INITIAL_RECORDS, len(stepper.RECORD_COLUMNS)))
         self._count = 0
-        self._steps_per_call = FIRST_STEPS_PER_CALL
+        self.start = self.row_now()
+
+    @classmethod
+    def network_for(cls, params: Parameters) -> ThermalNetwork:
+        return model.network_of(params)
 
     @property
     def t(self) -> float:
         return float(self.state.clock[0])
+
+    def steps_taken(self) -> int:
+        return int(self.stepper_counters[stepper.STEPS])
+
+    def compiled_call(self, t_stop: float, steps_allowed: int) -> int:
+        status, self._count = stepper.advance(
+            t_stop, steps_allowed, self.constants, self.network.arrays, self.state, self.scratch, self._records, self._count,
+            self.stepper_counters, self.marks, self._rows,
+        )
+        if status == stepper.RECORDS_FULL:
+            self._records = np.concatenate([self._records, np.zeros_like(self._records)])
+            return CALL_AGAIN
+        return PAUSED if status == stepper.PAUSED else int(status)
+
+    def explain(self, status: int) -> str:
+        return str(self.budget.reason) if status == BUDGET_EXCEEDED else DESCRIPTION.status_messages[status]
 
     @property
     def records(self) -> np.ndarray:
         """One row per finished contact (:data:`stepper.RECORD_COLUMNS`), in the order they ended."""
         return self._records[: self._count].copy()
 
-    def advance(self, t_stop: float, heartbeat: Callable[[float], None] | None = None) -> int:
-        """Step to ``t_stop`` (s); returns a status (:data:`STATUS_MESSAGES`, or BUDGET_EXCEEDED).
-
-        ``heartbeat(t)`` is called between compiled calls; Ctrl-C raises ``KeyboardInterrupt`` once the
-        call under way has returned, with the state consistent at its last step.
-        """
-        while not self.budget.spent():
-            steps_before = int(self.counters[stepper.STEPS])
-            started = time.perf_counter()
-            allowed = min(self._steps_per_call, self.budget.steps_left)
-            with interrupt_after_compiled_code():
-                status, self._count = stepper.advance(
-                    t_stop, allowed, self.constants, self.state, self.scratch, self._records, self._count,
-                    self.counters, self.marks, self._rows,
-                )
-            steps = int(self.counters[stepper.STEPS]) - steps_before
-            self.budget.steps += steps
-            if status == stepper.RECORDS_FULL:
-                self._records = np.concatenate([self._records, np.zeros_like(self._records)])
-                continue
-            if status != stepper.PAUSED:
-                return int(status)
-            rate = steps / max(time.perf_counter() - started, 1e-9)
-            self._steps_per_call = int(min(max(rate * CALL_SECONDS, 1.0), MAX_STEPS_PER_CALL))
-            if heartbeat is not None:
-                heartbeat(self.t)
-        return BUDGET_EXCEEDED
-
     @property
     def rows(self) -> np.ndarray:
         """The states recorded at the marks reached so far (:func:`model.row_fields` layout)."""
-        return self._rows[: self.counters[stepper.ROWS_WRITTEN]]
+        return self._rows[: self.stepper_counters[stepper.ROWS_WRITTEN]]
 
     def row_now(self) -> np.ndarray:
         """The state now, laid out as a recorded row."""
         row = np.zeros((1, self._rows.shape[1]))
-        stepper.write_row(self.constants, self.state, self.scratch, row[0])
+        stepper.write_row(self.constants, self.network.arrays, self.state, self.scratch, row[0])
         return row
 
-    def explain(self, status: int) -> str:
-        return str(self.budget.reason) if status == BUDGET_EXCEEDED else STATUS_MESSAGES[status]
+    def history(self) -> StateHistory:
+        rows = np.vstack([self.start, self.rows])
+        samples = rows[self._is_sample[: len(rows)]]
+        if samples[-1, 0] < self.t:
+            samples = np.vstack([samples, self.row_now()])  # a stopped run shows its last state
+        return history_of(*model.unpack_rows(samples, self.params.n_balls), self.constants)
+
+    def window_history(self) -> StateHistory:
+        rows = np.vstack([self.start, self.rows])[self._in_window[: len(self.rows) + 1]]
+        return history_of(*model.unpack_rows(rows, self.params.n_balls), self.constants)
+
+    def impact_columns(self, since: float = -math.inf) -> dict[str, np.ndarray]:
+        return impact_columns(self.records, since)
+
+    def counters(self) -> dict[str, int]:
+        counters = {name: int(value) for name, value in zip(stepper.COUNTER_NAMES, self.stepper_counters)}
+        counters.update(rejected_steps=0, rhs_evaluations=counters["steps"])
+        return counters
 
     def kinetic_energy(self) -> float:
         """Translational plus rotational kinetic energy of the balls (J)."""
@@ -111,17 +148,96 @@ class Engine:
 
     def thermal_energy(self) -> float:
         """Σ C·θ of balls, vial and air (J above 0 K): its change is the heat they stored."""
-        k, theta = self.constants, self.state.temperature
+        return float(np.dot(self.network.arrays.capacity, self.state.temperature))
+
+    def energy_audit(self) -> EnergyAudit:
+        """Where the work of the vial and of gravity went (MODEL.md §12.6), from the start to now."""
+        k, s = self.constants, self.state
         n = k.n_balls
-        return float(np.dot(k.capacity_ball, theta[:n]) + k.capacity_vial * theta[n] + k.capacity_air * theta[n + 1])
+        capacity = self.network.arrays.capacity
+        initial = {name: values[0] for name, values in model.unpack_rows(self.start, n)[1].items()}
+        kinetic_start = 0.5 * float(
+            np.sum(k.mass * np.sum(initial["velocity"] ** 2, axis=1)) + np.sum(k.inertia * np.sum(initial["angular_velocity"] ** 2, axis=1))
+        )
+        warming = s.temperature - initial["temperature"]
+        totals = s.totals - initial["totals"]
+        channels = dict(zip(CHANNELS, totals[model.DISSIPATED_NORMAL : model.DISSIPATED_ROLLING + 1], strict=True))
+        dissipated = float(sum(channels.values()))
+        heat = float(totals[model.HEAT_GENERATED])
+        return EnergyAudit(
+            work_by_vial=float(totals[model.WORK_VIAL]),
+            kinetic_energy_change=self.kinetic_energy() - kinetic_start,
+            elastic_energy_change=self.stored_contact_energy(),
+            dissipated=dissipated,
+            heat_generated=heat,
+            heat_to_ball=float(np.sum(s.heat_into[:n] - initial["heat_into"][:n])),
+            heat_to_vial=float(s.heat_into[n] - initial["heat_into"][n]),
+            not_converted_to_heat=dissipated - heat,
+            stored_ball=float(np.dot(capacity[:n], warming[:n])),
+            stored_vial=float(capacity[n] * warming[n]),
+            stored_air=float(capacity[n + 1] * warming[n + 1]),
+            heat_lost_to_surroundings=float(totals[model.HEAT_LOST]),
+            projection_correction=0.0,
+            work_by_gravity=float(totals[model.WORK_GRAVITY]),
+            work_by_stiffening=float(totals[model.WORK_STIFFENING]),
+            dissipated_by_channel={name: float(value) for name, value in channels.items()},
+        )
 
+    @property
+    def projection_correction(self) -> float:
+        """No projection: the velocity-Verlet bookkeeping closes the energy balance exactly."""
+        return 0.0
 
-TARGETS = np.array(["left", "right", "side"])
+    def no_impact_note(self) -> str:
+        return ""
+
+    def measured(self) -> Measured:
+        s = self.state
+        dissipated = float(s.totals[model.DISSIPATED_NORMAL : model.DISSIPATED_ROLLING + 1].sum())
+        return Measured(s.heat_into.copy(), s.velocity_term_integral.copy(), dissipated)
+
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray) -> NetworkLoad:
+        """The heat into each ball and the vial as measured (the stepper splits each contact's heat)."""
+        heat = np.asarray(heat_rates, dtype=float)
+        terms = np.asarray(term_means, dtype=float)
+        return NetworkLoad(np.append(heat, 0.0), terms, float(heat.sum()), float(terms.mean()))
+
+    def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
+        """Each ball's contacts, with the vial or another ball; the vial's; the air's none."""
+        n = self.params.n_balls
+        balls = [int(np.sum(impacts["ball"] == ball) + np.sum(impacts["other_ball"] == ball)) for ball in range(n)]
+        return np.array([*balls, int(np.sum(impacts["target"] != "ball")), 0])
+
+    def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray,
+                         load: NetworkLoad, dissipated_power: float) -> StateHistory:
+        k, n = self.constants, self.params.n_balls
+        count = times.size
+        totals = np.zeros((count, len(model.TOTAL_NAMES)))
+        totals[:, model.WORK_VIAL] = dissipated_power * times  # on average the balls' kinetic energy does not change
+        totals[:, model.HEAT_GENERATED] = load.heat_power * times
+        totals[:, model.HEAT_LOST] = heat_lost
+        totals[:, model.DISSIPATED_NORMAL : model.DISSIPATED_ROLLING + 1] = np.nan  # the split is in the window's impacts
+        vial = np.zeros((count, 6))
+        rates = np.zeros(6)
+        for row, t in enumerate(times):
+            fourier_coordinates(t, k.omega, k.phase, k.harmonics, vial[row], rates)
+        motion = np.full((count, n, 3), np.nan)
+        fields = {
+            "position": motion,
+            "velocity": motion,
+            "angular_velocity": motion,
+            "temperature": temperatures.T,
+            "totals": totals,
+            "heat_into": np.outer(times, load.heat[: n + 1]),
+            "velocity_term_integral": np.outer(times, load.terms),
+            "vial": vial,
+        }
+        return history_of(times, fields, k)
 
 
 def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.ndarray]:
     """The contact records that began at ``since`` (s) or later, in time order, as columns with SI units
-    (:data:`IMPACT_UNITS`): ``target`` names the other body (left, right, side, ball), ``other_ball`` is
+    (``description.IMPACT_UNITS``): ``target`` names the other body (left, right, side, ball), ``other_ball`` is
     its index (−1 for a wall)."""
     column = {name: index for index, name in enumerate(stepper.RECORD_COLUMNS)}
     records = records[records[:, column["time"]] >= since]
@@ -136,7 +252,7 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
         "other_ball": np.where(other >= 0, other, -1),
         "impact_speed": records[:, column["normal_speed"]],
         "tangential_speed": records[:, column["tangential_speed"]],
-        **{f"dissipated_{name}": channels[:, index] for index, name in enumerate(model.CHANNELS)},
+        **{f"dissipated_{name}": channels[:, index] for index, name in enumerate(CHANNELS)},
         "dissipated_energy": channels.sum(axis=1),
         "heat_generated": heat_to_ball + heat_to_other,
         "heat_to_ball": heat_to_ball,
@@ -147,19 +263,36 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
     }
 
 
-IMPACT_UNITS = {
-    "time": "s",
-    "ball": "",
-    "target": "",
-    "other_ball": "",
-    "impact_speed": "m/s",
-    "tangential_speed": "m/s",
-    **{f"dissipated_{name}": "J" for name in model.CHANNELS},
-    "dissipated_energy": "J",
-    "heat_generated": "J",
-    "heat_to_ball": "J",
-    "heat_to_other": "J",
-    "peak_force": "N",
-    "max_overlap": "m",
-    "duration": "s",
-}
+def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Constants) -> StateHistory:
+    """The states with units: temperatures of each ball (and their mean, ``theta_ball``), vial and air, the
+    balls' motion in the lab frame (axis x, y, z; z up), the vial's pose and the running totals."""
+    n = k.n_balls
+    theta, totals, heat_into = fields["temperature"], fields["totals"], fields["heat_into"]
+    terms, vial = fields["velocity_term_integral"], fields["vial"]
+    variables: dict[str, tuple[np.ndarray, dict[str, str]]] = {
+        "theta_ball": (theta[:, :n].mean(axis=1), attributes("K", "mean ball temperature")),
+        "theta_vial": (theta[:, n], attributes("K", "vial temperature")),
+        "theta_air": (theta[:, n + 1], attributes("K", "inner air temperature")),
+        BALL_TEMPERATURES: (theta[:, :n], attributes("K", "temperature of each ball")),
+    }
+    with_celsius(variables, (*CELSIUS_VARIABLES, BALL_TEMPERATURES))
+    for name, units, long_name in (
+        ("position", "m", "ball centre, lab frame"),
+        ("velocity", "m s-1", "ball velocity, lab frame"),
+        ("angular_velocity", "rad s-1", "ball angular velocity, lab frame"),
+    ):
+        variables[name] = (fields[name], attributes(units, long_name))
+    variables["vial_centre"] = (vial[:, :3], attributes("m", "vial centre, lab frame"))
+    variables["vial_angles"] = (vial[:, 3:], attributes("rad", "vial roll, pitch and yaw"))
+    for index, name in enumerate(model.TOTAL_NAMES):
+        variables[name] = (totals[:, index], attributes("J", f"cumulative {name.replace('_', ' ')}"))
+    dissipated = totals[:, model.DISSIPATED_NORMAL : model.DISSIPATED_ROLLING + 1].sum(axis=1)
+    variables["dissipated"] = (dissipated, attributes("J", "cumulative energy dissipated in contacts"))
+    variables["heat_into_balls"] = (heat_into[:, :n], attributes("J", "cumulative impact heat into each ball"))
+    variables["heat_into_vial"] = (heat_into[:, n], attributes("J", "cumulative impact heat into the vial"))
+    variables["velocity_term_integrals"] = (terms, attributes("s", "time integral of each ball's Whitaker velocity term"))
+    variables["velocity_term_integral"] = (terms.mean(axis=1), attributes("s", "the balls' mean of velocity_term_integrals"))
+    dimensions = {name: _PER_BALL for name in (BALL_TEMPERATURES, f"{BALL_TEMPERATURES}_C", "heat_into_balls", "velocity_term_integrals")}
+    dimensions.update({name: _VECTORS for name in ("position", "velocity", "angular_velocity")})
+    dimensions.update(vial_centre=("time", "axis"), vial_angles=("time", "angle"))
+    return StateHistory(times, variables, dimensions)

@@ -12,9 +12,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from shakermill.engines.network import network_constants
-from shakermill.parameters.kinematic_models import motion_terms
-from shakermill.parameters.schema import MOTION_COORDINATES, Parameters
+from shakermill.engines.thermal.network import ThermalNetwork, air_constants, build_network
+from shakermill.parameters.keys import Parameters
+from shakermill.parameters.kinematic_models import MOTION_COORDINATES, motion_terms
 from shakermill.physics import contact
 from shakermill.physics.kinematics import fourier_coordinates, rotation_matrix
 
@@ -49,7 +49,6 @@ TOTAL_NAMES = (
     # as a supply of its own rather than hide it in a dissipation channel.
     "work_stiffening",
 )
-CHANNELS = ("normal", "tangential", "sliding", "rolling")
 
 
 class Constants(NamedTuple):
@@ -90,24 +89,11 @@ class Constants(NamedTuple):
     max_flight_step: float  # s
     max_overlap: float  # m: beyond it the step control failed
     thermal_step: float  # s: the thermal network is advanced on this clock
-    # Thermal network (MODEL.md §§4–6 with a node per ball, §12.5)
+    # Convection (MODEL.md §§4, 12.5): each ball's Re. The thermal network it drives is an argument of its own:
+    # every array in these constants costs a reference count at each use inside the compiled step (~10 % of its time).
     relative_convection: bool
     air_density: float
     viscosity_ambient: float
-    prandtl: float
-    mu_ref: float
-    t_ref: float
-    sutherland: float
-    air_conductivity: float
-    beta: float
-    h_inner: float
-    h_outer: float
-    inner_area: float
-    outer_area: float
-    capacity_ball: np.ndarray  # J/K per ball
-    capacity_vial: float
-    capacity_air: float
-    t_ambient: float
 
 
 class State(NamedTuple):
@@ -120,7 +106,7 @@ class State(NamedTuple):
     force: np.ndarray  # (N, 3) N: contact forces of the last evaluation (gravity apart)
     torque: np.ndarray  # (N, 3) N·m
     temperature: np.ndarray  # (N + 2,) K: the balls, the vial, the air
-    pending_heat: np.ndarray  # (N + 1,) J into balls and vial since the last thermal update
+    pending_heat: np.ndarray  # (N + 2,) J into the balls, the vial (and the air: none) since the last thermal update
     pending_velocity_term: np.ndarray  # (N,) s: ∫w dt since the last thermal update
     totals: np.ndarray  # (len(TOTAL_NAMES),) J
     heat_into: np.ndarray  # (N + 1,) J: all heat into each ball and the vial so far
@@ -184,7 +170,22 @@ def _motion_bounds(harmonics: np.ndarray, omega: float, reach: float) -> tuple[f
     return float(angular_rate), acceleration
 
 
+def _masses(params: Parameters) -> np.ndarray:
+    """Each ball's mass ρ·4/3·π R³ (kg)."""
+    return np.array(params.ball_values("ball_density")) * 4.0 / 3.0 * math.pi * np.array(params.ball_values("ball_radius")) ** 3
+
+
+def network_of(params: Parameters) -> ThermalNetwork:
+    """The thermal network of ``params``' balls, vial and air (MODEL.md §12.5)."""
+    radius = params.ball_values("ball_radius")
+    capacity = _masses(params) * np.array(params.ball_values("ball_heat_capacity"))
+    names = [f"ball {i}" for i in range(params.n_balls)]
+    share = "λ of the heat of its contacts with the vial, its effusivity share of those with other balls (MODEL.md §12.4)"
+    return build_network(params, radius, capacity, names, share)
+
+
 def constants_from(params: Parameters) -> Constants:
+    """Everything the stepping needs but the thermal network (:func:`network_of`)."""
     n = params.n_balls
     radius = np.array(params.ball_values("ball_radius"))
     density = np.array(params.ball_values("ball_density"))
@@ -192,7 +193,7 @@ def constants_from(params: Parameters) -> Constants:
     poisson = np.array(params.ball_values("ball_poisson_ratio"))
     heat_capacity = np.array(params.ball_values("ball_heat_capacity"))
     conductivity = np.array(params.ball_values("ball_conductivity"))
-    mass = density * 4.0 / 3.0 * math.pi * radius**3
+    mass = _masses(params)
     effusivity = np.sqrt(conductivity * density * heat_capacity)
     pair_modulus, pair_shear, pair_radius, pair_mass, share = (np.zeros((n, n)) for _ in range(5))
     for i in range(n):
@@ -212,7 +213,9 @@ def constants_from(params: Parameters) -> Constants:
     )
     fastest_node = min(value for value, _ in params.thermal_time_constants_at_rest.values())
     return Constants(
-        **network_constants(params),
+        relative_convection=params.relative_convection,
+        air_density=params.air_density,
+        viscosity_ambient=air_constants(params)["viscosity_ambient"],
         n_balls=n,
         radius=radius,
         mass=mass,
@@ -245,7 +248,6 @@ def constants_from(params: Parameters) -> Constants:
         max_flight_step=params.max_flight_step,
         max_overlap=MAX_OVERLAP_FRACTION * float(radius.min()),
         thermal_step=min(THERMAL_STEP, THERMAL_STEP_FRACTION * fastest_node),
-        capacity_ball=mass * heat_capacity,
     )
 
 
@@ -289,7 +291,7 @@ def initial_state(params: Parameters, k: Constants) -> State:
         force=np.zeros((n, 3)),
         torque=np.zeros((n, 3)),
         temperature=temperature,
-        pending_heat=np.zeros(n + 1),
+        pending_heat=np.zeros(n + 2),
         pending_velocity_term=np.zeros(n),
         totals=np.zeros(len(TOTAL_NAMES)),
         heat_into=np.zeros(n + 1),
@@ -344,3 +346,63 @@ def unpack_rows(rows: np.ndarray, n_balls: int) -> tuple[np.ndarray, dict[str, n
         fields[name] = rows[:, offset : offset + size].reshape(len(rows), *shape)
         offset += size
     return rows[:, 0], fields
+
+
+class Scratch(NamedTuple):
+    """Arrays of one call, allocated once so that the compiled loop allocates nothing per step."""
+
+    coordinates: np.ndarray  # (6,) the vial's x, y, z, roll, pitch, yaw
+    rates: np.ndarray  # (6,) their time derivatives
+    orientation: np.ndarray  # (3, 3) vial frame to lab frame
+    angular: np.ndarray  # (3,) the vial's angular velocity now
+    angular_before: np.ndarray  # (3,) at the step's start
+    half_velocity: np.ndarray  # (N, 3) after the first half kick
+    half_spin: np.ndarray  # (N, 3)
+    velocity_before: np.ndarray  # (N, 3) at the step's start
+    spin_before: np.ndarray  # (N, 3)
+    normal_force: np.ndarray  # (S, 3) new forces and torques on ball i per slot
+    tangential_force: np.ndarray
+    lever_torque_i: np.ndarray
+    lever_torque_j: np.ndarray
+    rolling_torque: np.ndarray
+    wall_velocity: np.ndarray  # (S, 3) the vial's velocity at the contact point
+    elastic_energy: np.ndarray  # (S,)
+    stiffness: np.ndarray  # (S,) tangential k_t
+    stretch: np.ndarray  # (S,) |δ_t|²
+    live: np.ndarray  # (S,) slots touching now or at the step's start
+    touching: np.ndarray  # (S,) bool: touching at the step's end
+    normal: np.ndarray  # (3,) vectors of the contact being evaluated
+    point_velocity: np.ndarray
+    other_velocity: np.ndarray
+    lever: np.ndarray
+    relative_spin: np.ndarray
+
+
+def scratch_for(n_balls: int, slots: int) -> Scratch:
+    return Scratch(
+        coordinates=np.zeros(6),
+        rates=np.zeros(6),
+        orientation=np.zeros((3, 3)),
+        angular=np.zeros(3),
+        angular_before=np.zeros(3),
+        half_velocity=np.zeros((n_balls, 3)),
+        half_spin=np.zeros((n_balls, 3)),
+        velocity_before=np.zeros((n_balls, 3)),
+        spin_before=np.zeros((n_balls, 3)),
+        normal_force=np.zeros((slots, 3)),
+        tangential_force=np.zeros((slots, 3)),
+        lever_torque_i=np.zeros((slots, 3)),
+        lever_torque_j=np.zeros((slots, 3)),
+        rolling_torque=np.zeros((slots, 3)),
+        wall_velocity=np.zeros((slots, 3)),
+        elastic_energy=np.zeros(slots),
+        stiffness=np.zeros(slots),
+        stretch=np.zeros(slots),
+        live=np.zeros(slots, dtype=np.int64),
+        touching=np.zeros(slots, dtype=np.bool_),
+        normal=np.zeros(3),
+        point_velocity=np.zeros(3),
+        other_velocity=np.zeros(3),
+        lever=np.zeros(3),
+        relative_spin=np.zeros(3),
+    )

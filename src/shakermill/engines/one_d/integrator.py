@@ -1,52 +1,44 @@
-"""Compiled adaptive Runge–Kutta integration of the full-resolution model (MODEL.md section 7).
+"""Compiled adaptive Runge–Kutta integration of the full-resolution 1-D model (MODEL.md section 7).
 
-The solver is an explicit FSAL Runge–Kutta pair given as data
-(:class:`ButcherTableau`, checked at construction); the default is
-Bogacki–Shampine 3(2), the method of MATLAB's ``ode23`` and SciPy's ``RK23``.
-Step-size control (:class:`StepController`) follows SciPy's RK23: RMS error
-norm over the dynamic state, scale ``atol + rtol·max(|y_n|, |y_n+1|)``; inside
-a contact the mechanics are measured against the impact's own scales instead
-(:func:`_contact_error_scale`).
+The method is an explicit FSAL Runge–Kutta pair given as data (``tableau``, Bogacki–Shampine 3(2) by default).
+Step-size control follows SciPy's RK23: RMS error norm over the dynamic state, scale
+``atol + rtol·max(|y_n|, |y_n+1|)``; inside a contact the mechanics are measured against the impact's own scales
+instead (:func:`_contact_error_scale`). Contacts are events of the mechanics (``contacts``): a free-flight step
+lands on the contact onset, never steps over it, and inside a contact the step is at most
+``contact_step_limit`` (0.9 t_R by default); the overlap, the momentum and the dissipated energy are controlled
+relative to the Hertz maximum overlap, m·v_in and m·v_in²/2 at a share of rtol (``CONTACT_TOLERANCE_SHARE``).
+One record per impact is written when the ball leaves the wall.
 
-Contacts are events of the mechanics, handled in the compiled loop:
-
-* In flight the ball moves on a straight line and the walls on a sine, so the
-  gap to each wall is known exactly over a trial step. Its first zero is
-  searched with a curvature bound (|gap''| ≤ X_v·ω²) that rules out a wall
-  touching and leaving within the step; the step is then shortened to land on
-  the contact onset. A contact start is therefore never stepped over.
-* Inside a contact the step is at most ``contact_step_limit`` (0.9 t_R by
-  default); the overlap, the momentum and the dissipated energy are controlled
-  relative to the Hertz maximum overlap, m·v_in and m·v_in²/2 at a share of
-  rtol (``CONTACT_TOLERANCE_SHARE``), and the steps are graded towards both ends of the contact, where the
-  damping force has a ζ^{1/4} singularity.
-* One record per impact is written when the ball leaves the wall.
-
-Everything runs in chunks (:meth:`Integrator.advance`), so a caller can show
-progress and keep what was computed when interrupted. Within a chunk the
-compiled loop also hands control back about every CALL_SECONDS of wall time, so
-that tiny steps cannot hold off Ctrl-C, the run's budget or progress.
+Everything runs in chunks (:meth:`Integrator.advance`), so a caller can show progress and keep what was
+computed when interrupted; within a chunk the compiled loop hands control back about every tenth of a second
+of wall time (``engines.calls``), so that tiny steps cannot hold off Ctrl-C, the run's budget or progress.
 """
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
-from fractions import Fraction
-from typing import Callable, NamedTuple
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 from numba import njit
 
-from shakermill.engines.budget import RunBudget, interrupt_after_compiled_code
+from shakermill.engines.budget import RunBudget
+from shakermill.engines.calls import PAUSED, CompiledRun
+from shakermill.engines.one_d.contacts import (
+    SLOWEST_APPROACH,
+    STACK_ROWS,
+    TIME_RESOLUTION,
+    bound_step,
+    rate_into_wall,
+    shortest_contact_step,
+)
+from shakermill.engines.one_d.description import MAX_WINDOW_POINTS, STATUS_MESSAGES, STEP_UNDERFLOW, WINDOWS_FULL
 from shakermill.engines.one_d.model import (
     DISSIPATED,
     HEAT_GENERATED,
-    LEFT_WALL,
     N_DYNAMIC,
     N_STATE,
     NO_WALL,
-    RIGHT_WALL,
     WORK_VIAL,
     Constants,
     P,
@@ -55,43 +47,10 @@ from shakermill.engines.one_d.model import (
     gap,
     rhs,
 )
+from shakermill.engines.one_d.tableau import BOGACKI_SHAMPINE, ButcherTableau, StepController
 from shakermill.engines.status import BUDGET_EXCEEDED, NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.physics import kinematics
-from shakermill.physics.contact import elastic_energy, hertz_contact_time, hertz_max_overlap
-
-# Status codes of the compiled loop (negative: failure).
-STEP_UNDERFLOW = -3
-# Checked between compiled calls (Integrator.advance), not in the loop: the size of the record windows.
-WINDOWS_FULL = -7
-# Every step inside a record window is kept: ~1000 rows a simulated second at the defaults (35 min of
-# windows fit, 4 min at rtol 1e-6), but tiny steps would fill memory and disk (a vacuum vial,
-# air_density = 1e-8, takes 1.7e8 steps a second). 2·10⁶ rows are ~220 MB, in memory and in windows.nc.
-MAX_WINDOW_POINTS = 2_000_000
-# Not an outcome: the loop took the steps it was allowed and hands control back mid-chunk.
-_PAUSED = 2
-
-STATUS_MESSAGES = {
-    REACHED_STOP: "The solver reached the end of the integration interval.",
-    NOT_FINITE: "The state became NaN or infinite.",
-    OVERLAP_TOO_LARGE: (
-        "The contact overlap exceeded the allowed fraction of the ball radius: the materials are too soft for "
-        "this impact speed (check ball_youngs_modulus and vial_youngs_modulus), or the step control failed."
-    ),
-    STEP_UNDERFLOW: "The step size fell below the resolution of the time variable.",
-    BUDGET_EXCEEDED: "The run used up its budget (max_wall_time or max_steps).",
-    WINDOWS_FULL: (
-        f"The record windows filled the {MAX_WINDOW_POINTS:,} points (~220 MB) a run keeps of them: the steps "
-        "inside them are tiny. Shorten record_windows, or leave it empty, to run on."
-    ),
-}
-
-# Wall time (s) a compiled call aims at before it hands control back to Python. The steps it may take
-# adapt to this: a step costs ~0.5 µs in flight, but up to ~0.4 ms where the contact search is hard
-# (ω ~ 1e5 rad/s), so no fixed count keeps Ctrl-C prompt. After its first call a default run's 10-s
-# chunks (~10⁴ steps, ~5 ms) end long before the adapted count, so it makes no further calls.
-CALL_SECONDS = 0.1
-FIRST_STEPS_PER_CALL = 1_000
-MAX_STEPS_PER_CALL = 10_000_000
+from shakermill.physics.contact import elastic_energy, hertz_max_overlap
 
 # Columns of the impact records.
 IMPACT_COLUMNS = (
@@ -115,122 +74,16 @@ COUNTER_NAMES = ("steps", "rejected_steps", "rhs_evaluations", "impacts")
 _CORRECTION, _UNPROJECTED = range(2)
 
 _INITIAL_CAPACITY = 1024
-# Pending intervals of the contact-onset search: one per halving of a step, and a step halves at most
-# ~60 times before reaching the resolution of the time variable.
-_STACK_ROWS = 128
-# Safeguarded Newton converges in a handful of iterations; bisection alone would need ~60.
-_ROOT_ITERATIONS = 100
-# First step of a contact as a fraction of the Hertz duration at the approach speed. The damping
-# force grows like ζ^{1/4} from the onset, so the error estimate of a step that starts there is
-# unreliable; a short first step followed by the controller's geometric growth grades the mesh
-# towards the singular point and keeps its error small (~0.1 % of the impact's dissipated energy at
-# rtol 1e-3; at tighter tolerances the controller shortens it).
-ONSET_STEP_FRACTION = 1e-2
-# The damping force falls like ζ^{1/4} into the separation too. A step that straddles it samples a zero
-# force in its last stages while the dissipation is still large, and the embedded estimate (its weights
-# nearly cancel on equal stages) does not see it: one such step took up to ~0.8 % off an impact's
-# dissipated energy. So a contact step is kept below this fraction of the time the overlap needs to close
-# at its current rate, which grades the mesh towards the separation as the onset step does from the
-# onset, down to the same ONSET_STEP_FRACTION of the contact.
-SEPARATION_GRADING = 0.9
 # Share of rtol given to each step of a contact. Its ~16 steps add local errors of one sign: against the
 # full scale an impact's dissipated energy comes out 0.3–1 % low at rtol 1e-3 (the energy projection passes
 # that on to the rebound, and the motion shifts with it); at a quarter it is 0.2–0.4 % low, and the default
 # heat power stays within 1 % of converged over the operating range (benchmarks/bench_converged_defaults.py).
 CONTACT_TOLERANCE_SHARE = 0.25
-# Approach speed (m/s) below which a contact's scales stop shrinking: guards a tangential onset against 0.
-_SLOWEST_APPROACH = 1e-12
 # Components under error control. In a contact also the dissipated energy: it is the heat and, through
 # the energy projection, sets the rebound. The vial's work needs no control of its own: it is the force
 # times the smooth wall velocity, integrated with the same weights as the momentum.
 _FLIGHT_CONTROLLED = np.arange(N_DYNAMIC)
 _CONTACT_CONTROLLED = np.append(np.arange(N_DYNAMIC), DISSIPATED)
-# Relative resolution of the time variable used to stop bisection of a contact onset.
-_TIME_RESOLUTION = 4.0 * np.finfo(float).eps
-
-
-@dataclass(frozen=True)
-class ButcherTableau:
-    """An explicit, first-same-as-last embedded Runge–Kutta pair.
-
-    ``b`` gives the propagated solution (order ``order``), ``b_hat`` the
-    embedded one (order ``error_order``); their difference estimates the error.
-    The order conditions up to ``order`` are checked at construction.
-    """
-
-    name: str
-    order: int
-    error_order: int
-    a: tuple[tuple[Fraction, ...], ...]
-    b: tuple[Fraction, ...]
-    b_hat: tuple[Fraction, ...]
-    c: tuple[Fraction, ...]
-
-    def __post_init__(self) -> None:
-        stages = len(self.c)
-        if len(self.a) != stages or any(len(row) != stages for row in self.a):
-            raise ValueError(f"{self.name}: a must be {stages}x{stages}")
-        for i, row in enumerate(self.a):
-            if any(row[j] != 0 for j in range(i, stages)):
-                raise ValueError(f"{self.name}: a must be strictly lower triangular for an explicit method")
-            if sum(row) != self.c[i]:
-                raise ValueError(f"{self.name}: row {i} of a does not sum to c[{i}]")
-        if tuple(self.a[-1]) != tuple(self.b) or self.c[-1] != 1:
-            raise ValueError(f"{self.name}: not first-same-as-last (last row of a must equal b, c[-1] = 1)")
-        self._check_order(self.b, self.order, "b")
-        self._check_order(self.b_hat, self.error_order, "b_hat")
-
-    def _check_order(self, weights: tuple[Fraction, ...], order: int, label: str) -> None:
-        a, c = self.a, self.c
-        ac = [sum(a[i][j] * c[j] for j in range(len(c))) for i in range(len(c))]
-        conditions = {
-            1: [(sum(weights), Fraction(1))],
-            2: [(sum(w * ci for w, ci in zip(weights, c)), Fraction(1, 2))],
-            3: [
-                (sum(w * ci * ci for w, ci in zip(weights, c)), Fraction(1, 3)),
-                (sum(w * aci for w, aci in zip(weights, ac)), Fraction(1, 6)),
-            ],
-        }
-        if order > max(conditions):
-            raise ValueError(f"{self.name}: order conditions above {max(conditions)} are not implemented")
-        for level in range(1, order + 1):
-            for value, expected in conditions[level]:
-                if value != expected:
-                    raise ValueError(f"{self.name}: {label} violates an order-{level} condition")
-
-    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(a, b, error weights b − b_hat, c) as float arrays for the compiled loop."""
-        a = np.array([[float(v) for v in row] for row in self.a])
-        b = np.array([float(v) for v in self.b])
-        error = np.array([float(bi - bh) for bi, bh in zip(self.b, self.b_hat)])
-        c = np.array([float(v) for v in self.c])
-        return a, b, error, c
-
-
-_F = Fraction
-BOGACKI_SHAMPINE = ButcherTableau(
-    name="Bogacki-Shampine 3(2)",
-    order=3,
-    error_order=2,
-    a=(
-        (_F(0), _F(0), _F(0), _F(0)),
-        (_F(1, 2), _F(0), _F(0), _F(0)),
-        (_F(0), _F(3, 4), _F(0), _F(0)),
-        (_F(2, 9), _F(1, 3), _F(4, 9), _F(0)),
-    ),
-    b=(_F(2, 9), _F(1, 3), _F(4, 9), _F(0)),
-    b_hat=(_F(7, 24), _F(1, 4), _F(1, 3), _F(1, 8)),
-    c=(_F(0), _F(1, 2), _F(3, 4), _F(1)),
-)
-
-
-@dataclass(frozen=True)
-class StepController:
-    """Elementary error-per-step controller with SciPy's RK23 constants."""
-
-    safety: float = 0.9
-    min_factor: float = 0.2
-    max_factor: float = 10.0
 
 
 @dataclass
@@ -301,77 +154,6 @@ def _grow(buffer: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _gap_rate(t: float, velocity: float, wall: int, k: Constants) -> float:
-    """d(gap)/dt in free flight (m/s)."""
-    vial_velocity = kinematics.vial_velocity(t, k.amplitude, k.omega, k.phase)
-    return velocity - vial_velocity if wall == LEFT_WALL else vial_velocity - velocity
-
-
-@njit(cache=True)
-def _refine_root(t: float, x: float, velocity: float, wall: int, k: Constants,
-                 a: float, b: float, resolution: float) -> float:
-    """The single zero of a monotone gap on [a, b] (gap(a) > 0 ≥ gap(b)), by safeguarded Newton.
-
-    Returns the lower end of the final bracket: the landing point is a hair before the onset
-    (gap > 0), so the step that lands feels no contact force. A force in its last stage would
-    enter the error estimate through the embedded weights and get the step rejected.
-    """
-    s = b
-    for _ in range(_ROOT_ITERATIONS):
-        if b - a <= resolution:
-            break
-        gap_s = gap(t + s, x + velocity * s, wall, k)
-        if gap_s > 0.0:
-            a = s
-        else:
-            b = s
-        rate = _gap_rate(t + s, velocity, wall, k)
-        newton = s - gap_s / rate if rate != 0.0 else a
-        # Step a little past the Newton point so the bracket closes from both sides.
-        newton += resolution if gap_s > 0.0 else -resolution
-        s = newton if a < newton < b else 0.5 * (a + b)
-    return a
-
-
-@njit(cache=True)
-def _first_touch_of_wall(t: float, h: float, x: float, velocity: float, wall: int, curvature: float,
-                         k: Constants, stack: np.ndarray) -> float:
-    """Earliest s in [0, h] where the free-flight gap to ``wall`` reaches 0, or −1 if none.
-
-    Intervals are examined left to right. One is discarded only when the bound
-    gap(s) ≥ min(gap(a), gap(b)) − curvature·(b − a)²/8 proves it free of zeros;
-    a sign change is refined once the slope bound |gap'(b)| > curvature·(b − a)
-    proves the gap monotone there, so the zero found is the first one.
-    ``stack`` is scratch space of at least 2 × 64 rows: each halving leaves one pending interval.
-    """
-    resolution = _TIME_RESOLUTION * max(1.0, abs(t) + h)
-    stack[0, 0] = 0.0
-    stack[0, 1] = h
-    stack[0, 2] = gap(t, x, wall, k)
-    stack[0, 3] = gap(t + h, x + velocity * h, wall, k)
-    if stack[0, 2] < 0.0:
-        return 0.0
-    top = 1
-    while top > 0:
-        top -= 1
-        a, b, gap_a, gap_b = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
-        width = b - a
-        if min(gap_a, gap_b) - curvature * width * width / 8.0 > 0.0:
-            continue
-        if gap_b <= 0.0 and (width <= resolution or abs(_gap_rate(t + b, velocity, wall, k)) > curvature * width):
-            return _refine_root(t, x, velocity, wall, k, a, b, resolution)
-        if width <= resolution:
-            continue
-        middle = 0.5 * (a + b)
-        gap_middle = gap(t + middle, x + velocity * middle, wall, k)
-        # right half below the left half, so the left half is examined first
-        stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = middle, b, gap_middle, gap_b
-        stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2], stack[top + 1, 3] = a, middle, gap_a, gap_middle
-        top += 2
-    return -1.0
-
-
-@njit(cache=True)
 def _hermite(theta: float, h: float, y0: np.ndarray, f0: np.ndarray, y1: np.ndarray, f1: np.ndarray, out: np.ndarray) -> None:
     """Cubic Hermite interpolant of a step at fraction ``theta`` (the dense output of ode23)."""
     t2 = theta * theta
@@ -426,7 +208,7 @@ def _contact_error_scale(speed_in: float, rtol: float, k: Constants, scale: np.n
     speed, the momentum against m·v_in and the dissipated energy against m·v_in²/2. There is no
     absolute term, so the contact converges as rtol → 0.
     """
-    speed = max(speed_in, _SLOWEST_APPROACH)
+    speed = max(speed_in, SLOWEST_APPROACH)
     share = CONTACT_TOLERANCE_SHARE * rtol
     scale[X] = share * hertz_max_overlap(k.ball_mass, k.radius, k.e_star, speed)
     scale[P] = share * k.ball_mass * speed
@@ -487,29 +269,6 @@ def _project_momentum(impact: np.ndarray, y_new: np.ndarray, elastic_new: float,
 
 
 @njit(cache=True)
-def _rate_into_wall(wall: int, velocity: float, vial_velocity: float) -> float:
-    """ζ̇ for ``wall``: positive while the ball and the wall approach (MODEL.md §2)."""
-    return vial_velocity - velocity if wall == LEFT_WALL else velocity - vial_velocity
-
-
-@njit(cache=True)
-def _shortest_contact_step(speed_in: float, k: Constants) -> float:
-    """First and last steps of a contact (s): ONSET_STEP_FRACTION of the Hertz duration at the approach speed."""
-    return ONSET_STEP_FRACTION * hertz_contact_time(k.ball_mass, k.radius, k.e_star, max(speed_in, _SLOWEST_APPROACH))
-
-
-@njit(cache=True)
-def _separation_step_limit(t: float, x: float, p: float, wall: int, speed_in: float, k: Constants) -> float:
-    """Longest contact step that keeps the mesh graded towards the separation (see SEPARATION_GRADING)."""
-    vial_velocity = kinematics.vial_velocity(t, k.amplitude, k.omega, k.phase)
-    overlap_rate = _rate_into_wall(wall, p / k.ball_mass, vial_velocity)
-    if overlap_rate >= 0.0:
-        return np.inf
-    overlap = -gap(t, x, wall, k)
-    return max(SEPARATION_GRADING * overlap / -overlap_rate, _shortest_contact_step(speed_in, k))
-
-
-@njit(cache=True)
 def _work_arrays(n_stages: int, n: int) -> tuple[np.ndarray, ...]:
     """Work arrays of one compiled call, allocated once per call rather than per step.
 
@@ -518,28 +277,7 @@ def _work_arrays(n_stages: int, n: int) -> tuple[np.ndarray, ...]:
     contact-onset search.
     """
     stages = np.empty((n_stages, n))
-    return stages, stages[n_stages - 1], np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty((_STACK_ROWS, 4))
-
-
-@njit(cache=True)
-def _bound_step(t: float, h: float, t_stop: float, x: float, p: float, wall: int, speed_in: float, k: Constants,
-                contact_step_limit: float, stack: np.ndarray) -> tuple[float, int]:
-    """The step to try from (t, x, p), at most ``h`` and ending by ``t_stop``, and the wall it ends on.
-
-    In a contact with ``wall`` the step is graded towards the separation. In flight (``wall`` = NO_WALL)
-    it is shortened to the first contact onset within it, and the wall it lands on is returned: the flight
-    path is exact, so this costs no right-hand-side evaluations, and no trial step runs into a wall.
-    """
-    h = min(h, t_stop - t)
-    if wall != NO_WALL:
-        return min(h, contact_step_limit, _separation_step_limit(t, x, p, wall, speed_in, k)), wall
-    # Bound on |gap''|: the ball's path is straight, the wall's a sine of amplitude X_v.
-    curvature = k.amplitude * k.omega * k.omega
-    for candidate in (LEFT_WALL, RIGHT_WALL):
-        touch = _first_touch_of_wall(t, h, x, p / k.ball_mass, candidate, curvature, k, stack)
-        if touch >= 0.0 and (wall == NO_WALL or touch < h):
-            h, wall = touch, candidate
-    return h, wall
+    return stages, stages[n_stages - 1], np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty((STACK_ROWS, 4))
 
 
 @njit(cache=True)
@@ -682,7 +420,7 @@ def _close_impact(t_new: float, y_new: np.ndarray, overlap: float, overlap_rate:
     impact_buffer[row, 0] = impact[_START]
     impact_buffer[row, 1] = wall
     impact_buffer[row, 2] = impact[_SPEED_IN]
-    impact_buffer[row, 3] = -_rate_into_wall(wall, y_new[P] / k.ball_mass, vial_at_separation)
+    impact_buffer[row, 3] = -rate_into_wall(wall, y_new[P] / k.ball_mass, vial_at_separation)
     impact_buffer[row, 4] = y_new[DISSIPATED] - impact[_DISSIPATED0]
     impact_buffer[row, 5] = y_new[HEAT_GENERATED] - impact[_HEAT0]
     impact_buffer[row, 6] = impact[_MAX_OVERLAP]
@@ -699,12 +437,12 @@ def _next_step_size(h: float, factor: float, landed: bool, left_wall: bool, spee
     """The step to try after an accepted step of ``h`` whose error allows ``factor`` times it."""
     if landed:
         # A contact starts with a short step: see ONSET_STEP_FRACTION.
-        return min(contact_step_limit, _shortest_contact_step(speed_in, k))
+        return min(contact_step_limit, shortest_contact_step(speed_in, k))
     h = h * factor
     if left_wall:
         # Flight is exact for the mechanics and smooth for the temperatures, so offer a whole drive
         # period: the onset search cuts it at the next contact.
-        h = max(h, 2.0 * np.pi / k.omega)
+        h = max(h, k.period)
     return h
 
 
@@ -712,7 +450,7 @@ def _next_step_size(h: float, factor: float, landed: bool, left_wall: bool, spee
 def _advance(t_stop: float, steps_allowed: int, k: Constants, tableau: tuple, control: _StepControl,
              accuracy: _Accuracy, state: _State, recording: _Recording, window_buffer: np.ndarray,
              impact_buffer: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
-    """Integrate from ``state.clock[0]`` to ``t_stop``, or for ``steps_allowed`` accepted steps (status _PAUSED)
+    """Integrate from ``state.clock[0]`` to ``t_stop``, or for ``steps_allowed`` accepted steps (status PAUSED)
     if that comes first (see :meth:`Integrator.advance`); returns (status, window buffer, impact buffer).
 
     The arrays are unpacked once, here: every array passed to a compiled call that is not inlined costs
@@ -728,9 +466,9 @@ def _advance(t_stop: float, steps_allowed: int, k: Constants, tableau: tuple, co
     while t < t_stop:
         in_contact = impact[_ACTIVE] != 0.0
         wall = int(impact[_WALL]) if in_contact else NO_WALL
-        h, wall = _bound_step(t, h, t_stop, y[X], y[P], wall, impact[_SPEED_IN], k, contact_step_limit, stack)
+        h, wall = bound_step(t, h, t_stop, y[X], y[P], wall, impact[_SPEED_IN], k, contact_step_limit, stack)
         touching, landing = wall != NO_WALL, wall != NO_WALL and not in_contact
-        if not landing and h <= _TIME_RESOLUTION * max(1.0, abs(t)):
+        if not landing and h <= TIME_RESOLUTION * max(1.0, abs(t)):
             status = STEP_UNDERFLOW
             break
         stages[0] = f0
@@ -767,7 +505,7 @@ def _advance(t_stop: float, steps_allowed: int, k: Constants, tableau: tuple, co
         if _meets_a_window(t, t_new, windows):
             window_buffer = _record_windows(t, h, y, f0, y_new, f_new, windows, window_buffer, counters, point)
         if touching:
-            overlap_rate = _rate_into_wall(wall, y_new[P] / k.ball_mass, vial_velocity)
+            overlap_rate = rate_into_wall(wall, y_new[P] / k.ball_mass, vial_velocity)
             if landing:
                 _open_impact(t_new, y_new, wall, overlap_rate, elastic_new, impact, k)
             elif overlap > 0.0:  # still touching; overlap <= 0 below means it left the wall
@@ -788,12 +526,18 @@ def _advance(t_stop: float, steps_allowed: int, k: Constants, tableau: tuple, co
             # rejected_last is False as on entry, so a pause leaves the integration bit for bit unchanged.
             break
     clock[0], clock[1] = t, h
-    return (_PAUSED if status == REACHED_STOP and t < t_stop else status), window_buffer, impact_buffer
+    return (PAUSED if status == REACHED_STOP and t < t_stop else status), window_buffer, impact_buffer
 
 
 @dataclass
-class Integrator:
+class Integrator(CompiledRun):
     """Chunked driver of the compiled loop; holds the state between chunks."""
+
+    # A step costs ~0.5 µs in flight, but up to ~0.4 ms where the contact search is hard (ω ~ 1e5 rad/s).
+    # After its first call a default run's 10-s chunks (~10⁴ steps, ~5 ms) end long before the adapted
+    # count, so it makes no further calls.
+    first_steps_per_call: ClassVar[int] = 1_000
+    most_steps_per_call: ClassVar[int] = 10_000_000
 
     constants: Constants
     y: np.ndarray
@@ -820,7 +564,6 @@ class Integrator:
         self.counters = np.zeros(6, dtype=np.int64)
         self.counters[RHS_EVALUATIONS] = 1
         self.diagnostics = np.zeros(2)
-        self._steps_per_call = FIRST_STEPS_PER_CALL
 
     @property
     def energy_correction(self) -> float:
@@ -835,29 +578,10 @@ class Integrator:
     def t(self) -> float:
         return float(self.clock[0])
 
-    def advance(self, t_stop: float, heartbeat: Callable[[float], None] | None = None) -> int:
-        """Integrate up to ``t_stop``; returns a status code (see ``STATUS_MESSAGES``).
+    def steps_taken(self) -> int:
+        return int(self.counters[STEPS])
 
-        The compiled loop runs in calls of about CALL_SECONDS each. Before every call the budget and
-        the record windows' size are checked: a spent budget ends the integration with BUDGET_EXCEEDED
-        (:meth:`explain` says which limit), full windows with WINDOWS_FULL.
-        After a call that stopped short of ``t_stop``, ``heartbeat(t)`` is called. Ctrl-C during a call
-        raises ``KeyboardInterrupt`` once it has returned.
-        """
-        while (limit := self._limit_reached()) is None:
-            steps_before = int(self.counters[STEPS])
-            started = time.perf_counter()
-            status = self._compiled_call(t_stop, min(self._steps_per_call, self.budget.steps_left))
-            steps = int(self.counters[STEPS]) - steps_before
-            self.budget.steps += steps
-            if status != _PAUSED:
-                return status
-            self._steps_per_call = _steps_for_call_seconds(steps, time.perf_counter() - started)
-            if heartbeat is not None:
-                heartbeat(self.t)
-        return limit
-
-    def _limit_reached(self) -> int | None:
+    def limit_reached(self) -> int | None:
         """BUDGET_EXCEEDED or WINDOWS_FULL when the integration may not go on, else None."""
         if self.budget.spent():
             return BUDGET_EXCEEDED
@@ -867,7 +591,7 @@ class Integrator:
         """The message of ``status``; for BUDGET_EXCEEDED, which limit was reached and how to raise it."""
         return str(self.budget.reason) if status == BUDGET_EXCEEDED else STATUS_MESSAGES[status]
 
-    def _compiled_call(self, t_stop: float, steps_allowed: int) -> int:
+    def compiled_call(self, t_stop: float, steps_allowed: int) -> int:
         controller, tolerances = self.controller, self.tolerances
         control = _StepControl(controller.safety, controller.min_factor, controller.max_factor,
                                -1.0 / (self.tableau.error_order + 1))
@@ -875,11 +599,10 @@ class Integrator:
                              tolerances.max_overlap, self.project_energy)
         state = _State(self.clock, self.y, self.f, self._impact, self.counters, self.diagnostics)
         recording = _Recording(self.sample_times, self.samples, self.windows)
-        with interrupt_after_compiled_code():
-            status, self._window_buffer, self._impact_buffer = _advance(
-                t_stop, steps_allowed, self.constants, self._tableau, control, accuracy, state, recording,
-                self._window_buffer, self._impact_buffer,
-            )
+        status, self._window_buffer, self._impact_buffer = _advance(
+            t_stop, steps_allowed, self.constants, self._tableau, control, accuracy, state, recording,
+            self._window_buffer, self._impact_buffer,
+        )
         return int(status)
 
     @property
@@ -895,9 +618,3 @@ class Integrator:
     @property
     def impacts(self) -> np.ndarray:
         return self._impact_buffer[: self.counters[IMPACTS]].copy()
-
-
-def _steps_for_call_seconds(steps: int, seconds: float) -> int:
-    """The steps that take about CALL_SECONDS at the rate of the last call (``steps`` in ``seconds``)."""
-    rate = steps / max(seconds, 1e-9)
-    return int(min(max(rate * CALL_SECONDS, 1.0), MAX_STEPS_PER_CALL))

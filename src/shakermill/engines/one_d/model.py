@@ -25,13 +25,13 @@ temperatures, then θ_v and θ_a; the quadratures stay per system.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
 
-from shakermill.engines.network import network_constants
-from shakermill.parameters.schema import Parameters
+from shakermill.engines.thermal.network import air_constants
+from shakermill.parameters.keys import Parameters
 from shakermill.physics import contact, kinematics, thermal
 
 X, P, THETA_BALL, THETA_VIAL, THETA_AIR, WORK_VIAL, DISSIPATED, HEAT_GENERATED, HEAT_LOST, VELOCITY_TERM = range(10)
@@ -61,6 +61,7 @@ class Constants(NamedTuple):
     half_length: float
     amplitude: float
     omega: float
+    period: float  # s, 2π/ω
     phase: float
     e_star: float
     beta_e: float
@@ -88,17 +89,40 @@ class Constants(NamedTuple):
     ball_only: bool
 
 
+def _network_constants(params: Parameters) -> dict[str, Any]:
+    """The three-node network's fields of :class:`Constants`, by name (MODEL.md §§4–6): the same values the
+    one network (``engines.thermal``) is built from, written out for the right-hand side."""
+    return {
+        **air_constants(params),
+        "relative_convection": params.relative_convection,
+        "air_density": params.air_density,
+        "mu_ref": params.air_viscosity_ref,
+        "t_ref": params.air_reference_temperature,
+        "sutherland": params.sutherland,
+        "air_conductivity": params.air_conductivity,
+        "beta": params.beta,
+        "h_inner": params.h_inner,
+        "h_outer": params.h_outer,
+        "inner_area": params.inner_area,
+        "outer_area": params.outer_area,
+        "capacity_vial": params.vial_mass * params.vial_heat_capacity,
+        "capacity_air": params.air_mass * params.air_heat_capacity,
+        "t_ambient": params.ambient_temperature,
+    }
+
+
 def constants_from(params: Parameters) -> Constants:
     e_star = contact.effective_modulus(
         params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus, params.vial_poisson_ratio
     )
     return Constants(
-        **network_constants(params),
+        **_network_constants(params),
         ball_mass=params.ball_mass,
         radius=params.ball_radius,
         half_length=0.5 * params.vial_length,
         amplitude=params.amplitude,
         omega=params.omega,
+        period=params.period,
         phase=params.phase,
         e_star=e_star,
         beta_e=contact.damping_ratio(params.restitution),

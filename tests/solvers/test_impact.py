@@ -8,14 +8,14 @@ import math
 import pytest
 
 import shakermill as sm
-from shakermill.parameters.schema import ParameterError
+from shakermill.parameters.errors import ParameterError
 from shakermill.physics.contact import (
     effective_modulus,
     hertz_contact_time,
     hertz_force,
     hertz_max_overlap,
 )
-from shakermill.studies.impact import single_impact
+from shakermill.solvers.impact import single_impact
 
 # A contact step of 2 % of the Rayleigh time: ~250 steps a contact, restitution within 4e-4 of e, contact
 # time within 0.4 % (one step). The default 0.05 leaves restitution errors up to ~8e-4.

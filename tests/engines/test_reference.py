@@ -7,7 +7,7 @@ import math
 import pytest
 
 import shakermill as sm
-from shakermill.solvers.reference import simulate_scipy
+from shakermill.engines.one_d.reference import simulate_scipy
 
 SETTLING_TIME = 3.0  # s: the start from rest at the centre is over after ~1 s
 COMPARISON_TIME = 10.0  # s
@@ -33,6 +33,7 @@ def settled_parameters() -> sm.Parameters:
     )
 
 
+@pytest.mark.slow
 def test_compiled_and_scipy_paths_agree(settled_parameters: sm.Parameters) -> None:
     compiled = sm.simulate(settled_parameters)
     reference = simulate_scipy(settled_parameters)

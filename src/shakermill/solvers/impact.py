@@ -17,12 +17,13 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from shakermill.parameters.schema import PER_BALL_KEYS, ParameterError, Parameters
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import PER_BALL_KEYS, Parameters
 
 if TYPE_CHECKING:
     import numpy as np
 
-    from shakermill.engines.dem.engine import Engine
+    from shakermill.engines.dem.engine import DemEngine
 
 TARGETS = ("wall", "ball")
 # Faster than any mill or verification test; a ball this fast overlaps beyond what the engine allows anyway.
@@ -131,9 +132,11 @@ def single_impact(
     """
     check_inputs(speed, angle_deg, target, spin, params.ball_radius)
     # Imported when first used: the command line reads this module's bounds when it starts.
-    from shakermill.engines.dem.engine import Engine
+    import numpy as np
 
-    engine = Engine(impact_parameters(params, target))
+    from shakermill.engines.dem.engine import DemEngine
+
+    engine = DemEngine(impact_parameters(params, target), None, np.zeros(1), 0.0)
     contact_time, gap = _hertz_scales(engine, target, speed * math.cos(math.radians(angle_deg)))
     incoming = _launch(engine, target, speed, math.radians(angle_deg), spin, gap)
     kinetic_in = engine.kinetic_energy()
@@ -141,7 +144,7 @@ def single_impact(
     return _outcome(engine, record, incoming, speed, math.radians(angle_deg), kinetic_in)
 
 
-def _hertz_scales(engine: Engine, target: str, normal_speed: float) -> tuple[float, float]:
+def _hertz_scales(engine: DemEngine, target: str, normal_speed: float) -> tuple[float, float]:
     """The Hertz contact time (s) and the start gap (m) of an impact at ``normal_speed``."""
     from shakermill.engines.dem.model import LEFT_END
     from shakermill.physics.contact import hertz_contact_time, hertz_max_overlap
@@ -155,7 +158,7 @@ def _hertz_scales(engine: Engine, target: str, normal_speed: float) -> tuple[flo
     return hertz_contact_time(mass, radius, modulus, normal_speed), START_GAP_FRACTION * overlap
 
 
-def _launch(engine: Engine, target: str, speed: float, angle: float, spin: float, gap: float) -> int:
+def _launch(engine: DemEngine, target: str, speed: float, angle: float, spin: float, gap: float) -> int:
     """Place the balls so that the first touch is on the vial's axis with the normal along +x, set the
     incoming ball's velocity and spin; returns the incoming ball's index."""
     k, s = engine.constants, engine.state
@@ -175,7 +178,7 @@ def _launch(engine: Engine, target: str, speed: float, angle: float, spin: float
     return incoming
 
 
-def _first_record(engine: Engine, contact_time: float) -> np.ndarray:
+def _first_record(engine: DemEngine, contact_time: float) -> np.ndarray:
     """Advance ``engine`` a Hertz contact time at a time until its first contact has ended; its record row."""
     from shakermill.engines.status import REACHED_STOP
 
@@ -192,7 +195,7 @@ def _first_record(engine: Engine, contact_time: float) -> np.ndarray:
 
 
 def _outcome(
-    engine: Engine, record: np.ndarray, incoming: int, speed: float, angle: float, kinetic_in: float
+    engine: DemEngine, record: np.ndarray, incoming: int, speed: float, angle: float, kinetic_in: float
 ) -> ImpactOutcome:
     from shakermill.engines.dem.model import WORK_STIFFENING
     from shakermill.engines.dem.stepper import RECORD_COLUMNS

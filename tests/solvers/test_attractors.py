@@ -9,8 +9,17 @@ import pandas as pd
 import pytest
 
 import shakermill as sm
-from shakermill.analysis.attractors import FAILED, AttractorScan, MEASURE_PERIODS, POSITION_SPREAD, SettledStart, find_attractors, group, initial_states, settle
+from shakermill.analysis.attractors import (
+    FAILED,
+    MEASURE_PERIODS,
+    POSITION_SPREAD,
+    AttractorScan,
+    SettledStart,
+    group,
+    initial_states,
+)
 from shakermill.analysis.regime import IRREGULAR, NO_IMPACTS, PHASE_TOLERANCE
+from shakermill.solvers.attractors import find_attractors, settle
 from shakermill.studies.sweep import sweep
 
 # A stroke of 23 mm, just above the free gap of 22.65 mm: period-1 and period-2 coexist at every ω of
@@ -48,6 +57,7 @@ def test_a_periodic_attractor_hits_a_whole_number_of_times_per_cycle(coexisting)
         assert per_cycle == pytest.approx(round(per_cycle), abs=1e-9) and per_cycle >= 1
 
 
+@pytest.mark.slow
 def test_every_start_reaches_an_attractor_at_the_default_stroke():
     params = sm.default_parameters(omega=110.0)
     scan = find_attractors(params)
@@ -162,7 +172,7 @@ def test_resting_starts_are_one_attractor_and_failed_starts_none():
 
 
 def test_a_start_that_fails_is_reported_not_grouped(monkeypatch):
-    from shakermill.analysis import attractors as module
+    from shakermill.solvers import attractors as module
 
     real_settle = module.settle
 
@@ -184,6 +194,7 @@ def test_a_start_that_fails_is_reported_not_grouped(monkeypatch):
 # The averaged solver and sweeps ----------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_averaged_run_follows_the_configured_start_and_warns_of_the_other_attractor(coexisting):
     params, scan = coexisting
     # Three hours outlast three slowest time constants, so the only warning left is the attractor's.
@@ -200,6 +211,7 @@ def test_averaged_run_follows_the_configured_start_and_warns_of_the_other_attrac
     assert probed.summary["warnings"] == [warning]
 
 
+@pytest.mark.slow
 def test_one_attractor_at_the_default_stroke_and_no_warning():
     result = sm.simulate(sm.default_parameters(solver="averaged", duration=10800.0, omega=110.0, record_windows=()))
     assert result.summary["n_attractors"] == len(result.attractors.attractors) == 1
@@ -227,6 +239,7 @@ def test_only_a_heat_power_more_than_one_percent_away_is_worth_a_warning():
     assert "1 of 3 starts (basin fraction 0.33)" in warning and "+3.0 %" in warning
 
 
+@pytest.mark.slow
 def test_sweep_rows_count_the_attractors_and_their_heat_spread(tmp_path):
     base = sm.default_parameters(solver="averaged", duration=60.0, omega=110.0)
     points = [{"amplitude": SHORT_STROKE, "solver": "averaged"}, {"amplitude": SHORT_STROKE, "solver": "full"}]

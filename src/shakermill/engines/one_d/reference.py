@@ -17,8 +17,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from shakermill.engines.one_d import model
-from shakermill.engines.one_d.setup import tolerances_for
-from shakermill.parameters.schema import Parameters
+from shakermill.engines.one_d.engine import tolerances_for
+from shakermill.parameters.keys import Parameters
 
 # Flight segments: SciPy only sees a contact if the gap changes sign between two steps, so the step is
 # bounded to a small part of the drive period to make a grazing touch unlikely to be missed.
@@ -69,7 +69,7 @@ def simulate_scipy(params: Parameters, t_end: float | None = None, method: str =
     atol = np.full(model.N_STATE, _QUADRATURE_ATOL)
     atol[: model.N_DYNAMIC] = tolerances.atol
     contact_step = tolerances.contact_step_limit
-    flight_step = 2.0 * np.pi / params.omega / FLIGHT_STEPS_PER_PERIOD
+    flight_step = params.period / FLIGHT_STEPS_PER_PERIOD
     onsets = [_wall_event(wall, k, -1.0) for wall in (model.LEFT_WALL, model.RIGHT_WALL)]
     separations = {wall: [_wall_event(wall, k, +1.0)] for wall in (model.LEFT_WALL, model.RIGHT_WALL)}
 

@@ -1,0 +1,285 @@
+"""The typer application of the ``shakermill`` command line and what its commands share: one ``error:`` line and
+exit code 2 for bad input, tables on stdout, warnings and a progress bar on stderr, options declared once.
+
+Only light modules are imported here and in the command modules: `shakermill --help` and the listing commands must
+not wait for NumPy, Numba, pandas, xarray, SciPy or Matplotlib. Each command imports what it uses when it runs.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from contextlib import contextmanager
+from datetime import datetime
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, NoReturn, Sequence
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+from rich.text import Text
+from typer.core import TyperGroup
+
+from shakermill.engines.budget import BudgetExceeded
+from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.errors import ParameterError
+from shakermill.support.atomic import StorageError
+from shakermill.support.version import __version__
+
+if TYPE_CHECKING:
+
+    from shakermill.parameters.keys import Parameters
+    from shakermill.solvers.result import Result
+
+EXIT_FAILED_RUN = 1
+
+
+EXIT_USAGE = 2
+
+
+EXIT_INTERRUPTED = 130
+
+
+# A run's or a fit's progress bar appears once it has taken this long (s): quick ones end without a flicker.
+PROGRESS_DELAY_S = 1.0
+
+
+PIPED_TABLE_WIDTH = 160
+
+
+DEFAULT_RESULTS_FOLDER = Path("results")
+
+
+class OneLineUsageErrors(TyperGroup):
+    """typer's command group, with its own usage errors (an unknown option or command, a value of the
+    wrong type or outside an option's range) as one ``error:`` line and exit code 2, like every other
+    bad input: typer draws them in a box over several lines, which scripts and logs read badly."""
+
+    def main(self, args: Sequence[str] | None = None, *rest: Any, standalone_mode: bool = True, **extra: Any) -> Any:
+        arguments = sys.argv[1:] if args is None else list(args)
+        if not standalone_mode or not arguments:  # no arguments: typer shows the help, as it should
+            return super().main(args, *rest, standalone_mode=standalone_mode, **extra)
+        try:
+            outcome = super().main(arguments, *rest, standalone_mode=False, **extra)
+        except typer.Abort:
+            # Outside Click's handling now: typer.Exit (what fail raises) would not be caught.
+            echo_error("aborted")
+            sys.exit(EXIT_FAILED_RUN)
+        except Exception as exc:
+            # Click's usage errors, told by what they carry: typer vendors Click and exports none of its classes.
+            if getattr(exc, "exit_code", None) != EXIT_USAGE or not hasattr(exc, "format_message"):
+                raise
+            echo_error(exc.format_message())
+            sys.exit(EXIT_USAGE)
+        sys.exit(outcome if isinstance(outcome, int) else 0)
+
+
+app = typer.Typer(
+    cls=OneLineUsageErrors,
+    name="shakermill",
+    help="Simulate a high-energy shaker mill (SPEX 8000M type): ball motion, impacts and temperatures.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    # Plain help, as Click formats it: rich's panels import Markdown and take a third of `shakermill --help`.
+    rich_markup_mode=None,
+)
+
+
+def _version(show: bool) -> None:
+    if show:
+        typer.echo(f"shakermill {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
+    ] = False,
+) -> None:
+    """Simulate a high-energy shaker mill (SPEX 8000M type): ball motion, impacts and temperatures."""
+
+
+def stdout_console() -> Console:
+    # Piped into a file, tables are read later at any width; 80 columns would wrap every source citation.
+    console = Console()
+    return console if console.is_terminal else Console(width=PIPED_TABLE_WIDTH)
+
+
+def add_plain_row(table: Table, *cells: str) -> None:
+    # Plain text: values such as "[0, 1]" or "[start ≥ 0, ...]" would otherwise be parsed as rich markup.
+    table.add_row(*(Text(cell) for cell in cells))
+
+
+def echo_error(message: str) -> None:
+    # typer.echo, not rich: rich would wrap a long message over several lines and read "[...]" as markup.
+    typer.echo(f"error: {' '.join(message.splitlines())}", err=True)
+
+
+def fail(message: str, code: int = EXIT_USAGE) -> NoReturn:
+    echo_error(message)
+    raise typer.Exit(code)
+
+
+@contextmanager
+def user_errors() -> Iterator[None]:
+    """Turn bad input into one ``error:`` line and exit code 2."""
+    try:
+        yield
+    except (ParameterError, StorageError) as exc:
+        fail(str(exc))
+
+
+@contextmanager
+def nothing_written_when_interrupted(what: str) -> Iterator[None]:
+    """Ctrl-C before anything was written: one line and exit code 130."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        fail(f"interrupted; nothing was written ({what})", EXIT_INTERRUPTED)
+
+
+@contextmanager
+def writing(target: Path, what: str) -> Iterator[None]:
+    """A write that fails (a full or read-only disk, a path under a file): one ``error:`` line and exit code 2."""
+    try:
+        yield
+    except OSError as exc:
+        fail(f"{target}: cannot write {what} ({exc.strerror or exc})")
+
+
+@contextmanager
+def nothing_written_when_a_run_is_stopped(what: str) -> Iterator[None]:
+    """A run of a scan or fit used up its budget: one line and exit code 1, as a failed run."""
+    try:
+        yield
+    except BudgetExceeded as exc:
+        fail(f"{what} stopped, nothing was written: {exc}", EXIT_FAILED_RUN)
+
+
+# Options shared by several commands, declared once.
+ConfigArgument = Annotated[
+    Path | None,
+    typer.Argument(metavar="CONFIG", help="TOML file with canonical keys (and optionally preset = NAME)."),
+]
+
+
+PresetOption = Annotated[
+    str | None, typer.Option("--preset", "-p", show_default=DEFAULT_PRESET, help="Preset to start from.")
+]
+
+
+SettingsOption = Annotated[
+    list[str] | None,
+    typer.Option("--set", "-s", metavar="KEY=VALUE", help="Override one key, units allowed: --set ball_radius='5 mm'."),
+]
+
+
+JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")]
+
+
+OverwriteOption = Annotated[
+    bool, typer.Option("--overwrite", help="Replace what --out holds (never a folder that shakermill did not write).")
+]
+
+
+FullResolutionOption = Annotated[
+    bool, typer.Option("--full-resolution", help="Use the full-resolution solver (default: averaged).")
+]
+
+
+def echo_warnings(warnings: Sequence[str]) -> None:
+    """One ``warning: ...`` line on stderr each (stdout stays clean for ``--json``)."""
+    for warning in warnings:
+        typer.echo(f"warning: {' '.join(warning.splitlines())}", err=True)
+
+
+@contextmanager
+def warnings_as_lines() -> Iterator[None]:
+    """The library's warnings (an unreadable point file) as ``warning: ...`` lines, like a run's own."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.showwarning = lambda message, *_: echo_warnings([str(message)])
+        yield
+
+
+def timestamped_folder(kind: str) -> Path:
+    """``results/<kind>-<local timestamp>``, with a counter if one started in the same second."""
+    stem = f"{kind}-{datetime.now():%Y%m%d-%H%M%S}"
+    candidate = DEFAULT_RESULTS_FOLDER / stem
+    counter = 1
+    while candidate.exists():
+        candidate = DEFAULT_RESULTS_FOLDER / f"{stem}-{counter}"
+        counter += 1
+    return candidate
+
+
+def simulate_with_progress(params: Parameters) -> Result:
+    """``simulate``, with a transient progress bar on stderr once the run takes a while, when stderr is a terminal.
+
+    The bar counts the simulated seconds of each phase in turn: the averaged solver's mechanics (out of
+    averaging_max_time), the whole duration, then its attractor probe (all starts together).
+    """
+    from shakermill.solvers.simulate import simulate
+
+    counter = "{task.completed:.5g}/{task.total:.5g} s simulated"
+    with progress_bar("simulating", counter, params.duration, delay_s=PROGRESS_DELAY_S) as update:
+        return simulate(params, progress=None if update is None else lambda done, total: update(done, total=total))
+
+
+@contextmanager
+def progress_bar(
+    verb: str, counter: str, total: float | None, delay_s: float = 0.0, **fields: Any
+) -> Iterator[Callable[..., None] | None]:
+    """``update(completed, **fields)`` of a transient progress bar with an ETA on stderr; None when stderr is not a terminal.
+
+    The bar shows from the first update ``delay_s`` seconds after the start, or at once without a delay.
+    Pipes and logs stay clean: a bar redrawn many times a second would fill them.
+    """
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        yield None
+        return
+    columns = (TextColumn(verb), BarColumn(), TextColumn(counter), TimeRemainingColumn())
+    bar = Progress(*columns, console=console, transient=True)
+    task = bar.add_task(verb, total=total, **fields)
+    shown_from = time.monotonic() + delay_s
+
+    def show_when_due() -> None:
+        if not bar.live.is_started and time.monotonic() >= shown_from:
+            bar.start()
+
+    def update(completed: float, **updates: Any) -> None:
+        bar.update(task, completed=completed, **updates)
+        show_when_due()
+
+    show_when_due()
+    try:
+        yield update
+    finally:
+        if bar.live.is_started:
+            bar.stop()
+
+
+def number(value: Any, spec: str) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "n/a"
+    return format(value, spec)
+
+
+def format_value(key: str, value: Any) -> str:
+    """A preset value with its unit, e.g. '0.00635 m', 'true', '[0, 1], [600, 0.1] s'."""
+    from shakermill.parameters.keys import field_unit
+    unit = field_unit(key)
+    if isinstance(value, bool):
+        return str(value).lower()
+    if key == "record_windows":
+        pairs = ", ".join(f"[{start:g}, {length:g}]" for start, length in value)
+        return f"{pairs} {unit}" if pairs else "none"
+    if isinstance(value, (int, float)):
+        return f"{value:g} {unit}".rstrip()
+    return str(value)

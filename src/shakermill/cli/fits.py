@@ -1,0 +1,274 @@
+"""``shakermill validate`` and ``calibrate``: this model against the experiment and the paper, and free keys fitted to
+a measured curve or targets."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, Mapping, Sequence
+
+import typer
+from rich.console import Console
+from rich.table import Table
+from rich.text import Text
+
+from shakermill.cli.common import (
+    EXIT_FAILED_RUN,
+    PROGRESS_DELAY_S,
+    ConfigArgument,
+    FullResolutionOption,
+    JsonOption,
+    PresetOption,
+    SettingsOption,
+    add_plain_row,
+    fail,
+    nothing_written_when_a_run_is_stopped,
+    nothing_written_when_interrupted,
+    number,
+    progress_bar,
+    stdout_console,
+    user_errors,
+    writing,
+)
+from shakermill.parameters.defaults import DEFAULT_FREE, DEM_DEFAULT_FREE, TARGET_KEYS
+from shakermill.parameters.errors import ParameterError
+from shakermill.support.atomic import check_writable_place
+
+if TYPE_CHECKING:
+
+    from shakermill.studies.calibrate import Calibration
+
+def validate(
+    solver: Annotated[
+        str, typer.Option("--solver", help="'full' (default, as the paper) or 'averaged' (seconds instead of minutes).")
+    ] = "full",
+    study: Annotated[
+        bool, typer.Option(help="Also fit several free sets to the experiment's curve and say which follow it (~15 s).")
+    ] = True,
+    three_d: Annotated[
+        bool,
+        typer.Option(
+            "--three-d/--no-three-d",
+            help="Also the held-out five-ball prediction of the calibrated 3-D preset, the one-ball comparison of "
+            "the engines and the sensitivity to the assumed SPEX kinematics (averaged solver, a few minutes).",
+        ),
+    ] = True,
+    json_output: JsonOption = False,
+) -> None:
+    """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
+    calibrated parameters, which free sets of a calibration can follow the curve, and (3-D) the five-ball
+    experiment that no fit has seen."""
+    from shakermill.io.runs import to_jsonable
+    from shakermill.studies.validation import TABLE5
+    from shakermill.studies.validation_report import SOLVERS, validation_report
+
+    if solver not in SOLVERS:
+        fail(f"solver: {solver!r} is not allowed; allowed: one of {', '.join(map(repr, SOLVERS))}")
+    with progress_bar("3-D validation", "{task.completed}/{task.total} runs", None) as update:
+        show = None if update is None else lambda done, total: update(done, total=total)
+        report = validation_report(solver, study, three_d, progress=show)
+    if json_output:
+        typer.echo(json.dumps(to_jsonable(report.as_dict()), sort_keys=True, allow_nan=False))
+        return
+    console = stdout_console()
+    console.print(validation_table(report.runs))
+    for run in report.runs:
+        console.print(Text(run.statement))
+    console.print(Text(f"The experiment's ratio is for five balls: {TABLE5[-1].experiment_note}."))
+    if report.outcomes:
+        console.print(free_set_table(report.outcomes))
+    if report.held_out is not None:
+        print_held_out(console, report.held_out)
+
+
+def print_held_out(console: Console, held_out: Any) -> None:
+    from shakermill.studies.held_out import COMPARED_KEYS, FIVE_BALL_SOURCE
+
+    prediction, comparison, sensitivity = held_out.prediction, held_out.comparison, held_out.sensitivity
+    table = Table("quantity", "unit", "experiment", "predicted", "error", title=f"Held out: five balls ({FIVE_BALL_SOURCE})")
+    for row in prediction.rows:
+        add_plain_row(table, row.label, row.unit, f"{row.experiment:g}", f"{row.predicted:.3g}", f"{100 * row.relative_error:+.0f} %")
+    console.print(table)
+    console.print(Text(prediction.statement))
+    table = Table("one ball", *(f"{label} [{unit}]" for _, label, unit in COMPARED_KEYS), title="One ball: what the third dimension, gravity and friction change")
+    for index, case in enumerate(comparison.cases):
+        cells = [
+            f"{values:.3g}" + ("" if index == 0 else f" ({100 * comparison.change(key, index):+.0f} %)")
+            for key, values in ((key, comparison.values[index][key]) for key, _, _ in COMPARED_KEYS)
+        ]
+        add_plain_row(table, case.label, *cells)
+    console.print(table)
+    console.print(sensitivity_table(sensitivity))
+
+
+def sensitivity_table(sensitivity: Any) -> Table:
+    """Each assumed amplitude halved and raised by half: the measures' relative changes against the baseline."""
+    measures = list(sensitivity.baseline)
+    table = Table("assumed key × factor", "value (SI)", *measures, title=f"Sensitivity to the assumed {sensitivity.kinematics} motion (five balls)")
+    add_plain_row(table, "baseline", "", *(f"{sensitivity.baseline[name]:.4g}" for name in measures))
+    for row in sensitivity.rows:
+        # A temperature's relative change depends on where its scale starts: in kelvin it says more.
+        changes = (
+            f"{row.measures[name] - sensitivity.baseline[name]:+.1f} K" if name.endswith("_C") else f"{100 * row.relative_change[name]:+.1f} %"
+            for name in measures
+        )
+        add_plain_row(table, f"{row.key} × {row.factor:g}", f"{row.value:.4g}", *changes)
+    return table
+
+
+def validation_table(runs: Sequence[Any]) -> Table:
+    from shakermill.studies.validation import EXPERIMENT, TABLE5
+
+    table = Table("quantity", "unit", "experiment", "paper's model", title=f"Table 5 ({EXPERIMENT})")
+    for run in runs:
+        table.add_column(f"{run.preset}", justify="right")
+        table.add_column("vs exp.", justify="right")
+    for index, entry in enumerate(TABLE5):
+        cells = [entry.label, entry.unit, f"{entry.experiment:g}", f"{entry.paper_model:g}"]
+        for run in runs:
+            row = run.rows[index]
+            cells += [f"{row.value:.4g} ({row.role})", f"{100 * row.error_vs_experiment:+.2f} %"]
+        add_plain_row(table, *cells)
+    # The experiment's exponential plateau is its own estimate of the steady state; the paper gives none.
+    steady = ["ball steady state (MODEL.md §11)", "°C", f"{TABLE5[0].experiment:g}", "n/a"]
+    for run in runs:
+        value = run.summary["ball_steady_C"]
+        steady += [f"{value:.4g} (predicted)", f"{100 * (value - TABLE5[0].experiment) / TABLE5[0].experiment:+.2f} %"]
+    add_plain_row(table, *steady)
+    deviation = ["RMS deviation from the experiment's curve, 0–60 min", "K", "0", "n/a"]
+    for run in runs:
+        deviation += [f"{run.curve_rms_K:.3g}", ""]
+    add_plain_row(table, *deviation)
+    return table
+
+
+def free_set_table(outcomes: Sequence[Any]) -> Table:
+    table = Table(
+        "free keys", "fitted values", "RMS K", "vial/ball ratio (exp. 0.46)", "verdict",
+        title="Which free sets can follow the experiment's curve (fits within physically defensible ranges)",
+    )
+    for outcome in outcomes:
+        calibration = outcome.calibration
+        fitted = ", ".join(f"{key} {value:.3g}" for key, value in calibration.fitted.items())
+        ratio = calibration.predictions.get("vial_ball_ratio", math.nan)
+        add_plain_row(table, ", ".join(outcome.free), fitted, number(calibration.curve_rms_K, ".2f"), number(ratio, ".3f"), outcome.verdict)
+    return table
+
+
+def calibrate(
+    config: ConfigArgument = None,
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
+    target: Annotated[
+        list[str] | None,
+        typer.Option("--target", "-t", metavar="NAME=VALUE", help=f"A target: {', '.join(TARGET_KEYS)}."),
+    ] = None,
+    curve: Annotated[
+        Path | None,
+        typer.Option(
+            "--curve",
+            help="CSV with time_s (or time_min) and ball_C columns to fit (default, without --target: the "
+            "experiment's curve 48 - 28 exp(-t/16.7 min) over 0-60 min).",
+        ),
+    ] = None,
+    free: Annotated[
+        list[str] | None,
+        typer.Option("--free", "-f", metavar="KEY[,KEY]", help=f"Keys to fit (default: {','.join(DEFAULT_FREE)}; engine = 'dem': {','.join(DEM_DEFAULT_FREE)})."),
+    ] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
+    full_resolution: FullResolutionOption = False,
+    json_output: JsonOption = False,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
+) -> None:
+    """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
+    from shakermill.io.runs import to_jsonable
+    from shakermill.parameters.config import load_config
+    from shakermill.studies.calibrate import calibrate as fit_parameters
+    from shakermill.studies.calibrate import default_free, parse_free, parse_targets
+    from shakermill.studies.validation import Curve
+
+    with user_errors():
+        run_config = load_config(config, preset=preset, overrides=settings or [])
+        targets = parse_targets(target or [])
+        free_keys = parse_free(free or [], default_free(run_config.params))
+        measured = Curve.from_csv(curve) if curve is not None else None
+        if out is not None:
+            # Checked before the fit, which takes a while.
+            check_preset_target(out, overwrite)
+        with nothing_written_when_interrupted("the fit starts again from the beginning"), nothing_written_when_a_run_is_stopped(
+            "the fit"
+        ), progress_bar("fitting", "{task.completed} model evaluations", None, delay_s=PROGRESS_DELAY_S) as update:
+            calibration = fit_parameters(
+                run_config.params, free_keys, targets, measured, full_resolution=full_resolution, progress=update
+            )
+    if out is not None:
+        write_fitted_preset(calibration, out, run_config.preset, free_keys, targets)
+    if json_output:
+        typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False))
+    else:
+        print_calibration(calibration, free_keys, targets, out)
+    if not calibration.success:
+        typer.echo(f"error: calibration did not meet its targets: {calibration.message}", err=True)
+        raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def check_preset_target(out: Path, overwrite: bool) -> None:
+    """Raise ParameterError when the fitted preset cannot be written to ``out``."""
+    if out.exists() and out.is_dir():
+        raise ParameterError(f"out: {out} is a folder; give a .toml file name")
+    if out.exists() and not overwrite:
+        raise ParameterError(f"out: {out} exists; choose another --out, or add --overwrite to replace it")
+    check_writable_place(out)
+
+
+def write_fitted_preset(
+    calibration: Calibration, out: Path, base_preset: str, free_keys: Sequence[str], targets: Mapping[str, float]
+) -> None:
+    """Write the fitted preset TOML, saying in it which command fitted which keys to what."""
+    from shakermill.studies.calibrate import write_preset
+
+    command = "shakermill calibrate " + " ".join(sys.argv[2:])
+    fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]
+    description = (
+        f"{base_preset} with {', '.join(free_keys)} fitted to {', '.join(fitted_to)}; "
+        f"{', '.join(calibration.predictions)} are predictions"
+    )
+    with writing(out, "the preset"):
+        write_preset(calibration, out, base_preset=base_preset, command=command, description=description)
+
+
+def print_calibration(
+    calibration: Calibration, free_keys: Sequence[str], targets: Mapping[str, float], out: Path | None
+) -> None:
+    """The fitted parameters, what the fitted model predicts, the residuals of the targets and of the curve."""
+    console = stdout_console()
+    table = Table("parameter", "start", "fitted", "std. error", "physically defensible?", title="calibration")
+    for key in free_keys:
+        add_plain_row(
+            table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}",
+            number(calibration.parameter_stderr[key], ".3g"), calibration.defensible[key],
+        )
+    console.print(table)
+    predictions = Table("not fitted, predicted", "value", title="what the fitted model predicts")
+    for key, value in calibration.predictions.items():
+        add_plain_row(predictions, key, number(value, ".4g"))
+    console.print(predictions)
+    if targets:
+        residuals = Table("target", "wanted", "achieved", "residual", *[f"∂ln/∂ln {key}" for key in free_keys])
+        for key, wanted in targets.items():
+            sensitivities = [f"{calibration.sensitivities[key][name]:+.3f}" for name in free_keys]
+            add_plain_row(
+                residuals, key, f"{wanted:g}", f"{calibration.achieved[key]:.6g}",
+                f"{100 * calibration.relative_residuals[key]:+.3f} %", *sensitivities,
+            )
+        console.print(residuals)
+    if calibration.curve_rms_K is not None:
+        console.print(Text(f"curve ({calibration.curve_source}): RMS residual {calibration.curve_rms_K:.3g} K"))
+        for label, values in calibration.sensitivities.items():
+            if label not in targets:
+                console.print(Text(f"d {label} / d ln(key), K: " + ", ".join(f"{key} {value:+.3g}" for key, value in values.items())))
+    console.print(Text(f"{calibration.evaluations} model evaluations ({calibration.solver} solver): {calibration.message}"))
+    if out is not None:
+        console.print(Text(f"preset written to {out}; use it with `shakermill run {out}`"))

@@ -1,0 +1,279 @@
+"""``shakermill run``, ``compare-solvers`` and ``impact``: one simulation and its run folder, the two solvers side by
+side, one impact on its own."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, Mapping, Sequence
+
+import typer
+from rich.table import Table
+from rich.text import Text
+
+from shakermill.cli.common import (
+    EXIT_FAILED_RUN,
+    EXIT_INTERRUPTED,
+    ConfigArgument,
+    JsonOption,
+    OverwriteOption,
+    PresetOption,
+    SettingsOption,
+    add_plain_row,
+    echo_warnings,
+    fail,
+    nothing_written_when_interrupted,
+    number,
+    simulate_with_progress,
+    stdout_console,
+    timestamped_folder,
+    user_errors,
+    writing,
+)
+from shakermill.parameters.defaults import HIT_SPEED
+
+if TYPE_CHECKING:
+
+    from shakermill.parameters.keys import Parameters
+    from shakermill.solvers.result import Result
+
+FIGURES_FOLDER = "figures"
+
+
+def run(
+    config: ConfigArgument = None,
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", show_default="results/run-<timestamp>", help="Run folder to write."),
+    ] = None,
+    json_output: JsonOption = False,
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
+    overwrite: OverwriteOption = False,
+) -> None:
+    """Run one simulation and write its run folder (data, summary, configuration, figures)."""
+    from shakermill.io.runs import check_target, to_jsonable
+    from shakermill.parameters.config import load_config
+    from shakermill.parameters.keys import unit_slip_warnings
+    from shakermill.solvers.result import INTERRUPTED
+
+    overrides = settings or []
+    with user_errors():
+        run_config = load_config(config, preset=preset, overrides=overrides)
+        target = out if out is not None else timestamped_folder("run")
+        check_target(target, overwrite=overwrite)
+    # Unit slips are said before a possibly long run, the rest once it is known.
+    said_first = unit_slip_warnings(run_config.params)
+    echo_warnings(said_first)
+    # A run returns what it computed when interrupted; Ctrl-C in the attractor probe or the thermal network leaves none.
+    with nothing_written_when_interrupted("the run had no results to keep yet"):
+        result = simulate_with_progress(run_config.params)
+    if result.status != INTERRUPTED:
+        # An interrupted run is short by choice: its warnings (run length, steady state) stay in summary.json.
+        echo_warnings([line for line in result.warnings if line not in said_first])
+    provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
+    target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots, overwrite=overwrite)
+    if json_output:
+        summary = to_jsonable({**result.summary, "output_dir": str(target)})
+        typer.echo(json.dumps(summary, sort_keys=True, allow_nan=False))
+    else:
+        stdout_console().print(summary_table(result, target))
+    _exit_for_status(result, target)
+
+
+def _write(
+    result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool, overwrite: bool
+) -> Path:
+    """Write the run folder (with figures unless told not to); return its absolute path."""
+    from shakermill.io.runs import write_run
+
+    def add_figures(folder: Path) -> None:
+        from shakermill.views.figures.run import plot_run
+
+        plot_run(result, folder / FIGURES_FOLDER)
+
+    try:
+        with user_errors(), writing(target, "the run folder"):
+            return write_run(
+                result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None,
+                overwrite=overwrite,
+            )
+    except KeyboardInterrupt:
+        fail(f"interrupted while writing {target}; no partial folder was left there", EXIT_INTERRUPTED)
+
+
+def _exit_for_status(result: Result, target: Path) -> None:
+    from shakermill.solvers.result import INTERRUPTED
+
+    if result.status == INTERRUPTED:
+        typer.echo(f"interrupted: {result.message} Partial results in {target}", err=True)
+        raise typer.Exit(EXIT_INTERRUPTED)
+    if not result.success:
+        typer.echo(f"error: {result.message} Results so far in {target}", err=True)
+        raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def _radii_mm(params: Parameters) -> str:
+    """The ball radius in mm, or each ball's where they differ."""
+    radii = sorted(set(params.ball_values("ball_radius")))
+    return ", ".join(number(radius * 1e3, ".4g") for radius in radii)
+
+
+def summary_table(result: Result, target: Path) -> Table:
+    """The human summary of a run: fitted and final temperatures, impacts, power, numerics."""
+    from shakermill.engines.registry import describe
+
+    s = result.summary
+    table = Table(title="shakermill run", show_header=True)
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    table.add_column("unit")
+    fit_window = f"0–{number(s['simulated_s'] / 60.0, '.4g')} min"
+    description = describe(result.params.engine)
+    # With several balls the temperatures, steady state and fit are the balls' means; their own rows say more.
+    ball = "balls' mean" if description.several_balls else "ball"
+    rows = [
+        ("status", s["message"] if not result.success else "ok", ""),
+        ("solver", s["solver"], ""),
+        ("drive ω", f"{number(s['omega_rad_s'], '.4g')} rad/s = {number(s['omega_hz'], '.4g')} Hz = {number(s['omega_rpm'], '.0f')}", "rpm"),
+        ("amplitude; ball radius", f"{number(s['amplitude_mm'], '.4g')}; {_radii_mm(result.params)}", "mm"),
+        ("ambient; initial temperature", f"{number(s['ambient_temperature_C'], '.4g')}; {number(s['initial_temperature_C'], '.4g')}", "°C"),
+        ("simulated time", number(s["simulated_s"], ".6g"), "s"),
+        (f"{ball} steady state", number(s["ball_steady_C"], ".2f"), "°C"),
+        ("vial; air steady state", f"{number(s['vial_steady_C'], '.2f')}; {number(s['air_steady_C'], '.2f')}", "°C"),
+        ("slowest time constant", number(s["slowest_time_constant_min"], ".1f"), "min"),
+        (f"{ball} θ∞ of the exponential fitted over {fit_window}", number(s["theta_inf_C"], ".2f"), "°C"),
+        ("τ of that fit", number(s["tau_min"], ".2f"), "min"),
+        ("initial heating rate θ̇₀ of that fit", number(s["rate0_C_per_min"], ".3f"), "°C/min"),
+        (f"{ball} at the end", number(s["ball_C"], ".2f"), "°C"),
+        ("vial at the end", number(s["vial_C"], ".2f"), "°C"),
+        ("air at the end", number(s["air_C"], ".2f"), "°C"),
+        ("vial/ball increment ratio", number(s["vial_ball_ratio"], ".3f"), ""),
+        *(several_ball_rows(s, description.channels) if description.several_balls else ()),
+        ("impacts", number(s["impacts"], "d"), ""),
+        ("impact rate", number(s["impact_rate_hz"], ".2f"), "Hz"),
+        ("mean impact speed", number(s["mean_impact_speed_m_s"], ".3f"), "m/s"),
+        (f"hits ≥ {HIT_SPEED:g} m/s: rate; mean speed", f"{number(s['hit_rate_hz'], '.2f')} Hz; {number(s['mean_hit_speed_m_s'], '.3f')}", "m/s"),
+        ("heat generated", number(s["heat_power_W"], ".3f"), "W"),
+        ("steps (rejected)", f"{s['steps']} ({s['rejected_steps']})", ""),
+        ("wall time", number(s["wall_time_s"], ".2f"), "s"),
+        ("energy audit residual", number(s["energy_audit_residual"], ".2e"), "relative"),
+        ("output folder", str(target), ""),
+    ]
+    for row in rows:
+        add_plain_row(table, *row)
+    return table
+
+
+# Up to this many balls the run table gives each ball's temperature; beyond, the coolest and the hottest.
+EACH_BALL_UP_TO = 6
+
+
+def several_ball_rows(s: Mapping[str, Any], channels: Sequence[str]) -> list[tuple[str, str, str]]:
+    """The run table's rows of an engine of several balls: balls, their temperatures at the end and steady states,
+    impacts on the walls and between balls, heat by dissipation channel (``channels``)."""
+    rows = [("engine; balls; fill of the vial", f"{s['engine']}; {s['n_balls']}; {number(s.get('fill_fraction'), '.3f')}", "")]
+    for key, what in (("ball_temperatures_C", "at the end"), ("balls_steady_C", "steady state")):
+        values = [value for value in s.get(key) or () if value is not None]
+        if not values:
+            continue
+        if len(values) <= EACH_BALL_UP_TO:
+            rows.append((f"each ball {what} (ball 0; 1; …)", "; ".join(number(value, ".2f") for value in values), "°C"))
+        else:
+            rows.append((f"balls {what}: coolest; hottest", f"{number(min(values), '.2f')}; {number(max(values), '.2f')}", "°C"))
+    rows.append(("impacts on the walls; between balls", f"{s['wall_impacts']}; {s['ball_ball_impacts']}", ""))
+    heat = [s.get(f"heat_{channel}_W") for channel in channels]
+    if any(value is not None for value in heat):
+        # The averaged solver has no split by channel: its heat comes from the thermal network's means.
+        rows.append((f"heat by channel: {'; '.join(channels)}", "; ".join(number(value, ".3g") for value in heat), "W"))
+    return rows
+
+
+def compare_solvers(
+    config: ConfigArgument = None,
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
+    json_output: JsonOption = False,
+) -> None:
+    """Run the same configuration with the full and the averaged solver; print both, the differences and the speed ratio."""
+    from shakermill.io.runs import to_jsonable
+    from shakermill.parameters.config import load_config
+    from shakermill.studies.compare import compare_solvers as compare
+
+    with user_errors(), nothing_written_when_interrupted("compare-solvers writes no files"):
+        params = load_config(config, preset=preset, overrides=settings or []).params
+        comparison = compare(params, simulate_with_progress)
+    if json_output:
+        typer.echo(json.dumps(to_jsonable(comparison.as_dict()), sort_keys=True, allow_nan=False))
+    else:
+        table = Table("quantity", "full", "averaged", "averaged − full", "unit", title="full vs averaged solver")
+        for label, unit, full_value, averaged_value, difference in comparison.rows():
+            add_plain_row(table, label, number(full_value, ".4g"), number(averaged_value, ".4g"), number(difference, "+.3g"), unit)
+        console = stdout_console()
+        console.print(table)
+        console.print(Text(f"averaged solver: {comparison.averaged.message}"))
+        console.print(Text(f"speed ratio full/averaged: {comparison.speed_ratio:.0f}x"))
+    for result in (comparison.full, comparison.averaged):
+        if not result.success:
+            typer.echo(f"error: the {result.params.solver} run did not finish cleanly: {result.message}", err=True)
+            raise typer.Exit(EXIT_FAILED_RUN)
+
+
+# The vial's size plays no part in a lone impact, only its material: a vial of the largest usual size (0.5 m) lets
+# any ball of the allowed radii be set without resizing the vial too. The user's own settings come after.
+IMPACT_VIAL = ["vial_length=0.5 m", "vial_diameter=0.5 m"]
+IMPACT_ROWS = (
+    ("normal_restitution", "normal restitution", 1.0, ".6f", ""),
+    ("tangential_velocity_out_m_s", "tangential velocity of the centre after", 1.0, ".6g", "m/s"),
+    ("angular_velocity_rad_s", "angular velocity after (about n × t)", 1.0, ".6g", "rad/s"),
+    ("contact_time_s", "contact time", 1e6, ".5g", "µs"),
+    ("max_overlap_m", "largest overlap", 1e6, ".5g", "µm"),
+    ("max_normal_force_N", "largest normal force", 1.0, ".5g", "N"),
+    ("dissipated_J", "dissipated", 1.0, ".4g", "J"),
+    ("dissipated_normal_J", "  by normal damping", 1.0, ".4g", "J"),
+    ("dissipated_tangential_J", "  by tangential damping", 1.0, ".4g", "J"),
+    ("dissipated_sliding_J", "  by sliding", 1.0, ".4g", "J"),
+    ("dissipated_rolling_J", "  by rolling resistance", 1.0, ".4g", "J"),
+)
+
+
+def impact(
+    config: ConfigArgument = None,
+    preset: PresetOption = None,
+    settings: SettingsOption = None,
+    speed: Annotated[
+        float, typer.Option("--speed", help="Speed of the incoming ball relative to its target, m/s.")
+    ] = ...,
+    angle: Annotated[
+        float, typer.Option("--angle", help="Angle between the incoming velocity and the normal, degrees (0: head-on).")
+    ] = 0.0,
+    target: Annotated[
+        str, typer.Option("--target", help="'wall': the vial's end face at rest; 'ball': an identical ball at rest.")
+    ] = "wall",
+    spin: Annotated[
+        float,
+        typer.Option(
+            "--spin", help="Angular velocity of the incoming ball about the normal to the plane of incidence, rad/s."
+        ),
+    ] = 0.0,
+    json_output: JsonOption = False,
+) -> None:
+    """One impact on its own, through the 'dem' engine: restitution, rebound, spin, contact time, peak force and
+    the dissipated energy by channel. Materials, restitution, friction and the contact step come from --set."""
+    from shakermill.parameters.config import load_config
+    from shakermill.parameters.keys import unit_slip_warnings
+    from shakermill.solvers.impact import single_impact
+
+    with user_errors(), nothing_written_when_interrupted("impact writes no files"):
+        params = load_config(config, preset=preset, overrides=[*IMPACT_VIAL, *(settings or [])]).params
+        echo_warnings(unit_slip_warnings(params))
+        outcome = single_impact(params, speed, angle, target, spin).as_dict()
+    if json_output:
+        typer.echo(json.dumps(outcome, allow_nan=False))
+        return
+    table = Table("quantity", "value", "unit", title=f"one impact: {speed:g} m/s at {angle:g}° on a {target} at rest")
+    for key, label, scale, spec, unit in IMPACT_ROWS:
+        add_plain_row(table, label, number(scale * outcome[key], spec), unit)
+    stdout_console().print(table)
+

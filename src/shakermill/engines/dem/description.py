@@ -1,0 +1,60 @@
+"""What the 'dem' engine is (MODEL.md section 12): its description for the layers above, its status messages,
+its dissipation channels and its impact columns. Plain data: reading it loads no compiled code."""
+
+from __future__ import annotations
+
+from shakermill.engines.interface import EngineDescription
+from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
+from shakermill.parameters.engine_keys import THREE_DIMENSIONAL
+
+CHANNELS = ("normal", "tangential", "sliding", "rolling")
+
+STATUS_MESSAGES = {
+    REACHED_STOP: "The engine reached the end of the integration interval.",
+    NOT_FINITE: "The state became NaN or infinite.",
+    OVERLAP_TOO_LARGE: (
+        "A contact overlap exceeded 5 % of the smallest ball radius: the materials are too soft for these impact "
+        "speeds, or contact_step_fraction is too large."
+    ),
+}
+
+IMPACT_UNITS = {
+    "time": "s",
+    "ball": "",
+    "target": "",
+    "other_ball": "",
+    "impact_speed": "m/s",
+    "tangential_speed": "m/s",
+    **{f"dissipated_{name}": "J" for name in CHANNELS},
+    "dissipated_energy": "J",
+    "heat_generated": "J",
+    "heat_to_ball": "J",
+    "heat_to_other": "J",
+    "peak_force": "N",
+    "max_overlap": "m",
+    "duration": "s",
+}
+
+# Keys that enter only the thermal network, never a force or the heat a contact makes (λ, η and the balls'
+# effusivities split that heat inside the stepper, and the air's properties set the Whitaker term).
+THERMAL_ONLY_KEYS = (
+    "h_inner", "h_outer", "inner_area", "outer_area", "vial_mass", "vial_heat_capacity", "beta",
+    "ambient_temperature", "initial_temperature", "duration", "output_interval",
+)
+
+DESCRIPTION = EngineDescription(
+    keys=THREE_DIMENSIONAL,
+    channels=CHANNELS,
+    impact_units=IMPACT_UNITS,
+    impact_target="target",
+    per_ball=("theta_balls", "theta_balls_C", "heat_into_balls", "velocity_term_integrals", "position", "velocity",
+              "angular_velocity"),
+    read_back=("time", "position", "velocity", "theta_ball", "theta_balls", "theta_vial", "theta_air"),
+    motion=("position", "velocity", "angular_velocity"),
+    heat_variables=("heat_into_balls", "heat_into_vial"),
+    term_variables=("velocity_term_integrals",),
+    status_messages=STATUS_MESSAGES,
+    averaging_error_key="dem_averaging_rel_error",
+    thermal_only_keys=THERMAL_ONLY_KEYS,
+    attractor_starts=False,
+)

@@ -1,0 +1,141 @@
+"""What an engine's run records, independent of the engine: its state history with units (:class:`StateHistory`)
+and where the supplied work went (:class:`EnergyAudit`). The solvers assemble a ``Result`` from these."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Mapping
+
+import numpy as np
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+
+# Temperatures (K) that the datasets also carry in °C, as ``<name>_C``.
+CELSIUS_VARIABLES = ("theta_ball", "theta_vial", "theta_air")
+
+TIME_ATTRIBUTES = {"units": "s", "long_name": "simulated time"}
+
+# The variable of every ball's temperature (K), over (time, ball), of an engine that moves several balls.
+BALL_TEMPERATURES = "theta_balls"
+
+
+@dataclass(frozen=True)
+class StateHistory:
+    """A state history as NumPy arrays over ``times`` (s), each variable with its attributes (units, long_name).
+    A variable is over ``time`` alone unless ``dimensions`` names its dimensions (e.g. time, ball, axis).
+
+    Run files are written from it directly, and :meth:`dataset` is the xarray view: a run that only
+    writes its files never imports xarray, whose first Dataset imports dask and pint (half a second).
+    """
+
+    times: np.ndarray
+    variables: dict[str, tuple[np.ndarray, dict[str, str]]]
+    dimensions: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+
+    def dims(self, name: str) -> tuple[str, ...]:
+        return self.dimensions.get(name, ("time",))
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.variables[name][0]
+
+    def with_attributes(self, extra: Mapping[str, Mapping[str, str]]) -> StateHistory:
+        """The same history with ``extra[name]`` added to the attributes of variable ``name``."""
+        variables = {
+            name: (values, {**attributes, **extra.get(name, {})}) for name, (values, attributes) in self.variables.items()
+        }
+        return StateHistory(self.times, variables, self.dimensions)
+
+    def dataset(self) -> xr.Dataset:
+        import xarray as xr
+
+        data_vars = {
+            name: (self.dims(name), values, dict(attributes)) for name, (values, attributes) in self.variables.items()
+        }
+        return xr.Dataset(data_vars, coords={"time": ("time", self.times, dict(TIME_ATTRIBUTES))})
+
+
+def attributes(units: str, long_name: str) -> dict[str, str]:
+    """A history variable's attributes."""
+    return {"units": units, "long_name": long_name}
+
+
+def with_celsius(variables: dict[str, tuple[np.ndarray, dict[str, str]]], names: tuple[str, ...]) -> None:
+    """Add ``<name>_C`` beside each temperature ``name`` (K): ``ds.theta_ball_C.plot()`` is then labelled with the
+    unit of its values, which converting ``theta_ball`` by hand would not change from [K]."""
+    for name in names:
+        kelvin, kelvin_attributes = variables[name]
+        variables[f"{name}_C"] = (kelvin_to_celsius(kelvin), attributes("degC", kelvin_attributes["long_name"]))
+
+
+@dataclass(frozen=True)
+class EnergyAudit:
+    """Where the vial's work went, in J, over the simulated interval.
+
+    work_by_vial = Δkinetic + Δelastic + dissipated
+    dissipated   = heat_generated + not_converted_to_heat
+    heat_generated = Δstored (ball + vial + air) + heat_lost_to_surroundings
+
+    ``projection_correction`` is the total |Δ kinetic energy| the energy
+    projection applied at the end of contacts: the integrator's truncation
+    error in the contact mechanics, which the projection removes from the
+    balance above but which this field keeps visible.
+    """
+
+    work_by_vial: float
+    kinetic_energy_change: float
+    elastic_energy_change: float
+    dissipated: float
+    heat_generated: float
+    heat_to_ball: float
+    heat_to_vial: float
+    not_converted_to_heat: float
+    stored_ball: float
+    stored_vial: float
+    stored_air: float
+    heat_lost_to_surroundings: float
+    projection_correction: float
+    # The 'dem' engine adds the work of gravity and splits the dissipation by channel (MODEL.md §12.4).
+    work_by_gravity: float = 0.0
+    # ... and the energy its tangential springs gain by stiffening with the load (engines.dem.model.TOTAL_NAMES)
+    work_by_stiffening: float = 0.0
+    dissipated_by_channel: Mapping[str, float] = field(default_factory=dict)
+
+    @property
+    def mechanical_residual(self) -> float:
+        supplied = self.work_by_vial + self.work_by_gravity + self.work_by_stiffening
+        return supplied - self.kinetic_energy_change - self.elastic_energy_change - self.dissipated
+
+    @property
+    def thermal_residual(self) -> float:
+        stored = self.stored_ball + self.stored_vial + self.stored_air
+        return self.heat_generated - stored - self.heat_lost_to_surroundings
+
+    @property
+    def residual(self) -> float:
+        return self.mechanical_residual + self.thermal_residual
+
+    @property
+    def relative_residual(self) -> float:
+        """|residual| over the largest flow in the balance (0 when nothing flowed, NaN when a term is not finite)."""
+        if not math.isfinite(self.residual):
+            return math.nan
+        scale = max(abs(self.work_by_vial), abs(self.dissipated), abs(self.heat_generated))
+        return abs(self.residual) / scale if scale > 0.0 else 0.0
+
+    def as_dict(self) -> dict[str, float]:
+        values = {key: value for key, value in self.__dict__.items() if key != "dissipated_by_channel"}
+        values.update({f"dissipated_{channel}": value for channel, value in self.dissipated_by_channel.items()})
+        values.update(
+            mechanical_residual=self.mechanical_residual,
+            thermal_residual=self.thermal_residual,
+            residual=self.residual,
+            relative_residual=self.relative_residual,
+        )
+        return values
+
+
+def kelvin_to_celsius(kelvin: float) -> float:
+    return kelvin - 273.15

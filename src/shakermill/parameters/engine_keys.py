@@ -1,0 +1,108 @@
+"""What each engine takes, by name: the vial motions, how many balls, the thermal models and how the air moves.
+
+``Parameters`` checks a run's keys against the engine it names (key ``engine``), so these declarations live
+in this layer, below the engines; each engine carries its own as part of its description
+(``engines/interface.py``), and registering a new engine (``engines/registry.py``) adds its declaration here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
+
+# The most balls any engine moves; the pair search of the 'dem' engine is O(N²).
+MAX_BALLS = 50
+
+
+@dataclass(frozen=True)
+class EngineKeys:
+    """The keys and values an engine takes, stated once for validation and for its description."""
+
+    name: str  # the value of the key ``engine``
+    title: str  # how messages name it: "the 1-D engine"
+    summary: str  # what it moves, for `shakermill keys`
+    kinematics: tuple[str, ...]  # values of ``kinematics`` it moves the vial by
+    most_balls: int
+    thermal_models: tuple[str, ...]  # values of ``model``
+    # Whether the air moves with the vial, so that convection takes the ball's speed relative to it by default
+    # (``convection_velocity = 'auto'``, MODEL.md §§4, 12.5).
+    air_moves_with_vial: bool
+
+    @property
+    def several_balls(self) -> bool:
+        return self.most_balls > 1
+
+
+ONE_DIMENSIONAL = EngineKeys(
+    name="1d",
+    title="the 1-D engine",
+    summary="one ball on the vial's axis (MODEL.md sections 1-7)",
+    kinematics=("axial",),
+    most_balls=1,
+    thermal_models=("three_node", "ball_only"),
+    air_moves_with_vial=False,
+)
+THREE_DIMENSIONAL = EngineKeys(
+    name="dem",
+    title="the 'dem' engine",
+    summary="n_balls spheres in three dimensions with friction and rotation (section 12)",
+    kinematics=tuple(KINEMATIC_MODELS),
+    most_balls=MAX_BALLS,
+    thermal_models=("three_node",),
+    air_moves_with_vial=True,
+)
+
+BUILT_IN = (ONE_DIMENSIONAL.name, THREE_DIMENSIONAL.name)
+ENGINE_KEYS: dict[str, EngineKeys] = {keys.name: keys for keys in (ONE_DIMENSIONAL, THREE_DIMENSIONAL)}
+
+
+def declare(keys: EngineKeys) -> None:
+    """Make ``keys.name`` a value of ``engine`` that parameters accept; an engine's name is declared once."""
+    known = ENGINE_KEYS.get(keys.name)
+    if known is not None and known != keys:
+        raise ValueError(f"engine {keys.name!r} is declared already, with other keys")
+    ENGINE_KEYS[keys.name] = keys
+
+
+def undeclare(name: str) -> None:
+    """Take a registered engine's name out of the values ``engine`` takes; the built-in ones stay."""
+    if name in BUILT_IN:
+        raise ValueError(f"engine {name!r} is built in")
+    del ENGINE_KEYS[name]
+
+
+def engines_taking(accepts: Callable[[EngineKeys], bool]) -> str:
+    """"engine = 'dem'" (or "engine one of 'a', 'b'"): the engines whose keys satisfy ``accepts``, for a message."""
+    names = [repr(keys.name) for keys in ENGINE_KEYS.values() if accepts(keys)]
+    return f"engine = {names[0]}" if len(names) == 1 else f"engine one of {', '.join(names)}"
+
+
+def engine_problem(params: Any, fill: bool = False) -> str | None:
+    """Why ``params`` (a ``Parameters``) ask of their engine what it does not take, in one line, or None: more
+    balls than it moves (or, with ``fill``, a fill of the vial from an engine of one ball), a vial motion or a
+    thermal model it does not have."""
+    keys = ENGINE_KEYS[params.engine]
+    engine = f"engine = {keys.name!r}"
+    if fill and not keys.several_balls:
+        return (
+            f"fill: sets the number of balls of an engine that moves several; allowed fill = 0 with {engine}, or set "
+            f"{engines_taking(lambda other: other.several_balls)}"
+        )
+    if params.n_balls > keys.most_balls:
+        moves = "one ball" if keys.most_balls == 1 else f"at most {keys.most_balls} balls"
+        return (
+            f"n_balls: {keys.title} moves {moves}; allowed n_balls {'=' if keys.most_balls == 1 else '<='} "
+            f"{keys.most_balls} with {engine}, or set {engines_taking(lambda other: other.most_balls >= params.n_balls)}"
+        )
+    if params.kinematics not in keys.kinematics:
+        allowed = ", ".join(map(repr, keys.kinematics))
+        return (
+            f"kinematics: {keys.title} does not move the vial as {params.kinematics!r}; allowed {allowed} with {engine}, "
+            f"or set {engines_taking(lambda other: params.kinematics in other.kinematics)}"
+        )
+    if params.model not in keys.thermal_models:
+        allowed = ", ".join(map(repr, keys.thermal_models))
+        return f"model: {keys.title} has no {params.model!r} thermal model; allowed {allowed} with {engine}"
+    return None

@@ -1,0 +1,136 @@
+"""The one run driver of every engine and solver: a run advanced in chunks with its budget, progress and Ctrl-C
+(:func:`run_until`), and the mechanics advanced batch by batch until the means that drive the thermal network
+converge (:func:`measure_means`, the averaged solver's batch means: MSER truncation, White 1997)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from shakermill.analysis.batch_means import batch_rates, mser_truncation, normalised, relative_error, standard_error
+from shakermill.engines.interface import Engine, Measured, ProgressCallback
+from shakermill.engines.status import REACHED_STOP
+from shakermill.engines.thermal.network import NetworkLoad
+from shakermill.parameters.keys import Parameters
+from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages
+
+# Simulated seconds per chunk: the granularity of progress reports (tiny steps hand back control sooner,
+# engines/calls.py). Chunk ends shorten a step, so this is part of what makes a run's numbers.
+CHUNK_SECONDS = 10.0
+
+
+def sample_times(params: Parameters) -> np.ndarray:
+    """The output grid of a run: every ``output_interval`` from 0, and the end (s)."""
+    count = int(math.floor(params.duration / params.output_interval + 1e-9))
+    times = np.arange(count + 1) * params.output_interval
+    if times[-1] < params.duration:
+        times = np.append(times, params.duration)
+    return times
+
+
+def run_until(engine: Engine, end: float, progress: ProgressCallback | None) -> int:
+    """Advance ``engine`` to ``end`` (s) in chunks, telling ``progress(t, end)``; the engine's status, or
+    INTERRUPTED for Ctrl-C, with everything computed so far kept in the engine."""
+    heartbeat = None if progress is None else lambda t: progress(t, end)
+    status = REACHED_STOP
+    try:
+        while engine.t < end and status == REACHED_STOP:
+            status = engine.advance(min(end, engine.t + CHUNK_SECONDS), heartbeat)
+            if heartbeat is not None:
+                heartbeat(engine.t)
+    except KeyboardInterrupt:
+        status = INTERRUPTED
+    return status
+
+
+def stop_message(engine: Engine, status: int) -> str:
+    """What ``status`` means, and for a run that stopped early where it stopped."""
+    message = INTERRUPTED_MESSAGE if status == INTERRUPTED else engine.explain(status)
+    if status < 0 or status == INTERRUPTED:
+        message = f"{message} Stopped at t = {engine.t:.6g} s; results up to then are kept."
+    return message
+
+
+@dataclass(frozen=True)
+class Means:
+    """The settled mechanics: the load of the thermal network, and the averages with their errors."""
+
+    load: NetworkLoad
+    averages: MechanicsAverages
+
+
+def _flat(measured: Measured) -> np.ndarray:
+    return np.concatenate([measured.heat, measured.terms, [measured.dissipated]])
+
+
+def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback | None) -> tuple[Means, int]:
+    """Run the mechanics batch by batch until the means converge (or ``averaging_max_time``); returns the means and
+    the engine's last status. ``progress(t, averaging_max_time)`` is told how far the mechanics has got.
+
+    Converged: after the start-up transient (MSER on the total heat power and the balls' mean velocity term),
+    at least ``averaging_min_batches`` batches, and every total, source and ball mean known to the engine's
+    target relative standard error (``description.averaging_error_key``).
+    """
+    key = engine.description.averaging_error_key
+    target = getattr(params, key)
+    batch = params.averaging_batch_periods * params.period
+    first = engine.measured()
+    sources, balls = first.heat.size, first.terms.size
+    cumulative = [_flat(first)]
+    heartbeat = None if progress is None else lambda t: progress(t, params.averaging_max_time)
+    status, converged, cut, message = REACHED_STOP, False, 0, ""
+    while True:
+        status = engine.advance(engine.t + batch, heartbeat)
+        if status != REACHED_STOP:
+            message = f"the mechanics failed: {engine.explain(status)}"
+            break
+        if heartbeat is not None:
+            heartbeat(engine.t)
+        cumulative.append(_flat(engine.measured()))
+        rates = batch_rates(np.array(cumulative), batch)  # (batches, sources, balls' terms, dissipated)
+        if len(rates) >= 2 * params.averaging_min_batches:
+            totals = np.column_stack([rates[:, :sources].sum(axis=1), rates[:, sources : sources + balls].mean(axis=1)])
+            cut = max(mser_truncation(normalised(column)) for column in totals.T)
+            kept = np.column_stack([totals[cut:], rates[cut:, : sources + balls]])
+            if len(kept) >= params.averaging_min_batches and all(relative_error(column) <= target for column in kept.T):
+                converged = True
+                message = f"converged after {engine.t:.3g} s of mechanics ({len(kept)} batches of {batch:.3g} s)"
+                break
+        if engine.t + batch > params.averaging_max_time:
+            message = (
+                f"the averages did not converge to a relative standard error of {target:g} ({key}) within "
+                f"averaging_max_time = {params.averaging_max_time:g} s (irregular or slowly settling motion)"
+            )
+            break
+    rates = batch_rates(np.array(cumulative), batch)[cut:]
+    return _means(engine, rates, sources, balls, cut * batch, batch, converged, message), status
+
+
+def _means(engine: Engine, rates: np.ndarray, sources: int, balls: int, transient: float, batch: float,
+           converged: bool, message: str) -> Means:
+    """The means of the kept batch ``rates`` (columns: each source's heat, each ball's term, the dissipation)."""
+    heat, terms = rates[:, :sources], rates[:, sources : sources + balls]
+    total_heat, mean_terms = heat.sum(axis=1), terms.mean(axis=1)
+    window = len(rates) * batch
+    impacts = len(engine.impact_columns(since=transient)["time"])
+    averages = MechanicsAverages(
+        heat_power=_mean(total_heat),
+        heat_power_stderr=standard_error(total_heat),
+        dissipated_power=_mean(rates[:, -1]),
+        velocity_term=_mean(mean_terms),
+        velocity_term_stderr=standard_error(mean_terms),
+        transient=transient,
+        window=window,
+        batches=len(rates),
+        impact_interval=window / impacts if impacts else math.inf,
+        converged=converged,
+        message=message,
+    )
+    load = engine.load(np.array([_mean(column) for column in heat.T]), np.array([_mean(column) for column in terms.T]))
+    return Means(load, averages)
+
+
+def _mean(values: np.ndarray) -> float:
+    return float(values.mean()) if values.size else math.nan

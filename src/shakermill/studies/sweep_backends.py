@@ -1,0 +1,281 @@
+"""Where the points of a sweep run: in this process, on a local pool of worker processes, or on a Dask
+distributed cluster; each gives back the points' outcomes as they finish."""
+
+from __future__ import annotations
+
+import ast
+import logging
+import os
+import sys
+import warnings
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Iterator, Mapping, Sequence
+
+from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import Parameters
+from shakermill.studies.sweep_points import PointInterrupted, PointOutcome, run_point
+from shakermill.studies.sweep_storage import in_one_line
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+
+
+Task = tuple[str, Mapping[str, Any]]
+
+
+Outcomes = Iterator[tuple[str, "PointOutcome | BaseException"]]
+
+
+@dataclass
+class _InProcess:
+    slots: int = 1
+
+    def outcomes(self, base: Parameters, tasks: Sequence[Task], keep_runs: bool) -> Outcomes:
+        for identifier, values in tasks:
+            try:
+                yield identifier, run_point(base, values, keep_runs)
+            except PointInterrupted:
+                raise KeyboardInterrupt from None
+
+
+@dataclass
+class _LocalPool:
+    slots: int
+    executor: Any = field(default=None)
+
+    def outcomes(self, base: Parameters, tasks: Sequence[Task], keep_runs: bool) -> Outcomes:
+        from concurrent.futures import as_completed
+
+        futures = {self.executor.submit(run_point, base, values, keep_runs): identifier for identifier, values in tasks}
+        for future in as_completed(futures):
+            error = future.exception()
+            yield futures[future], error if error is not None else future.result()
+
+
+@dataclass
+class _Cluster:
+    client: Client
+    slots: int
+
+    def outcomes(self, base: Parameters, tasks: Sequence[Task], keep_runs: bool) -> Outcomes:
+        from distributed import as_completed
+
+        # pure=False: a point is a computation to run, not a value Dask may deduplicate or cache.
+        futures = {self.client.submit(run_point, base, values, keep_runs, pure=False): identifier for identifier, values in tasks}
+        # The client is not Dask's default one (set_as_default=False), so as_completed is told its loop.
+        for future in as_completed(futures, loop=self.client.loop):
+            yield futures[future], future.result() if future.status == "finished" else _cluster_error(future)
+
+
+def _cluster_error(future: Any) -> BaseException:
+    """Why the cluster did not finish a point: the worker's exception, or the future's state (cancelled, lost)."""
+    if future.status == "error":
+        return future.exception()
+    return RuntimeError(f"the cluster reports the point as {future.status}")
+
+
+@contextmanager
+def backend_for(workers: int | None, scheduler: str | None, timeout: float, pending: int) -> Iterator[Any]:
+    if scheduler is not None:
+        client = connect(scheduler, timeout)
+        try:
+            yield _Cluster(client, max(1, sum(client.nthreads().values())))
+        finally:
+            client.close()
+        return
+    size = min(workers or os.cpu_count() or 1, pending)
+    if size <= 1:
+        yield _InProcess()
+        return
+    context = _start_context()
+    if context is None:
+        warnings.warn(
+            "sweep: called from the top level of a script without an `if __name__ == \"__main__\":` guard, where "
+            "worker processes cannot start on this platform; the points run one after another in this process",
+            stacklevel=4,
+        )
+        yield _InProcess()
+        return
+    executor = _process_pool(size, context)
+    try:
+        yield _LocalPool(size, executor)
+    except BaseException:
+        # Ctrl-C or an error while storing: queued points are dropped; running ones end with the pool.
+        executor.shutdown(wait=False, cancel_futures=True)
+        raise
+    executor.shutdown()
+
+
+def _process_pool(size: int, context: Any) -> Any:
+    """A process pool of ``context`` whose workers ignore Ctrl-C; the sweep's own process handles it and stops the pool."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(
+        max_workers=size, mp_context=context, initializer=_start_worker, initargs=(os.getpid(),)
+    )
+
+
+def _start_context() -> Any:
+    """How to start the workers: None when no worker could start, and the points must run in this process.
+
+    forkserver, where the platform has it: its workers import shakermill once, from a clean
+    single-threaded server, whereas fork from a process with threads (a progress bar, a Dask client)
+    can deadlock, and spawn re-imports everything in every worker. But forkserver and spawn also run
+    the main script again in each worker; called from a script's top level without a
+    ``__main__`` guard, each worker would start a sweep of its own and fail. There, Linux forks (the
+    script has no threads of shakermill's, and Numba's compiled code survives a fork); elsewhere,
+    where fork is unsafe, there is no way to start workers.
+    """
+    import multiprocessing
+
+    methods = multiprocessing.get_all_start_methods()
+    if _called_from_unguarded_main():
+        return multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
+    context = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+    if "forkserver" in methods:
+        context.set_forkserver_preload([__name__])
+    return context
+
+
+def _called_from_unguarded_main() -> bool:
+    """Whether this call comes from the top level of the main script, outside ``if __name__ == "__main__":``.
+
+    A notebook's or the interpreter's ``__main__`` has no file and is not run again by the workers.
+    """
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if main is None or path is None or getattr(main, "__spec__", None) is not None:
+        return False  # run with -m, the workers import it under its own name with the guard honoured
+    frame = sys._getframe(1)
+    while frame is not None and not (frame.f_globals is vars(main) and frame.f_code.co_name == "<module>"):
+        frame = frame.f_back
+    if frame is None:
+        return False
+    try:
+        tree = ast.parse(Path(path).read_text(encoding="utf-8"))
+    except (OSError, SyntaxError, ValueError):
+        return True
+    return not any(_is_main_guard(node) and node.lineno <= frame.f_lineno <= node.end_lineno for node in tree.body)
+
+
+def _is_main_guard(node: ast.stmt) -> bool:
+    if not isinstance(node, ast.If) or not isinstance(node.test, ast.Compare):
+        return False
+    operands = [node.test.left, *node.test.comparators]
+    names = {operand.id for operand in operands if isinstance(operand, ast.Name)}
+    constants = {operand.value for operand in operands if isinstance(operand, ast.Constant)}
+    return names == {"__name__"} and constants == {"__main__"}
+
+
+# How often a pool worker checks that the sweep that started it is still alive.
+PARENT_CHECK_INTERVAL_S = 1.0
+
+
+def _start_worker(sweep_pid: int) -> None:
+    """Ignore Ctrl-C (the sweep handles it), and exit when the sweep's process is gone.
+
+    A sweep killed with SIGKILL (by the user, or the out-of-memory killer) cannot stop its pool;
+    without this, its workers would wait for more points forever. A thread watches the sweep's
+    process and ends the worker once that process is gone or a zombie: killed, but not yet reaped
+    by its own parent (a shell or a job runner may take its time), when it still has its process id.
+
+    Why not ``prctl(PR_SET_PDEATHSIG)``, or watching ``os.getppid()``: a worker's parent is the
+    forkserver, not the sweep, and the forkserver lives on as long as its workers hold their end of
+    its "alive" pipe, so neither ever fires. psutil tells a zombie from a live process on every
+    platform, and compares start times, so a process id reused by another process is not taken
+    for the sweep. The thread runs between compiled chunks, so a worker ends within seconds.
+    """
+    import signal
+    import threading
+    import time
+
+    import psutil
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        sweep_process = psutil.Process(sweep_pid)
+    except psutil.NoSuchProcess:
+        os._exit(1)
+
+    def alive() -> bool:
+        try:
+            return sweep_process.is_running() and sweep_process.status() != psutil.STATUS_ZOMBIE
+        except psutil.NoSuchProcess:
+            return False
+
+    def exit_with_the_sweep() -> None:
+        while alive():
+            time.sleep(PARENT_CHECK_INTERVAL_S)
+        os._exit(1)
+
+    threading.Thread(target=exit_with_the_sweep, name="exit-with-the-sweep", daemon=True).start()
+
+
+def connect(address: str, timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S) -> Client:
+    """A Dask client of the scheduler at ``address``, or :class:`ParameterError` with one line saying why not."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ParameterError("scheduler: dask.distributed is not installed (pip install 'dask[distributed]')") from None
+    from distributed.security import Security
+
+    # The environment's TLS settings (distributed.comm.tls.* in Dask's configuration, or the
+    # DASK_DISTRIBUTED__COMM__TLS__* variables): the same for the handshake as for the client.
+    security = Security()
+    with _quiet_dask_logging():
+        _check_scheduler_answers(address, timeout, security)
+        try:
+            return Client(address, timeout=timeout, set_as_default=False, security=security)
+        except Exception as exc:  # noqa: BLE001 - whatever Dask raises, the user gets one line
+            raise ParameterError(f"scheduler: cannot connect to {address}: {in_one_line(exc)}") from None
+
+
+def _check_scheduler_answers(address: str, timeout: float, security: Any) -> None:
+    """Open one connection to ``address`` and complete Dask's handshake, within ``timeout`` for each.
+
+    Done before a :class:`~distributed.Client` is made, because a Client waits for the handshake
+    without limit (a server that never speaks first, such as the HTTP dashboard on port 8787, keeps
+    it waiting forever), and a Client whose start failed hangs the interpreter's exit closing itself.
+    The probe runs on its own event loop in its own thread, so it works inside a running loop (Jupyter).
+    """
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect as open_comm
+
+    async def handshake() -> None:
+        # open_comm bounds the connection by ``timeout`` but not the handshake; wait_for bounds both.
+        comm = await open_comm(address, timeout=timeout, **security.get_connection_args("client"))
+        await comm.close()
+
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="scheduler-probe") as probe:
+        try:
+            probe.submit(asyncio.run, asyncio.wait_for(handshake(), 2 * timeout)).result()
+        except asyncio.TimeoutError:
+            raise ParameterError(
+                f"scheduler: {address} accepted the connection but did not answer as a Dask scheduler "
+                f"(waited {2 * timeout:g} s); give the scheduler's address (tcp://HOST:8786), not the dashboard's"
+            ) from None
+        except (OSError, ValueError, TypeError) as exc:
+            # OSError: refused or timed out; ValueError/TypeError: an address Dask cannot parse.
+            raise ParameterError(f"scheduler: cannot connect to {address}: {in_one_line(exc)}") from None
+        except Exception as exc:  # noqa: BLE001 - a peer speaking another protocol can make Dask raise anything
+            raise ParameterError(
+                f"scheduler: {address} does not answer as a Dask scheduler ({type(exc).__name__} in the handshake)"
+            ) from None
+
+
+@contextmanager
+def _quiet_dask_logging() -> Iterator[None]:
+    # Dask logs each failed connection attempt; the user gets one line from connect() instead.
+    logger = logging.getLogger("distributed")
+    level = logger.level
+    logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)

@@ -1,0 +1,83 @@
+"""Everything ``shakermill validate`` reports, composed: the paper's Table 5 and the experiment's curve against this
+model with published and calibrated parameters (:mod:`validation`), which free sets of a calibration can follow the
+curve (:func:`calibrate.free_set_study`), and the three-dimensional studies held against what no fit has seen
+(:mod:`held_out`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from shakermill.parameters.config import load_config
+from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.keys import Parameters
+from shakermill.studies.calibrate import FreeSetOutcome, free_set_study
+from shakermill.studies.held_out import HeldOutStudies, held_out_studies
+from shakermill.studies.validation import EXPERIMENT, TABLE5, ValidationRun, validate
+
+SOLVERS = ("full", "averaged")
+
+
+@dataclass(frozen=True)
+class ValidationReport:
+    """The runs of the presets against Table 5, the free-set study (empty when not asked) and the held-out
+    studies (None when not asked)."""
+
+    solver: str
+    runs: tuple[ValidationRun, ...]
+    outcomes: tuple[FreeSetOutcome, ...]
+    held_out: HeldOutStudies | None
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON object of ``validate --json``."""
+        return {
+            "experiment_source": EXPERIMENT,
+            "solver": self.solver,
+            "quantities": {
+                entry.key: {"label": entry.label, "unit": entry.unit, "experiment": entry.experiment, "paper_model": entry.paper_model}
+                for entry in TABLE5
+            },
+            "runs": {run.preset: _run_entry(run) for run in self.runs},
+            "free_set_study": [_outcome_entry(outcome) for outcome in self.outcomes],
+            **(self.held_out.as_dict() if self.held_out is not None else {}),
+        }
+
+
+def _run_entry(run: ValidationRun) -> dict[str, Any]:
+    return {
+        "fitted_parameters": list(run.fitted),
+        "statement": run.statement,
+        "values": {row.quantity.key: row.value for row in run.rows},
+        "relative_error_vs_experiment": {row.quantity.key: row.error_vs_experiment for row in run.rows},
+        "role": {row.quantity.key: row.role for row in run.rows},
+        "curve_rms_K": run.curve_rms_K,
+        "ball_steady_C": run.summary["ball_steady_C"],
+        "slowest_time_constant_min": run.summary["slowest_time_constant_min"],
+    }
+
+
+def _outcome_entry(outcome: FreeSetOutcome) -> dict[str, Any]:
+    return {
+        "free": list(outcome.free),
+        "fitted": outcome.calibration.fitted,
+        "curve_rms_K": outcome.calibration.curve_rms_K,
+        "follows_curve": outcome.follows_curve,
+        "at_edges": outcome.calibration.at_bounds,
+        "predictions": outcome.calibration.predictions,
+        "verdict": outcome.verdict,
+    }
+
+
+def preset_parameters(name: str) -> Parameters:
+    """The parameters of preset ``name`` without record windows."""
+    return load_config(preset=name, overrides=["record_windows="]).params
+
+
+def validation_report(solver: str, study: bool = True, three_d: bool = True,
+                      progress: Callable[[int, int], None] | None = None) -> ValidationReport:
+    """Validate with ``solver`` ('full' or 'averaged'); with ``study`` the free-set study of the default preset, with
+    ``three_d`` the held-out studies (``progress(done, total)`` counts their runs)."""
+    runs = tuple(validate(solver))
+    outcomes = tuple(free_set_study(preset_parameters(DEFAULT_PRESET))) if study else ()
+    held_out = held_out_studies(progress) if three_d else None
+    return ValidationReport(solver, runs, outcomes, held_out)

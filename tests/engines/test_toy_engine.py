@@ -1,0 +1,244 @@
+"""A third engine, registered through the registry alone, runs through simulate (both solvers), storage, the summary
+and a figure with no other module touched: the engine interface is the only seam (docs/ARCHITECTURE.md).
+
+The toy is a point ball that crosses the vial's free gap at the vial's peak speed and bounces rigidly off each end
+face, the vial handing back the kinetic energy the bounce's restitution took: each hit makes η·½·m·u²·(1 − e²) of
+heat, λ of it into the ball. Its thermal network is the one every engine shares, integrated with the hits' mean
+heat rate; its numbers are hand-computable, so the test checks them, not only that files appear."""
+
+from __future__ import annotations
+
+import math
+from typing import Callable, ClassVar, Mapping, Sequence
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import shakermill as sm
+from shakermill.engines.budget import RunBudget
+from shakermill.engines.interface import EngineDescription, Measured
+from shakermill.engines.records import CELSIUS_VARIABLES, EnergyAudit, StateHistory, attributes, with_celsius
+from shakermill.engines.registry import describe, register, unregister
+from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
+from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork, air_constants, build_network
+from shakermill.io.runs import load_run, write_run
+from shakermill.parameters.engine_keys import EngineKeys
+from shakermill.parameters.keys import Parameters
+from shakermill.physics import thermal
+from shakermill.views.figures.run import temperature_figure
+
+IMPACT_UNITS = {"time": "s", "wall": "", "impact_speed": "m/s", "dissipated_energy": "J", "heat_generated": "J",
+                "peak_force": "N", "max_overlap": "m", "duration": "s"}
+DESCRIPTION = EngineDescription(
+    keys=EngineKeys(
+        name="toy", title="the toy engine", summary="a point ball bouncing rigidly between the end faces",
+        kinematics=("axial",), most_balls=1, thermal_models=("three_node",), air_moves_with_vial=False,
+    ),
+    channels=("normal",),
+    impact_units=IMPACT_UNITS,
+    impact_target="wall",
+    per_ball=(),
+    read_back=("time", "x", "theta_ball", "theta_vial", "theta_air"),
+    motion=("x", "velocity"),
+    heat_variables=("heat_generated",),
+    term_variables=("velocity_term_integral",),
+    status_messages={REACHED_STOP: "The toy reached the end."},
+    averaging_error_key="averaging_rel_error",
+    thermal_only_keys=(),
+    attractor_starts=False,
+)
+
+
+class ToyEngine:
+    """The engine interface, implemented for the toy (module docstring)."""
+
+    description: ClassVar[EngineDescription] = DESCRIPTION
+
+    def __init__(self, params: Parameters, budget: RunBudget | None = None, samples: Sequence[float] = (0.0,),
+                 horizon: float = 0.0) -> None:
+        self.params = params
+        self.budget = budget if budget is not None else RunBudget.of(params)
+        self.network = self.network_for(params)
+        self.speed = params.amplitude * params.omega
+        self.gap = params.vial_length / 2.0 - params.ball_radius
+        self.hit_heat = params.eta * 0.5 * params.ball_mass * self.speed**2 * (1.0 - params.restitution**2)
+        reynolds = thermal.reynolds_number(params.ball_radius, params.air_density, self.speed, air_constants(params)["viscosity_ambient"])
+        self.term = thermal.whitaker_velocity_term(reynolds)
+        self.samples = np.asarray(samples, dtype=float)
+        self.clock = 0.0
+        self.temperatures = [self.network.initial_temperatures(params.initial_temperature)]
+        self.lost = [0.0]
+        self.times = [0.0]
+
+    @classmethod
+    def network_for(cls, params: Parameters) -> ThermalNetwork:
+        return build_network(params, [params.ball_radius], [params.ball_mass * params.ball_heat_capacity], ("ball",),
+                             "λ of each hit's heat")
+
+    @property
+    def heat_power(self) -> float:
+        return self.hit_heat * self.speed / (2.0 * self.gap)
+
+    @property
+    def t(self) -> float:
+        return self.clock
+
+    def advance(self, t_stop: float, heartbeat: Callable[[float], None] | None = None) -> int:
+        if self.budget.spent():
+            return BUDGET_EXCEEDED
+        grid = self.samples[(self.samples > self.clock) & (self.samples <= t_stop)]
+        load = self.load(np.array([self.heat_power]), np.array([self.term]))
+
+        def rates(t: float, state: np.ndarray) -> np.ndarray:
+            node_rates, lost = self.network.rates(state[:-1], load.heat, load.terms)
+            return np.append(node_rates, lost)
+
+        start = np.append(self.temperatures[-1], self.lost[-1])
+        solution = solve_ivp(rates, (self.clock, t_stop), start, method="LSODA", t_eval=np.union1d(grid, [t_stop]), rtol=1e-9,
+                             atol=1e-9)
+        for time, state in zip(solution.t, solution.y.T):
+            self.times.append(float(time))
+            self.temperatures.append(state[:-1])
+            self.lost.append(float(state[-1]))
+        self.clock = t_stop
+        return REACHED_STOP
+
+    def explain(self, status: int) -> str:
+        return str(self.budget.reason) if status == BUDGET_EXCEEDED else DESCRIPTION.status_messages[status]
+
+    def _states(self, times: np.ndarray, theta: np.ndarray, lost: np.ndarray) -> StateHistory:
+        """The history at ``times`` (s) of the temperatures ``theta`` (time, node) and the heat ``lost`` (J)."""
+        # The ball's position on its sawtooth path across the gap.
+        phase = (self.speed * times + self.gap) % (4.0 * self.gap)
+        x = np.where(phase < 2.0 * self.gap, phase - self.gap, 3.0 * self.gap - phase)
+        variables = {
+            "x": (x, attributes("m", "ball centre position")),
+            "velocity": (np.where(phase < 2.0 * self.gap, self.speed, -self.speed), attributes("m s-1", "ball velocity")),
+            "theta_ball": (theta[:, 0], attributes("K", "ball temperature")),
+            "theta_vial": (theta[:, 1], attributes("K", "vial temperature")),
+            "theta_air": (theta[:, 2], attributes("K", "inner air temperature")),
+            "heat_generated": (self.heat_power * times, attributes("J", "cumulative heat generated")),
+            "heat_lost": (lost, attributes("J", "cumulative heat lost")),
+            "velocity_term_integral": (self.term * times, attributes("s", "integral of Whitaker's velocity term")),
+        }
+        with_celsius(variables, CELSIUS_VARIABLES)
+        return StateHistory(times, variables)
+
+    def history(self) -> StateHistory:
+        times = np.asarray(self.times)
+        keep = np.isin(times, self.samples) | (times == self.clock)
+        return self._states(times[keep], np.asarray(self.temperatures)[keep], np.asarray(self.lost)[keep])
+
+    def window_history(self) -> StateHistory:
+        return self._states(np.empty(0), np.empty((0, 3)), np.empty(0))
+
+    def impact_columns(self, since: float = -math.inf) -> dict[str, np.ndarray]:
+        first = self.gap / self.speed
+        times = first + 2.0 * self.gap / self.speed * np.arange(int(max(self.clock - first, 0.0) * self.speed / (2.0 * self.gap)) + 1)
+        times = times[(times <= self.clock) & (times >= since)]
+        count = times.size
+        return {
+            "time": times,
+            "wall": np.where(np.arange(count) % 2 == 0, "right", "left"),
+            "impact_speed": np.full(count, self.speed),
+            "dissipated_energy": np.full(count, self.hit_heat / self.params.eta),
+            "heat_generated": np.full(count, self.hit_heat),
+            "peak_force": np.full(count, math.inf),  # a rigid bounce
+            "max_overlap": np.zeros(count),
+            "duration": np.zeros(count),
+        }
+
+    def counters(self) -> dict[str, int]:
+        impacts = len(self.impact_columns()["time"])
+        return {"steps": impacts, "rejected_steps": 0, "rhs_evaluations": 0, "impacts": impacts}
+
+    def energy_audit(self) -> EnergyAudit:
+        """The vial restores the speed each hit takes: its work is what the hits dissipate."""
+        capacity = self.network.arrays.capacity
+        warming = self.temperatures[-1] - self.temperatures[0]
+        heat = self.heat_power * self.clock
+        dissipated = heat / self.params.eta
+        return EnergyAudit(
+            work_by_vial=dissipated, kinetic_energy_change=0.0, elastic_energy_change=0.0, dissipated=dissipated,
+            heat_generated=heat, heat_to_ball=self.params.lam * heat, heat_to_vial=(1.0 - self.params.lam) * heat,
+            not_converted_to_heat=dissipated - heat, stored_ball=float(capacity[0] * warming[0]),
+            stored_vial=float(capacity[1] * warming[1]), stored_air=float(capacity[2] * warming[2]),
+            heat_lost_to_surroundings=self.lost[-1], projection_correction=0.0,
+        )
+
+    @property
+    def projection_correction(self) -> float:
+        return 0.0
+
+    def no_impact_note(self) -> str:
+        return ""
+
+    def measured(self) -> Measured:
+        return Measured(np.array([self.heat_power * self.clock]), np.array([self.term * self.clock]),
+                        self.heat_power / self.params.eta * self.clock)
+
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray) -> NetworkLoad:
+        power, lam = float(heat_rates[0]), self.params.lam
+        return NetworkLoad(np.array([lam * power, (1.0 - lam) * power, 0.0]), np.array(term_means, dtype=float), power,
+                           float(term_means[0]))
+
+    def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
+        count = len(impacts["time"])
+        return np.array([count, count, 0])
+
+    def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray, load: NetworkLoad,
+                         dissipated_power: float) -> StateHistory:
+        return self._states(times, temperatures.T, heat_lost)
+
+
+@pytest.fixture(name="toy")
+def toy_fixture():
+    register(ToyEngine)
+    yield sm.default_parameters(engine="toy", duration=600.0, output_interval=10.0, record_windows=())
+    unregister("toy")
+
+
+def test_the_toy_is_only_in_the_registry_while_registered(toy):
+    assert describe("toy") is DESCRIPTION
+    unregister("toy")
+    with pytest.raises(sm.ParameterError, match=r"^engine: input should be '1d' or 'dem' \(got 'toy'\)"):
+        toy.replace(duration=60.0)
+    register(ToyEngine)
+
+
+@pytest.mark.slow
+def test_a_registered_engine_runs_through_simulate_storage_the_summary_and_a_figure(toy, tmp_path):
+    result = sm.simulate(toy)
+    assert result.success, result.message
+    hits = result.impact_count
+    engine = ToyEngine(toy)
+    # A hit every crossing of the free gap, the first after half of one.
+    assert hits == math.floor((600.0 - engine.gap / engine.speed) * engine.speed / (2 * engine.gap)) + 1
+    assert result.summary["impact_rate_hz"] == pytest.approx(hits / 600.0)
+    assert result.summary["mean_impact_speed_m_s"] == pytest.approx(toy.amplitude * toy.omega)
+    assert result.summary["heat_power_W"] == pytest.approx(engine.heat_power, rel=1e-12)
+    # The steady state of the shared network: all the heat leaves through h_o·A_o.
+    assert result.summary["vial_steady_C"] == pytest.approx(
+        toy.ambient_temperature + engine.heat_power / (toy.h_outer * toy.outer_area) - 273.15, rel=1e-9
+    )
+    assert result.energy.relative_residual < 1e-6
+    folder = write_run(result, tmp_path / "run", preset="spex8000m")
+    stored = load_run(folder)
+    assert stored.params.engine == "toy"
+    assert stored.summary["heat_power_W"] == result.summary["heat_power_W"]
+    np.testing.assert_array_equal(stored.timeseries["theta_ball"].values, result.history["theta_ball"])
+    assert stored.impact_units == IMPACT_UNITS
+    figure = temperature_figure(stored)
+    lines = {line.get_label(): line for line in figure.axes[0].get_lines()}
+    np.testing.assert_allclose(lines["ball"].get_ydata(), result.history["theta_ball"] - 273.15)
+
+
+def test_the_averaged_solver_drives_a_registered_engine_too(toy):
+    result = sm.simulate(toy.replace(solver="averaged"))
+    assert result.success, result.message
+    assert result.solver == "averaged" and result.averages.converged
+    engine = ToyEngine(toy)
+    assert result.averages.heat_power == pytest.approx(engine.heat_power, rel=1e-12)
+    full = sm.simulate(toy)
+    np.testing.assert_allclose(result.history["theta_ball"], full.history["theta_ball"], rtol=1e-6)
