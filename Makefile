@@ -20,9 +20,10 @@ run: install
 	$(BIN)/shakermill run --overwrite --out $(OUT)
 
 # scripts/ensure-browser installs Chromium for the report's browser test, or prints why it cannot
-# (the test then skips with that reason).
+# (the test then skips with that reason). One worker per core (pytest-xdist, at most 4): the suite is
+# mostly engine runs on one thread each.
 test: install
-	@reason="$$(scripts/ensure-browser)"; SHAKERMILL_BROWSER_UNAVAILABLE="$$reason" $(BIN)/python -m pytest
+	@reason="$$(scripts/ensure-browser)"; SHAKERMILL_BROWSER_UNAVAILABLE="$$reason" $(BIN)/python -m pytest -n auto --maxprocesses 4
 
 # The unit tests alone: every test not marked slow (pyproject.toml), in under a minute.
 test-fast: install

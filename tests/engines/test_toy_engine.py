@@ -8,18 +8,20 @@ heat rate; its numbers are hand-computable, so the test checks them, not only th
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Callable, ClassVar, Mapping, Sequence
 
 import numpy as np
 import pytest
+import xarray as xr
 from scipy.integrate import solve_ivp
 
 import shakermill as sm
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.interface import EngineDescription, Measured
 from shakermill.engines.records import CELSIUS_VARIABLES, EnergyAudit, StateHistory, attributes, with_celsius
-from shakermill.engines.registry import describe, register, unregister
+from shakermill.engines.registry import describe, engine_named, register, unregister
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork, air_constants, build_network
 from shakermill.io.runs import load_run, write_run
@@ -41,6 +43,7 @@ DESCRIPTION = EngineDescription(
     per_ball=(),
     read_back=("time", "x", "theta_ball", "theta_vial", "theta_air"),
     motion=("x", "velocity"),
+    averaged_flows=("heat_generated", "velocity_term_integral"),
     heat_variables=("heat_generated",),
     term_variables=("velocity_term_integral",),
     status_messages={REACHED_STOP: "The toy reached the end."},
@@ -105,7 +108,7 @@ class ToyEngine:
         return REACHED_STOP
 
     def explain(self, status: int) -> str:
-        return str(self.budget.reason) if status == BUDGET_EXCEEDED else DESCRIPTION.status_messages[status]
+        return self.budget.explain(status, DESCRIPTION.status_messages)
 
     def _states(self, times: np.ndarray, theta: np.ndarray, lost: np.ndarray) -> StateHistory:
         """The history at ``times`` (s) of the temperatures ``theta`` (time, node) and the heat ``lost`` (J)."""
@@ -207,6 +210,17 @@ def test_the_toy_is_only_in_the_registry_while_registered(toy):
     register(ToyEngine)
 
 
+def test_a_built_in_engine_can_be_neither_replaced_nor_taken_out():
+    built_in = describe("1d")
+    with pytest.raises(ValueError, match="'1d' is built in"):
+        register(type("Impostor", (ToyEngine,), {"description": dataclasses.replace(DESCRIPTION, keys=built_in.keys)}))
+    with pytest.raises(ValueError, match="'dem' is built in"):
+        unregister("dem")
+    assert describe("1d") is built_in
+    assert describe("dem").name == "dem"
+    assert engine_named("dem").__name__ == "DemEngine"
+
+
 @pytest.mark.slow
 def test_a_registered_engine_runs_through_simulate_storage_the_summary_and_a_figure(toy, tmp_path):
     result = sm.simulate(toy)
@@ -234,7 +248,7 @@ def test_a_registered_engine_runs_through_simulate_storage_the_summary_and_a_fig
     np.testing.assert_allclose(lines["ball"].get_ydata(), result.history["theta_ball"] - 273.15)
 
 
-def test_the_averaged_solver_drives_a_registered_engine_too(toy):
+def test_the_averaged_solver_drives_a_registered_engine_too(toy, tmp_path):
     result = sm.simulate(toy.replace(solver="averaged"))
     assert result.success, result.message
     assert result.solver == "averaged" and result.averages.converged
@@ -242,3 +256,9 @@ def test_the_averaged_solver_drives_a_registered_engine_too(toy):
     assert result.averages.heat_power == pytest.approx(engine.heat_power, rel=1e-12)
     full = sm.simulate(toy)
     np.testing.assert_allclose(result.history["theta_ball"], full.history["theta_ball"], rtol=1e-6)
+    # Its files say what the averaged run did not compute, and what it extended from the window, as it declares.
+    with xr.open_dataset(write_run(result, tmp_path / "averaged", preset="spex8000m") / "timeseries.nc", engine="h5netcdf") as series:
+        assert "x, velocity are NaN" in series.attrs["coverage"]
+        assert "heat_generated, velocity_term_integral are the averaging window's mean" in series.attrs["coverage"]
+        assert "mean rate times time" in series["velocity_term_integral"].attrs["coverage"]
+        assert "not computed" in series["x"].attrs["coverage"] and "coverage" not in series["theta_air"].attrs

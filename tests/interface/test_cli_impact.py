@@ -30,7 +30,7 @@ JSON_KEYS = [
     "dissipated_sliding_J",
     "dissipated_rolling_J",
 ]
-# Fine contact steps: the measured restitution is then within 4e-4 of the given one (tests/studies/test_impact.py).
+# Fine contact steps: the measured restitution is then within 4e-4 of the given one (tests/solvers/test_impact.py).
 FINE = ["--set", "contact_step_fraction=0.02"]
 
 runner = CliRunner()
@@ -115,7 +115,7 @@ def test_installed_command_refuses_a_negative_speed_in_one_line():
 
 
 # The Chung & Ooi (2011) verification set through the command itself (inputs: docs/notes/dem-references.md §1;
-# the full set, with more angles and speeds, is in tests/studies/test_impact.py).
+# the full set, with more angles and speeds, is in tests/solvers/test_impact.py).
 RIGID_WALL = ["--set", "vial_youngs_modulus=1.2e12"]
 ALUMINA = ["--set", "ball_radius=2.5mm", "--set", "ball_density=4000", "--set", "ball_youngs_modulus=3.8e11",
            "--set", "ball_poisson_ratio=0.23"]

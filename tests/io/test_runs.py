@@ -168,6 +168,7 @@ def test_to_jsonable_makes_numpy_values_plain_and_non_finite_values_null():
 
 def test_writing_again_replaces_the_old_run_completely(run_folder, short_result):
     (run_folder / "stale.txt").write_text("from the old run")
+
     def add_extra(folder: Path) -> None:
         (folder / "extra.txt").write_text("new")
 

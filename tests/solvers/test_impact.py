@@ -1,4 +1,4 @@
-"""One impact on its own (studies/impact.py) against Hertz theory, rigid-body Coulomb theory and the
+"""One impact on its own (solvers/impact.py) against Hertz theory, rigid-body Coulomb theory and the
 Chung & Ooi (Granular Matter 13 (2011) 643–656) verification set; inputs from docs/notes/dem-references.md §1."""
 
 from __future__ import annotations

@@ -44,6 +44,8 @@ def test_mechanics_measured_for_other_mechanical_keys_are_refused(base):
     mechanics = settle_mechanics(base.replace(averaging_max_time=0.2), DemEngine)
     measured = mechanics.params
     assert mechanics.serves(measured.replace(h_outer=10.0)) and not mechanics.serves(measured.replace(lam=0.5))
+    # The room's temperature sets the air's viscosity in the Reynolds number of the measured Whitaker term.
+    assert not mechanics.serves(measured.replace(ambient_temperature=measured.ambient_temperature + 10.0))
     with pytest.raises(ValueError, match="thermal-only keys"):
         simulate_averaged(measured.replace(restitution=0.8), DemEngine, None, None, mechanics)
 

@@ -9,10 +9,12 @@ import shakermill as sm
 from shakermill.parameters.config import load_config
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.presets import PRESETS
+from shakermill.parameters.defaults import DEM_DEFAULT_FREE
 from shakermill.studies.calibrate import (
     DEFAULT_FREE,
     DEFENSIBLE_RANGES,
     calibrate,
+    default_free,
     free_set_study,
     log_bounds,
     parse_free,
@@ -225,3 +227,9 @@ def test_fit_bounds_keep_off_an_open_hard_bound() -> None:
     low, high = np.exp(log_bounds("air_heat_capacity_ratio", 1.4))
     assert 1.0 < low < 1.0 + 1e-8 and high == pytest.approx(5 / 3)
     sm.default_parameters(air_heat_capacity_ratio=float(low))
+
+
+def test_the_default_free_set_is_what_moves_the_engines_network_alone():
+    assert default_free(sm.default_parameters()) == DEFAULT_FREE
+    # The 'dem' engine measures its mechanics once per fit: λ splits the heat inside the stepping.
+    assert default_free(sm.default_parameters(engine="dem")) == DEM_DEFAULT_FREE == ("beta", "vial_mass", "h_outer")

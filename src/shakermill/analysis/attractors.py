@@ -235,9 +235,8 @@ def initial_states(params: Parameters, count: int) -> list[tuple[float, float]]:
 
 
 def settle_span(params: Parameters) -> float:
-    """Simulated seconds :func:`settle` integrates: SETTLE_PERIODS and MEASURE_PERIODS drive periods."""
+    """Simulated seconds :func:`shakermill.solvers.attractors.settle` integrates: SETTLE_PERIODS and MEASURE_PERIODS drive periods."""
     return (SETTLE_PERIODS + MEASURE_PERIODS) * params.period
-
 
 
 def group(settled: tuple[SettledStart, ...], omega: float, phase: float) -> tuple[Attractor, ...]:

@@ -113,5 +113,3 @@ def classify_impacts(settled: ImpactColumns, omega: float, phase: float) -> tupl
         if all(signatures_match(signatures[k], signatures[k + period]) for k in range(len(signatures) - period)):
             return f"period-{period}", period
     return IRREGULAR, None
-
-

@@ -43,7 +43,3 @@ def main() -> None:
         # Everything is written by now. Tearing down NumPy, SciPy, Numba and pandas at exit collects
         # every object they made, about 0.4 s of a short run; frozen objects are left to the OS instead.
         gc.freeze()
-
-
-if __name__ == "__main__":
-    main()

@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 
     from shakermill.studies.calibrate import Calibration
 
+
 def validate(
     solver: Annotated[
         str, typer.Option("--solver", help="'full' (default, as the paper) or 'averaged' (seconds instead of minutes).")

@@ -21,6 +21,7 @@ if TYPE_CHECKING:
 
     from shakermill.io.runs import RunData
 
+
 def load_run_or_fail(folder: Path) -> RunData:
     """The run folder at ``folder``, or one ``error:`` line and exit code 2."""
     from shakermill.io.runs import load_run

@@ -276,4 +276,3 @@ def impact(
     for key, label, scale, spec, unit in IMPACT_ROWS:
         add_plain_row(table, label, number(scale * outcome[key], spec), unit)
     stdout_console().print(table)
-

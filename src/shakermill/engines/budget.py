@@ -15,7 +15,9 @@ import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Iterator
+from typing import TYPE_CHECKING, Iterator, Mapping
+
+from shakermill.engines.status import BUDGET_EXCEEDED
 
 if TYPE_CHECKING:
     from shakermill.parameters.keys import Parameters
@@ -54,6 +56,11 @@ class RunBudget:
         if self.reason is None:
             self.reason = self._overrun()
         return self.reason is not None
+
+    def explain(self, status: int, messages: Mapping[int, str]) -> str:
+        """The message of an engine's ``status`` from its ``messages``; for BUDGET_EXCEEDED, which limit was reached
+        and how to raise it."""
+        return str(self.reason) if status == BUDGET_EXCEEDED else messages[status]
 
     def _overrun(self) -> str | None:
         if self.steps >= self.max_steps:

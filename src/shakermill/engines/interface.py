@@ -18,13 +18,6 @@ if TYPE_CHECKING:
     from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
     from shakermill.parameters.keys import Parameters
 
-# The impact columns every engine writes (its ``impact_units`` may add more): the summary, the regime and the
-# figures read these.
-COMMON_IMPACT_COLUMNS = ("time", "impact_speed", "dissipated_energy", "heat_generated", "peak_force", "max_overlap", "duration")
-# The history variables every engine writes, over time: the ball's (or the balls' mean) temperature, the vial's and
-# the air's (K, and in °C as ``<name>_C``), and the cumulative heat generated (J).
-COMMON_HISTORY_VARIABLES = ("theta_ball", "theta_vial", "theta_air", "heat_generated")
-
 
 @dataclass(frozen=True)
 class EngineDescription:
@@ -34,14 +27,16 @@ class EngineDescription:
     channels: tuple[str, ...]  # the dissipation channels of its contacts (MODEL.md §12.4), as named in its records
     impact_units: Mapping[str, str]  # each column of its impact records and its unit
     impact_target: str  # the impact column that names what a ball hit: end faces, side wall, another ball
-    per_ball: tuple[str, ...]  # history variables with a ball dimension (over time, ball, ...)
+    per_ball: tuple[str, ...]  # history variables with a ball dimension, (time, ball, ...)
     read_back: tuple[str, ...]  # history variables that plot and report read from a run folder
     motion: tuple[str, ...]  # history variables of the balls' motion: not computed by the averaged solver (NaN)
+    # Cumulative history variables that an averaged run fills with its averaging window's mean rates times time.
+    averaged_flows: tuple[str, ...]
     # History variables that accumulate the heat of its sources (J) and each ball's Whitaker term (s): their rates
     # over a run's second half, through ``Engine.load``, drive its steady state.
     heat_variables: tuple[str, ...]
     term_variables: tuple[str, ...]
-    status_messages: Mapping[int, str]  # its own status codes (beyond engines/status.py) and what they mean
+    status_messages: Mapping[int, str]  # every status code it reports (engines/status.py's and its own) and what it means
     averaging_error_key: str  # the key of its averaged solver's target relative standard error
     # Keys that enter its thermal network alone, never its mechanics: runs that differ in these share one
     # measured mechanics (solvers.simulate.thermal_variants). Empty where the temperatures share the mechanics'

@@ -43,11 +43,14 @@ from shakermill.support.atomic import (
     partial_path,
     remove_abandoned_writes,
 )
+from shakermill.support.limits import in_one_line
 from shakermill.support.version import __version__
 
 if TYPE_CHECKING:
     import pandas as pd
     import xarray as xr
+
+    from shakermill.engines.interface import EngineDescription
 
 TIMESERIES_FILE = "timeseries.nc"
 WINDOWS_FILE = "windows.nc"
@@ -59,9 +62,6 @@ RUN_FILES = (TIMESERIES_FILE, WINDOWS_FILE, IMPACTS_FILE, SUMMARY_FILE, CONFIG_F
 UNITS_METADATA_KEY = b"units"
 # Key of what a file covers, where it is less than the whole run (averaged solver): attribute and Parquet metadata.
 COVERAGE_KEY = "coverage"
-# Variables of an averaged run's timeseries.nc that are the averaging window's rates times time (the motion, never
-# computed, is the engine's ``description.motion``).
-AVERAGED_FLOW_VARIABLES = ("work_vial", "dissipated", "heat_generated", "velocity_term_integral")
 # Reading goes through xarray with this engine; writing uses h5netcdf directly (:func:`netcdf_bytes`).
 NETCDF_ENGINE = "h5netcdf"
 
@@ -189,7 +189,7 @@ def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenan
     attributes = _run_attributes(result, preset)
     description = describe(result.params.engine)
     coverage = averaging_coverage(result)
-    history = _mark_averaged_variables(result.history, description.motion, coverage) if coverage else result.history
+    history = _mark_averaged_variables(result.history, description, coverage) if coverage else result.history
     title = "shakermill sampled state history"
     series = netcdf_bytes(history, title=title, **attributes, **_covers(coverage, "timeseries"))
     (folder / TIMESERIES_FILE).write_bytes(series)
@@ -220,7 +220,7 @@ def averaging_coverage(result: Result) -> dict[str, str]:
     averages = result.averages
     if result.impact_window is None or averages is None:
         return {}
-    motion_variables = describe(result.params.engine).motion
+    description = describe(result.params.engine)
     start, end = averages.transient, averages.transient + averages.window
     motion = (
         f"the ball's motion was integrated at full resolution only up to t = {end:.6g} s (the averaged solver's "
@@ -228,8 +228,9 @@ def averaging_coverage(result: Result) -> dict[str, str]:
     )
     return {
         "timeseries": (
-            f"averaged solver: the temperatures cover the whole run; {', '.join(motion_variables)} are NaN "
-            f"(not computed), and {', '.join(AVERAGED_FLOW_VARIABLES)} are the averaging window's mean rates times time"
+            f"averaged solver: the temperatures cover the whole run; {', '.join(description.motion)} are NaN "
+            f"(not computed), and {', '.join(description.averaged_flows)} are the averaging window's mean rates times "
+            "time"
         ),
         "motion": motion,
         "impacts": (
@@ -245,9 +246,10 @@ def _covers(coverage: Mapping[str, str], part: str) -> dict[str, str]:
     return {COVERAGE_KEY: coverage[part]} if coverage else {}
 
 
-def _mark_averaged_variables(history: StateHistory, motion: tuple[str, ...], coverage: Mapping[str, str]) -> StateHistory:
-    marks = {name: {COVERAGE_KEY: coverage["motion_variable"]} for name in motion if name in history.variables}
-    marks.update({name: {COVERAGE_KEY: coverage["flow_variable"]} for name in AVERAGED_FLOW_VARIABLES})
+def _mark_averaged_variables(history: StateHistory, description: EngineDescription,
+                             coverage: Mapping[str, str]) -> StateHistory:
+    marks = {name: {COVERAGE_KEY: coverage["motion_variable"]} for name in description.motion if name in history.variables}
+    marks.update({name: {COVERAGE_KEY: coverage["flow_variable"]} for name in description.averaged_flows})
     return history.with_attributes(marks)
 
 
@@ -425,7 +427,7 @@ def _read_part(path: Path, read: Callable[[Path], Any]) -> Any:
         return read(path)
     except (OSError, ValueError, KeyError, TypeError) as exc:
         # ValueError covers malformed JSON, TOML and Parquet (ArrowInvalid) and a configuration that no longer validates.
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else " ".join(str(exc).split())
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else in_one_line(exc)
         # A configuration error names the file already.
         reason = reason.removeprefix(f"{path}: ") or type(exc).__name__
         raise StorageError(f"{path.parent}: not a readable shakermill run folder ({path.name}: {reason})") from None

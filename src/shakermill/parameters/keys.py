@@ -687,5 +687,3 @@ def _with_unit_hint(message: str, values: Mapping[str, Any]) -> str:
     key = message.partition(":")[0]
     slip = unit_slip(key, values[key]) if key in guards.PLAUSIBLE_RANGES else None
     return message if slip is None else f"{message} ({slip})"
-
-

@@ -130,7 +130,6 @@ def allowed_names() -> str:
     return f"one of {', '.join(names())} (aliases: {aliases})"
 
 
-
 def allowed_for(key: str) -> str:
     """The values ``key`` takes: one name (``ball_material``, ``vial_material``) or a list of them (``ball_materials``)."""
     return f"an empty list or n_balls names, each {allowed_names()}" if key == "ball_materials" else f"'' (none) or {allowed_names()}"

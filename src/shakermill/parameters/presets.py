@@ -212,8 +212,6 @@ def _base_of(path: Path) -> str:
 PRESETS: dict[str, Preset] = load_presets(PRESET_FOLDER, SPEX_8000M)
 
 
-
-
 def preset_values(name: str) -> dict[str, Any]:
     if name not in PRESETS:
         raise ParameterError(f"preset: unknown preset {name!r}; available: {', '.join(sorted(PRESETS))}")

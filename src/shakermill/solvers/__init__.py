@@ -1,2 +1,4 @@
-"""Orchestration: parameters in, :class:`~shakermill.solvers.result.Result` out, at full resolution
-(``full``) or with the averaged multiscale solver (``averaged``), and the SciPy cross-check (``reference``)."""
+"""Orchestration: parameters in, :class:`~shakermill.solvers.result.Result` out. One run driver (``driver``:
+chunks, budgets, progress, Ctrl-C, batch means) under the full-resolution solver (``full``) and the averaged
+multiscale solver (``averaged``); the probe for coexisting attractors (``attractors``), a lone impact
+(``impact``), and the dispatch by engine and solver (``simulate``)."""

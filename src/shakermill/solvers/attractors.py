@@ -91,7 +91,6 @@ def find_attractors(
     return AttractorScan(tuple(settled), group(tuple(settled), params.omega, params.phase))
 
 
-
 def probe_attractors(result: Result, budget: RunBudget, progress: ProgressCallback | None) -> None:
     """Attach the attractors of the run's parameters; a probe that used up the budget makes the run stopped."""
     scan = find_attractors(result.params, budget, progress)

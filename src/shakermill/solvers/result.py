@@ -120,7 +120,7 @@ class Result:
 
     @cached_property
     def impacts(self) -> pd.DataFrame:
-        """One row per impact, SI units (:data:`IMPACT_UNITS`)."""
+        """One row per impact, SI units (its engine's ``description.impact_units``)."""
         import pandas as pd
 
         return pd.DataFrame(self.impact_columns)
@@ -132,6 +132,7 @@ class Result:
 
     def _repr_html_(self) -> str:
         return present("result html", self)
+
 
 def conclude(result: Result, steady: SteadyState) -> Result:
     """The ``steady`` state (MODEL.md §11), physical bounds, energy audit and warnings of a finished run, then its
@@ -151,6 +152,7 @@ def conclude(result: Result, steady: SteadyState) -> Result:
     result.summary = summarize(result)
     return result
 
+
 def physical_bounds_problem(result: Result) -> str | None:
     """Why the temperatures of a run cannot be physical, or None."""
     series = result.history
@@ -167,6 +169,7 @@ def physical_bounds_problem(result: Result) -> str | None:
         return f"A temperature fell to {coldest:.4g} K, below absolute zero: the thermal network is not physical here."
     return None
 
+
 def energy_audit_problem(result: Result) -> str | None:
     """Why the energy audit of a run says its heat cannot be trusted, or None."""
     residual = result.energy.relative_residual
@@ -179,6 +182,7 @@ def energy_audit_problem(result: Result) -> str | None:
         f"(atol_temperature where the energies are very small), {projection}, and check the inputs."
     )
 
+
 def fit_warning(result: Result) -> str | None:
     """A line when the exponential fit of the ball temperature failed: the summary's θ∞, τ and θ̇₀ then mean nothing."""
     fit = result.ball_fit
@@ -188,6 +192,7 @@ def fit_warning(result: Result) -> str | None:
         f"the exponential fit of the ball temperature failed ({fit.message}): theta_inf_C, tau_min and "
         "rate0_C_per_min are not usable"
     )
+
 
 def steady_state_bound_warning(result: Result) -> str | None:
     """A line when the run stays in range but its steady state would not."""
@@ -199,6 +204,7 @@ def steady_state_bound_warning(result: Result) -> str | None:
         f"the ball's steady state ({kelvin_to_celsius(steady.ball):.4g} °C) is above ball_temperature_limit "
         f"({kelvin_to_celsius(limit):.4g} °C): a longer run would leave the model's range"
     )
+
 
 def understood_inputs(params: Parameters) -> dict[str, float]:
     """The inputs people most often give in other units, echoed in those units (guards against unit slips)."""
@@ -214,6 +220,7 @@ def understood_inputs(params: Parameters) -> dict[str, float]:
         "ambient_temperature_C": kelvin_to_celsius(params.ambient_temperature),
         "initial_temperature_C": kelvin_to_celsius(params.initial_temperature),
     }
+
 
 def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]:
     """The flat summary printed by ``run --json`` and stored as ``summary.json``."""

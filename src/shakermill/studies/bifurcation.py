@@ -27,6 +27,7 @@ class Bifurcation:
     attractors: pd.DataFrame  # <key>, attractor, regime, period, basin_fraction, impact_rate_hz, heat_power_W, starts
     phases: pd.DataFrame  # <key>, start, attractor, phase, wall: the settled impacts of every start
 
+
 def bifurcation(
     base: Parameters,
     values: Sequence[float],
@@ -70,14 +71,17 @@ def bifurcation(
     table["period"] = table["period"].astype("Int64")
     return Bifurcation(key, table, pd.concat(attractors, ignore_index=True), pd.concat(phases, ignore_index=True))
 
+
 def _keyed(table: pd.DataFrame, key: str, value: float) -> pd.DataFrame:
     """``table`` with the scanned value as its first column."""
     table.insert(0, key, float(value))
     return table
 
+
 BIFURCATION_TABLES = ("bifurcation_regimes", "bifurcation_attractors", "bifurcation_phases")
 
 BIFURCATION_FIGURE = "bifurcation"
+
 
 def write_bifurcation(scan: Bifurcation, folder: Path) -> list[Path]:
     """``bifurcation_regimes``, ``bifurcation_attractors`` and ``bifurcation_phases`` tables (Parquet and CSV) in ``folder``."""
@@ -87,10 +91,12 @@ def write_bifurcation(scan: Bifurcation, folder: Path) -> list[Path]:
     tables = dict(zip(BIFURCATION_TABLES, (scan.regimes, scan.attractors, scan.phases)))
     return [path for stem, table in tables.items() for path in write_table(table, folder, stem)]
 
+
 def is_bifurcation_folder(folder: Path) -> bool:
     """Whether ``folder`` holds only files that ``shakermill bifurcation`` writes, and so may be replaced."""
     names = {f"{stem}.{suffix}" for stem in BIFURCATION_TABLES for suffix in ("parquet", "csv")}
     names |= {f"{BIFURCATION_FIGURE}.{suffix}" for suffix in FIGURE_FORMATS}
     return all(entry.name in names and entry.is_file() for entry in folder.iterdir())
+
 
 BIFURCATION_FOLDER = FolderKind("bifurcation scan", is_bifurcation_folder)

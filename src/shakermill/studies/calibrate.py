@@ -31,7 +31,7 @@ import tomli_w
 from scipy.optimize import least_squares
 
 from shakermill.engines.registry import describe
-from shakermill.parameters.defaults import DEFAULT_FREE, DEM_DEFAULT_FREE
+from shakermill.parameters.defaults import DEFAULT_FREE
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters, bounds, check_known_keys
 from shakermill.solvers.result import Result
@@ -157,8 +157,10 @@ def _plain_number(text: str) -> float | None:
 
 def default_free(params: Parameters) -> tuple[str, ...]:
     """The free set a calibration of ``params`` fits when none is given: DEFAULT_FREE, or for an engine whose fits
-    measure the mechanics once (the 'dem' engine: it declares thermal-only keys) those that move the network alone."""
-    return DEM_DEFAULT_FREE if describe(params.engine).thermal_only_keys else DEFAULT_FREE
+    measure the mechanics once (it declares thermal-only keys: the 'dem' engine, DEM_DEFAULT_FREE) those of
+    DEFAULT_FREE that move its network alone."""
+    thermal_only = describe(params.engine).thermal_only_keys
+    return tuple(key for key in DEFAULT_FREE if key in thermal_only) if thermal_only else DEFAULT_FREE
 
 
 def parse_free(items: Sequence[str], default: tuple[str, ...] = DEFAULT_FREE) -> tuple[str, ...]:
@@ -494,4 +496,3 @@ def free_set_study(
     """Fit each free set to ``curve`` (the experiment's by default) from ``base``."""
     curve = curve or experiment_curve()
     return [FreeSetOutcome(tuple(free), calibrate(base, free, curve=curve)) for free in free_sets]
-

@@ -58,9 +58,6 @@ class SweepProgress:
     running: int
 
 
-# Grids and points ---------------------------------------------------------------------------------
-
-
 # One point --------------------------------------------------------------------------------------
 
 
@@ -157,11 +154,3 @@ class _Tracker:
         if self.progress is not None:
             running = min(self.slots, self.total - self.done)
             self.progress(SweepProgress(self.total, self.done, self.failed, running))
-
-
-# Execution backends ---------------------------------------------------------------------------------
-
-
-# The table ------------------------------------------------------------------------------------------
-
-

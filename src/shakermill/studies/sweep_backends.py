@@ -17,11 +17,10 @@ from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.studies.sweep_points import PointInterrupted, PointOutcome, run_point
-from shakermill.studies.sweep_storage import in_one_line
+from shakermill.support.limits import in_one_line
 
 if TYPE_CHECKING:
     from distributed import Client
-
 
 
 Task = tuple[str, Mapping[str, Any]]

@@ -86,4 +86,3 @@ def _caused_by_ctrl_c(error: BaseException | None) -> bool:
 def failed_row(values: Mapping[str, Any], error: str) -> dict[str, Any]:
     """The row of a point without a result: its values, why, and ``success`` false."""
     return to_jsonable({**values, "regime": None, "period": None, "error": error, "success": False})
-

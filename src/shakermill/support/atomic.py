@@ -155,4 +155,3 @@ def check_writable_place(path: Path) -> None:
 
 def _read_only(folder: Path) -> bool:
     return hasattr(os, "statvfs") and bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
-

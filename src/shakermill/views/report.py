@@ -124,7 +124,7 @@ figcaption { color: #444; font-size: 0.9em; margin-top: 0.3em; }
 def write_report(run_dir: Path | str, out: Path | str | None = None, compare_dir: Path | str | None = None) -> Path:
     """Write the HTML report of the run folder ``run_dir`` (default ``run_dir/report.html``); return its path.
 
-    Raises :class:`shakermill.storage.StorageError` when a folder is not a run folder.
+    Raises :class:`shakermill.support.atomic.StorageError` when a folder is not a run folder.
     """
     run = load_run(run_dir)
     other = load_run(compare_dir) if compare_dir is not None else None
@@ -168,9 +168,6 @@ def render_report(run: RunData, other: RunData | None = None) -> str:
         + "\n".join(sections)
         + f"\n<p class=\"note\">Report written by shakermill {esc(__version__)}.</p>\n</body>\n</html>\n"
     )
-
-
-# ---------------------------------------------------------------- HTML and number helpers
 
 
 # ---------------------------------------------------------------- run facts
@@ -230,7 +227,7 @@ def fitted_targets(preset: Preset | None) -> tuple[str, ...]:
     """The Table 5 quantities (summary keys) a preset's calibration was fitted to.
 
     ``Preset.fitted`` names the *parameters* the calibration set (beta, vial_mass); the quantities they
-    were fitted to come from its provenance, as in :func:`shakermill.validation.validate`.
+    were fitted to come from its provenance, as in :func:`shakermill.studies.validation.validate`.
     """
     if preset is None:
         return ()

@@ -37,7 +37,7 @@ FIGURE_CAPTIONS = {
 }
 
 
-# A 'dem' run's figures (views/figures.py, SEVERAL_BALL_FIGURES) and its impact figures, where they differ.
+# A 'dem' run's figures (views/figures/run.py, SEVERAL_BALL_FIGURES) and its impact figures, where they differ.
 SEVERAL_BALL_CAPTIONS = {
     "temperatures": (
         "Temperature (°C) of each ball, the vial and the inner air over the run (min), with the exponential "
@@ -245,4 +245,3 @@ def numerics_section(run: RunData) -> str:
     # The averaged solver adds its statistics (averaged_*, averaging_*) to the summary.
     rows += [(key, number(value, ".4g"), "") for key, value in summary.items() if key.startswith("averag")]
     return section("Numerics", table(("quantity", "value", "unit"), rows, numeric=(1,)))
-

@@ -1,3 +1,4 @@
-"""The several-ball, three-dimensional engine (MODEL.md section 12): constants and state derived from
-parameters (``model``), the compiled velocity-Verlet stepping with Hertz–Mindlin contacts and heat per
-dissipation channel (``stepper``), and a run driven from Python in budgeted chunks (``engine``)."""
+"""The several-ball, three-dimensional engine (MODEL.md section 12): what it declares (``description``),
+constants and state derived from parameters (``model``), the compiled Hertz–Mindlin contacts with heat per
+dissipation channel (``contacts``, on the small vector helpers of ``vectors``), the compiled velocity-Verlet
+stepping (``stepper``), and the engine the solvers drive (``engine``)."""

@@ -35,11 +35,12 @@ IMPACT_UNITS = {
     "duration": "s",
 }
 
-# Keys that enter only the thermal network, never a force or the heat a contact makes (λ, η and the balls'
-# effusivities split that heat inside the stepper, and the air's properties set the Whitaker term).
+# Keys that enter only the thermal network, never a force, the heat a contact makes or the Whitaker term the
+# stepping measures (λ, η and the balls' effusivities split that heat inside the stepper; the air's density and
+# its viscosity at the ambient temperature set each ball's Reynolds number there).
 THERMAL_ONLY_KEYS = (
     "h_inner", "h_outer", "inner_area", "outer_area", "vial_mass", "vial_heat_capacity", "beta",
-    "ambient_temperature", "initial_temperature", "duration", "output_interval",
+    "initial_temperature", "duration", "output_interval",
 )
 
 DESCRIPTION = EngineDescription(
@@ -51,6 +52,8 @@ DESCRIPTION = EngineDescription(
               "angular_velocity"),
     read_back=("time", "position", "velocity", "theta_ball", "theta_balls", "theta_vial", "theta_air"),
     motion=("position", "velocity", "angular_velocity"),
+    averaged_flows=("work_vial", "heat_generated", "heat_into_balls", "heat_into_vial", "velocity_term_integrals",
+                    "velocity_term_integral"),
     heat_variables=("heat_into_balls", "heat_into_vial"),
     term_variables=("velocity_term_integrals",),
     status_messages=STATUS_MESSAGES,

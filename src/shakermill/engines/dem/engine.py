@@ -23,7 +23,6 @@ from shakermill.engines.records import (
     attributes,
     with_celsius,
 )
-from shakermill.engines.status import BUDGET_EXCEEDED
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.keys import Parameters
 from shakermill.physics.kinematics import fourier_coordinates
@@ -31,7 +30,7 @@ from shakermill.physics.kinematics import fourier_coordinates
 INITIAL_RECORDS = 4096
 # The record windows hold the motion at this interval (10 kHz): a drive period in ~570 points.
 WINDOW_INTERVAL = 1e-4
-TARGETS = np.array(["left", "right", "side"])
+TARGETS = np.array(model.WALL_NAMES)
 _PER_BALL = ("time", "ball")
 _VECTORS = ("time", "ball", "axis")
 
@@ -96,7 +95,7 @@ class DemEngine(CompiledRun):
         return PAUSED if status == stepper.PAUSED else int(status)
 
     def explain(self, status: int) -> str:
-        return str(self.budget.reason) if status == BUDGET_EXCEEDED else DESCRIPTION.status_messages[status]
+        return self.budget.explain(status, DESCRIPTION.status_messages)
 
     @property
     def records(self) -> np.ndarray:
@@ -145,10 +144,6 @@ class DemEngine(CompiledRun):
         contacts = self.state.contacts
         springs = 0.5 * contacts.stiffness * contacts.stretch
         return float(np.sum(contacts.elastic_energy[contacts.active]) + np.sum(springs[contacts.active]))
-
-    def thermal_energy(self) -> float:
-        """Σ C·θ of balls, vial and air (J above 0 K): its change is the heat they stored."""
-        return float(np.dot(self.network.arrays.capacity, self.state.temperature))
 
     def energy_audit(self) -> EnergyAudit:
         """Where the work of the vial and of gravity went (MODEL.md §12.6), from the start to now."""

@@ -589,7 +589,7 @@ class Integrator(CompiledRun):
 
     def explain(self, status: int) -> str:
         """The message of ``status``; for BUDGET_EXCEEDED, which limit was reached and how to raise it."""
-        return str(self.budget.reason) if status == BUDGET_EXCEEDED else STATUS_MESSAGES[status]
+        return self.budget.explain(status, STATUS_MESSAGES)
 
     def compiled_call(self, t_stop: float, steps_allowed: int) -> int:
         controller, tolerances = self.controller, self.tolerances

@@ -37,18 +37,6 @@ from shakermill.physics import contact, kinematics, thermal
 X, P, THETA_BALL, THETA_VIAL, THETA_AIR, WORK_VIAL, DISSIPATED, HEAT_GENERATED, HEAT_LOST, VELOCITY_TERM = range(10)
 N_DYNAMIC = 5
 N_STATE = 10
-STATE_NAMES = (
-    "x",
-    "p",
-    "theta_ball",
-    "theta_vial",
-    "theta_air",
-    "work_vial",
-    "dissipated",
-    "heat_generated",
-    "heat_lost",
-    "velocity_term_integral",
-)
 
 NO_WALL, LEFT_WALL, RIGHT_WALL = 0, 1, 2
 

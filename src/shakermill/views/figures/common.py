@@ -37,7 +37,7 @@ LEGEND_COLUMNS = 6
 
 
 class RunLike(Protocol):
-    """What the figures need: a :class:`shakermill.simulate.Result` or a :class:`shakermill.storage.RunData`."""
+    """What the figures need: a :class:`shakermill.solvers.result.Result` or a :class:`shakermill.io.runs.RunData`."""
 
     @property
     def params(self) -> Parameters: ...
@@ -74,7 +74,7 @@ def check_window(params: Parameters, window: int) -> None:
 def run_context(run: RunLike) -> str:
     """"spex8000m, 60 min, averaged solver": what a figure of ``run`` shows, for its title.
 
-    The preset is known for a stored run (:class:`shakermill.storage.RunData`), not for a bare Result.
+    The preset is known for a stored run (:class:`shakermill.io.runs.RunData`), not for a bare Result.
     """
     minutes = run.summary.get("simulated_s", run.params.duration) / 60.0
     parts = [getattr(run, "preset", None), f"{minutes:.3g} min", f"{run.params.solver} solver"]

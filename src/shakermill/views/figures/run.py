@@ -360,8 +360,3 @@ def comparison_temperature_figure(runs: dict[str, RunLike]) -> Figure:
     axis.legend(loc="upper left", fontsize="small")
     axis.grid(alpha=0.3)
     return figure
-
-
-# Sweeps and regime maps ------------------------------------------------------------------------------
-
-
