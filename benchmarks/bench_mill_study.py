@@ -9,7 +9,7 @@ temperature after 1 h in °C), the wall time per point (median) and in total, an
 into ``docs/figures/mill-study.png``. A second part runs one hour of five 12.7-mm balls at the preset's own
 settings and prints its wall time, heat power and the balls' and vial's temperatures.
 
-The preset is ``spex8000m-3d-calibrated``, fitted to the one-ball curve only. A point whose
+The preset is ``spex8000m-3d-calibrated-paper`` (the paper's three-node network), fitted to the one-ball curve only. A point whose
 mechanics do not converge within ``averaging_max_time`` fails with its reason (``averaging_fallback =
 'fail'``) instead of falling back to a full-resolution hour, which would take hours for a lone ball.
 
@@ -41,7 +41,7 @@ from shakermill.studies.sweep_storage import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURE = ROOT / "docs" / "figures" / "mill-study.png"
-PRESET = "spex8000m-3d-calibrated"
+PRESET = "spex8000m-3d-calibrated-paper"
 BALL_COUNTS = (1, 2, 3, 4, 5)
 DIAMETERS_MM = (8.0, 10.0, 12.7)
 MATERIALS = ("hardened-steel", "tungsten-carbide")

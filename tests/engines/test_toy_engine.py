@@ -35,7 +35,8 @@ IMPACT_UNITS = {"time": "s", "wall": "", "impact_speed": "m/s", "dissipated_ener
 DESCRIPTION = EngineDescription(
     keys=EngineKeys(
         name="toy", title="the toy engine", summary="a point ball bouncing rigidly between the end faces",
-        kinematics=("axial",), most_balls=1, thermal_models=("three_node",), air_moves_with_vial=False,
+        kinematics=("axial",), most_balls=1, thermal_models=("three_node",), networks=("paper",),
+        air_moves_with_vial=False,
     ),
     channels=("normal",),
     impact_units=IMPACT_UNITS,
@@ -181,7 +182,7 @@ class ToyEngine:
         return Measured(np.array([self.heat_power * self.clock]), np.array([self.term * self.clock]),
                         self.heat_power / self.params.eta * self.clock)
 
-    def load(self, heat_rates: np.ndarray, term_means: np.ndarray) -> NetworkLoad:
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
         power, lam = float(heat_rates[0]), self.params.lam
         return NetworkLoad(np.array([lam * power, (1.0 - lam) * power, 0.0]), np.array(term_means, dtype=float), power,
                            float(term_means[0]))
@@ -191,7 +192,7 @@ class ToyEngine:
         return np.array([count, count, 0])
 
     def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray, load: NetworkLoad,
-                         dissipated_power: float) -> StateHistory:
+                         dissipated_power: float, network: ThermalNetwork) -> StateHistory:
         return self._states(times, temperatures.T, heat_lost)
 
 

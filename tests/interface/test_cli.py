@@ -750,3 +750,26 @@ def test_a_run_without_figures_writes_its_files_without_the_heavy_libraries(tmp_
     run = load_run(tmp_path / "run")  # and what it wrote reads back as a full run's files do
     assert run.summary["solver"] == "averaged" and run.timeseries["theta_ball_C"].attrs["units"] == "degC"
     assert len(run.impacts) == len(run.impacts["wall"].dropna()) > 0
+
+
+def test_a_run_of_a_calibrated_preset_reports_intervals_and_where_its_heat_goes(tmp_path):
+    out = tmp_path / "calibrated"
+    result = invoke("run", "--preset", "spex8000m-calibrated", *SHORT, "--set", "solver=averaged", "--out", str(out), "--no-plots")
+    assert result.exit_code == 0, result.stderr
+    summary = load_run(out).summary
+    for key in ("ball_C", "vial_C", "ball_steady_C", "vial_steady_C"):
+        assert summary[f"{key}_low"] < summary[key] < summary[f"{key}_high"], key
+    assert "covariance" in summary["interval_note"] and "averaging error" in summary["interval_note"]
+    assert "90 % interval, ball at the end" in result.stdout
+    paths = summary["heat_paths_W"]
+    assert set(paths) == {"ball → air", "vial → air", "vial → room"}
+    assert "heat path vial → room" in result.stdout
+    # At the end of the run what the contacts give the vial and the ball has gone to the air, the room or stays.
+    assert paths["vial → room"] > 0.0 and paths["ball → air"] > 0.0
+
+
+def test_a_run_of_an_uncalibrated_preset_reports_no_intervals(tmp_path):
+    out = tmp_path / "plain"
+    result = invoke("run", *SHORT, "--out", str(out), "--no-plots", "--json")
+    assert result.exit_code == 0, result.stderr
+    assert not any(key.endswith("_low") for key in json.loads(result.stdout))

@@ -10,7 +10,8 @@ import pytest
 from typer.testing import CliRunner
 
 from shakermill import cli
-from shakermill.studies import held_out
+from shakermill.studies import held_out, validation_report
+from shakermill.studies.validation_matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
 
 runner = CliRunner()
 # A few drive periods at full resolution for every run: the command's shape, not its numbers.
@@ -22,6 +23,9 @@ def quick_runs_fixture(monkeypatch):
     monkeypatch.setattr(held_out, "five_ball_prediction", functools.partial(held_out.five_ball_prediction, QUICK))
     monkeypatch.setattr(held_out, "five_ball_sensitivity", functools.partial(held_out.five_ball_sensitivity, QUICK))
     monkeypatch.setattr(held_out, "engine_comparison", functools.partial(held_out.engine_comparison, overrides=QUICK))
+    monkeypatch.setattr(validation_report, "validation_matrix", functools.partial(validation_matrix, overrides=QUICK))
+    # Each structure's fit runs the one-ball hour: its study has tests of its own.
+    monkeypatch.setattr(validation_report, "structure_study", lambda progress: ())
 
 
 @pytest.mark.slow
@@ -35,6 +39,9 @@ def test_validate_prints_the_five_ball_prediction_the_engines_and_the_sensitivit
     for case in held_out.ENGINE_CASES:
         assert case.label[:30] in text
     assert "lateral_amplitude × 0.5" in text and "yaw_amplitude × 1.5" in text
+    assert "Validation matrix" in text and "It falsifies" in text
+    for preset in THERMAL_MODEL_PRESETS:
+        assert preset in text
 
 
 @pytest.mark.slow
@@ -56,3 +63,14 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
         ("lateral_amplitude", 0.5), ("lateral_amplitude", 1.5), ("yaw_amplitude", 0.5), ("yaw_amplitude", 1.5),
     ]
     assert set(sensitivity["baseline"]) == set(held_out.SENSITIVITY_MEASURES)
+    matrix = payload["validation_matrix"]
+    assert set(matrix["experiments"]) == {experiment.name for experiment in load_experiments()}
+    points = sum(len(experiment.points) for experiment in load_experiments())
+    assert len(matrix["rows"]) == points * len(THERMAL_MODEL_PRESETS)
+    for row in matrix["rows"]:
+        if row["measured_K"] is None:
+            assert row["role"] == "prediction" and row["relative_error"] is None
+        else:
+            assert row["relative_error"] == pytest.approx(row["predicted_K"] / row["measured_K"] - 1.0)
+            low, high = row["interval_90_K"]
+            assert row["inside_interval"] == (low <= row["measured_K"] <= high)

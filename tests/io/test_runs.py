@@ -86,6 +86,8 @@ def test_summary_json_is_strict_json_matching_the_result(run_folder, short_resul
     for key, value in short_result.summary.items():
         if isinstance(value, (str, list)):
             assert document["summary"][key] == value
+        elif isinstance(value, dict):
+            assert document["summary"][key] == pytest.approx(value, rel=1e-15), key
         else:
             assert document["summary"][key] == pytest.approx(float(value), rel=1e-15), key
     assert document["energy_audit"]["relative_residual"] == pytest.approx(short_result.energy.relative_residual)

@@ -42,6 +42,7 @@ class SteadyState:
     solved: bool
     message: str
     balls: tuple[float, ...] = ()  # each ball's steady temperature (K)
+    others: tuple[tuple[str, float], ...] = ()  # each further node's (the clamp's) name and steady temperature (K)
 
     @property
     def slowest_time_constant(self) -> float:
@@ -55,21 +56,24 @@ class SteadyState:
             "slowest_time_constant_min": self.slowest_time_constant / 60.0,
             "steady_state_heat_power_W": self.heat_power,
             "steady_state_message": self.message,
+            **{f"{name}_steady_C": value - 273.15 for name, value in self.others},
         }
 
 
 def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:
     """The root of ``network`` driven by ``load`` and its time constants (MODEL.md §11). The first guess puts every
-    free node where all the heat would leave through the constant paths to the room."""
-    if network.outer_conductance() <= 0.0 and not network.arrays.held.any() and load.heat_power > 0.0:
+    free node where all the heat would leave through the paths to the room."""
+    drives = load.drives
+    outer = network.room_conductance(drives)
+    heat = load.heat_power + network.fixed_heat
+    if outer <= 0.0 and not network.arrays.held.any() and heat > 0.0:
         return _unsolved(load, NO_HEAT_LEAVES)
     free = network.free
 
     def rates(theta: np.ndarray) -> np.ndarray:
-        return network.rates(network.with_free(theta), load.heat, load.terms)[0][free]
+        return network.rates(network.with_free(theta), load.heat, drives)[0][free]
 
-    outer = network.outer_conductance()
-    rise = load.heat_power / outer if outer > 0 else 0.0
+    rise = heat / outer if outer > 0 else 0.0
     solved = _solve(rates, np.full(free.size, network.ambient + rise))
     if isinstance(solved, str):
         return _unsolved(load, solved)
@@ -79,6 +83,7 @@ def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:
     return SteadyState(
         float(np.mean(balls)), float(temperatures[network.vial]), float(temperatures[network.air]), time_constants,
         load.heat_power, load.velocity_term, True, "solved", balls,
+        tuple((node.name, float(temperatures[index])) for index, node in enumerate(network.nodes) if index > network.air),
     )
 
 

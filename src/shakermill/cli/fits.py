@@ -80,8 +80,58 @@ def validate(
     console.print(Text(f"The experiment's ratio is for five balls: {TABLE5[-1].experiment_note}."))
     if report.outcomes:
         console.print(free_set_table(report.outcomes))
+    if report.matrix is not None:
+        print_matrix(console, report.matrix)
+    if report.structures:
+        print_structures(console, report.structures)
     if report.held_out is not None:
         print_held_out(console, report.held_out)
+
+
+def print_matrix(console: Console, matrix: Any) -> None:
+    """Each thermal model's calibrated preset against each experiment: the rise measured and predicted (K), with the
+    prediction's 90 % interval, its error and whether the measurement lies inside; then what each experiment is and
+    what each prediction would falsify."""
+    table = Table("preset (thermal model)", "experiment", "node", "t [min]", "role", "measured [K]", "predicted [K]",
+                  "90 % interval [K]", "error", "inside?", title="Validation matrix: rises above the start")
+    for row in matrix.rows:
+        measured = row.point.rise_K
+        interval = "—" if math.isnan(row.low_K) else f"{row.low_K:.3g} to {row.high_K:.3g}"
+        add_plain_row(
+            table, f"{row.preset} ({row.thermal_model})", row.experiment.name, row.point.node, f"{row.point.time_s / 60:g}",
+            row.role, "—" if measured is None else f"{measured:.3g}", f"{row.predicted_K:.3g}", interval,
+            "—" if measured is None else f"{100 * row.error:+.0f} %", {None: "—", True: "yes", False: "no"}[row.inside],
+        )
+    console.print(table)
+    for experiment in matrix.experiments:
+        console.print(Text(f"{experiment.name}: {experiment.title}. Source: {experiment.source}. Measured: {experiment.how_measured}."))
+        if experiment.falsifies:
+            console.print(Text(f"  It falsifies: {experiment.falsifies}."))
+
+
+def print_structures(console: Console, outcomes: Sequence[Any]) -> None:
+    """Each network structure fitted to the one-ball curve, whether it meets the bar of a physical fit, and what it
+    predicts for five balls, nothing refitted."""
+    from shakermill.studies.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
+    from shakermill.studies.validation_matrix import FOLLOWS_CURVE_K
+
+    table = Table("structure (free keys)", "one-ball RMS [K]", "on a range edge", "paths computed", "meets the bar",
+                  f"5 balls: ball [K] (exp. {FIVE_BALL_BALL_RISE_K:g})", f"vial [K] (exp. {FIVE_BALL_VIAL_RISE_K:g})",
+                  title="Which structure follows the one-ball curve with physical couplings, and what it then predicts")
+    for outcome in outcomes:
+        ball, vial = outcome.ball_rise_K, outcome.vial_rise_K
+        add_plain_row(
+            table, outcome.structure.label, f"{outcome.curve_rms_K:.2f}", ", ".join(outcome.edges) or "none",
+            "yes" if outcome.structure.physical else "no", "yes" if outcome.meets_point_7 else "no",
+            f"{ball:.3g} ({100 * (ball / FIVE_BALL_BALL_RISE_K - 1):+.0f} %)", f"{vial:.3g} ({100 * (vial / FIVE_BALL_VIAL_RISE_K - 1):+.0f} %)",
+        )
+    console.print(table)
+    meeting = [outcome for outcome in outcomes if outcome.meets_point_7]
+    console.print(Text(
+        f"The bar: the one-ball curve within {FOLLOWS_CURVE_K:g} K RMS, every free key strictly inside its range, every "
+        "computed path at its correlation's value. "
+        + (f"Met by: {', '.join(outcome.structure.label for outcome in meeting)}." if meeting else "No structure meets it.")
+    ))
 
 
 def print_held_out(console: Console, held_out: Any) -> None:
@@ -245,11 +295,13 @@ def print_calibration(
 ) -> None:
     """The fitted parameters, what the fitted model predicts, the residuals of the targets and of the curve."""
     console = stdout_console()
-    table = Table("parameter", "start", "fitted", "std. error", "physically defensible?", title="calibration")
+    ranges = calibration.posterior_ranges
+    table = Table("parameter", "start", "fitted", "std. error", "90 % of the posterior", "physically defensible?", title="calibration")
     for key in free_keys:
+        posterior = f"{ranges[key][0]:.3g} to {ranges[key][1]:.3g}" if key in ranges else "—"
         add_plain_row(
             table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}",
-            number(calibration.parameter_stderr[key], ".3g"), calibration.defensible[key],
+            number(calibration.parameter_stderr[key], ".3g"), posterior, calibration.defensible[key],
         )
     console.print(table)
     predictions = Table("not fitted, predicted", "value", title="what the fitted model predicts")

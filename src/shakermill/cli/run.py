@@ -4,6 +4,7 @@ side, one impact on its own."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Mapping, Sequence
 
@@ -69,6 +70,7 @@ def run(
     # A run returns what it computed when interrupted; Ctrl-C in the attractor probe or the thermal network leaves none.
     with nothing_written_when_interrupted("the run had no results to keep yet"):
         result = simulate_with_progress(run_config.params)
+        with_intervals(result, run_config.preset)
     if result.status != INTERRUPTED:
         # An interrupted run is short by choice: its warnings (run length, steady state) stay in summary.json.
         echo_warnings([line for line in result.warnings if line not in said_first])
@@ -80,6 +82,18 @@ def run(
     else:
         stdout_console().print(summary_table(result, target))
     _exit_for_status(result, target)
+
+
+def with_intervals(result: Result, preset: str | None) -> None:
+    """Add to the summary of a run of a calibrated preset the 90 % intervals of its headline temperatures
+    (``studies.uncertainty``), which carry the calibration's uncertainty and the averaging error."""
+    from shakermill.parameters.presets import PRESETS
+    from shakermill.studies.uncertainty import intervals, uncertainty_of
+
+    uncertainty = uncertainty_of(PRESETS[preset]) if preset in PRESETS else None
+    found = intervals(result, uncertainty) if uncertainty is not None else None
+    if found is not None:
+        result.summary.update(found.as_summary())
 
 
 def _write(
@@ -150,7 +164,9 @@ def summary_table(result: Result, target: Path) -> Table:
         ("vial at the end", number(s["vial_C"], ".2f"), "°C"),
         ("air at the end", number(s["air_C"], ".2f"), "°C"),
         ("vial/ball increment ratio", number(s["vial_ball_ratio"], ".3f"), ""),
+        *interval_rows(s),
         *(several_ball_rows(s, description.channels) if description.several_balls else ()),
+        *heat_path_rows(s),
         ("impacts", number(s["impacts"], "d"), ""),
         ("impact rate", number(s["impact_rate_hz"], ".2f"), "Hz"),
         ("mean impact speed", number(s["mean_impact_speed_m_s"], ".3f"), "m/s"),
@@ -164,6 +180,30 @@ def summary_table(result: Result, target: Path) -> Table:
     for row in rows:
         add_plain_row(table, *row)
     return table
+
+
+def interval_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
+    """The clamp's temperatures (thermal_model = 'mill-head') and the 90 % intervals of a calibrated preset's run."""
+    rows = []
+    if "clamp_C" in s:
+        rows.append(("clamp at the end; steady state", f"{number(s['clamp_C'], '.2f')}; {number(s.get('clamp_steady_C'), '.2f')}", "°C"))
+    for key, label in (("ball_C", "ball at the end"), ("vial_C", "vial at the end"), ("ball_steady_C", "ball steady state"),
+                       ("vial_steady_C", "vial steady state")):
+        if f"{key}_low" in s:
+            rows.append((f"  90 % interval, {label}", f"{number(s[f'{key}_low'], '.1f')} to {number(s[f'{key}_high'], '.1f')}", "°C"))
+    return rows
+
+
+def heat_path_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
+    """Each heat path's mean flow over the run, the balls' like paths summed (``ball 2 → air`` counts in ``balls → air``)."""
+    totals: dict[str, float] = {}
+    for name, value in (s.get("heat_paths_W") or {}).items():
+        general = re.sub(r"ball \d+", "balls", name) if s.get("n_balls", 1) > 1 else name
+        totals[general] = totals.get(general, 0.0) + (value or 0.0)
+    rows = [(f"heat path {name}", number(value, ".3g"), "W") for name, value in totals.items()]
+    if s.get("drive_heat_W"):
+        rows.append(("drive heat into the clamp", number(s["drive_heat_W"], ".3g"), "W"))
+    return rows
 
 
 # Up to this many balls the run table gives each ball's temperature; beyond, the coolest and the hottest.

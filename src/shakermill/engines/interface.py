@@ -44,6 +44,9 @@ class EngineDescription:
     thermal_only_keys: tuple[str, ...]
     # Whether its runs can start from the spread of one-ball starts on the axis that the attractor probe settles.
     attractor_starts: bool
+    # History variables that accumulate the heat per kelvin its contacts conducted (J/K), if it measures it: their
+    # rates over the settled half of a full run are the contact conductances of the network (``kernel.contact_drive``).
+    conduction_variables: tuple[str, ...] = ()
 
     @property
     def name(self) -> str:
@@ -57,11 +60,13 @@ class EngineDescription:
 class Measured(NamedTuple):
     """What the averaged solver averages, cumulative since the start: the heat of each of the engine's heat
     sources (J; its ``load`` turns their rates into the heat into each node), each ball's integral of the Whitaker
-    velocity term (s), and the energy dissipated in contacts (J)."""
+    velocity term (s), the energy dissipated in contacts (J) and, for an engine that measures them, the heat per
+    kelvin its contacts conducted (J/K, in ``kernel.contact_drive`` order)."""
 
     heat: np.ndarray
     terms: np.ndarray
     dissipated: float
+    conduction: "np.ndarray" = ()
 
 
 ProgressCallback = Callable[[float, float], None]
@@ -120,14 +125,15 @@ class Engine(Protocol):
     def measured(self) -> Measured:
         """The cumulative quantities the averaged solver averages (:class:`Measured`)."""
 
-    def load(self, heat_rates: np.ndarray, term_means: np.ndarray) -> NetworkLoad:
-        """The thermal network's load from the mean rates of the heat of its sources (W) and each ball's mean
-        velocity term: of :meth:`measured` or of ``heat_variables`` and ``term_variables``."""
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
+        """The thermal network's load from the mean rates of the heat of its sources (W), each ball's mean
+        velocity term and its contacts' mean conductances (W/K, if it measures them): of :meth:`measured` or of
+        ``heat_variables`` and ``term_variables``."""
 
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
         """How many of ``impacts`` heated each node of the network."""
 
     def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray,
-                         load: NetworkLoad, dissipated_power: float) -> StateHistory:
+                         load: NetworkLoad, dissipated_power: float, network: ThermalNetwork) -> StateHistory:
         """The history of an averaged run: the network's ``temperatures`` (node, time) and the cumulative heat
         lost; the flows as the load's mean rates times time; the motion, not computed, NaN."""

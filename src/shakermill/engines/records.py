@@ -76,7 +76,7 @@ class EnergyAudit:
 
     work_by_vial = Δkinetic + Δelastic + dissipated
     dissipated   = heat_generated + not_converted_to_heat
-    heat_generated = Δstored (ball + vial + air) + heat_lost_to_surroundings
+    heat_generated + drive_heat = Δstored (ball + vial + air + clamp) + heat_lost_to_surroundings
 
     ``projection_correction`` is the total |Δ kinetic energy| the energy
     projection applied at the end of contacts: the integrator's truncation
@@ -102,6 +102,9 @@ class EnergyAudit:
     # ... and the energy its tangential springs gain by stiffening with the load (engines.dem.model.TOTAL_NAMES)
     work_by_stiffening: float = 0.0
     dissipated_by_channel: Mapping[str, float] = field(default_factory=dict)
+    # A network with a mill head (thermal_model = 'mill-head') stores heat there and receives the drive's.
+    stored_clamp: float = 0.0
+    drive_heat: float = 0.0
 
     @property
     def mechanical_residual(self) -> float:
@@ -110,8 +113,8 @@ class EnergyAudit:
 
     @property
     def thermal_residual(self) -> float:
-        stored = self.stored_ball + self.stored_vial + self.stored_air
-        return self.heat_generated - stored - self.heat_lost_to_surroundings
+        stored = self.stored_ball + self.stored_vial + self.stored_air + self.stored_clamp
+        return self.heat_generated + self.drive_heat - stored - self.heat_lost_to_surroundings
 
     @property
     def residual(self) -> float:

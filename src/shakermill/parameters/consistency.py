@@ -43,6 +43,21 @@ def ball_fits_vial(params: Any) -> None:
         raise ValueError(f"ball_position: the ball must start inside the vial, allowed |ball_position| < {half_gap:g} m")
 
 
+def outside_holds_the_bore(params: Any) -> None:
+    """With ``thermal_model = 'mill-head'`` the vial's outside (whose convection it computes) is larger than its bore,
+    and the paper's ball-only model, which holds the vial at the room temperature, is not asked for with it."""
+    if params.thermal_model != "mill-head":
+        return
+    for outer, inner in (("outer_diameter", "vial_diameter"), ("outer_length", "vial_length")):
+        if getattr(params, outer) <= getattr(params, inner):
+            raise ValueError(
+                f"{outer}: the vial's outside must be larger than its bore; allowed {outer} > {inner} = "
+                f"{getattr(params, inner):g} m"
+            )
+    if params.model != "three_node":
+        raise ValueError("model: thermal_model = 'mill-head' has a vial and a clamp of their own; allowed model = 'three_node'")
+
+
 def fill_sets_the_balls(params: Any, per_ball_keys: Sequence[str]) -> None:
     """``fill`` > 0 makes n_balls equal balls (:func:`balls_for_fill`); an n_balls that says otherwise is refused.
 
@@ -203,4 +218,16 @@ def thermal_time_constants_at_rest(params: Any) -> dict[str, tuple[float, tuple[
     air = air_capacity / (inner + ball_conductance) if inner + ball_conductance > 0 else math.inf
     constants["vial"] = (vial, ("vial_mass", "vial_heat_capacity", "h_inner", "inner_area", "h_outer", "outer_area"))
     constants["air"] = (air, ("air_density", "vial_length", "vial_diameter", "h_inner", "inner_area"))
+    if params.thermal_model == "mill-head":
+        # The vial's outer paths are then computed (tens of W/(m²·K)): its joint to the clamp bounds it from below.
+        joint = params.clamp_conductance + inner
+        constants["vial"] = (
+            params.vial_mass * params.vial_heat_capacity / joint if joint > 0 else math.inf,
+            ("vial_mass", "vial_heat_capacity", "clamp_conductance", "h_inner", "inner_area"),
+        )
+        clamp = params.clamp_conductance + params.clamp_loss
+        constants["clamp"] = (
+            params.clamp_heat_capacity / clamp if clamp > 0 else math.inf,
+            ("clamp_heat_capacity", "clamp_conductance", "clamp_loss"),
+        )
     return constants

@@ -26,6 +26,7 @@ class EngineKeys:
     kinematics: tuple[str, ...]  # values of ``kinematics`` it moves the vial by
     most_balls: int
     thermal_models: tuple[str, ...]  # values of ``model``
+    networks: tuple[str, ...]  # values of ``thermal_model``
     # Whether the air moves with the vial, so that convection takes the ball's speed relative to it by default
     # (``convection_velocity = 'auto'``, MODEL.md §§4, 12.5).
     air_moves_with_vial: bool
@@ -42,6 +43,8 @@ ONE_DIMENSIONAL = EngineKeys(
     kinematics=("axial",),
     most_balls=1,
     thermal_models=("three_node", "ball_only"),
+    # Its right-hand side writes the paper's three nodes out for speed (engines/one_d/model.py).
+    networks=("paper",),
     air_moves_with_vial=False,
 )
 THREE_DIMENSIONAL = EngineKeys(
@@ -51,6 +54,7 @@ THREE_DIMENSIONAL = EngineKeys(
     kinematics=tuple(KINEMATIC_MODELS),
     most_balls=MAX_BALLS,
     thermal_models=("three_node",),
+    networks=("paper", "mill-head"),
     air_moves_with_vial=True,
 )
 
@@ -105,4 +109,10 @@ def engine_problem(params: Any, fill: bool = False) -> str | None:
     if params.model not in keys.thermal_models:
         allowed = ", ".join(map(repr, keys.thermal_models))
         return f"model: {keys.title} has no {params.model!r} thermal model; allowed {allowed} with {engine}"
+    if params.thermal_model not in keys.networks:
+        allowed = ", ".join(map(repr, keys.networks))
+        return (
+            f"thermal_model: {keys.title} has no {params.thermal_model!r} network; allowed {allowed} with {engine}, or set "
+            f"{engines_taking(lambda other: params.thermal_model in other.networks)}"
+        )
     return None

@@ -49,6 +49,11 @@ def _material_name(of: str, keys: str) -> Any:
     )
 
 
+def _choice(description: str) -> Any:
+    """A key that names one of a few alternatives (a ``Literal``), and what each means."""
+    return Field(json_schema_extra={"description": description})
+
+
 def _per_ball(scalar_key: str) -> Any:
     return Field(
         max_length=MAX_BALLS,
@@ -104,7 +109,9 @@ class Parameters(BaseModel):
     ball_material: str = _material_name(
         "the balls", "ball_density, ball_youngs_modulus, ball_poisson_ratio, ball_heat_capacity, ball_conductivity"
     )
-    vial_material: str = _material_name("the vial", "vial_density, vial_youngs_modulus, vial_poisson_ratio, vial_heat_capacity")
+    vial_material: str = _material_name(
+        "the vial", "vial_density, vial_youngs_modulus, vial_poisson_ratio, vial_heat_capacity, vial_conductivity"
+    )
     # 500 kg/m³: below every solid milling medium (polyethylene ~950); 25 000: above osmium (22 590), the
     # densest element. A ball of 1e-6 kg/m³ has no heat capacity and made a run take hours.
     ball_density: float = _quantity("kg/m^3", "ball density ρ_b", ge=500.0, le=25_000.0)
@@ -148,6 +155,24 @@ class Parameters(BaseModel):
     # 10 m²: the whole surface of a vial of 1 m, the largest allowed.
     inner_area: float = _quantity("m^2", "vial surface exchanging heat with the inner air A_i", gt=0, le=10.0)
     outer_area: float = _quantity("m^2", "vial surface exchanging heat with the surroundings A_o", gt=0, le=10.0)
+    # The thermal network of a real mill (MODEL.md section 13): its structure and the paths beyond the paper's.
+    thermal_model: Literal["paper", "mill-head"] = _choice(
+        "'paper': ball, vial and air, the vial losing h_outer·outer_area to the room (MODEL.md §5); 'mill-head': the "
+        "vial's outer convection and radiation at its own speed, conduction through contacts, a clamp warmed by the drive (§13)"
+    )
+    # 1 mm to 1 m as the bore; the outside must hold the bore (checked below).
+    outer_diameter: float = _quantity("m", "outer diameter of the vial D_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0)
+    outer_length: float = _quantity("m", "outer length of the vial L_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0)
+    # Polished metal ~0.05, oxidised steel ~0.8, black paint ~0.95.
+    emissivity: float = _quantity("", "emissivity ε of the vial's outside (thermal_model = 'mill-head')", ge=0, le=1)
+    # Gases' 0.005 to diamond's 2000, as the balls'.
+    vial_conductivity: float = _quantity("W/(m*K)", "vial thermal conductivity k_v", ge=0.01, le=2000.0)
+    # Up to ~50 kg of steel in a clamp and mill head; 0 is refused: the node needs a heat capacity. The joint and the
+    # loss up to a soldered joint over 10 cm² (0 decouples); the drive's heat up to a mill's whole motor (~0.1-1 kW).
+    clamp_heat_capacity: float = _quantity("J/K", "heat capacity C_k of the clamp and mill head ('mill-head')", gt=0, le=1e5)
+    clamp_conductance: float = _quantity("W/K", "vial-to-clamp contact conductance G_vk ('mill-head')", ge=0, le=1e3)
+    clamp_loss: float = _quantity("W/K", "clamp-to-room conductance G_k (thermal_model = 'mill-head')", ge=0, le=1e3)
+    drive_heat: float = _quantity("W", "heat Q_m the drive puts into the clamp whatever the balls do ('mill-head')", ge=0, le=1e3)
     # Collision and heat generation (Table 4)
     # A perfectly plastic contact (0) has no damping ratio. Towards 0 the ball chatters on the face and a
     # run takes more steps (20 times at 0.05, 40 at 1e-6), but it stays correct and finishes.
@@ -195,17 +220,14 @@ class Parameters(BaseModel):
     max_steps: int = Field(
         gt=0,
         le=10**12,  # at ~0.5 µs a step, about a week of computing
-
         json_schema_extra={"unit": "", "description": "step budget of one run: accepted integrator steps, all its integrations together"},
     )
     # Solver choice (full resolution, or the multiscale averaged solver)
-    solver: Literal["full", "averaged"] = Field(
-        json_schema_extra={"description": "'full': every impact for the whole run; 'averaged': mechanics until its statistics converge, then the slow thermal network"}
+    solver: Literal["full", "averaged"] = _choice(
+        "'full': every impact for the whole run; 'averaged': mechanics until its statistics converge, then the slow network"
     )
     # Any target is safe: one that is never reached ends at averaging_max_time, and the run falls back.
-    averaging_rel_error: float = _quantity(
-        "", "averaged solver: target relative standard error of the averages", gt=0, lt=1
-    )
+    averaging_rel_error: float = _quantity("", "averaged solver: target relative standard error of the averages", gt=0, lt=1)
     # The several balls' motion is chaotic: its means converge as 1/√T, and 1e-3 would take ~15 min of mechanics.
     dem_averaging_rel_error: float = _quantity(
         "",
@@ -219,9 +241,7 @@ class Parameters(BaseModel):
     averaging_min_batches: int = _count("averaged solver: fewest batches after the transient", ge=4, le=10_000)
     # An hour of mechanics costs what a full-resolution hour does; averaging converges in ~20 s.
     averaging_max_time: float = _quantity("s", "averaged solver: longest mechanics window before giving up", gt=0, le=3600.0)
-    averaging_fallback: Literal["full", "fail"] = Field(
-        json_schema_extra={"description": "averaged solver: what to do when averaging is not valid"}
-    )
+    averaging_fallback: Literal["full", "fail"] = _choice("averaged solver: what to do when averaging is not valid")
     # Each start costs a settled run at every point of a scan; 100 cover the gap far more densely than
     # the basins found so far need (the default 8 finds them).
     attractor_starts: int = _count(
@@ -231,28 +251,20 @@ class Parameters(BaseModel):
         le=100,
     )
     # Model options (MODEL.md sections 2-4: the alternatives the spec allows)
-    model: Literal["three_node", "ball_only"] = Field(
-        json_schema_extra={
-            "description": "'three_node': ball, vial and air (this paper); 'ball_only': air held at ambient and no vial "
-            "reservoir, the author's 2023 predecessor"
-        }
+    model: Literal["three_node", "ball_only"] = _choice(
+        "'three_node': ball, vial and air (this paper); 'ball_only': air held at ambient and no vial "
+        "reservoir, the author's 2023 predecessor"
     )
     no_tension: bool = Field(strict=True, json_schema_extra={"description": "clip the contact force at zero (no adhesion)"})
-    heat_model: Literal["relative", "paper"] = Field(
-        json_schema_extra={"description": "'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed"}
-    )
-    convection_velocity: Literal["auto", "ball", "relative"] = Field(
-        json_schema_extra={
-            "description": "velocity in Re: the ball's ('ball', as the paper) or relative to the vial, which carries "
-            "the air ('relative'); 'auto': 'ball' for the 1-D engine, 'relative' for 'dem' (MODEL.md §12.5)"
-        }
+    heat_model: Literal["relative", "paper"] = _choice("'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed")
+    convection_velocity: Literal["auto", "ball", "relative"] = _choice(
+        "velocity in Re: the ball's ('ball', as the paper) or relative to the vial, which carries "
+        "the air ('relative'); 'auto': 'ball' for the 1-D engine, 'relative' for 'dem' (MODEL.md §12.5)"
     )
     # The engine (engine_keys.py; engines/registry.py adds any registered): its name is checked by _known_engine.
-    engine: str = Field(
-        json_schema_extra={
-            "description": "'1d': one ball on the vial's axis (MODEL.md sections 1-7); 'dem': n_balls spheres in three "
-            "dimensions with friction and rotation (section 12)"
-        }
+    engine: str = _choice(
+        "'1d': one ball on the vial's axis (MODEL.md sections 1-7); 'dem': n_balls spheres in three "
+        "dimensions with friction and rotation (section 12)"
     )
     # 50 balls of the smallest radius still fit any vial the bounds allow; the pair search is O(N²).
     n_balls: int = _count("number of balls (engine = 'dem'; the 1-D engine has one)", ge=1, le=MAX_BALLS)
@@ -287,13 +299,11 @@ class Parameters(BaseModel):
     # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
     friction: float = _quantity("", "Coulomb friction coefficient μ of every contact (engine = 'dem')", ge=0, le=5.0)
     rolling_friction: float = _quantity("", "rolling resistance coefficient μ_r (engine = 'dem')", ge=0, le=1.0)
-    kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc"] = Field(
-        json_schema_extra={
-            "description": "vial motion of the 'dem' engine (parameters/kinematic_models.py): 'axial' (amplitude, "
-            "omega, phase: the 1-D drive), 'fourier' (the harmonics in motion), 'spex8000m' (the clamp's figure of "
-            "eight: amplitude, lateral_amplitude, yaw_amplitude) or 'mixer-mill-arc' (a jar swung on a horizontal "
-            "arc: amplitude along the arc, swing_radius)"
-        }
+    kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc"] = _choice(
+        "vial motion of the 'dem' engine (parameters/kinematic_models.py): 'axial' (amplitude, "
+        "omega, phase: the 1-D drive), 'fourier' (the harmonics in motion), 'spex8000m' (the clamp's figure of "
+        "eight: amplitude, lateral_amplitude, yaw_amplitude) or 'mixer-mill-arc' (a jar swung on a horizontal "
+        "arc: amplitude along the arc, swing_radius)"
     )
     # The SPEX clamp's lateral motion and yaw (kinematics = 'spex8000m'); 0 leaves either out. Half a metre,
     # as any translation of a vial; a quarter turn, far beyond the few degrees a clamp turns.
@@ -340,6 +350,7 @@ class Parameters(BaseModel):
         """The checks across keys (:mod:`consistency`) and of the per-ball values' bounds, in this order: the first
         problem is the one reported."""
         consistency.ball_fits_vial(self)
+        consistency.outside_holds_the_bore(self)
         consistency.fill_sets_the_balls(self, PER_BALL_KEYS)
         consistency.engine_takes_the_keys(self)
         for key in PER_BALL_KEYS:

@@ -40,6 +40,16 @@ class Preset:
     fitted: tuple[str, ...] = ()
     provenance: Mapping[str, Any] = dataclasses.field(default_factory=dict)
 
+    @property
+    def covariance(self) -> list[list[float]] | None:
+        """The calibration's covariance of the logarithms of ``fitted`` (in that order), if it recorded one."""
+        return self.provenance.get("covariance_log")
+
+    @property
+    def posterior(self) -> list[list[float]] | None:
+        """The calibration's posterior samples of the logarithms of ``fitted``, if it recorded them."""
+        return self.provenance.get("posterior_log")
+
 
 SPEX_8000M = Preset(
     name=DEFAULT_PRESET,
@@ -79,6 +89,35 @@ SPEX_8000M = Preset(
             f"{PAPER}, Table 1 (A_o = 567.06 mm²: the two end faces only; a real vial also loses heat through its "
             "side, MODEL.md §11)",
         ),
+        "thermal_model": Cited("paper", f"{PAPER}, section 2.3: ball, vial and air (MODEL.md section 13)"),
+        "outer_diameter": Cited(
+            50e-3,
+            "estimate: walls ~6 mm round a Ø38 mm bore (the SPEX 8001 vial's outside is not published, "
+            "docs/notes/dem-references.md §2.3); thermal_model = 'mill-head' only",
+        ),
+        "outer_length": Cited(70e-3, "estimate: ends ~6 mm beyond a 58 mm bore, as outer_diameter; thermal_model = 'mill-head' only"),
+        "emissivity": Cited(
+            0.2,
+            "assumption: machined, lightly oxidised steel, 0.1-0.3 (Incropera & DeWitt, Table A.11: stainless steel "
+            "0.17-0.30, polished 0.07-0.1); thermal_model = 'mill-head' only",
+        ),
+        "vial_conductivity": Cited(46.6, "as ball_conductivity: hardened steel (AISI 52100, ASM data sheet)"),
+        "clamp_heat_capacity": Cited(
+            2000.0,
+            "assumption: ~4 kg of steel in the clamp, its arm and the mill head (not published); a free parameter of "
+            "calibrations with thermal_model = 'mill-head'",
+        ),
+        "clamp_conductance": Cited(
+            10.0,
+            "order of magnitude: steel-on-steel contact conductance 10³-10⁴ W/(m²·K) under clamping pressure "
+            "(Madhusudana, Thermal Contact Conductance, 1996) over ~10⁻³ m² at each clamped end",
+        ),
+        "clamp_loss": Cited(
+            3.0,
+            "assumption: ~0.1 m² of clamp and head at ~25 W/(m²·K) of forced convection, plus conduction into the "
+            "frame (not measured)",
+        ),
+        "drive_heat": Cited(0.0, "none unless measured or fitted (thermal_model = 'mill-head')"),
         "restitution": Cited(0.7, f"{PAPER}, Table 4 (e)"),
         "eta": Cited(0.9, f"{PAPER}, Table 4 (η)"),
         "lam": Cited(0.368, f"{PAPER}, Table 4 (λ)"),

@@ -26,12 +26,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from shakermill.analysis.fit import fit_exponential
-from shakermill.analysis.steady import steady_state
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.interface import Engine, ProgressCallback
 from shakermill.engines.records import EnergyAudit
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
-from shakermill.engines.thermal.network import ThermalNetwork
+from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.attractors import probe_attractors
 from shakermill.solvers.driver import Means, measure_means, sample_times
@@ -112,7 +111,7 @@ def _from_mechanics(params: Parameters, engine_class: type[Engine], mechanics: M
     problem = means.averages.message if not means.averages.converged else time_scale_problem(mechanics.engine, network, means)
     if problem is not None:
         return _refuse(params, engine_class, mechanics, _not_valid(means.averages, problem), progress, budget, started)
-    thermal = integrate_network(network, means, params)
+    thermal = integrate_network(network, means.load, params)
     if progress is not None:
         progress(params.duration, params.duration)
     if not thermal.success:
@@ -127,7 +126,7 @@ def _averaged_result(params: Parameters, network: ThermalNetwork, mechanics: Mec
     impacts of the averaging window, the audit of the mean rates."""
     engine, means = mechanics.engine, mechanics.means
     averages, load = means.averages, means.load
-    history = engine.averaged_history(thermal.t, thermal.y[:-1], thermal.y[-1], load, averages.dissipated_power)
+    history = engine.averaged_history(thermal.t, thermal.y[:-1], thermal.y[-1], load, averages.dissipated_power, network)
     impacts = engine.impact_columns(since=averages.transient)
     note = "" if math.isfinite(averages.impact_interval) else engine.no_impact_note()
     result = Result(
@@ -146,7 +145,7 @@ def _averaged_result(params: Parameters, network: ThermalNetwork, mechanics: Mec
         impact_window=averages.window,
         averages=averages,
     )
-    return conclude(result, steady_state(network, load))
+    return conclude(result, network, load)
 
 
 def time_scale_problem(engine: Engine, network: ThermalNetwork, means: Means) -> str | None:
@@ -156,7 +155,7 @@ def time_scale_problem(engine: Engine, network: ThermalNetwork, means: Means) ->
     averages exactly."""
     window = means.averages.window
     hits = engine.node_hits(engine.impact_columns(since=means.averages.transient))
-    conductances = network.node_conductances(means.load.terms)
+    conductances = network.node_conductances(means.load.drives)
     for node, count in enumerate(hits):
         capacity = network.nodes[node].capacity
         constant = capacity / conductances[node] if conductances[node] > 0 else math.inf
@@ -168,13 +167,12 @@ def time_scale_problem(engine: Engine, network: ThermalNetwork, means: Means) ->
     return None
 
 
-def integrate_network(network: ThermalNetwork, means: Means, params: Parameters) -> Any:
-    """``network`` driven by the means, and the heat it loses (the last component), sampled on the run's output
-    grid. LSODA switches to BDF where the network is stiff (the air is ~10⁴ times faster than the vial)."""
-    load = means.load
+def integrate_network(network: ThermalNetwork, load: NetworkLoad, params: Parameters) -> Any:
+    """``network`` driven by the mechanics' mean ``load``, and the heat it loses (the last component), sampled on the
+    run's output grid. LSODA switches to BDF where the network is stiff (the air is ~10⁴ times faster than the vial)."""
 
     def rates(t: float, state: np.ndarray) -> np.ndarray:
-        node_rates, lost = network.rates(state[:-1], load.heat, load.terms)
+        node_rates, lost = network.rates(state[:-1], load.heat, load.drives)
         return np.append(node_rates, lost)
 
     initial = np.append(network.initial_temperatures(params.initial_temperature), 0.0)
@@ -209,6 +207,8 @@ def averaged_energy(engine: Engine, network: ThermalNetwork, means: Means, therm
         stored_ball=float(np.dot(capacity[balls], warming[balls])),
         stored_vial=float(capacity[vial] * warming[vial]),
         stored_air=float(capacity[air] * warming[air]),
+        stored_clamp=float(np.dot(capacity[air + 1 :], warming[air + 1 :])),
+        drive_heat=network.fixed_heat * duration,
         heat_lost_to_surroundings=float(thermal.y[-1, -1]),
         projection_correction=engine.projection_correction,
         dissipated_by_channel={name: value / total * dissipated if total > 0 else 0.0 for name, value in by_channel.items()},

@@ -62,7 +62,7 @@ class Means:
 
 
 def _flat(measured: Measured) -> np.ndarray:
-    return np.concatenate([measured.heat, measured.terms, [measured.dissipated]])
+    return np.concatenate([measured.heat, measured.terms, measured.conduction, [measured.dissipated]])
 
 
 def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback | None) -> tuple[Means, int]:
@@ -89,7 +89,7 @@ def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback
         if heartbeat is not None:
             heartbeat(engine.t)
         cumulative.append(_flat(engine.measured()))
-        rates = batch_rates(np.array(cumulative), batch)  # (batches, sources, balls' terms, dissipated)
+        rates = batch_rates(np.array(cumulative), batch)  # (batches, sources, balls' terms, conductances, dissipated)
         if len(rates) >= 2 * params.averaging_min_batches:
             totals = np.column_stack([rates[:, :sources].sum(axis=1), rates[:, sources : sources + balls].mean(axis=1)])
             cut = max(mser_truncation(normalised(column)) for column in totals.T)
@@ -110,8 +110,10 @@ def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback
 
 def _means(engine: Engine, rates: np.ndarray, sources: int, balls: int, transient: float, batch: float,
            converged: bool, message: str) -> Means:
-    """The means of the kept batch ``rates`` (columns: each source's heat, each ball's term, the dissipation)."""
-    heat, terms = rates[:, :sources], rates[:, sources : sources + balls]
+    """The means of the kept batch ``rates`` (columns: each source's heat, each ball's term, each contact
+    conductance, the dissipation). The conductances are averaged but not held to the target error: a pair of balls
+    that rarely touch has a noisy one, and a small one."""
+    heat, terms, conductances = rates[:, :sources], rates[:, sources : sources + balls], rates[:, sources + balls : -1]
     total_heat, mean_terms = heat.sum(axis=1), terms.mean(axis=1)
     window = len(rates) * batch
     impacts = len(engine.impact_columns(since=transient)["time"])
@@ -128,7 +130,7 @@ def _means(engine: Engine, rates: np.ndarray, sources: int, balls: int, transien
         converged=converged,
         message=message,
     )
-    load = engine.load(np.array([_mean(column) for column in heat.T]), np.array([_mean(column) for column in terms.T]))
+    load = engine.load(*(np.array([_mean(column) for column in part.T]) for part in (heat, terms, conductances)))
     return Means(load, averages)
 
 

@@ -8,7 +8,7 @@ import time
 import numpy as np
 
 from shakermill.analysis.fit import fit_exponential
-from shakermill.analysis.steady import settled_rates, steady_state
+from shakermill.analysis.steady import settled_rates
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.interface import Engine, ProgressCallback
 from shakermill.engines.records import StateHistory
@@ -36,7 +36,7 @@ def simulate_full(params: Parameters, engine_class: type[Engine], progress: Prog
 def concluded(engine: Engine, status: int, message: str, wall_time: float, **extra: object) -> Result:
     """The result of what ``engine`` has integrated, concluded with the steady state of its settled means."""
     result = result_of(engine, status, message, wall_time, **extra)
-    return conclude(result, steady_state(engine.network, settled_load(engine, result.history)))
+    return conclude(result, engine.network, settled_load(engine, result.history))
 
 
 def result_of(engine: Engine, status: int, message: str, wall_time: float, **extra: object) -> Result:
@@ -64,6 +64,7 @@ def settled_load(engine: Engine, history: StateHistory) -> NetworkLoad:
     description = engine.description
 
     def rates(names: tuple[str, ...]) -> np.ndarray:
-        return np.concatenate([np.atleast_1d(settled_rates(history.times, history[name])) for name in names])
+        return np.concatenate([np.atleast_1d(settled_rates(history.times, history[name])) for name in names] or [np.zeros(0)])
 
-    return engine.load(rates(description.heat_variables), rates(description.term_variables))
+    return engine.load(*(rates(names) for names in (description.heat_variables, description.term_variables,
+                                                     description.conduction_variables)))

@@ -13,7 +13,7 @@ import numpy as np
 
 from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
-from shakermill.analysis.steady import SteadyState, run_length_warning
+from shakermill.analysis.steady import SteadyState, run_length_warning, steady_state
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
     CELSIUS_VARIABLES,
@@ -23,6 +23,7 @@ from shakermill.engines.records import (
 )
 from shakermill.engines.registry import describe
 from shakermill.engines.status import REACHED_STOP
+from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.defaults import HIT_SPEED
 from shakermill.parameters.keys import Parameters, unit_slip_warnings
 from shakermill.support.presenters import present
@@ -95,6 +96,10 @@ class Result:
     impact_window: float | None = None  # s covered by ``impacts``; None means the whole run
     averages: MechanicsAverages | None = None
     steady: SteadyState | None = None
+    # Each heat path's mean flow over the run (W, from its hot end to its cold end; MODEL.md §13.1), and the mean
+    # load of the network they were computed with (of the settled second half, for a full run)
+    heat_paths: dict[str, float] = field(default_factory=dict)
+    load: NetworkLoad | None = None
     attractors: AttractorScan | None = None  # the settled motions of other starts, where they were probed
     # One line each, for things a user should know that do not stop the run (stderr and summary.json).
     warnings: list[str] = field(default_factory=list)
@@ -134,11 +139,13 @@ class Result:
         return present("result html", self)
 
 
-def conclude(result: Result, steady: SteadyState) -> Result:
-    """The ``steady`` state (MODEL.md §11), physical bounds, energy audit and warnings of a finished run, then its
-    summary."""
+def conclude(result: Result, network: ThermalNetwork, load: NetworkLoad) -> Result:
+    """The steady state of ``network`` under ``load`` (MODEL.md §11), the mean flow of each heat path over the run,
+    physical bounds, energy audit and warnings of a finished run, then its summary."""
     params = result.params
-    result.steady = steady
+    result.steady = steady_state(network, load)
+    result.load = load
+    result.heat_paths = mean_path_flows(network, result.history, load.drives)
     result.warnings.extend(unit_slip_warnings(params))
     lines = (run_length_warning(result.t_end, result.steady), steady_state_bound_warning(result), fit_warning(result))
     for line in lines:
@@ -151,6 +158,24 @@ def conclude(result: Result, steady: SteadyState) -> Result:
             result.status, result.message = status, problem
     result.summary = summarize(result)
     return result
+
+
+def node_temperatures(network: ThermalNetwork, history: StateHistory) -> np.ndarray:
+    """Every node's temperature (K) at the samples of ``history``, over (node, time)."""
+    balls = history[BALL_TEMPERATURES].T if BALL_TEMPERATURES in history.variables else np.atleast_2d(history["theta_ball"])
+    others = [history[f"theta_{node.name}"] for node in network.nodes[network.n_balls :]]
+    return np.vstack([balls, *others])
+
+
+def mean_path_flows(network: ThermalNetwork, history: StateHistory, drives: np.ndarray) -> dict[str, float]:
+    """Each path's flow (W) averaged over the run: at the sampled temperatures and the motion's mean ``drives``,
+    by the trapezoidal rule; for a run of no length, at its start."""
+    theta = node_temperatures(network, history)
+    flows = np.array([network.flows(theta[:, index], drives) for index in range(theta.shape[1])])
+    times = history.times
+    span = times[-1] - times[0]
+    means = np.trapezoid(flows, times, axis=0) / span if span > 0 else flows[0]
+    return {path.name: float(value) for path, value in zip(network.paths, means, strict=True)}
 
 
 def physical_bounds_problem(result: Result) -> str | None:
@@ -269,8 +294,13 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
     }
     summary.update(understood_inputs(params))
     summary.update(several_ball_summary(result))
+    for node in ("clamp",):
+        if f"theta_{node}" in series.variables:
+            summary[f"{node}_C"] = kelvin_to_celsius(float(series[f"theta_{node}"][-1]))
     if result.steady is not None:
         summary.update(result.steady.as_summary())
+    summary["heat_paths_W"] = dict(result.heat_paths)
+    summary["drive_heat_W"] = result.energy.drive_heat / duration
     if result.averages is not None:
         summary.update(result.averages.as_summary())
     if result.attractors is not None:

@@ -41,7 +41,7 @@ def _whole(result: Result, budget: RunBudget) -> Result:
 
 
 # The mechanics of the last few thermal_variants bases: the mechanics are deterministic, so a study that
-# fits several free sets to one base (validate's, the README's) measures them once.
+# fits several free sets to one base, or compares thermal models on it (validate's, the README's), measures them once.
 _SETTLED: dict[Parameters, Mechanics] = {}
 _SETTLED_KEPT = 2
 
@@ -54,7 +54,7 @@ def thermal_variants(params: Parameters) -> Callable[[Parameters], Result]:
     engine = engine_named(params.engine)
     if not engine.description.thermal_only_keys or params.solver != "averaged":
         return simulate_whole
-    mechanics = _SETTLED.get(params)
+    mechanics = next((settled for settled in _SETTLED.values() if settled.serves(params)), None)
     if mechanics is None:
         budget = RunBudget.of(params)
         mechanics = settle_mechanics(params, engine, budget=budget)

@@ -55,8 +55,9 @@ BOUND_FACTOR = 100.0
 # Relative step of the finite-difference Jacobian in log space: large enough to rise above the
 # averaged solver's statistical noise (relative standard error ~1e-4 to 1e-3 on mechanical inputs).
 JACOBIAN_STEP = 1e-2
-# A parameter within this relative distance of a bound is reported as stuck on it.
-AT_BOUND = 1e-3
+# A parameter within this relative distance (1 %) of a bound is reported as on it: an ill-conditioned fit stops just
+# short of the bound it is pulled to.
+AT_BOUND = 1e-2
 # A scalar target further off than this (relative) after the fit counts as not met.
 TARGET_TOLERANCE = 5e-3
 # Scalar targets are matched relatively; curve points in kelvin: one kelvin weighs like 1 % on a target.
@@ -77,6 +78,10 @@ class Calibration:
     achieved: dict[str, float]
     curve_rms_K: float | None
     parameter_stderr: dict[str, float]
+    # Of the natural logarithms of ``free``, in that order (None where the Jacobian does not determine it)
+    covariance: list[list[float]] | None
+    # Samples of the posterior of those logarithms (emcee), where an evaluation is cheap enough to sample it
+    posterior: list[list[float]] | None
     # target -> parameter -> d ln(target)/d ln(parameter); for a curve, "ball_C at T min" -> K per e-fold
     sensitivities: dict[str, dict[str, float]]
     predictions: dict[str, float]  # what the fitted model says of quantities that were not fitted
@@ -91,6 +96,14 @@ class Calibration:
     @property
     def relative_residuals(self) -> dict[str, float]:
         return {key: (self.achieved[key] - value) / value for key, value in self.targets.items()}
+
+    @property
+    def posterior_ranges(self) -> dict[str, tuple[float, float]]:
+        """Each fitted key's 5th and 95th posterior percentiles (its own unit); empty without a posterior."""
+        if self.posterior is None:
+            return {}
+        low, high = np.exp(np.percentile(np.asarray(self.posterior), [5.0, 95.0], axis=0))
+        return {key: (float(low[i]), float(high[i])) for i, key in enumerate(self.free)}
 
     @property
     def defensible(self) -> dict[str, str]:
@@ -116,6 +129,9 @@ class Calibration:
             "relative_residuals": self.relative_residuals,
             "curve_rms_K": self.curve_rms_K,
             "parameter_stderr": self.parameter_stderr,
+            "covariance_log": self.covariance,
+            "posterior_samples": 0 if self.posterior is None else len(self.posterior),
+            "posterior_90": {key: list(bounds) for key, bounds in self.posterior_ranges.items()},
             "sensitivities": self.sensitivities,
             "predictions": self.predictions,
             "defensible": self.defensible,
@@ -214,6 +230,25 @@ DEFENSIBLE_RANGES: dict[str, DefensibleRange] = {
         "two steel bodies share the heat of a contact about evenly (equal thermal effusivities give 0.5); "
         "the paper's 0.368 lies inside",
     ),
+    "drive_heat": DefensibleRange(
+        0.01, 30.0,
+        "no published value: from nearly none to ~10 % of a motor of a few hundred watts reaching the clamp as heat "
+        "(motor, bearings, the clamp's springs; an assumed bound, not a measurement)",
+    ),
+    "clamp_heat_capacity": DefensibleRange(
+        200.0, 10_000.0,
+        "no published value: 0.4-20 kg of steel (c ≈ 460-500 J/(kg·K)) in the clamp, its arm and the parts of the mill "
+        "head in good thermal contact with them",
+    ),
+    "clamp_loss": DefensibleRange(
+        0.5, 10.0,
+        "no published value: 0.02-0.4 m² of clamp and head at ~25 W/(m²·K) of forced convection, plus conduction into "
+        "the frame",
+    ),
+    "clamp_conductance": DefensibleRange(
+        1.0, 100.0,
+        "steel-on-steel contact conductance 10³-10⁴ W/(m²·K) (Madhusudana 1996) over 10⁻³-10⁻² m² of clamped faces",
+    ),
     "eta": DefensibleRange(
         0.7, 1.0,
         "most plastic work in metals becomes heat (Taylor-Quinney coefficient ~0.9); with no powder in the "
@@ -249,21 +284,16 @@ def calibrate(
     *,
     full_resolution: bool = False,
     progress: Callable[[int], None] | None = None,
+    sample_posterior: bool = True,
 ) -> Calibration:
     """Fit ``free`` keys of ``base`` to ``targets`` and/or ``curve``; see the module docstring.
 
-    ``progress(evaluations)`` is called after every model evaluation. A run that uses up its budget
-    stops the fit (:class:`~shakermill.budget.BudgetExceeded`): its partial result is no evaluation.
+    ``progress(evaluations)`` is called after every model evaluation. With ``sample_posterior``, a fit whose
+    evaluations integrate the network alone (the engine has thermal-only keys) also samples the posterior of its keys
+    (:func:`posterior_samples`, a few minutes). A run that uses up its budget stops the fit
+    (:class:`~shakermill.budget.BudgetExceeded`): its partial result is no evaluation.
     """
-    targets = dict(targets or {})
-    check_targets(targets)
-    if not targets and curve is None:
-        curve = experiment_curve()
-    free = tuple(free)
-    _check_free_for_engine(base, free)
-    for key in free:
-        if getattr(base, key) <= 0:
-            raise ParameterError(f"free: {key} must start positive to be fitted in log space, got {getattr(base, key)}")
+    targets, curve, free = _checked(base, free, targets, curve)
     solver = "full" if full_resolution else "averaged"
     start = {key: float(getattr(base, key)) for key in free}
     x0 = np.log([start[key] for key in free])
@@ -296,6 +326,12 @@ def calibrate(
     missed = {key: (achieved[key] - value) / value for key, value in targets.items()}
     missed = {key: error for key, error in missed.items() if abs(error) > TARGET_TOLERANCE}
     curve_rms = _curve_rms(result, curve)
+    covariance = _log_covariance(solution.jac, residuals, len(free), curve)
+    # Sampled only where an evaluation is a network alone: thousands of them take minutes there, hours elsewhere.
+    posterior = None
+    if sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution:
+        variance = _residual_variance(residuals, len(free), curve)
+        posterior = posterior_samples(lambda x: evaluate(x)[0], solution.x, lower, upper, variance).tolist()
     off_curve = curve_rms is not None and curve_rms > CURVE_TOLERANCE_K
     stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
     return Calibration(
@@ -306,7 +342,9 @@ def calibrate(
         targets=targets,
         achieved=achieved,
         curve_rms_K=curve_rms,
-        parameter_stderr=_parameter_stderr(solution, free, fitted, residuals, curve),
+        parameter_stderr=_stderr(covariance, free, fitted),
+        covariance=None if covariance is None else covariance.tolist(),
+        posterior=posterior,
         sensitivities=_sensitivities(solution.jac, free, targets, curve),
         predictions={key: float(result.summary[key]) for key in PREDICTED_KEYS if key not in targets},
         at_bounds=at_bounds,
@@ -317,6 +355,22 @@ def calibrate(
         curve_source=curve.source if curve is not None else "",
         result=result,
     )
+
+
+def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float] | None,
+             curve: Curve | None) -> tuple[dict[str, float], Curve | None, tuple[str, ...]]:
+    """The targets, the curve (the experiment's when neither is given) and the free keys of a fit, checked: every
+    target in its range, every free key one the engine's fits may move, starting positive (fitted in log space)."""
+    targets = dict(targets or {})
+    check_targets(targets)
+    if not targets and curve is None:
+        curve = experiment_curve()
+    free = tuple(free)
+    _check_free_for_engine(base, free)
+    for key in free:
+        if getattr(base, key) <= 0:
+            raise ParameterError(f"free: {key} must start positive to be fitted in log space, got {getattr(base, key)}")
+    return targets, curve, free
 
 
 def _check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
@@ -374,24 +428,67 @@ def _curve_rms(result: Result, curve: Curve | None) -> float | None:
     return None if curve is None else curve.rms_K(*_ball_history(result))
 
 
-def _parameter_stderr(solution, free, fitted, residuals, curve) -> dict[str, float]:
-    """Standard errors from the Jacobian; meaningful only for a curve with more points than parameters.
+def _log_covariance(jacobian: np.ndarray, residuals: np.ndarray, free_count: int, curve: Curve | None) -> np.ndarray | None:
+    """The covariance of the logarithms of the fitted keys, (JᵀJ)⁻¹·s² with s² the residual variance; meaningful
+    only for a curve with more points than parameters, None otherwise or where JᵀJ is singular.
 
     The residual variance is floored at the curve's stated measurement error, if it has one: a
     curve that is itself a smooth summary can be fitted exactly, which says nothing about how well
     it was measured.
     """
-    points = residuals.size
-    if curve is None or points <= len(free):
-        return {key: math.nan for key in free}
-    variance = float(np.sum(residuals**2)) / (points - len(free))
+    if curve is None or residuals.size <= free_count:
+        return None
+    try:
+        return np.linalg.inv(jacobian.T @ jacobian) * _residual_variance(residuals, free_count, curve)
+    except np.linalg.LinAlgError:
+        return None
+
+
+def _residual_variance(residuals: np.ndarray, free_count: int, curve: Curve) -> float:
+    """The residuals' variance over their degrees of freedom, floored at the curve's stated measurement error."""
+    variance = float(np.sum(residuals**2)) / (residuals.size - free_count)
     if curve.sigma_K is not None:
         variance = max(variance, (curve.sigma_K / CURVE_SCALE_K) ** 2)
-    try:
-        covariance = np.linalg.inv(solution.jac.T @ solution.jac) * variance
-    except np.linalg.LinAlgError:
+    return variance
+
+
+# The posterior: emcee's affine-invariant ensemble, WALKERS_PER_KEY walkers a key, POSTERIOR_STEPS steps of which the
+# first half is burn-in; POSTERIOR_KEPT samples are kept, evenly thinned. ~2400 evaluations of a three-key fit,
+# a few minutes of networks (benchmarks/bench_calibrate_3d.py); the seed makes it deterministic.
+WALKERS_PER_KEY = 4
+POSTERIOR_STEPS = 200
+POSTERIOR_KEPT = 200
+POSTERIOR_SEED = 20261125
+
+
+def posterior_samples(residuals_of: Callable[[np.ndarray], np.ndarray], best: np.ndarray, lower: np.ndarray,
+                      upper: np.ndarray, variance: float) -> np.ndarray:
+    """Samples (POSTERIOR_KEPT, keys) of the logarithms of the fitted keys: a Gaussian likelihood of the residuals with
+    ``variance`` (the fit's), a prior uniform in the logarithms within [``lower``, ``upper``] (the defensible
+    ranges). Where one curve leaves a direction of the keys undetermined, the ranges bound it, which the
+    covariance cannot."""
+    import emcee
+
+    def log_probability(x: np.ndarray) -> float:
+        if np.any(x < lower) or np.any(x > upper):
+            return -np.inf
+        return -0.5 * float(np.sum(residuals_of(x) ** 2)) / variance
+
+    keys = best.size
+    walkers = WALKERS_PER_KEY * keys
+    rng = np.random.default_rng(POSTERIOR_SEED)
+    start = np.clip(best + 1e-3 * rng.standard_normal((walkers, keys)), lower, upper)
+    sampler = emcee.EnsembleSampler(walkers, keys, log_probability)
+    sampler.random_state = np.random.RandomState(POSTERIOR_SEED).get_state()
+    sampler.run_mcmc(start, POSTERIOR_STEPS)
+    chain = sampler.get_chain(discard=POSTERIOR_STEPS // 2, flat=True)
+    return chain[np.linspace(0, len(chain) - 1, POSTERIOR_KEPT).astype(int)]
+
+
+def _stderr(covariance: np.ndarray | None, free: Sequence[str], fitted: Mapping[str, float]) -> dict[str, float]:
+    """Each fitted key's standard error in its own unit: in log space the standard error is relative."""
+    if covariance is None:
         return {key: math.nan for key in free}
-    # In log space the standard error is relative; convert to the parameter's own units.
     return {key: float(fitted[key] * math.sqrt(max(covariance[i, i], 0.0))) for i, key in enumerate(free)}
 
 
@@ -439,6 +536,11 @@ def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str
             "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         },
     }
+    # TOML has no null: a fit that does not determine its covariance or samples no posterior leaves the key out.
+    if calibration.covariance is not None:
+        document["provenance"]["covariance_log"] = calibration.covariance
+    if calibration.posterior is not None:
+        document["provenance"]["posterior_log"] = calibration.posterior
     if calibration.curve_rms_K is not None:
         document["provenance"]["curve_rms_K"] = calibration.curve_rms_K
         document["provenance"]["curve"] = calibration.curve_source

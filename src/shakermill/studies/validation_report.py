@@ -14,6 +14,15 @@ from shakermill.parameters.keys import Parameters
 from shakermill.studies.calibrate import FreeSetOutcome, free_set_study
 from shakermill.studies.held_out import HeldOutStudies, held_out_studies
 from shakermill.studies.validation import EXPERIMENT, TABLE5, ValidationRun, validate
+from shakermill.studies.validation_matrix import (
+    STRUCTURES,
+    THERMAL_MODEL_PRESETS,
+    StructureOutcome,
+    ValidationMatrix,
+    load_experiments,
+    structure_study,
+    validation_matrix,
+)
 
 SOLVERS = ("full", "averaged")
 
@@ -27,6 +36,8 @@ class ValidationReport:
     runs: tuple[ValidationRun, ...]
     outcomes: tuple[FreeSetOutcome, ...]
     held_out: HeldOutStudies | None
+    matrix: ValidationMatrix | None = None
+    structures: tuple[StructureOutcome, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON object of ``validate --json``."""
@@ -40,6 +51,8 @@ class ValidationReport:
             "runs": {run.preset: _run_entry(run) for run in self.runs},
             "free_set_study": [_outcome_entry(outcome) for outcome in self.outcomes],
             **(self.held_out.as_dict() if self.held_out is not None else {}),
+            **({"validation_matrix": self.matrix.as_dict()} if self.matrix is not None else {}),
+            **({"structure_study": [outcome.as_dict() for outcome in self.structures]} if self.structures else {}),
         }
 
 
@@ -76,8 +89,17 @@ def preset_parameters(name: str) -> Parameters:
 def validation_report(solver: str, study: bool = True, three_d: bool = True,
                       progress: Callable[[int, int], None] | None = None) -> ValidationReport:
     """Validate with ``solver`` ('full' or 'averaged'); with ``study`` the free-set study of the default preset, with
-    ``three_d`` the held-out studies (``progress(done, total)`` counts their runs)."""
+    ``three_d`` the validation matrix of the thermal models and the held-out studies (``progress(done, total)``
+    counts their runs)."""
     runs = tuple(validate(solver))
     outcomes = tuple(free_set_study(preset_parameters(DEFAULT_PRESET))) if study else ()
-    held_out = held_out_studies(progress) if three_d else None
-    return ValidationReport(solver, runs, outcomes, held_out)
+    if not three_d:
+        return ValidationReport(solver, runs, outcomes, None)
+    show = progress if progress is not None else (lambda done, total: None)
+    experiments = load_experiments()
+    pairs = len(experiments) * len(THERMAL_MODEL_PRESETS)
+    matrix = validation_matrix(experiments=experiments, progress=show)
+    structures = structure_study(progress=lambda done, total: show(pairs + done, pairs + total))
+    before = pairs + len(STRUCTURES)
+    held_out = held_out_studies(lambda done, total: show(before + done, before + total))
+    return ValidationReport(solver, runs, outcomes, held_out, matrix, structures)

@@ -19,6 +19,7 @@ _COMPILED_SOURCES = tuple(
         "physics/kinematics.py",
         "physics/contact.py",
         "physics/thermal.py",
+        "physics/heat_paths.py",
         "engines/thermal/kernel.py",
         "engines/one_d/model.py",
         "engines/one_d/contacts.py",

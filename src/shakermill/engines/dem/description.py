@@ -33,14 +33,17 @@ IMPACT_UNITS = {
     "peak_force": "N",
     "max_overlap": "m",
     "duration": "s",
+    "conduction": "J/K",
 }
 
 # Keys that enter only the thermal network, never a force, the heat a contact makes or the Whitaker term the
 # stepping measures (λ, η and the balls' effusivities split that heat inside the stepper; the air's density and
-# its viscosity at the ambient temperature set each ball's Reynolds number there).
+# its viscosity at the ambient temperature set each ball's Reynolds number there, the materials' conductivities
+# each contact's conduction).
 THERMAL_ONLY_KEYS = (
     "h_inner", "h_outer", "inner_area", "outer_area", "vial_mass", "vial_heat_capacity", "beta",
-    "initial_temperature", "duration", "output_interval",
+    "initial_temperature", "duration", "output_interval", "thermal_model", "outer_diameter", "outer_length",
+    "emissivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss", "drive_heat",
 )
 
 DESCRIPTION = EngineDescription(
@@ -53,11 +56,12 @@ DESCRIPTION = EngineDescription(
     read_back=("time", "position", "velocity", "theta_ball", "theta_balls", "theta_vial", "theta_air"),
     motion=("position", "velocity", "angular_velocity"),
     averaged_flows=("work_vial", "heat_generated", "heat_into_balls", "heat_into_vial", "velocity_term_integrals",
-                    "velocity_term_integral"),
+                    "velocity_term_integral", "contact_conduction"),
     heat_variables=("heat_into_balls", "heat_into_vial"),
     term_variables=("velocity_term_integrals",),
     status_messages=STATUS_MESSAGES,
     averaging_error_key="dem_averaging_rel_error",
     thermal_only_keys=THERMAL_ONLY_KEYS,
     attractor_starts=False,
+    conduction_variables=("contact_conduction",),
 )

@@ -63,12 +63,12 @@ class DemEngine(CompiledRun):
         self.budget = budget if budget is not None else RunBudget.of(params)
         self.network = self.network_for(params)
         self.constants = model.constants_from(params)
-        self.state = model.initial_state(params, self.constants)
+        self.state = model.initial_state(params, self.constants, self.network)
         self.scratch = model.scratch_for(params.n_balls, model.slot_count(params.n_balls))
         self.stepper_counters = np.zeros(len(stepper.COUNTER_NAMES) + 1, dtype=np.int64)
         times, self._is_sample, self._in_window = marks(params, np.asarray(samples, dtype=float), horizon)
         self.marks = times[1:]
-        self._rows = np.zeros((self.marks.size, model.row_width(params.n_balls)))
+        self._rows = np.zeros((self.marks.size, model.row_width(params.n_balls, self.node_count)))
         self._records = np.zeros((INITIAL_RECORDS, len(stepper.RECORD_COLUMNS)))
         self._count = 0
         self.start = self.row_now()
@@ -76,6 +76,10 @@ class DemEngine(CompiledRun):
     @classmethod
     def network_for(cls, params: Parameters) -> ThermalNetwork:
         return model.network_of(params)
+
+    @property
+    def node_count(self) -> int:
+        return len(self.network.nodes)
 
     @property
     def t(self) -> float:
@@ -118,11 +122,13 @@ class DemEngine(CompiledRun):
         samples = rows[self._is_sample[: len(rows)]]
         if samples[-1, 0] < self.t:
             samples = np.vstack([samples, self.row_now()])  # a stopped run shows its last state
-        return history_of(*model.unpack_rows(samples, self.params.n_balls), self.constants)
+        return self._history(samples)
 
     def window_history(self) -> StateHistory:
-        rows = np.vstack([self.start, self.rows])[self._in_window[: len(self.rows) + 1]]
-        return history_of(*model.unpack_rows(rows, self.params.n_balls), self.constants)
+        return self._history(np.vstack([self.start, self.rows])[self._in_window[: len(self.rows) + 1]])
+
+    def _history(self, rows: np.ndarray) -> StateHistory:
+        return history_of(*model.unpack_rows(rows, self.params.n_balls, self.node_count), self.constants, self.network)
 
     def impact_columns(self, since: float = -math.inf) -> dict[str, np.ndarray]:
         return impact_columns(self.records, since)
@@ -150,7 +156,7 @@ class DemEngine(CompiledRun):
         k, s = self.constants, self.state
         n = k.n_balls
         capacity = self.network.arrays.capacity
-        initial = {name: values[0] for name, values in model.unpack_rows(self.start, n)[1].items()}
+        initial = {name: values[0] for name, values in model.unpack_rows(self.start, n, self.node_count)[1].items()}
         kinetic_start = 0.5 * float(
             np.sum(k.mass * np.sum(initial["velocity"] ** 2, axis=1)) + np.sum(k.inertia * np.sum(initial["angular_velocity"] ** 2, axis=1))
         )
@@ -171,6 +177,8 @@ class DemEngine(CompiledRun):
             stored_ball=float(np.dot(capacity[:n], warming[:n])),
             stored_vial=float(capacity[n] * warming[n]),
             stored_air=float(capacity[n + 1] * warming[n + 1]),
+            stored_clamp=float(np.dot(capacity[n + 2 :], warming[n + 2 :])),
+            drive_heat=self.network.fixed_heat * (self.t - float(self.start[0, 0])),
             heat_lost_to_surroundings=float(totals[model.HEAT_LOST]),
             projection_correction=0.0,
             work_by_gravity=float(totals[model.WORK_GRAVITY]),
@@ -189,13 +197,15 @@ class DemEngine(CompiledRun):
     def measured(self) -> Measured:
         s = self.state
         dissipated = float(s.totals[model.DISSIPATED_NORMAL : model.DISSIPATED_ROLLING + 1].sum())
-        return Measured(s.heat_into.copy(), s.velocity_term_integral.copy(), dissipated)
+        n = self.params.n_balls
+        return Measured(s.heat_into.copy(), s.drive_integrals[:n].copy(), dissipated, s.drive_integrals[n:].copy())
 
-    def load(self, heat_rates: np.ndarray, term_means: np.ndarray) -> NetworkLoad:
-        """The heat into each ball and the vial as measured (the stepper splits each contact's heat)."""
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
+        """The heat into each ball and the vial as measured (the stepper splits each contact's heat), none into the
+        air; the contacts' mean conductances."""
         heat = np.asarray(heat_rates, dtype=float)
         terms = np.asarray(term_means, dtype=float)
-        return NetworkLoad(np.append(heat, 0.0), terms, float(heat.sum()), float(terms.mean()))
+        return NetworkLoad(np.append(heat, 0.0), terms, float(heat.sum()), float(terms.mean()), np.asarray(conductances, dtype=float))
 
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
         """Each ball's contacts, with the vial or another ball; the vial's; the air's none."""
@@ -204,7 +214,7 @@ class DemEngine(CompiledRun):
         return np.array([*balls, int(np.sum(impacts["target"] != "ball")), 0])
 
     def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray,
-                         load: NetworkLoad, dissipated_power: float) -> StateHistory:
+                         load: NetworkLoad, dissipated_power: float, network: ThermalNetwork) -> StateHistory:
         k, n = self.constants, self.params.n_balls
         count = times.size
         totals = np.zeros((count, len(model.TOTAL_NAMES)))
@@ -224,10 +234,10 @@ class DemEngine(CompiledRun):
             "temperature": temperatures.T,
             "totals": totals,
             "heat_into": np.outer(times, load.heat[: n + 1]),
-            "velocity_term_integral": np.outer(times, load.terms),
+            "drive_integrals": np.outer(times, load.drives),
             "vial": vial,
         }
-        return history_of(times, fields, k)
+        return history_of(times, fields, k, network)
 
 
 def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.ndarray]:
@@ -255,22 +265,27 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
         "peak_force": records[:, column["peak_force"]],
         "max_overlap": records[:, column["max_overlap"]],
         "duration": records[:, column["duration"]],
+        "conduction": records[:, column["conduction"]],
     }
 
 
-def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Constants) -> StateHistory:
-    """The states with units: temperatures of each ball (and their mean, ``theta_ball``), vial and air, the
-    balls' motion in the lab frame (axis x, y, z; z up), the vial's pose and the running totals."""
+def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Constants, network: ThermalNetwork) -> StateHistory:
+    """The states with units: temperatures of each ball (and their mean, ``theta_ball``), vial and air (and any
+    further node of ``network``, ``theta_<name>``), the balls' motion in the lab frame (axis x, y, z; z up), the
+    vial's pose and the running totals."""
     n = k.n_balls
     theta, totals, heat_into = fields["temperature"], fields["totals"], fields["heat_into"]
-    terms, vial = fields["velocity_term_integral"], fields["vial"]
+    terms, vial = fields["drive_integrals"][:, :n], fields["vial"]
     variables: dict[str, tuple[np.ndarray, dict[str, str]]] = {
         "theta_ball": (theta[:, :n].mean(axis=1), attributes("K", "mean ball temperature")),
         "theta_vial": (theta[:, n], attributes("K", "vial temperature")),
         "theta_air": (theta[:, n + 1], attributes("K", "inner air temperature")),
         BALL_TEMPERATURES: (theta[:, :n], attributes("K", "temperature of each ball")),
     }
-    with_celsius(variables, (*CELSIUS_VARIABLES, BALL_TEMPERATURES))
+    others = tuple(f"theta_{node.name}" for node in network.nodes[n + 2 :])
+    for index, name in enumerate(others, start=n + 2):
+        variables[name] = (theta[:, index], attributes("K", f"{network.nodes[index].name} temperature"))
+    with_celsius(variables, (*CELSIUS_VARIABLES, BALL_TEMPERATURES, *others))
     for name, units, long_name in (
         ("position", "m", "ball centre, lab frame"),
         ("velocity", "m s-1", "ball velocity, lab frame"),
@@ -287,7 +302,12 @@ def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Consta
     variables["heat_into_vial"] = (heat_into[:, n], attributes("J", "cumulative impact heat into the vial"))
     variables["velocity_term_integrals"] = (terms, attributes("s", "time integral of each ball's Whitaker velocity term"))
     variables["velocity_term_integral"] = (terms.mean(axis=1), attributes("s", "the balls' mean of velocity_term_integrals"))
+    variables["contact_conduction"] = (
+        fields["drive_integrals"][:, n:],
+        attributes("J K-1", "heat per kelvin conducted by the contacts of each ball with the vial, then of each pair"),
+    )
     dimensions = {name: _PER_BALL for name in (BALL_TEMPERATURES, f"{BALL_TEMPERATURES}_C", "heat_into_balls", "velocity_term_integrals")}
+    dimensions["contact_conduction"] = ("time", "contact")
     dimensions.update({name: _VECTORS for name in ("position", "velocity", "angular_velocity")})
     dimensions.update(vial_centre=("time", "axis"), vial_angles=("time", "angle"))
     return StateHistory(times, variables, dimensions)

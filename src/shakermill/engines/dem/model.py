@@ -12,6 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.network import ThermalNetwork, air_constants, build_network
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.kinematic_models import MOTION_COORDINATES, motion_terms
@@ -67,6 +68,11 @@ class Constants(NamedTuple):
     wall_modulus: np.ndarray  # E* with the vial, per ball
     wall_shear_modulus: np.ndarray
     wall_radius: np.ndarray  # (N, 3): R* against the left end, the right end, the side
+    # Conduction through contacts (MODEL.md §13.1): each ball's and the vial's effusivity √(ρck) and conductivity
+    effusivity: np.ndarray  # (N,) W·s^½/(m²·K)
+    conductivity: np.ndarray  # (N,) W/(m·K)
+    vial_effusivity: float
+    vial_conductivity: float
     beta_e: float
     no_tension: bool
     friction: float
@@ -105,12 +111,14 @@ class State(NamedTuple):
     spin: np.ndarray  # (N, 3) rad/s, angular velocity
     force: np.ndarray  # (N, 3) N: contact forces of the last evaluation (gravity apart)
     torque: np.ndarray  # (N, 3) N·m
-    temperature: np.ndarray  # (N + 2,) K: the balls, the vial, the air
-    pending_heat: np.ndarray  # (N + 2,) J into the balls, the vial (and the air: none) since the last thermal update
-    pending_velocity_term: np.ndarray  # (N,) s: ∫w dt since the last thermal update
+    temperature: np.ndarray  # (nodes,) K: the balls, the vial, the air (and the clamp: the thermal network's nodes)
+    pending_heat: np.ndarray  # (nodes,) J from the contacts into the balls and the vial since the last thermal update
+    # The network's drives (engines.thermal.kernel): each ball's Whitaker term integral ∫w dt (s), then the heat per
+    # kelvin of the contacts (J/K) of each ball with the vial and of each pair, since the last thermal update...
+    pending_drives: np.ndarray  # (D,)
     totals: np.ndarray  # (len(TOTAL_NAMES),) J
     heat_into: np.ndarray  # (N + 1,) J: all heat into each ball and the vial so far
-    velocity_term_integral: np.ndarray  # (N,) s: ∫w dt of each ball so far
+    drive_integrals: np.ndarray  # (D,) ...and since the start
     contacts: "Contacts"
 
 
@@ -195,6 +203,7 @@ def constants_from(params: Parameters) -> Constants:
     conductivity = np.array(params.ball_values("ball_conductivity"))
     mass = _masses(params)
     effusivity = np.sqrt(conductivity * density * heat_capacity)
+    vial_effusivity = math.sqrt(params.vial_conductivity * params.vial_density * params.vial_heat_capacity)
     pair_modulus, pair_shear, pair_radius, pair_mass, share = (np.zeros((n, n)) for _ in range(5))
     for i in range(n):
         for j in range(n):
@@ -228,6 +237,10 @@ def constants_from(params: Parameters) -> Constants:
         wall_modulus=np.array([contact.effective_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]),
         wall_shear_modulus=np.array([contact.effective_shear_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]),
         wall_radius=wall_radius,
+        effusivity=effusivity,
+        conductivity=conductivity,
+        vial_effusivity=vial_effusivity,
+        vial_conductivity=params.vial_conductivity,
         beta_e=contact.damping_ratio(params.restitution),
         no_tension=params.no_tension,
         friction=params.friction,
@@ -267,9 +280,10 @@ THERMAL_STEP = 1e-3
 THERMAL_STEP_FRACTION = 0.1
 
 
-def initial_state(params: Parameters, k: Constants) -> State:
+def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> State:
     """Balls at rest where :meth:`Parameters.initial_positions` puts them (one ball: ``ball_position`` and
-    ``ball_momentum`` along the axis, as the 1-D engine), everything at the initial temperature."""
+    ``ball_momentum`` along the axis, as the 1-D engine), every node of ``network`` at the initial temperature
+    (held ones at the ambient)."""
     n = params.n_balls
     slots = slot_count(n)
     centre = np.zeros(6)
@@ -280,9 +294,7 @@ def initial_state(params: Parameters, k: Constants) -> State:
     position = centre[:3] + params.initial_positions() @ orientation.T
     velocity = np.zeros((n, 3))
     velocity[0, 0] = params.ball_momentum / k.mass[0] if n == 1 else 0.0
-    temperature = np.full(n + 2, params.initial_temperature)
-    if params.model == "ball_only":
-        temperature[n:] = params.ambient_temperature
+    drives = kernel.drive_count(n)
     return State(
         clock=np.zeros(2),
         position=position,
@@ -290,12 +302,12 @@ def initial_state(params: Parameters, k: Constants) -> State:
         spin=np.zeros((n, 3)),
         force=np.zeros((n, 3)),
         torque=np.zeros((n, 3)),
-        temperature=temperature,
-        pending_heat=np.zeros(n + 2),
-        pending_velocity_term=np.zeros(n),
+        temperature=network.initial_temperatures(params.initial_temperature),
+        pending_heat=np.zeros(len(network.nodes)),
+        pending_drives=np.zeros(drives),
         totals=np.zeros(len(TOTAL_NAMES)),
         heat_into=np.zeros(n + 1),
-        velocity_term_integral=np.zeros(n),
+        drive_integrals=np.zeros(drives),
         contacts=Contacts(
             active=np.zeros(slots, dtype=np.bool_),
             normal_force=np.zeros((slots, 3)),
@@ -320,28 +332,29 @@ def initial_state(params: Parameters, k: Constants) -> State:
     )
 
 
-def row_fields(n_balls: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
-    """Layout of a recorded state row (after its time): each field's name and shape."""
+def row_fields(n_balls: int, nodes: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
+    """Layout of a recorded state row (after its time) of ``n_balls`` and a network of ``nodes``: each field's
+    name and shape."""
     return (
         ("position", (n_balls, 3)),
         ("velocity", (n_balls, 3)),
         ("angular_velocity", (n_balls, 3)),
-        ("temperature", (n_balls + 2,)),
+        ("temperature", (nodes,)),
         ("totals", (len(TOTAL_NAMES),)),
         ("heat_into", (n_balls + 1,)),
-        ("velocity_term_integral", (n_balls,)),
+        ("drive_integrals", (kernel.drive_count(n_balls),)),
         ("vial", (6,)),
     )
 
 
-def row_width(n_balls: int) -> int:
-    return 1 + sum(int(np.prod(shape)) for _, shape in row_fields(n_balls))
+def row_width(n_balls: int, nodes: int) -> int:
+    return 1 + sum(int(np.prod(shape)) for _, shape in row_fields(n_balls, nodes))
 
 
-def unpack_rows(rows: np.ndarray, n_balls: int) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+def unpack_rows(rows: np.ndarray, n_balls: int, nodes: int) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Times and named fields (each over (time, *shape)) of recorded state rows."""
     fields, offset = {}, 1
-    for name, shape in row_fields(n_balls):
+    for name, shape in row_fields(n_balls, nodes):
         size = int(np.prod(shape))
         fields[name] = rows[:, offset : offset + size].reshape(len(rows), *shape)
         offset += size

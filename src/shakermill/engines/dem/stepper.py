@@ -52,6 +52,7 @@ RECORD_COLUMNS = (
     "duration",
     "heat_to_ball",
     "heat_to_other",
+    "conduction",
 )
 COUNTER_NAMES = ("steps", "contact_steps", "flight_steps", "impacts", "thermal_updates")
 STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES, ROWS_WRITTEN = range(len(COUNTER_NAMES) + 1)
@@ -84,26 +85,27 @@ def _convect(dt: float, k: Constants, s: State, w: Scratch) -> None:
             speed_squared = dot(s.velocity[i], s.velocity[i])
         reynolds = thermal.reynolds_number(k.radius[i], k.air_density, math.sqrt(speed_squared), k.viscosity_ambient)
         term = thermal.whitaker_velocity_term(reynolds) * dt
-        s.pending_velocity_term[i] += term
-        s.velocity_term_integral[i] += term
+        s.pending_drives[i] += term
+        s.drive_integrals[i] += term
 
 
 @njit(cache=True)
 def advance_thermal(k: Constants, net: NetworkArrays, s: State) -> None:
-    """Advance the network (``engines.thermal``) over the time gathered since its last update, with the heat and
-    mean Whitaker terms of that time (explicit Euler, which conserves energy exactly)."""
+    """Advance the network (``engines.thermal``) over the time gathered since its last update, with the heat, the
+    mean Whitaker terms and the mean contact conductances of that time (explicit Euler, which conserves energy
+    exactly)."""
     # Its scratch is allocated here, at most once a thermal step (1 ms), rather than kept in ``Scratch``: every
     # array there costs reference counts at each use inside the compiled step.
     span = s.clock[1]
     if span <= 0.0:
         return
-    for i in range(k.n_balls):
-        s.pending_velocity_term[i] /= span
+    for drive in range(s.pending_drives.size):
+        s.pending_drives[drive] /= span
     s.totals[HEAT_LOST] += kernel.advance(
-        s.temperature, s.pending_heat, s.pending_velocity_term, span, net, np.empty(net.kind.size), np.empty(s.temperature.size)
+        s.temperature, s.pending_heat, s.pending_drives, span, net, np.empty(net.kind.size), np.empty(s.temperature.size)
     )
     s.pending_heat[:] = 0.0
-    s.pending_velocity_term[:] = 0.0
+    s.pending_drives[:] = 0.0
     s.clock[1] = 0.0
 
 
@@ -233,7 +235,7 @@ def write_row(k: Constants, net: NetworkArrays, s: State, w: Scratch, row: np.nd
     row[0] = s.clock[0]
     offset = 1
     for block in (s.position.ravel(), s.velocity.ravel(), s.spin.ravel(), s.temperature, s.totals, s.heat_into,
-                  s.velocity_term_integral, w.coordinates):
+                  s.drive_integrals, w.coordinates):
         row[offset : offset + block.size] = block
         offset += block.size
 

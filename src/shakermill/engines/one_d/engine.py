@@ -202,8 +202,9 @@ class OneDimensionalEngine:
         y = self.integrator.y
         return Measured(np.array([y[model.HEAT_GENERATED]]), np.array([y[model.VELOCITY_TERM]]), float(y[model.DISSIPATED]))
 
-    def load(self, heat_rates: np.ndarray, term_means: np.ndarray) -> NetworkLoad:
-        """The impacts' heat P splits λ : 1 − λ between the ball and the vial (MODEL.md §3)."""
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
+        """The impacts' heat P splits λ : 1 − λ between the ball and the vial (MODEL.md §3); its network (the paper's)
+        has no contact conduction."""
         power, term = float(heat_rates[0]), float(term_means[0])
         lam = self.params.lam
         return NetworkLoad(np.array([lam * power, (1.0 - lam) * power, 0.0]), np.array([term]), power, term)
@@ -214,7 +215,7 @@ class OneDimensionalEngine:
         return np.array([count, count, 0])
 
     def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray,
-                         load: NetworkLoad, dissipated_power: float) -> StateHistory:
+                         load: NetworkLoad, dissipated_power: float, network: ThermalNetwork) -> StateHistory:
         states = np.full((times.size, model.N_STATE), np.nan)
         states[:, model.THETA_BALL] = temperatures[0]
         states[:, model.THETA_VIAL] = temperatures[1]

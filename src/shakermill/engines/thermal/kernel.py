@@ -1,8 +1,10 @@
 """The thermal network in compiled form: its heat flows and the energy balance of its nodes.
 
-A network is arrays (:class:`NetworkArrays`): each node's heat capacity and whether it is held at the room
-temperature, and each heat path's model (:data:`WHITAKER`, :data:`CONSTANT`), its two ends (a node, or
-:data:`ROOM`) and its coefficients. The flows are positive from a path's ``hot`` end to its ``cold`` end.
+A network is arrays (:class:`NetworkArrays`): each node's heat capacity, whether it is held at the room
+temperature and the heat it receives whatever the balls do (the drive's, into a mill head), and each heat
+path's model (:data:`WHITAKER`, :data:`CONSTANT`, :data:`CONTACT`, :data:`RADIATION`), its two ends (a node,
+or :data:`ROOM`) and its coefficients. Paths that depend on the motion read it from ``drives``: each ball's
+mean Whitaker velocity term, then the mean conductances of the balls' contacts (:func:`drive_count`). The flows are positive from a path's ``hot`` end to its ``cold`` end.
 Every engine and solver evaluates the network through these functions: the 'dem' engine's stepping, the
 averaged solvers' integration and the steady state. The 1-D engine's right-hand side keeps the three-node
 network written out for speed (``engines.one_d.model.thermal_network``); a test holds it to these, term by term.
@@ -18,25 +20,29 @@ from numba import njit
 from shakermill.physics import thermal
 
 # Path models. WHITAKER: a ball's convection to the air, Whitaker's correlation at the ball's own mean velocity
-# term (MODEL.md §4); CONSTANT: a fixed conductance h·A (Newton cooling, MODEL.md §5).
-WHITAKER, CONSTANT = 0, 1
+# term (MODEL.md §4); CONSTANT: a fixed conductance h·A (Newton cooling, MODEL.md §5); CONTACT: conduction
+# through contacts at their measured mean conductance; RADIATION: ε·σ·A·(θ_hot⁴ − θ_cold⁴) (MODEL.md §13.1).
+WHITAKER, CONSTANT, CONTACT, RADIATION = 0, 1, 2, 3
 # The cold end of a path that leaves the system: the surroundings at the ambient temperature.
 ROOM = -1
 
 
 class NetworkArrays(NamedTuple):
     """A network as the compiled functions read it. Per node: ``capacity`` (J/K), ``held`` (kept at the
-    ambient temperature: a reservoir outside the balance). Per path: ``kind``, ``hot`` and ``cold`` ends,
-    ``conductance`` (W/K, CONSTANT), ``radius`` (m) and ``ball`` (whose velocity term, WHITAKER)."""
+    ambient temperature: a reservoir outside the balance), ``fixed_heat`` (W, whatever the balls do). Per path:
+    ``kind``, ``hot`` and ``cold`` ends, ``conductance`` (W/K for CONSTANT, ε·σ·A in W/K⁴ for RADIATION),
+    ``radius`` (m, WHITAKER) and ``drive`` (the index into ``drives`` of its velocity term or contact
+    conductance, WHITAKER and CONTACT)."""
 
     capacity: np.ndarray
     held: np.ndarray
+    fixed_heat: np.ndarray
     kind: np.ndarray
     hot: np.ndarray
     cold: np.ndarray
     conductance: np.ndarray
     radius: np.ndarray
-    ball: np.ndarray
+    drive: np.ndarray
     beta: float
     prandtl: float
     mu_ref: float
@@ -44,6 +50,22 @@ class NetworkArrays(NamedTuple):
     sutherland: float
     air_conductivity: float
     ambient: float
+
+
+def drive_count(n_balls: int) -> int:
+    """Entries of ``drives`` for ``n_balls``: a velocity term each, a contact conductance with the vial each, and
+    one per pair of balls."""
+    return 2 * n_balls + n_balls * (n_balls - 1) // 2
+
+
+@njit(cache=True)
+def contact_drive(ball: int, other: int, n_balls: int) -> int:
+    """Index into ``drives`` of the contact conductance of ``ball`` with the vial (``other`` < 0) or with ball
+    ``other``."""
+    if other < 0:
+        return n_balls + ball
+    low, high = min(ball, other), max(ball, other)
+    return 2 * n_balls + low * n_balls - low * (low + 1) // 2 + high - low - 1
 
 
 @njit(cache=True)
@@ -57,26 +79,32 @@ def whitaker_flow(theta_ball: float, theta_air: float, velocity_term: float, rad
 
 
 @njit(cache=True)
-def path_flows(theta: np.ndarray, velocity_terms: np.ndarray, net: NetworkArrays, out: np.ndarray) -> None:
-    """Each path's heat flow (W, hot end to cold end) into ``out``, at node temperatures ``theta`` (K) and each
-    ball's mean Whitaker velocity term."""
+def path_flows(theta: np.ndarray, drives: np.ndarray, net: NetworkArrays, out: np.ndarray) -> None:
+    """Each path's heat flow (W, hot end to cold end) into ``out``, at node temperatures ``theta`` (K) and the
+    motion's ``drives``."""
     for p in range(net.kind.shape[0]):
         hot = theta[net.hot[p]]
         cold = net.ambient if net.cold[p] == ROOM else theta[net.cold[p]]
-        if net.kind[p] == WHITAKER:
-            out[p] = whitaker_flow(hot, cold, velocity_terms[net.ball[p]], net.radius[p], net)
+        kind = net.kind[p]
+        if kind == WHITAKER:
+            out[p] = whitaker_flow(hot, cold, drives[net.drive[p]], net.radius[p], net)
+        elif kind == CONTACT:
+            out[p] = drives[net.drive[p]] * (hot - cold)
+        elif kind == RADIATION:
+            out[p] = net.conductance[p] * (hot**4 - cold**4)
         else:
             out[p] = net.conductance[p] * (hot - cold)
 
 
 @njit(cache=True)
-def balance(heat: np.ndarray, flows: np.ndarray, net: NetworkArrays, out: np.ndarray) -> float:
-    """Heat into each node (``heat`` in, each path's flow out of its hot end and into its cold end) into
-    ``out``, in the unit of ``heat`` and ``flows``; returns what leaves the system: the flows into the room or
-    a held node, less those out of a held node, and the heat into held nodes. Held nodes get 0: they are
-    reservoirs outside the balance."""
+def balance(heat: np.ndarray, flows: np.ndarray, span: float, net: NetworkArrays, out: np.ndarray) -> float:
+    """Heat into each node (``heat`` and the fixed heat over ``span`` in, each path's flow out of its hot end and
+    into its cold end) into ``out``, in the unit of ``heat`` and ``flows`` (W with ``span`` = 1, or J over
+    ``span`` seconds); returns what leaves the system: the flows into the room or a held node, less those out of
+    a held node, and the heat into held nodes. Held nodes get 0: they are reservoirs outside the balance."""
     lost = 0.0
-    out[:] = heat
+    for node in range(out.shape[0]):
+        out[node] = heat[node] + net.fixed_heat[node] * span
     for p in range(flows.shape[0]):
         hot, cold = net.hot[p], net.cold[p]
         if net.held[hot]:
@@ -89,32 +117,33 @@ def balance(heat: np.ndarray, flows: np.ndarray, net: NetworkArrays, out: np.nda
             out[cold] += flows[p]
     for node in range(out.shape[0]):
         if net.held[node]:
-            lost += heat[node]
+            lost += out[node]
             out[node] = 0.0
     return lost
 
 
 @njit(cache=True)
-def temperature_rates(theta: np.ndarray, heat: np.ndarray, velocity_terms: np.ndarray, net: NetworkArrays,
+def temperature_rates(theta: np.ndarray, heat: np.ndarray, drives: np.ndarray, net: NetworkArrays,
                       flows: np.ndarray, out: np.ndarray) -> float:
-    """dθ/dt (K/s) of every node into ``out`` (held nodes: 0) with ``heat`` (W) into each; returns the heat
-    leaving the system (W). ``flows`` is scratch of one entry per path."""
-    path_flows(theta, velocity_terms, net, flows)
-    lost = balance(heat, flows, net, out)
+    """dθ/dt (K/s) of every node into ``out`` (held nodes: 0) with ``heat`` (W) into each from the contacts;
+    returns the heat leaving the system (W). ``flows`` receives each path's flow (W)."""
+    path_flows(theta, drives, net, flows)
+    lost = balance(heat, flows, 1.0, net, out)
     for node in range(out.shape[0]):
         out[node] /= net.capacity[node]
     return lost
 
 
 @njit(cache=True)
-def advance(theta: np.ndarray, heat: np.ndarray, velocity_terms: np.ndarray, span: float, net: NetworkArrays,
+def advance(theta: np.ndarray, heat: np.ndarray, drives: np.ndarray, span: float, net: NetworkArrays,
             flows: np.ndarray, energy: np.ndarray) -> float:
-    """One explicit Euler step of ``span`` (s) from ``theta`` in place, with ``heat`` (J) received in it and the
-    flows at its start; returns the heat that left the system (J). Energy is conserved exactly."""
-    path_flows(theta, velocity_terms, net, flows)
+    """One explicit Euler step of ``span`` (s) from ``theta`` in place, with ``heat`` (J) received from the contacts
+    in it and the flows at its start; returns the heat that left the system (J), and leaves in ``flows`` the
+    heat through each path (J). Energy is conserved exactly."""
+    path_flows(theta, drives, net, flows)
     for p in range(flows.shape[0]):
         flows[p] *= span
-    lost = balance(heat, flows, net, energy)
+    lost = balance(heat, flows, span, net, energy)
     for node in range(theta.shape[0]):
         theta[node] += energy[node] / net.capacity[node]
     return lost

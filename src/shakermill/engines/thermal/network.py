@@ -1,18 +1,28 @@
-"""The thermal network of a run, built from its parameters: a node per ball, the vial and the air, the named
-heat paths between them and to the room, and the heat each node receives from the contacts (MODEL.md sections
-4-6, 11, 12.5). Every engine builds its network here and evaluates it through :mod:`kernel`."""
+"""The thermal network of a run, built from its parameters: a node per ball, the vial and the air (and with
+``thermal_model = 'mill-head'`` the clamp and mill head), the named heat paths between them and to the room,
+and the heat each node receives from the contacts and the drive (MODEL.md sections 4-6, 11, 12.5, 13). Every
+engine builds its network here and evaluates it through :mod:`kernel`."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
 
 from shakermill.engines.thermal import kernel
-from shakermill.engines.thermal.paths import HeatPath, ball_convection, newton_cooling
+from shakermill.engines.thermal.paths import (
+    HeatPath,
+    ball_convection,
+    contact_conduction,
+    fixed_conductance,
+    newton_cooling,
+    radiation,
+)
 from shakermill.parameters.keys import Parameters
-from shakermill.physics import thermal
+from shakermill.parameters.kinematic_models import MOTION_COORDINATES, motion_terms
+from shakermill.physics import heat_paths, thermal
 
 PAPER_PATHS = "Son 2025 (Mathematics 13, 446)"
 
@@ -37,26 +47,32 @@ class HeatSource:
 @dataclass(frozen=True)
 class NetworkLoad:
     """What drives the network with the mechanics replaced by its means (MODEL.md §11): the heat into each node
-    (W), each ball's mean Whitaker velocity term, and for the summary their total (W) and the balls' mean term."""
+    from the contacts (W), each ball's mean Whitaker velocity term, for the summary their total (W) and the balls'
+    mean term, and the mean contact conductances (W/K) in :func:`kernel.contact_drive` order (none for an engine
+    that does not measure them)."""
 
     heat: np.ndarray
     terms: np.ndarray
     heat_power: float
     velocity_term: float
+    conductances: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def drives(self) -> np.ndarray:
+        """The ``drives`` the network's paths read (:mod:`kernel`)."""
+        return np.concatenate([self.terms, self.conductances])
 
 
 @dataclass(frozen=True)
 class ThermalNetwork:
-    """Nodes, heat paths and heat sources; ``arrays`` is the compiled form. Node order: the balls, the vial, the air."""
+    """Nodes, heat paths and heat sources; ``arrays`` is the compiled form. Node order: the balls, the vial, the
+    air, then any others (the clamp)."""
 
+    n_balls: int
     nodes: tuple[Node, ...]
     paths: tuple[HeatPath, ...]
     sources: tuple[HeatSource, ...]
     arrays: kernel.NetworkArrays = field(repr=False)
-
-    @property
-    def n_balls(self) -> int:
-        return len(self.nodes) - 2
 
     @property
     def vial(self) -> int:
@@ -75,21 +91,29 @@ class ThermalNetwork:
         """Indices of the nodes whose temperatures evolve (not held)."""
         return np.flatnonzero(~self.arrays.held)
 
-    def flows(self, theta: np.ndarray, velocity_terms: np.ndarray) -> np.ndarray:
-        """Each path's heat flow (W) at node temperatures ``theta`` (K) and the balls' mean velocity terms."""
+    def flows(self, theta: np.ndarray, drives: np.ndarray) -> np.ndarray:
+        """Each path's heat flow (W) at node temperatures ``theta`` (K) and the motion's mean ``drives``
+        (:attr:`NetworkLoad.drives`)."""
         out = np.empty(len(self.paths))
-        kernel.path_flows(np.asarray(theta, dtype=float), np.asarray(velocity_terms, dtype=float), self.arrays, out)
+        kernel.path_flows(np.asarray(theta, dtype=float), np.asarray(drives, dtype=float), self.arrays, out)
         return out
 
-    def rates(self, theta: np.ndarray, heat: np.ndarray, velocity_terms: np.ndarray) -> tuple[np.ndarray, float]:
-        """dθ/dt (K/s) of every node with mean ``heat`` (W) into each, and the heat leaving the system (W)."""
+    def rates(self, theta: np.ndarray, heat: np.ndarray, drives: np.ndarray) -> tuple[np.ndarray, float]:
+        """dθ/dt (K/s) of every node with mean ``heat`` (W) into each from the contacts (the first nodes: those
+        after the last it names get none), and the heat leaving the system (W)."""
         out = np.empty(len(self.nodes))
         flows = np.empty(len(self.paths))
+        received = np.zeros(len(self.nodes))
+        received[: len(heat)] = heat
         lost = kernel.temperature_rates(
-            np.asarray(theta, dtype=float), np.asarray(heat, dtype=float), np.asarray(velocity_terms, dtype=float),
-            self.arrays, flows, out,
+            np.asarray(theta, dtype=float), received, np.asarray(drives, dtype=float), self.arrays, flows, out
         )
         return out, lost
+
+    @property
+    def fixed_heat(self) -> float:
+        """Heat into the network whatever the balls do (W): the drive's."""
+        return float(self.arrays.fixed_heat.sum())
 
     def with_free(self, free_temperatures: np.ndarray) -> np.ndarray:
         """All node temperatures: ``free_temperatures`` for the free nodes, the ambient for the held ones."""
@@ -101,18 +125,20 @@ class ThermalNetwork:
         """Every free node at ``initial`` (K), the held ones at the ambient."""
         return self.with_free(np.full(self.free.size, initial))
 
-    def outer_conductance(self) -> float:
-        """The conductance (W/K) of the constant paths to the room: where the heat leaves at steady state."""
-        return sum(path.conductance for path in self.paths if path.cold == kernel.ROOM and path.kind == kernel.CONSTANT)
+    def room_conductance(self, drives: np.ndarray) -> float:
+        """The conductance (W/K) of the paths to the room with every node 1 K above the ambient: where the heat
+        leaves at steady state."""
+        flows = self.flows(np.full(len(self.nodes), self.ambient + 1.0), drives)
+        return float(sum(flow for path, flow in zip(self.paths, flows, strict=True) if path.cold == kernel.ROOM))
 
-    def node_conductances(self, velocity_terms: np.ndarray) -> np.ndarray:
+    def node_conductances(self, drives: np.ndarray) -> np.ndarray:
         """The conductance (W/K) of all paths at each node: its heat flows when it alone is 1 K above the
         ambient, every other node at the ambient."""
         conductances = np.zeros(len(self.nodes))
         for node in range(len(self.nodes)):
             theta = np.full(len(self.nodes), self.ambient)
             theta[node] += 1.0
-            flows = self.flows(theta, velocity_terms)
+            flows = self.flows(theta, drives)
             for path, flow in zip(self.paths, flows, strict=True):
                 if node in (path.hot, path.cold):
                     conductances[node] += abs(flow)
@@ -130,42 +156,136 @@ def air_constants(params: Parameters) -> dict[str, float]:
 def build_network(params: Parameters, radii: Sequence[float], capacities: Sequence[float],
                   ball_names: Sequence[str], contact_share: str) -> ThermalNetwork:
     """The network of ``params`` for balls of ``radii`` (m) and heat ``capacities`` (J/K): each ball convects to
-    the air (Whitaker), the vial exchanges heat with the air inside and the room outside (constant h·A). In the
-    ``ball_only`` model the vial and the air are held at the ambient (the paper's 2023 predecessor).
-    ``contact_share`` says which part of the contacts' heat a ball receives."""
+    the air (Whitaker), the vial exchanges heat with the air inside and the room outside. ``thermal_model``
+    'paper': the outside at a constant h·A, and in the ``ball_only`` model the vial and the air held at the ambient
+    (the paper's 2023 predecessor); 'mill-head': :func:`mill_head_paths` as well. ``contact_share`` says which part
+    of the contacts' heat a ball receives."""
     n = len(radii)
     vial, air = n, n + 1
     held = params.model == "ball_only"
-    nodes = (
+    nodes = [
         *(Node(name, capacity) for name, capacity in zip(ball_names, capacities, strict=True)),
         Node("vial", params.vial_mass * params.vial_heat_capacity, held),
         Node("air", params.air_mass * params.air_heat_capacity, held),
-    )
-    paths = (
+    ]
+    paths = [
         *(ball_convection(f"{ball_names[i]} → air", i, air, i, radius) for i, radius in enumerate(radii)),
         newton_cooling("vial → air", vial, air, params.h_inner, params.inner_area,
                        f"h_inner, inner_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)"),
-        newton_cooling("vial → room", vial, kernel.ROOM, params.h_outer, params.outer_area,
-                       f"h_outer, outer_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)"),
-    )
-    sources = (
+    ]
+    sources = [
         *(HeatSource(i, contact_share) for i in range(n)),
         HeatSource(vial, "1 − λ of the heat of each contact with the vial"),
+    ]
+    fixed_heat = np.zeros(len(nodes))
+    if params.thermal_model == "mill-head":
+        clamp = len(nodes)
+        nodes.append(Node("clamp", params.clamp_heat_capacity))
+        paths += mill_head_paths(params, ball_names, vial, clamp)
+        sources.append(HeatSource(clamp, "drive_heat: the motor's and bearings' losses, whatever the balls do"))
+        fixed_heat = np.append(fixed_heat, params.drive_heat)
+    else:
+        paths.append(newton_cooling("vial → room", vial, kernel.ROOM, params.h_outer, params.outer_area,
+                                    f"h_outer, outer_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)"))
+    return ThermalNetwork(n, tuple(nodes), tuple(paths), tuple(sources), _arrays(params, nodes, paths, fixed_heat))
+
+
+def mill_head_paths(params: Parameters, ball_names: Sequence[str], vial: int, clamp: int) -> list[HeatPath]:
+    """The paths of a real mill beyond the paper's (MODEL.md §13.1): the vial's outside to the room by convection
+    at its own speed and by radiation, conduction through the contacts of each ball with the vial and with every
+    other ball, the vial to the clamp and the clamp to the room."""
+    n = len(ball_names)
+    outer = vial_outer_convection(params)
+    paths = [
+        newton_cooling("vial → room, convection", vial, kernel.ROOM, outer.coefficient, outer.area, outer.source, outer.validity),
+        radiation("vial → room, radiation", vial, kernel.ROOM, params.emissivity, outer.area),
+        *(contact_conduction(f"{ball_names[i]} → vial, contacts", i, vial, kernel.contact_drive(i, -1, n)) for i in range(n)),
+        *(contact_conduction(f"{ball_names[i]} → {ball_names[j]}, contacts", i, j, kernel.contact_drive(i, j, n))
+          for i in range(n) for j in range(i + 1, n)),
+        fixed_conductance("vial → clamp", vial, clamp, params.clamp_conductance, "clamp_conductance (see its source)",
+                          "a steady joint: the vial's and the clamp's own conduction are fast beside it"),
+        fixed_conductance("clamp → room", clamp, kernel.ROOM, params.clamp_loss, "clamp_loss (see its source)",
+                          "the clamp and mill head lumped at one temperature"),
+    ]
+    return paths
+
+
+@dataclass(frozen=True)
+class OuterConvection:
+    """The vial's outside to the room: the mean coefficient over its faces (W/(m²·K)), their area (m²), the speed it
+    is taken at (m/s) and what it rests on."""
+
+    coefficient: float
+    area: float
+    speed: float
+    source: str
+    validity: str
+
+
+# Natural convection depends on the vial's rise itself (as ΔT^1/4): it is taken at a rise typical of a milling
+# hour. Beside forced convection at metres per second it changes the outer coefficient by under 1 %.
+NATURAL_CONVECTION_RISE_K = 20.0
+
+
+def vial_outer_convection(params: Parameters) -> OuterConvection:
+    """Convection from the vial's outside (a cylinder of ``outer_diameter`` × ``outer_length``) at the rms speed of
+    its motion: the side as a plate along the flow, each end as a disk facing it, each combined with natural
+    convection (Churchill's rule); air properties at the ambient temperature."""
+    constants = air_constants(params)
+    viscosity, prandtl = constants["viscosity_ambient"], constants["prandtl"]
+    speed = vial_rms_speed(params)
+    diameter, length, k_air = params.outer_diameter, params.outer_length, params.air_conductivity
+    side_area, end_area = math.pi * diameter * length, 2.0 * math.pi * diameter**2 / 4.0
+    rayleigh = heat_paths.rayleigh_number(
+        diameter, NATURAL_CONVECTION_RISE_K, params.ambient_temperature + NATURAL_CONVECTION_RISE_K / 2, viscosity,
+        params.air_density, k_air, params.air_cp,
     )
-    return ThermalNetwork(nodes, paths, sources, _arrays(params, nodes, paths))
+    natural = heat_paths.churchill_chu_cylinder_nusselt(rayleigh, prandtl) * k_air / diameter
+    side = heat_paths.flat_plate_nusselt(thermal.reynolds_number(length / 2, params.air_density, speed, viscosity), prandtl)
+    end = heat_paths.disk_nusselt(thermal.reynolds_number(diameter / 2, params.air_density, speed, viscosity), prandtl)
+    h_side = heat_paths.mixed_convection_coefficient(side * k_air / length, natural)
+    h_end = heat_paths.mixed_convection_coefficient(end * k_air / diameter, natural)
+    area = side_area + end_area
+    return OuterConvection(
+        coefficient=(h_side * side_area + h_end * end_area) / area,
+        area=area,
+        speed=speed,
+        source=(
+            f"side: laminar flat plate, Nu = 0.664 Re_L^1/2 Pr^1/3 (Incropera & DeWitt Eq. 7.30); ends: disk facing the "
+            f"flow, Nu = 1.05 Re_D^1/2 Pr^0.36 (Sparrow & Geiger 1985, recalled, not re-read); each with natural "
+            f"convection (Churchill & Chu 1975, horizontal cylinder, at a {NATURAL_CONVECTION_RISE_K:g} K rise) by "
+            f"Churchill's rule; at the vial's rms speed {speed:.3g} m/s"
+        ),
+        validity=(
+            "quasi-steady flow: the vial's stroke is ~3 diameters (Keulegan-Carpenter number ~3), so steady "
+            "correlations at the rms speed are a ±30 % estimate; Re_L < 5e5 (laminar), the disk measured for "
+            "5e3 < Re_D < 5e4"
+        ),
+    )
 
 
-def _arrays(params: Parameters, nodes: Sequence[Node], paths: Sequence[HeatPath]) -> kernel.NetworkArrays:
+def vial_rms_speed(params: Parameters) -> float:
+    """The rms speed (m/s) of the vial's centre over a drive cycle, from the Fourier terms of its motion."""
+    amplitudes: dict[tuple[str, int], np.ndarray] = {}
+    for coordinate, k, cosine, sine in motion_terms(params.kinematics, params):
+        if coordinate in MOTION_COORDINATES[:3]:
+            amplitudes[(coordinate, k)] = amplitudes.get((coordinate, k), np.zeros(2)) + (cosine, sine)
+    mean_square = sum(0.5 * (k * params.omega) ** 2 * float(np.sum(pair**2)) for (_, k), pair in amplitudes.items())
+    return math.sqrt(mean_square)
+
+
+def _arrays(params: Parameters, nodes: Sequence[Node], paths: Sequence[HeatPath], fixed_heat: np.ndarray) -> kernel.NetworkArrays:
     constants = air_constants(params)
     return kernel.NetworkArrays(
         capacity=np.array([node.capacity for node in nodes]),
         held=np.array([node.held for node in nodes], dtype=np.bool_),
+        fixed_heat=np.asarray(fixed_heat, dtype=float),
         kind=np.array([path.kind for path in paths], dtype=np.int64),
         hot=np.array([path.hot for path in paths], dtype=np.int64),
         cold=np.array([path.cold for path in paths], dtype=np.int64),
         conductance=np.array([path.conductance for path in paths]),
         radius=np.array([path.radius for path in paths]),
-        ball=np.array([path.ball for path in paths], dtype=np.int64),
+        drive=np.array([path.drive for path in paths], dtype=np.int64),
         beta=params.beta,
         prandtl=constants["prandtl"],
         mu_ref=params.air_viscosity_ref,

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shakermill.engines.thermal.kernel import CONSTANT, WHITAKER
+from shakermill.engines.thermal.kernel import CONSTANT, CONTACT, RADIATION, WHITAKER
+from shakermill.physics.heat_paths import STEFAN_BOLTZMANN
 
 WHITAKER_CORRELATION = (
     "Q = 4πR²·β·h·(θ_b − θ_a), h = Nu·k_a/(2R), Nu = 2 + (0.4 Re^1/2 + 0.06 Re^2/3)·Pr^0.4·(μ(θ_b)/μ_r)^(−1/4), "
@@ -35,17 +36,51 @@ class HeatPath:
     correlation: str
     source: str
     validity: str
-    conductance: float = 0.0  # W/K, CONSTANT
+    conductance: float = 0.0  # W/K, CONSTANT; ε·σ·A (W/K⁴), RADIATION
     radius: float = 0.0  # m, WHITAKER: the ball's radius
-    ball: int = -1  # WHITAKER: whose velocity term
+    drive: int = -1  # WHITAKER, CONTACT: the index of its velocity term or contact conductance in the drives
 
 
 def ball_convection(name: str, hot: int, cold: int, ball: int, radius: float) -> HeatPath:
     """A ball's convection to the air around it (MODEL.md §4)."""
-    return HeatPath(name, hot, cold, WHITAKER, WHITAKER_CORRELATION, WHITAKER_SOURCE, WHITAKER_VALIDITY, radius=radius, ball=ball)
+    return HeatPath(name, hot, cold, WHITAKER, WHITAKER_CORRELATION, WHITAKER_SOURCE, WHITAKER_VALIDITY, radius=radius, drive=ball)
 
 
-def newton_cooling(name: str, hot: int, cold: int, h: float, area: float, source: str) -> HeatPath:
+def newton_cooling(name: str, hot: int, cold: int, h: float, area: float, source: str,
+                   validity: str = "h and A as given: no dependence on speed or temperature") -> HeatPath:
     """Heat through ``area`` (m²) at a constant coefficient ``h`` (W/(m²·K)) (MODEL.md §5)."""
-    validity = "h and A as given: no dependence on speed or temperature"
     return HeatPath(name, hot, cold, CONSTANT, NEWTON_CORRELATION, source, validity, conductance=h * area)
+
+
+def fixed_conductance(name: str, hot: int, cold: int, conductance: float, source: str, validity: str) -> HeatPath:
+    """Heat through a fixed conductance (W/K): a joint or a loss known as a whole, not per area."""
+    return HeatPath(name, hot, cold, CONSTANT, "Q = G·(θ_hot − θ_cold), G constant", source, validity, conductance=conductance)
+
+
+CONTACT_CORRELATION = (
+    "Q = G·(θ_hot − θ_cold), G the mean over the motion of each contact's heat per kelvin: the larger of "
+    "0.87·π·a²·√t_c/(1/e₁ + 1/e₂) (an impact) and 4a·t_c/(1/k₁ + 1/k₂) (a lasting contact), a = √(R*·δ_max)"
+)
+CONTACT_SOURCE = (
+    "Sun & Chen, Int. J. Heat Mass Transfer 31 (1988) 969 (impacts); Holm's constriction resistance 1/(4ka) of each "
+    "half-space (lasting contacts); the contacts' radii and durations from the 'dem' engine's records"
+)
+CONTACT_VALIDITY = (
+    "smooth elastic contacts, no interstitial gas or powder; the impact form for contact Fourier numbers ≪ 1, the "
+    "steady one ≫ 1; a lasting contact is counted when it ends"
+)
+
+
+def contact_conduction(name: str, hot: int, cold: int, drive: int) -> HeatPath:
+    """Conduction through the contacts of a ball with the vial or another ball, at their measured mean conductance."""
+    return HeatPath(name, hot, cold, CONTACT, CONTACT_CORRELATION, CONTACT_SOURCE, CONTACT_VALIDITY, drive=drive)
+
+
+def radiation(name: str, hot: int, cold: int, emissivity: float, area: float) -> HeatPath:
+    """A grey surface of ``area`` (m²) radiating to large surroundings: Q = ε·σ·A·(θ_hot⁴ − θ_cold⁴)."""
+    return HeatPath(
+        name, hot, cold, RADIATION, "Q = ε·σ·A·(θ_hot⁴ − θ_cold⁴)",
+        "Stefan-Boltzmann law for a small grey body in large isothermal surroundings (Incropera & DeWitt, Eq. 1.7)",
+        "ε the key emissivity, the room's walls at the ambient temperature",
+        conductance=emissivity * STEFAN_BOLTZMANN * area,
+    )
