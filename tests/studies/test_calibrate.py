@@ -21,7 +21,7 @@ from shakermill.studies.calibrate import (
     parse_targets,
     write_preset,
 )
-from shakermill.studies.validation import CURVE_TOLERANCE_K, TABLE5, Curve, experiment_curve
+from shakermill.studies.validation import CURVE_TOLERANCE_K, TABLE5, Curve, curve_from_option, experiment_curve
 
 TABLE5_TARGETS = {entry.key: entry.experiment for entry in TABLE5 if entry.key != "vial_ball_ratio"}
 
@@ -73,10 +73,10 @@ def test_shipped_calibrated_preset_follows_the_experiments_curve_at_full_resolut
 def test_experiment_curve_is_the_papers_exponential() -> None:
     curve = experiment_curve()
     assert curve.times[0] == 0.0 and curve.times[-1] == 3600.0 and curve.times.size == 61
-    assert curve.ball_C[0] == pytest.approx(20.0)
+    assert curve.temperature_C[0] == pytest.approx(20.0)
     # θ̇_0 = 28 K / 16.7 min, Table 5's 1.6766 °C/min.
-    assert (curve.ball_C[1] - curve.ball_C[0]) == pytest.approx(1.6766 * np.exp(-0.5 / 16.7), rel=1e-3)
-    assert curve.ball_C[-1] == pytest.approx(48.0 - 28.0 * np.exp(-60.0 / 16.7))
+    assert (curve.temperature_C[1] - curve.temperature_C[0]) == pytest.approx(1.6766 * np.exp(-0.5 / 16.7), rel=1e-3)
+    assert curve.temperature_C[-1] == pytest.approx(48.0 - 28.0 * np.exp(-60.0 / 16.7))
 
 
 @pytest.mark.slow
@@ -135,7 +135,7 @@ def test_curve_csv_is_read_in_minutes_or_seconds(tmp_path) -> None:
     path.write_text("time_min,ball_C\n0,20\n1,21.5\n")
     curve = Curve.from_csv(path)
     np.testing.assert_allclose(curve.times, [0.0, 60.0])
-    np.testing.assert_allclose(curve.ball_C, [20.0, 21.5])
+    np.testing.assert_allclose(curve.temperature_C, [20.0, 21.5])
     (tmp_path / "bad.csv").write_text("t,T\n0,20\n")
     with pytest.raises(ParameterError, match="needs columns"):
         Curve.from_csv(tmp_path / "bad.csv")
@@ -233,3 +233,44 @@ def test_the_default_free_set_is_what_moves_the_engines_network_alone():
     assert default_free(sm.default_parameters()) == DEFAULT_FREE
     # The 'dem' engine measures its mechanics once per fit: λ splits the heat inside the stepping.
     assert default_free(sm.default_parameters(engine="dem")) == DEM_DEFAULT_FREE == ("beta", "vial_mass", "h_outer")
+
+
+# --- several curves, each of its own node and conditions (issue 23) ------------------------------------------
+
+
+def test_a_curve_option_names_its_file_its_node_and_its_conditions(tmp_path) -> None:
+    path = tmp_path / "vial.csv"
+    path.write_text("time_min,vial_C\n0,20\n30,31\n")
+    curve = curve_from_option(f"{path}:n_balls=5, omega=120 rad/s")
+    assert curve.node == "vial" and curve.variable == "theta_vial"
+    assert curve.conditions == ("n_balls=5", "omega=120 rad/s")
+    np.testing.assert_allclose(curve.temperature_C, [20.0, 31.0])
+    assert curve_from_option(str(path)).conditions == ()
+    (tmp_path / "both.csv").write_text("time_s,ball_C,vial_C\n0,20,20\n")
+    with pytest.raises(ParameterError, match="one of ball_C or vial_C"):
+        Curve.from_csv(tmp_path / "both.csv")
+
+
+def test_a_curve_may_not_set_a_key_the_fit_moves() -> None:
+    curve = Curve(np.array([0.0, 60.0]), np.array([20.0, 21.0]), "lab", conditions=("beta=0.5",))
+    with pytest.raises(ParameterError, match="curve: the conditions of lab set beta, which the fit moves"):
+        calibrate(sm.default_parameters(), ("beta", "vial_mass"), curve=[curve])
+
+
+@pytest.mark.slow
+def test_curves_of_two_nodes_under_two_conditions_recover_the_parameters_that_made_them() -> None:
+    truth = {"beta": 0.6, "vial_mass": 0.1}
+    settings = {"solver": "averaged", "output_interval": 60.0, "record_windows": ()}
+    ball = sm.simulate(sm.default_parameters(**settings, **truth)).timeseries
+    vial = sm.simulate(sm.default_parameters(**settings, **truth, omega=100.0)).timeseries
+    curves = [
+        Curve(ball["time"].values, ball["theta_ball"].values - 273.15, "ball at 111 rad/s"),
+        Curve(vial["time"].values, vial["theta_vial"].values - 273.15, "vial at 100 rad/s", node="vial",
+              conditions=("omega=100",)),
+    ]
+    fit = calibrate(sm.default_parameters(**settings, beta=0.3, vial_mass=0.05), ("beta", "vial_mass"), curve=curves)
+    for key, value in truth.items():
+        assert fit.fitted[key] == pytest.approx(value, rel=1e-3)
+    assert fit.curve_rms_K < 0.01
+    assert "vial_C at 30 min (omega=100)" in fit.sensitivities
+    assert "vial at 100 rad/s (vial, omega=100)" in fit.curve_source

@@ -217,11 +217,13 @@ def calibrate(
         typer.Option("--target", "-t", metavar="NAME=VALUE", help=f"A target: {', '.join(TARGET_KEYS)}."),
     ] = None,
     curve: Annotated[
-        Path | None,
+        list[str] | None,
         typer.Option(
             "--curve",
-            help="CSV with time_s (or time_min) and ball_C columns to fit (default, without --target: the "
-            "experiment's curve 48 - 28 exp(-t/16.7 min) over 0-60 min).",
+            metavar="CSV[:KEY=VALUE,...]",
+            help="A measured curve to fit: CSV with time_s (or time_min) and ball_C or vial_C, and the settings of its "
+            "run that differ (e.g. curves.csv:n_balls=5); repeat for several curves, each of its own node and "
+            "conditions (default, without --target: the experiment's curve 48 - 28 exp(-t/16.7 min) over 0-60 min).",
         ),
     ] = None,
     free: Annotated[
@@ -233,18 +235,18 @@ def calibrate(
     json_output: JsonOption = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
 ) -> None:
-    """Fit free parameters to a measured curve (the experiment's by default) and/or Table 5 targets by bounded least squares."""
+    """Fit free parameters to measured curves (the experiment's by default) and/or Table 5 targets by bounded least squares."""
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import load_config
     from shakermill.studies.calibrate import calibrate as fit_parameters
     from shakermill.studies.calibrate import default_free, parse_free, parse_targets
-    from shakermill.studies.validation import Curve
+    from shakermill.studies.validation import curve_from_option
 
     with user_errors():
         run_config = load_config(config, preset=preset, overrides=settings or [])
         targets = parse_targets(target or [])
         free_keys = parse_free(free or [], default_free(run_config.params))
-        measured = Curve.from_csv(curve) if curve is not None else None
+        measured = [curve_from_option(item) for item in curve or ()]
         if out is not None:
             # Checked before the fit, which takes a while.
             check_preset_target(out, overwrite)

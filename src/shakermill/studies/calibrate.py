@@ -31,6 +31,7 @@ import tomli_w
 from scipy.optimize import least_squares
 
 from shakermill.engines.registry import describe
+from shakermill.parameters.config import parse_overrides
 from shakermill.parameters.defaults import DEFAULT_FREE
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters, bounds, check_known_keys
@@ -280,44 +281,34 @@ def calibrate(
     base: Parameters,
     free: Sequence[str] = DEFAULT_FREE,
     targets: Mapping[str, float] | None = None,
-    curve: Curve | None = None,
+    curve: Curve | Sequence[Curve] | None = None,
     *,
     full_resolution: bool = False,
     progress: Callable[[int], None] | None = None,
     sample_posterior: bool = True,
 ) -> Calibration:
-    """Fit ``free`` keys of ``base`` to ``targets`` and/or ``curve``; see the module docstring.
+    """Fit ``free`` keys of ``base`` to ``targets`` and/or one or several curves (``curve``), each of a node under
+    its own conditions (:class:`~shakermill.studies.validation.Curve`); see the module docstring.
 
     ``progress(evaluations)`` is called after every model evaluation. With ``sample_posterior``, a fit whose
     evaluations integrate the network alone (the engine has thermal-only keys) also samples the posterior of its keys
     (:func:`posterior_samples`, a few minutes). A run that uses up its budget stops the fit
     (:class:`~shakermill.budget.BudgetExceeded`): its partial result is no evaluation.
     """
-    targets, curve, free = _checked(base, free, targets, curve)
+    targets, curves, free = _checked(base, free, targets, curve)
     solver = "full" if full_resolution else "averaged"
     start = {key: float(getattr(base, key)) for key in free}
     x0 = np.log([start[key] for key in free])
     lower, upper = (np.array(side) for side in zip(*(log_bounds(key, start[key]) for key in free)))
     # The fit needs the configured motion only: probing other attractors would cost every evaluation.
-    longest = float(curve.times.max()) if curve is not None else 0.0
+    longest = max((float(measured.times.max()) for measured in curves), default=0.0)
     fitting = base.replace(solver=solver, attractor_starts=1, duration=max(base.duration, longest))
-    cache: dict[tuple[float, ...], tuple[np.ndarray, Result]] = {}
-    model = thermal_variants(fitting)
-
-    def evaluate(x: np.ndarray) -> tuple[np.ndarray, Result]:
-        key = tuple(np.round(x, 14))
-        if key not in cache:
-            params = fitting.replace(**{name: float(math.exp(v)) for name, v in zip(free, x)})
-            result = model(params)
-            cache[key] = (_residuals(result, targets, curve), result)
-            if progress is not None:
-                progress(len(cache))
-        return cache[key]
-
+    evaluate, cache = _evaluator(fitting, free, targets, curves, progress)
     solution = least_squares(
         lambda x: evaluate(x)[0], x0, bounds=(lower, upper), diff_step=JACOBIAN_STEP, x_scale=1.0, method="trf"
     )
-    residuals, result = evaluate(solution.x)
+    residuals, results = evaluate(solution.x)
+    result = results[()]
     fitted = {key: float(math.exp(v)) for key, v in zip(free, solution.x)}
     achieved = {key: float(result.summary[key]) for key in targets}
     at_bounds = [
@@ -325,12 +316,12 @@ def calibrate(
     ]
     missed = {key: (achieved[key] - value) / value for key, value in targets.items()}
     missed = {key: error for key, error in missed.items() if abs(error) > TARGET_TOLERANCE}
-    curve_rms = _curve_rms(result, curve)
-    covariance = _log_covariance(solution.jac, residuals, len(free), curve)
+    curve_rms = _curve_rms(results, curves)
+    covariance = _log_covariance(solution.jac, residuals, len(free), curves)
     # Sampled only where an evaluation is a network alone: thousands of them take minutes there, hours elsewhere.
     posterior = None
     if sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution:
-        variance = _residual_variance(residuals, len(free), curve)
+        variance = _residual_variance(residuals, len(free), curves)
         posterior = posterior_samples(lambda x: evaluate(x)[0], solution.x, lower, upper, variance).tolist()
     off_curve = curve_rms is not None and curve_rms > CURVE_TOLERANCE_K
     stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
@@ -345,32 +336,63 @@ def calibrate(
         parameter_stderr=_stderr(covariance, free, fitted),
         covariance=None if covariance is None else covariance.tolist(),
         posterior=posterior,
-        sensitivities=_sensitivities(solution.jac, free, targets, curve),
+        sensitivities=_sensitivities(solution.jac, free, targets, curves),
         predictions={key: float(result.summary[key]) for key in PREDICTED_KEYS if key not in targets},
         at_bounds=at_bounds,
         success=bool(solution.success) and not stuck and not missed and not off_curve and result.success,
         message=_outcome(str(solution.message), free, missed, at_bounds, curve_rms if off_curve else None),
         evaluations=len(cache),
         solver=solver,
-        curve_source=curve.source if curve is not None else "",
+        curve_source="; ".join(_described(measured) for measured in curves),
         result=result,
     )
 
 
+Evaluation = tuple[np.ndarray, dict[tuple[str, ...], Result]]
+
+
+def _evaluator(fitting: Parameters, free: Sequence[str], targets: Mapping[str, float], curves: Sequence[Curve],
+               progress: Callable[[int], None] | None) -> tuple[Callable[[np.ndarray], Evaluation], dict[tuple[float, ...], Evaluation]]:
+    """The model a fit evaluates at the logarithms ``x`` of its free keys: the residuals and the run of each set of
+    conditions (the fitted parameters' own, ``()``, always: the targets and the predictions are of it), each
+    evaluation once (the cache it returns); every set measures its mechanics once."""
+    bases = {conditions: fitting.replace(**parse_overrides(conditions)) for conditions in ((), *(c.conditions for c in curves))}
+    models = {conditions: thermal_variants(params) for conditions, params in bases.items()}
+    cache: dict[tuple[float, ...], Evaluation] = {}
+
+    def evaluate(x: np.ndarray) -> Evaluation:
+        key = tuple(np.round(x, 14))
+        if key not in cache:
+            values = {name: float(math.exp(v)) for name, v in zip(free, x)}
+            results = {conditions: models[conditions](params.replace(**values)) for conditions, params in bases.items()}
+            cache[key] = (_residuals(results, targets, curves), results)
+            if progress is not None:
+                progress(len(cache))
+        return cache[key]
+
+    return evaluate, cache
+
+
 def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float] | None,
-             curve: Curve | None) -> tuple[dict[str, float], Curve | None, tuple[str, ...]]:
-    """The targets, the curve (the experiment's when neither is given) and the free keys of a fit, checked: every
-    target in its range, every free key one the engine's fits may move, starting positive (fitted in log space)."""
+             curve: Curve | Sequence[Curve] | None) -> tuple[dict[str, float], tuple[Curve, ...], tuple[str, ...]]:
+    """The targets, the curves (the experiment's when neither is given) and the free keys of a fit, checked: every
+    target in its range, no curve's conditions setting a fitted key, every free key one the engine's fits may move,
+    starting positive (fitted in log space)."""
     targets = dict(targets or {})
     check_targets(targets)
-    if not targets and curve is None:
-        curve = experiment_curve()
+    curves = (curve,) if isinstance(curve, Curve) else tuple(curve or ())
+    if not targets and not curves:
+        curves = (experiment_curve(),)
     free = tuple(free)
+    for measured in curves:
+        clash = sorted(set(parse_overrides(measured.conditions)) & set(free))
+        if clash:
+            raise ParameterError(f"curve: the conditions of {measured.source} set {', '.join(clash)}, which the fit moves")
     _check_free_for_engine(base, free)
     for key in free:
         if getattr(base, key) <= 0:
             raise ParameterError(f"free: {key} must start positive to be fitted in log space, got {getattr(base, key)}")
-    return targets, curve, free
+    return targets, curves, free
 
 
 def _check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
@@ -410,45 +432,57 @@ def _outcome(
     return message
 
 
-def _ball_history(result: Result) -> tuple[np.ndarray, np.ndarray]:
-    series = result.timeseries
-    return series["time"].values, series["theta_ball"].values
+def _described(measured: Curve) -> str:
+    """A curve's source, its node and its conditions, for the record of a fit."""
+    conditions = f", {', '.join(measured.conditions)}" if measured.conditions else ""
+    return f"{measured.source} ({measured.node}{conditions})" if measured.node != "ball" or conditions else measured.source
 
 
-def _residuals(result: Result, targets: Mapping[str, float], curve: Curve | None) -> np.ndarray:
-    parts = [(float(result.summary[key]) - value) / value for key, value in targets.items()]
-    if curve is not None:
-        parts.extend(curve.residuals_K(*_ball_history(result)) / CURVE_SCALE_K)
+def _curve_residuals_K(results: Mapping[tuple[str, ...], Result], measured: Curve) -> np.ndarray:
+    """The run of ``measured``'s conditions minus ``measured`` at its times (K)."""
+    series = results[measured.conditions].timeseries
+    return measured.residuals_K(series["time"].values, series[measured.variable].values)
+
+
+def _residuals(results: Mapping[tuple[str, ...], Result], targets: Mapping[str, float], curves: Sequence[Curve]) -> np.ndarray:
+    parts = [(float(results[()].summary[key]) - value) / value for key, value in targets.items()]
+    for measured in curves:
+        parts.extend(_curve_residuals_K(results, measured) / CURVE_SCALE_K)
     values = np.array(parts, dtype=float)
     # A failed or unfittable run must push the optimiser away, not stop it.
     return np.where(np.isfinite(values), values, 1e3)
 
 
-def _curve_rms(result: Result, curve: Curve | None) -> float | None:
-    return None if curve is None else curve.rms_K(*_ball_history(result))
+def _curve_rms(results: Mapping[tuple[str, ...], Result], curves: Sequence[Curve]) -> float | None:
+    """The RMS residual (K) over every point of every curve; None without curves."""
+    if not curves:
+        return None
+    residuals = np.concatenate([_curve_residuals_K(results, measured) for measured in curves])
+    return math.sqrt(float(np.mean(residuals**2)))
 
 
-def _log_covariance(jacobian: np.ndarray, residuals: np.ndarray, free_count: int, curve: Curve | None) -> np.ndarray | None:
+def _log_covariance(jacobian: np.ndarray, residuals: np.ndarray, free_count: int, curves: Sequence[Curve]) -> np.ndarray | None:
     """The covariance of the logarithms of the fitted keys, (JᵀJ)⁻¹·s² with s² the residual variance; meaningful
-    only for a curve with more points than parameters, None otherwise or where JᵀJ is singular.
+    only for curves of more points than parameters, None otherwise or where JᵀJ is singular.
 
-    The residual variance is floored at the curve's stated measurement error, if it has one: a
+    The residual variance is floored at the curves' stated measurement error, if they state one: a
     curve that is itself a smooth summary can be fitted exactly, which says nothing about how well
     it was measured.
     """
-    if curve is None or residuals.size <= free_count:
+    if not curves or residuals.size <= free_count:
         return None
     try:
-        return np.linalg.inv(jacobian.T @ jacobian) * _residual_variance(residuals, free_count, curve)
+        return np.linalg.inv(jacobian.T @ jacobian) * _residual_variance(residuals, free_count, curves)
     except np.linalg.LinAlgError:
         return None
 
 
-def _residual_variance(residuals: np.ndarray, free_count: int, curve: Curve) -> float:
-    """The residuals' variance over their degrees of freedom, floored at the curve's stated measurement error."""
+def _residual_variance(residuals: np.ndarray, free_count: int, curves: Sequence[Curve]) -> float:
+    """The residuals' variance over their degrees of freedom, floored at the largest stated measurement error."""
     variance = float(np.sum(residuals**2)) / (residuals.size - free_count)
-    if curve.sigma_K is not None:
-        variance = max(variance, (curve.sigma_K / CURVE_SCALE_K) ** 2)
+    stated = [measured.sigma_K for measured in curves if measured.sigma_K is not None]
+    if stated:
+        variance = max(variance, (max(stated) / CURVE_SCALE_K) ** 2)
     return variance
 
 
@@ -493,19 +527,21 @@ def _stderr(covariance: np.ndarray | None, free: Sequence[str], fitted: Mapping[
 
 
 def _sensitivities(
-    jacobian: np.ndarray, free: Sequence[str], targets: Mapping[str, float], curve: Curve | None
+    jacobian: np.ndarray, free: Sequence[str], targets: Mapping[str, float], curves: Sequence[Curve]
 ) -> dict[str, dict[str, float]]:
-    """From the least-squares Jacobian: d ln(target)/d ln(parameter) for scalar targets, and for a curve
-    d θ_ball/d ln(parameter) in K at its middle and last point."""
+    """From the least-squares Jacobian: d ln(target)/d ln(parameter) for scalar targets, and for each curve
+    d θ/d ln(parameter) of its node in K at its middle and last point."""
     values = {
         target: {key: float(jacobian[row, column]) for column, key in enumerate(free)}
         for row, target in enumerate(targets)
     }
-    if curve is not None:
-        for point in (curve.times.size // 2, curve.times.size - 1):
-            row = len(targets) + point
-            label = f"ball_C at {curve.times[point] / 60.0:g} min"
-            values[label] = {key: float(CURVE_SCALE_K * jacobian[row, column]) for column, key in enumerate(free)}
+    offset = len(targets)
+    for measured in curves:
+        conditions = f" ({', '.join(measured.conditions)})" if measured.conditions else ""
+        for point in (measured.times.size // 2, measured.times.size - 1):
+            label = f"{measured.node}_C at {measured.times[point] / 60.0:g} min{conditions}"
+            values[label] = {key: float(CURVE_SCALE_K * jacobian[offset + point, column]) for column, key in enumerate(free)}
+        offset += measured.times.size
     return values
 
 

@@ -93,62 +93,89 @@ def target_range(name: str) -> str:
     return f"{TARGET_BOUNDS[name]} {quantity(name).unit}".rstrip()
 
 
+# The columns a curve file may measure, and the node of the network each is of (the balls' mean, the vial).
+NODE_COLUMNS = {"ball_C": "ball", "vial_C": "vial"}
+NODE_VARIABLES = {"ball": "theta_ball", "vial": "theta_vial"}
+
+
 @dataclass(frozen=True)
 class Curve:
-    """A measured ball-temperature history: times in s, temperatures in °C.
+    """A measured temperature history of a node (``ball``: the balls' mean, or ``vial``): times in s, temperatures
+    in °C, and the settings of its run that differ from the calibrated parameters (``conditions``, "KEY=VALUE"
+    with units, e.g. "n_balls=5").
 
     Checked on creation: finite times in [0, the longest run] that increase, finite temperatures above
     absolute zero, at most :data:`MAX_CURVE_POINTS` points; :class:`ParameterError` names the first point that is not.
     """
 
     times: np.ndarray
-    ball_C: np.ndarray
+    temperature_C: np.ndarray
     source: str = ""
     # Measurement error of each point (K) where the curve itself has no scatter to estimate it from.
     sigma_K: float | None = None
+    node: str = "ball"
+    conditions: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         what = f"curve {self.source}".rstrip()
-        if not 1 <= self.times.size <= MAX_CURVE_POINTS or self.times.shape != self.ball_C.shape:
+        if not 1 <= self.times.size <= MAX_CURVE_POINTS or self.times.shape != self.temperature_C.shape:
             raise ParameterError(
-                f"{what}: {self.times.size} times and {self.ball_C.size} temperatures; allowed 1 to {MAX_CURVE_POINTS:,} of each"
+                f"{what}: {self.times.size} times and {self.temperature_C.size} temperatures; allowed 1 to {MAX_CURVE_POINTS:,} of each"
             )
-        for index, (time, temperature) in enumerate(zip(self.times.tolist(), self.ball_C.tolist())):
+        for index, (time, temperature) in enumerate(zip(self.times.tolist(), self.temperature_C.tolist())):
             _check_point(what, index, time, temperature, self.times[index - 1] if index else None)
 
     @classmethod
-    def from_csv(cls, path: Path | str) -> Curve:
-        """Read ``time_s`` or ``time_min`` and ``ball_C`` columns (header required; other columns ignored)."""
+    def from_csv(cls, path: Path | str, conditions: tuple[str, ...] = ()) -> Curve:
+        """Read ``time_s`` or ``time_min`` and one of ``ball_C`` or ``vial_C`` (header required; other columns
+        ignored); ``conditions`` as the class says."""
         path = Path(path)
         what = f"curve {path}"
         rows = [row for row in read_csv_rows(path, what, MAX_CURVE_POINTS) if any(cell.strip() for cell in row)]
         if len(rows) < 2:
             raise ParameterError(f"{what}: has no data rows")
         header = [cell.strip() for cell in rows[0]]
-        if "ball_C" not in header or not {"time_s", "time_min"} & set(header):
-            raise ParameterError(f"{what}: needs columns time_s (or time_min) and ball_C, found {quoted(header)}")
+        measured = [name for name in NODE_COLUMNS if name in header]
+        if len(measured) != 1 or not {"time_s", "time_min"} & set(header):
+            raise ParameterError(
+                f"{what}: needs columns time_s (or time_min) and one of ball_C or vial_C, found {quoted(header)}"
+            )
         scale, column = (1.0, "time_s") if "time_s" in header else (60.0, "time_min")
         times, temperatures = [], []
         for number, row in enumerate(rows[1:], start=2):
             cells = dict(zip(header, row))
             try:
                 times.append(float(cells[column]) * scale)
-                temperatures.append(float(cells["ball_C"]))
+                temperatures.append(float(cells[measured[0]]))
             except (KeyError, ValueError):
-                raise ParameterError(f"{what} line {number}: needs a number in {column} and in ball_C") from None
+                raise ParameterError(f"{what} line {number}: needs a number in {column} and in {measured[0]}") from None
         import numpy as np
 
-        return cls(np.array(times), np.array(temperatures), str(path))
+        return cls(np.array(times), np.array(temperatures), str(path), node=NODE_COLUMNS[measured[0]],
+                   conditions=tuple(conditions))
 
-    def residuals_K(self, times: np.ndarray, theta_ball_K: np.ndarray) -> np.ndarray:
-        """A modelled ball temperature history (s, K) minus this curve at its times (K)."""
+    @property
+    def variable(self) -> str:
+        """The history variable (K) this curve measures."""
+        return NODE_VARIABLES[self.node]
+
+    def residuals_K(self, times: np.ndarray, theta_K: np.ndarray) -> np.ndarray:
+        """A modelled temperature history of this curve's node (s, K) minus this curve at its times (K)."""
         import numpy as np
 
-        return np.interp(self.times, times, theta_ball_K) - 273.15 - self.ball_C
+        return np.interp(self.times, times, theta_K) - 273.15 - self.temperature_C
 
-    def rms_K(self, times: np.ndarray, theta_ball_K: np.ndarray) -> float:
-        residuals = self.residuals_K(times, theta_ball_K)
+    def rms_K(self, times: np.ndarray, theta_K: np.ndarray) -> float:
+        residuals = self.residuals_K(times, theta_K)
         return math.sqrt(float((residuals**2).mean()))
+
+
+def curve_from_option(item: str) -> Curve:
+    """``calibrate --curve``'s value: ``FILE`` or ``FILE:KEY=VALUE,KEY=VALUE`` (the settings of the curve's run)."""
+    path, separator, settings = item.rpartition(":")
+    if not separator or "=" not in settings:
+        return Curve.from_csv(item)
+    return Curve.from_csv(path, tuple(setting.strip() for setting in settings.split(",") if setting.strip()))
 
 
 def _check_point(what: str, index: int, time: float, temperature: float, previous: float | None) -> None:
