@@ -301,9 +301,12 @@ def print_calibration(
     table = Table("parameter", "start", "fitted", "std. error", "90 % of the posterior", "physically defensible?", title="calibration")
     for key in free_keys:
         posterior = f"{ranges[key][0]:.3g} to {ranges[key][1]:.3g}" if key in ranges else "—"
+        stderr = calibration.parameter_stderr[key]
+        # A linear error beyond the value itself says the data leave the key undetermined, not how far it may move.
+        shown = "undetermined" if stderr > calibration.fitted[key] else number(stderr, ".3g")
         add_plain_row(
-            table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}",
-            number(calibration.parameter_stderr[key], ".3g"), posterior, calibration.defensible[key],
+            table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}", shown, posterior,
+            calibration.defensible[key],
         )
     console.print(table)
     predictions = Table("not fitted, predicted", "value", title="what the fitted model predicts")

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
@@ -118,7 +118,7 @@ class MatrixRow:
 @dataclass(frozen=True)
 class ValidationMatrix:
     experiments: tuple[Experiment, ...]
-    rows: tuple[MatrixRow, ...] = field(default=())
+    rows: tuple[MatrixRow, ...]
 
     def as_dict(self) -> dict[str, Any]:
         return {
