@@ -56,12 +56,17 @@ def test_an_empty_mill_warms_on_the_drives_heat_alone():
 
 
 @pytest.mark.parametrize(
-    ("physical", "rms", "edges", "meets"),
-    [(True, 1.9, (), True), (True, 2.1, (), False), (True, 1.0, ("clamp_loss",), False), (False, 0.5, (), False)],
+    ("preset", "free", "rms", "edges", "meets"),
+    [
+        ("spex8000m-3d-mill-head", ("drive_heat",), 1.9, (), True),
+        ("spex8000m-3d-mill-head", ("drive_heat",), 2.1, (), False),
+        ("spex8000m-3d-mill-head", ("drive_heat",), 1.0, ("clamp_loss",), False),
+        ("spex8000m-3d-mill-head", ("drive_heat", "beta"), 0.5, (), False),
+        ("spex8000m-3d", ("vial_mass",), 0.5, (), False),
+    ],
 )
-def test_the_bar_needs_the_curve_within_two_kelvin_no_edge_and_computed_paths(physical, rms, edges, meets):
-    structure = Structure("s", "spex8000m-3d-mill-head", ("drive_heat",), physical)
-    outcome = StructureOutcome(structure, {"drive_heat": 5.0}, rms, edges, 50.0, 20.0)
+def test_the_bar_needs_the_curve_within_two_kelvin_no_edge_and_computed_paths(preset, free, rms, edges, meets):
+    outcome = StructureOutcome(Structure("s", preset, free), {key: 1.0 for key in free}, rms, edges, 50.0, 20.0)
     assert outcome.meets_point_7 is meets
     assert outcome.as_dict()["meets_point_7"] is meets
 
@@ -70,3 +75,5 @@ def test_every_structure_fits_only_keys_with_a_stated_range_or_beta():
     for structure in STRUCTURES:
         assert set(structure.free) <= set(DEFENSIBLE_RANGES)
         assert structure.physical == ("beta" not in structure.free and structure.preset == "spex8000m-3d-mill-head")
+    # A mill-head network whose convection is not Whitaker's as published is not physical either.
+    assert not Structure("s", "spex8000m-3d-calibrated-paper", ("drive_heat",)).physical

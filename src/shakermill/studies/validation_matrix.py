@@ -21,7 +21,7 @@ import numpy as np
 from shakermill.engines.registry import engine_named
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork, build_network
 from shakermill.parameters.keys import Parameters
-from shakermill.parameters.presets import PRESETS, default_parameters
+from shakermill.parameters.presets import PRESETS, default_parameters, preset_values
 from shakermill.solvers.averaged import integrate_network
 from shakermill.solvers.simulate import thermal_variants
 from shakermill.studies.calibrate import DEFENSIBLE_RANGES, calibrate
@@ -206,26 +206,32 @@ def validation_matrix(presets: tuple[str, ...] = THERMAL_MODEL_PRESETS, experime
 
 
 # Network structures fitted to the one-ball curve from the uncalibrated 3-D presets, and what each then predicts for
-# five balls. "Physical" structures keep every computed path at its correlation's value (β = 1, the outer paths from
-# the vial's speed, conduction from the contacts) and fit only what no source gives (MODEL.md §13.2).
+# five balls.
 @dataclass(frozen=True)
 class Structure:
     label: str
     preset: str
     free: tuple[str, ...]
-    physical: bool
+
+    @property
+    def physical(self) -> bool:
+        """Whether every computed path stays at its correlation's value and only what no source gives is fitted
+        (MODEL.md §13.2): the mill-head network (outer paths from the vial's speed, conduction from the contacts)
+        with Whitaker's correlation as published (β = 1), β not fitted."""
+        values = preset_values(self.preset)
+        return values["thermal_model"] == "mill-head" and values["beta"] == 1.0 and "beta" not in self.free
 
 
 STRUCTURES: tuple[Structure, ...] = (
-    Structure("paper: β, vial mass", "spex8000m-3d", ("beta", "vial_mass"), False),
-    Structure("paper: β, vial mass, h_outer", "spex8000m-3d", ("beta", "vial_mass", "h_outer"), False),
-    Structure("mill-head: drive heat, clamp capacity", "spex8000m-3d-mill-head", ("drive_heat", "clamp_heat_capacity"), True),
+    Structure("paper: β, vial mass", "spex8000m-3d", ("beta", "vial_mass")),
+    Structure("paper: β, vial mass, h_outer", "spex8000m-3d", ("beta", "vial_mass", "h_outer")),
+    Structure("mill-head: drive heat, clamp capacity", "spex8000m-3d-mill-head", ("drive_heat", "clamp_heat_capacity")),
     Structure("mill-head: drive heat, clamp capacity, clamp loss", "spex8000m-3d-mill-head",
-              ("drive_heat", "clamp_heat_capacity", "clamp_loss"), True),
+              ("drive_heat", "clamp_heat_capacity", "clamp_loss")),
     Structure("mill-head: drive heat, clamp capacity, clamp loss and joint", "spex8000m-3d-mill-head",
-              ("drive_heat", "clamp_heat_capacity", "clamp_loss", "clamp_conductance"), True),
+              ("drive_heat", "clamp_heat_capacity", "clamp_loss", "clamp_conductance")),
     Structure("mill-head with β free (β not at its correlation)", "spex8000m-3d-mill-head",
-              ("drive_heat", "clamp_heat_capacity", "clamp_loss", "beta"), False),
+              ("drive_heat", "clamp_heat_capacity", "clamp_loss", "beta")),
 )
 # The one-ball curve is an exponential fitted to intermittent calorimetric measurements: a structure that follows it
 # this closely follows it within their likely scatter (issue 23, point 7).

@@ -196,7 +196,7 @@ def mill_head_paths(params: Parameters, ball_names: Sequence[str], vial: int, cl
     other ball, the vial to the clamp and the clamp to the room."""
     n = len(ball_names)
     outer = vial_outer_convection(params)
-    paths = [
+    return [
         newton_cooling("vial → room, convection", vial, kernel.ROOM, outer.coefficient, outer.area, outer.source, outer.validity),
         radiation("vial → room, radiation", vial, kernel.ROOM, params.emissivity, outer.area),
         *(contact_conduction(f"{ball_names[i]} → vial, contacts", i, vial, kernel.contact_drive(i, -1, n)) for i in range(n)),
@@ -207,7 +207,6 @@ def mill_head_paths(params: Parameters, ball_names: Sequence[str], vial: int, cl
         fixed_conductance("clamp → room", clamp, kernel.ROOM, params.clamp_loss, "clamp_loss (see its source)",
                           "the clamp and mill head lumped at one temperature"),
     ]
-    return paths
 
 
 @dataclass(frozen=True)
