@@ -45,10 +45,15 @@ def test_validate_prints_the_five_ball_prediction_the_engines_and_the_sensitivit
 
 
 @pytest.mark.slow
-def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_runs):
-    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-study", "--json"])
+def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_runs, tmp_path):
+    page = tmp_path / "validation.html"
+    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-study", "--json", "--report", str(page)])
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
+    html = page.read_text(encoding="utf-8")
+    for row in payload["validation_matrix"]["rows"]:
+        assert f"{row['predicted_K']:.3g}" in html
+    assert "Held out: five balls" in html and html.count("<img") == 1
     five = payload["five_balls"]
     assert five["preset"] == "spex8000m-3d-calibrated" and five["fitted_parameters"]
     rows = five["rows"]
@@ -74,3 +79,14 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
             assert row["relative_error"] == pytest.approx(row["predicted_K"] / row["measured_K"] - 1.0)
             low, high = row["interval_90_K"]
             assert row["inside_interval"] == (low <= row["measured_K"] <= high)
+
+
+def test_a_report_that_exists_is_refused_before_the_study_runs(tmp_path, monkeypatch):
+    page = tmp_path / "validation.html"
+    page.write_text("mine", encoding="utf-8")
+    monkeypatch.setattr(validation_report, "validation_report", lambda *args, **kwargs: pytest.fail("the study ran"))
+    outcome = runner.invoke(cli.app, ["validate", "--report", str(page)])
+    assert outcome.exit_code == 2 and "add --overwrite" in outcome.output
+    assert page.read_text(encoding="utf-8") == "mine"
+    outcome = runner.invoke(cli.app, ["validate", "--report", str(tmp_path)])
+    assert outcome.exit_code == 2 and "a folder" in outcome.output

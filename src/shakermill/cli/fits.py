@@ -57,19 +57,33 @@ def validate(
         ),
     ] = True,
     json_output: JsonOption = False,
+    html: Annotated[
+        Path | None,
+        typer.Option("--report", metavar="FILE", help="Also write the validation matrix, its figure, the structure study "
+                     "and the held-out prediction as one self-contained HTML page."),
+    ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the --report file if it exists.")] = False,
 ) -> None:
     """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
-    calibrated parameters, which free sets of a calibration can follow the curve, and (3-D) the five-ball
-    experiment that no fit has seen."""
+    calibrated parameters, which free sets of a calibration can follow the curve, and (3-D) the validation matrix of
+    the thermal models, the structures that follow the one-ball curve and the five-ball experiment no fit has seen."""
     from shakermill.io.runs import to_jsonable
     from shakermill.studies.validation import TABLE5
     from shakermill.studies.validation_report import SOLVERS, validation_report
 
     if solver not in SOLVERS:
         fail(f"solver: {solver!r} is not allowed; allowed: one of {', '.join(map(repr, SOLVERS))}")
+    if html is not None:
+        check_report_target(html, overwrite)
     with progress_bar("3-D validation", "{task.completed}/{task.total} runs", None) as update:
         show = None if update is None else lambda done, total: update(done, total=total)
         report = validation_report(solver, study, three_d, progress=show)
+    if html is not None:
+        from shakermill.views.validation_page import save_validation_page
+
+        with writing(html, "the validation report"):
+            save_validation_page(report, html)
+        typer.echo(f"validation report written to {html}", err=True)
     if json_output:
         typer.echo(json.dumps(to_jsonable(report.as_dict()), sort_keys=True, allow_nan=False))
         return
@@ -92,16 +106,11 @@ def print_matrix(console: Console, matrix: Any) -> None:
     """Each thermal model's calibrated preset against each experiment: the rise measured and predicted (K), with the
     prediction's 90 % interval, its error and whether the measurement lies inside; then what each experiment is and
     what each prediction would falsify."""
-    table = Table("preset (thermal model)", "experiment", "node", "t [min]", "role", "measured [K]", "predicted [K]",
-                  "90 % interval [K]", "error", "inside?", title="Validation matrix: rises above the start")
-    for row in matrix.rows:
-        measured = row.point.rise_K
-        interval = "—" if math.isnan(row.low_K) else f"{row.low_K:.3g} to {row.high_K:.3g}"
-        add_plain_row(
-            table, f"{row.preset} ({row.thermal_model})", row.experiment.name, row.point.node, f"{row.point.time_s / 60:g}",
-            row.role, "—" if measured is None else f"{measured:.3g}", f"{row.predicted_K:.3g}", interval,
-            "—" if measured is None else f"{100 * row.error:+.0f} %", {None: "—", True: "yes", False: "no"}[row.inside],
-        )
+    from shakermill.views.validation_page import MATRIX_HEADERS, matrix_rows
+
+    table = Table(*MATRIX_HEADERS, title="Validation matrix: rises above the start")
+    for row in matrix_rows(matrix):
+        add_plain_row(table, *row)
     console.print(table)
     for experiment in matrix.experiments:
         console.print(Text(f"{experiment.name}: {experiment.title}. Source: {experiment.source}. Measured: {experiment.how_measured}."))
@@ -112,26 +121,24 @@ def print_matrix(console: Console, matrix: Any) -> None:
 def print_structures(console: Console, outcomes: Sequence[Any]) -> None:
     """Each network structure fitted to the one-ball curve, whether it meets the bar of a physical fit, and what it
     predicts for five balls, nothing refitted."""
-    from shakermill.studies.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
-    from shakermill.studies.validation_matrix import FOLLOWS_CURVE_K
+    from shakermill.views.validation_page import structure_headers, structure_rows, structure_verdict
 
-    table = Table("structure (free keys)", "one-ball RMS [K]", "on a range edge", "paths computed", "meets the bar",
-                  f"5 balls: ball [K] (exp. {FIVE_BALL_BALL_RISE_K:g})", f"vial [K] (exp. {FIVE_BALL_VIAL_RISE_K:g})",
+    table = Table(*structure_headers(),
                   title="Which structure follows the one-ball curve with physical couplings, and what it then predicts")
-    for outcome in outcomes:
-        ball, vial = outcome.ball_rise_K, outcome.vial_rise_K
-        add_plain_row(
-            table, outcome.structure.label, f"{outcome.curve_rms_K:.2f}", ", ".join(outcome.edges) or "none",
-            "yes" if outcome.structure.physical else "no", "yes" if outcome.meets_point_7 else "no",
-            f"{ball:.3g} ({100 * (ball / FIVE_BALL_BALL_RISE_K - 1):+.0f} %)", f"{vial:.3g} ({100 * (vial / FIVE_BALL_VIAL_RISE_K - 1):+.0f} %)",
-        )
+    for row in structure_rows(outcomes):
+        add_plain_row(table, *row)
     console.print(table)
-    meeting = [outcome for outcome in outcomes if outcome.meets_point_7]
-    console.print(Text(
-        f"The bar: the one-ball curve within {FOLLOWS_CURVE_K:g} K RMS, every free key strictly inside its range, every "
-        "computed path at its correlation's value. "
-        + (f"Met by: {', '.join(outcome.structure.label for outcome in meeting)}." if meeting else "No structure meets it.")
-    ))
+    console.print(Text(structure_verdict(outcomes)))
+
+
+def check_report_target(target: Path, overwrite: bool) -> None:
+    """Before a long study: a --report that names a folder, or a file without --overwrite, is refused now."""
+    if target.is_dir():
+        fail(f"{target}: a folder; give the report a file name")
+    if target.exists() and not overwrite:
+        fail(f"{target}: exists; choose another --report, or add --overwrite to replace it")
+    with user_errors():
+        check_writable_place(target)
 
 
 def print_held_out(console: Console, held_out: Any) -> None:

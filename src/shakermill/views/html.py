@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import base64
+import errno
 import math
+from pathlib import Path
 from typing import TYPE_CHECKING, Iterable, Iterator, Mapping, Sequence
 
+from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
 from shakermill.views.figures.common import png_bytes
 from shakermill.views.notebook import esc
 
@@ -82,3 +85,17 @@ def figure_html(figure: Figure, caption: str, number: int) -> str:
 def figures_html(figures: Mapping[str, Figure], numbers: Iterator[int], captions: Mapping[str, str]) -> str:
     """The figures in order, numbered on from ``numbers`` (one count for the whole report)."""
     return "\n".join(figure_html(figure, captions.get(name, name), next(numbers)) for name, figure in figures.items())
+
+
+def check_page_target(target: Path) -> None:
+    """Refuse a folder as a page's file before the page is drawn: the rename would fail only after it was written."""
+    if target.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "a folder; give the report a file name", str(target))
+
+
+def write_page(target: Path, text: str) -> Path:
+    """Write an HTML page atomically (its folder made if needed); return ``target``."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    remove_abandoned_writes(target.parent)
+    write_text_atomically(target, text)
+    return target

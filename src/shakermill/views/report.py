@@ -12,7 +12,6 @@ others "predicted", with the relative error against the experiment either way.
 
 from __future__ import annotations
 
-import errno
 import itertools
 import math
 import tomllib
@@ -32,12 +31,12 @@ from shakermill.studies.validation import (
     fitted_quantities,
     operating_point_mismatches,
 )
-from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
 from shakermill.support.version import __version__
 from shakermill.views.figures.common import several_balls
 from shakermill.views.figures.run import comparison_temperature_figure, main_figure_names, model_of, paper_figures
 from shakermill.views.html import (
     bullet_list,
+    check_page_target,
     figure_html,
     figures_html,
     paragraph,
@@ -45,6 +44,7 @@ from shakermill.views.html import (
     pretty_unit,
     section,
     table,
+    write_page,
 )
 from shakermill.views.notebook import answer_sentences, esc, number
 from shakermill.views.report_sections import (
@@ -133,13 +133,8 @@ def write_report(run_dir: Path | str, out: Path | str | None = None, compare_dir
 
 def save_report(run: RunData, target: Path, other: RunData | None = None) -> Path:
     """Write the report of ``run`` (compared with ``other``, if given) to ``target``; return ``target``."""
-    if target.is_dir():
-        # Checked first: the rename would fail only after the whole report was drawn and written beside it.
-        raise IsADirectoryError(errno.EISDIR, "a folder; give the report a file name", str(target))
-    target.parent.mkdir(parents=True, exist_ok=True)
-    remove_abandoned_writes(target.parent)
-    write_text_atomically(target, render_report(run, other))
-    return target
+    check_page_target(target)
+    return write_page(target, render_report(run, other))
 
 
 def render_report(run: RunData, other: RunData | None = None) -> str:

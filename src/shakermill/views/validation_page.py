@@ -1,0 +1,143 @@
+"""What ``shakermill validate`` finds, as cells for the terminal's tables and as one self-contained HTML page
+(``validate --report``): the validation matrix with a figure of every prediction against its measurement, the
+structure study, and the held-out five-ball prediction."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Sequence
+
+from shakermill.support.version import __version__
+from shakermill.views.html import check_page_target, figure_html, paragraph, section, table, write_page
+from shakermill.views.notebook import esc
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from shakermill.studies.validation_matrix import StructureOutcome, ValidationMatrix
+    from shakermill.studies.validation_report import ValidationReport
+
+MATRIX_HEADERS = ("preset (thermal model)", "experiment", "node", "t [min]", "role", "measured [K]", "predicted [K]",
+                  "90 % interval [K]", "error", "inside?")
+MATRIX_NUMERIC = (3, 5, 6, 7, 8)
+
+
+def matrix_rows(matrix: ValidationMatrix) -> list[tuple[str, ...]]:
+    """One row of text per preset × point: the rise measured and predicted (K), the 90 % interval, the error."""
+    rows = []
+    for row in matrix.rows:
+        measured = row.point.rise_K
+        rows.append((
+            f"{row.preset} ({row.thermal_model})", row.experiment.name, row.point.node, f"{row.point.time_s / 60:g}",
+            row.role, "—" if measured is None else f"{measured:.3g}", f"{row.predicted_K:.3g}",
+            "—" if math.isnan(row.low_K) else f"{row.low_K:.3g} to {row.high_K:.3g}",
+            "—" if measured is None else f"{100 * row.error:+.0f} %", {None: "—", True: "yes", False: "no"}[row.inside],
+        ))
+    return rows
+
+
+def structure_headers() -> tuple[str, ...]:
+    from shakermill.studies.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
+
+    return ("structure (free keys)", "fitted", "one-ball RMS [K]", "on a range edge", "paths computed", "meets the bar",
+            f"5 balls: ball [K] (exp. {FIVE_BALL_BALL_RISE_K:g})", f"vial [K] (exp. {FIVE_BALL_VIAL_RISE_K:g})")
+
+
+def structure_rows(outcomes: Sequence[StructureOutcome]) -> list[tuple[str, ...]]:
+    """Each structure fitted to the one-ball curve: its fit, whether it meets the bar, its five-ball prediction."""
+    from shakermill.studies.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
+
+    rows = []
+    for outcome in outcomes:
+        ball, vial = outcome.ball_rise_K, outcome.vial_rise_K
+        rows.append((
+            outcome.structure.label, ", ".join(f"{key} {value:.3g}" for key, value in outcome.fitted.items()),
+            f"{outcome.curve_rms_K:.2f}", ", ".join(outcome.edges) or "none",
+            "yes" if outcome.structure.physical else "no", "yes" if outcome.meets_point_7 else "no",
+            f"{ball:.3g} ({100 * (ball / FIVE_BALL_BALL_RISE_K - 1):+.0f} %)",
+            f"{vial:.3g} ({100 * (vial / FIVE_BALL_VIAL_RISE_K - 1):+.0f} %)",
+        ))
+    return rows
+
+
+def structure_verdict(outcomes: Sequence[StructureOutcome]) -> str:
+    from shakermill.studies.validation_matrix import FOLLOWS_CURVE_K
+
+    meeting = [outcome.structure.label for outcome in outcomes if outcome.meets_point_7]
+    return (
+        f"The bar: the one-ball curve within {FOLLOWS_CURVE_K:g} K RMS, every free key strictly inside its range, every "
+        "computed path at its correlation's value. "
+        + (f"Met by: {', '.join(meeting)}." if meeting else "No structure meets it.")
+    )
+
+
+def matrix_figure(matrix: ValidationMatrix) -> Figure:
+    """Every predicted rise with its 90 % interval beside its measurement, one row per experiment's point."""
+    from shakermill.views.figures.common import new_figure
+
+    points = list(dict.fromkeys((row.experiment.name, row.point.node, row.point.time_s) for row in matrix.rows))
+    presets = list(dict.fromkeys(row.preset for row in matrix.rows))
+    figure, (axes,) = new_figure(height=1.0 + 0.45 * len(points) * max(1, len(presets)) / 2, width=8.0)
+    offsets = {preset: 0.3 * (index - (len(presets) - 1) / 2) / max(1, len(presets)) for index, preset in enumerate(presets)}
+    for preset in presets:
+        rows = [row for row in matrix.rows if row.preset == preset]
+        y = [points.index((row.experiment.name, row.point.node, row.point.time_s)) + offsets[preset] for row in rows]
+        predicted = [row.predicted_K for row in rows]
+        spread = [[max(0.0, row.predicted_K - row.low_K) if math.isfinite(row.low_K) else 0.0 for row in rows],
+                  [max(0.0, row.high_K - row.predicted_K) if math.isfinite(row.high_K) else 0.0 for row in rows]]
+        axes.errorbar(predicted, y, xerr=spread, fmt="o", capsize=3, label=f"{preset} (predicted, 90 %)")
+    rises = {(row.experiment.name, row.point.node, row.point.time_s): row.point.rise_K for row in matrix.rows}
+    measured = [(index, rises[point]) for index, point in enumerate(points) if rises[point] is not None]
+    if measured:
+        axes.plot([rise for _, rise in measured], [index for index, _ in measured], "k*", markersize=11, label="measured")
+    axes.set_yticks(range(len(points)), [f"{name}: {node}, {time / 60:g} min" for name, node, time in points])
+    axes.invert_yaxis()
+    axes.set_xlabel("rise above the start [K]")
+    axes.set_title("Validation matrix: each calibrated preset against each experiment")
+    axes.grid(axis="x", alpha=0.3)
+    axes.legend(loc="best", fontsize="small")
+    return figure
+
+
+def render_validation_page(report: ValidationReport) -> str:
+    """The whole page: the matrix, its figure and its experiments, the structures, the five balls held out."""
+    from shakermill.views.report import STYLE
+
+    sections = [f"<h1>shakermill validation ({esc(report.solver)} solver)</h1>"]
+    if report.matrix is not None:
+        experiments = [
+            paragraph(f"{experiment.name}: {experiment.title}. Source: {experiment.source}. Measured: "
+                      f"{experiment.how_measured}." + (f" It falsifies: {experiment.falsifies}." if experiment.falsifies else ""))
+            for experiment in report.matrix.experiments
+        ]
+        sections.append(section(
+            "Validation matrix: rises above the start",
+            table(MATRIX_HEADERS, matrix_rows(report.matrix), numeric=MATRIX_NUMERIC),
+            figure_html(matrix_figure(report.matrix), "Each prediction (points, bars: 90 % interval from the fit's "
+                        "uncertainty and the averaging error) against the measurement (stars).", 1),
+            *experiments,
+        ))
+    if report.structures:
+        sections.append(section(
+            "Which structure follows the one-ball curve with physical couplings, and what it then predicts",
+            table(structure_headers(), structure_rows(report.structures), numeric=(2, 6, 7)),
+            paragraph(structure_verdict(report.structures), "statement"),
+        ))
+    if report.held_out is not None:
+        prediction = report.held_out.prediction
+        rows = [(row.label, row.unit, f"{row.experiment:g}", f"{row.predicted:.3g}", f"{100 * row.relative_error:+.0f} %")
+                for row in prediction.rows]
+        sections.append(section("Held out: five balls", table(("quantity", "unit", "experiment", "predicted", "error"), rows,
+                                                              numeric=(2, 3, 4)), paragraph(prediction.statement, "statement")))
+    return (
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+        f"<title>shakermill validation</title>\n<style>{STYLE}</style>\n</head>\n<body>\n"
+        + "\n".join(sections)
+        + f"\n<p class=\"note\">Written by shakermill {esc(__version__)}.</p>\n</body>\n</html>\n"
+    )
+
+
+def save_validation_page(report: ValidationReport, target: Path) -> Path:
+    check_page_target(target)
+    return write_page(target, render_validation_page(report))
