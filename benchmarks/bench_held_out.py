@@ -16,33 +16,31 @@ from __future__ import annotations
 
 import time
 
-from shakermill.studies.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
 from shakermill.studies.validation_matrix import structure_study, validation_matrix
+from shakermill.views.validation_page import (
+    MATRIX_HEADERS,
+    matrix_rows,
+    structure_headers,
+    structure_rows,
+    structure_verdict,
+)
+
+
+def markdown_table(headers: tuple[str, ...], rows: list[tuple[str, ...]]) -> str:
+    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
+    return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows])
 
 
 def main() -> None:
     started = time.perf_counter()
     matrix = validation_matrix()
     print(f"validation matrix in {time.perf_counter() - started:.0f} s")
-    print("| preset (thermal model) | experiment | node | t | role | measured | predicted [90 % interval] | error | inside |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for row in matrix.rows:
-        measured = "—" if row.point.rise_K is None else f"{row.point.rise_K:.3g} K"
-        error = "—" if row.point.rise_K is None else f"{100 * row.error:+.0f} %"
-        inside = {None: "—", True: "yes", False: "no"}[row.inside]
-        print(f"| {row.preset} ({row.thermal_model}) | {row.experiment.name} | {row.point.node} | {row.point.time_s / 60:g} min "
-              f"| {row.role} | {measured} | {row.predicted_K:.3g} K [{row.low_K:.3g}, {row.high_K:.3g}] | {error} | {inside} |")
+    print(markdown_table(MATRIX_HEADERS, matrix_rows(matrix)))
     started = time.perf_counter()
     outcomes = structure_study()
     print(f"\nstructure study in {time.perf_counter() - started:.0f} s")
-    print(f"| structure | fitted | one-ball RMS | edges | meets the bar | 5 balls: ball ({FIVE_BALL_BALL_RISE_K:g} K) | vial ({FIVE_BALL_VIAL_RISE_K:g} K) |")
-    print("|---|---|---|---|---|---|---|")
-    for outcome in outcomes:
-        fitted = ", ".join(f"{key} {value:.3g}" for key, value in outcome.fitted.items())
-        ball, vial = outcome.ball_rise_K, outcome.vial_rise_K
-        print(f"| {outcome.structure.label} | {fitted} | {outcome.curve_rms_K:.2f} K | {', '.join(outcome.edges) or 'none'} "
-              f"| {'yes' if outcome.meets_point_7 else 'no'} | {ball:.3g} K ({100 * (ball / FIVE_BALL_BALL_RISE_K - 1):+.0f} %) "
-              f"| {vial:.3g} K ({100 * (vial / FIVE_BALL_VIAL_RISE_K - 1):+.0f} %) |")
+    print(markdown_table(structure_headers(), structure_rows(outcomes)))
+    print(structure_verdict(outcomes))
 
 
 if __name__ == "__main__":
