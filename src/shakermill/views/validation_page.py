@@ -78,7 +78,8 @@ def matrix_figure(matrix: ValidationMatrix) -> Figure:
 
     points = list(dict.fromkeys((row.experiment.name, row.point.node, row.point.time_s) for row in matrix.rows))
     presets = list(dict.fromkeys(row.preset for row in matrix.rows))
-    figure, (axes,) = new_figure(height=1.0 + 0.45 * len(points) * max(1, len(presets)) / 2, width=8.0)
+    roles = {(row.experiment.name, row.point.node, row.point.time_s): row.role for row in matrix.rows}
+    figure, (axes,) = new_figure(height=1.0 + 0.45 * len(points) * max(1, len(presets)) / 2, width=10.0)
     offsets = {preset: 0.3 * (index - (len(presets) - 1) / 2) / max(1, len(presets)) for index, preset in enumerate(presets)}
     for preset in presets:
         rows = [row for row in matrix.rows if row.preset == preset]
@@ -91,10 +92,11 @@ def matrix_figure(matrix: ValidationMatrix) -> Figure:
     measured = [(index, rises[point]) for index, point in enumerate(points) if rises[point] is not None]
     if measured:
         axes.plot([rise for _, rise in measured], [index for index, _ in measured], "k*", markersize=11, label="measured")
-    axes.set_yticks(range(len(points)), [f"{name}: {node}, {time / 60:g} min" for name, node, time in points])
+    axes.set_yticks(range(len(points)), [f"{name}: {node}, {time / 60:g} min ({roles[name, node, time]})"
+                                         for name, node, time in points])
     axes.invert_yaxis()
     axes.set_xlabel("rise above the start [K]")
-    axes.set_title("Validation matrix: each calibrated preset against each experiment")
+    axes.set_title("Each calibrated preset against each experiment")
     axes.grid(axis="x", alpha=0.3)
     axes.legend(loc="best", fontsize="small")
     return figure
