@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from shakermill.parameters.presets import PRESETS
+from shakermill.solvers.simulate import simulate
 from shakermill.studies.calibrate import DEFENSIBLE_RANGES
 from shakermill.studies.validation_matrix import (
     STRUCTURES,
@@ -22,16 +23,12 @@ from shakermill.studies.validation_matrix import (
 EXPERIMENTS = {experiment.name: experiment for experiment in load_experiments()}
 
 
-def never_run(params):
-    raise AssertionError("an empty mill has no mechanics to run")
-
-
 def test_every_experiment_says_where_it_comes_from_and_what_it_measured():
     assert set(EXPERIMENTS) == {"takacs-mchenry-one-ball", "takacs-mchenry-five-balls", "empty-mill", "one-ball-vial"}
     for experiment in EXPERIMENTS.values():
         assert experiment.title and experiment.source and experiment.how_measured and experiment.points
     five = EXPERIMENTS["takacs-mchenry-five-balls"]
-    assert five.n_balls == 5 and [(point.node, point.rise_K) for point in five.points] == [("ball", 46.0), ("vial", 21.0)]
+    assert five.conditions["n_balls"] == 5 and [(point.node, point.rise_K) for point in five.points] == [("ball", 46.0), ("vial", 21.0)]
     # The one-ball points are the summary's exponential 28·(1 − exp(−t/16.7 min)).
     for point in EXPERIMENTS["takacs-mchenry-one-ball"].points:
         assert point.rise_K == pytest.approx(28.0 * (1.0 - math.exp(-point.time_s / 60.0 / 16.7)), abs=1e-4)
@@ -46,7 +43,7 @@ def test_the_one_ball_curve_is_fitted_the_rest_held_out_or_predicted(preset):
 
 
 def test_an_empty_mill_warms_on_the_drives_heat_alone():
-    rows = {preset: predict(preset, EXPERIMENTS["empty-mill"], never_run)[0] for preset in THERMAL_MODEL_PRESETS}
+    rows = {preset: predict(preset, EXPERIMENTS["empty-mill"], simulate)[0] for preset in THERMAL_MODEL_PRESETS}
     paper, mill_head = rows["spex8000m-3d-calibrated-paper"], rows["spex8000m-3d-calibrated"]
     assert paper.predicted_K == 0.0 and paper.thermal_model == "paper"
     drive = PRESETS["spex8000m-3d-calibrated"].values["drive_heat"].value

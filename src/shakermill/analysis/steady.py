@@ -81,7 +81,7 @@ def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:
     temperatures = network.with_free(theta)
     balls = tuple(float(value) for value in temperatures[: network.n_balls])
     return SteadyState(
-        float(np.mean(balls)), float(temperatures[network.vial]), float(temperatures[network.air]), time_constants,
+        network.mean_ball(temperatures), float(temperatures[network.vial]), float(temperatures[network.air]), time_constants,
         load.heat_power, load.velocity_term, True, "solved", balls,
         tuple((node.name, float(temperatures[index])) for index, node in enumerate(network.nodes) if index > network.air),
     )
@@ -141,5 +141,12 @@ def run_length_warning(duration: float, steady: SteadyState) -> str | None:
     return (
         f"the run ({duration / 60:.3g} min) is shorter than {SETTLED_TIME_CONSTANTS:g} slowest time constants "
         f"({SETTLED_TIME_CONSTANTS:g} x {slowest / 60:.3g} min): the exponential fitted over it (theta_inf_C) is not "
-        f"the steady state; the ball settles at {steady.ball - 273.15:.1f} °C (ball_steady_C)"
+        f"the steady state; {settles(steady)}"
     )
+
+
+def settles(steady: SteadyState) -> str:
+    """Where the balls settle, or the vial in an empty mill."""
+    if steady.balls:
+        return f"the ball settles at {steady.ball - 273.15:.1f} °C (ball_steady_C)"
+    return f"the vial settles at {steady.vial - 273.15:.1f} °C (vial_steady_C)"

@@ -129,9 +129,9 @@ def _exit_for_status(result: Result, target: Path) -> None:
 
 
 def _radii_mm(params: Parameters) -> str:
-    """The ball radius in mm, or each ball's where they differ."""
+    """The ball radius in mm, or each ball's where they differ; "none" in an empty mill."""
     radii = sorted(set(params.ball_values("ball_radius")))
-    return ", ".join(number(radius * 1e3, ".4g") for radius in radii)
+    return ", ".join(number(radius * 1e3, ".4g") for radius in radii) or "none"
 
 
 def summary_table(result: Result, target: Path) -> Table:

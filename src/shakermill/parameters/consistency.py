@@ -136,7 +136,7 @@ def balls_fit_side_by_side(params: Any) -> None:
     if not ENGINE_KEYS[params.engine].several_balls:
         return
     radii = params.ball_values("ball_radius")
-    largest = max(radii)
+    largest = max(radii, default=0.0)
     if 2.0 * largest >= params.vial_diameter:
         key = "ball_radii" if params.ball_radii else "ball_radius"
         raise ValueError(

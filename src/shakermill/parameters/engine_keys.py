@@ -94,6 +94,11 @@ def engine_problem(params: Any, fill: bool = False) -> str | None:
             f"fill: sets the number of balls of an engine that moves several; allowed fill = 0 with {engine}, or set "
             f"{engines_taking(lambda other: other.several_balls)}"
         )
+    if params.n_balls == 0 and not keys.several_balls:
+        return (
+            f"n_balls: {keys.title} moves one ball; allowed n_balls = 1 with {engine}; an empty mill (n_balls = 0) needs "
+            f"{engines_taking(lambda other: other.several_balls)}"
+        )
     if params.n_balls > keys.most_balls:
         moves = "one ball" if keys.most_balls == 1 else f"at most {keys.most_balls} balls"
         return (

@@ -267,7 +267,7 @@ class Parameters(BaseModel):
         "dimensions with friction and rotation (section 12)"
     )
     # 50 balls of the smallest radius still fit any vial the bounds allow; the pair search is O(N²).
-    n_balls: int = _count("number of balls (engine = 'dem'; the 1-D engine has one)", ge=1, le=MAX_BALLS)
+    n_balls: int = _count("number of balls (engine = 'dem', 0: an empty mill; the 1-D engine has one)", ge=0, le=MAX_BALLS)
     fill: float = _quantity(
         "",
         "fraction of the vial's inner volume the balls take (engine = 'dem'): > 0 sets n_balls = max(1, "
@@ -376,7 +376,7 @@ class Parameters(BaseModel):
 
     def initial_positions(self) -> "numpy.ndarray | None":
         """Ball centres (n_balls, 3) in the vial frame at t = 0 (m): one ball at ``ball_position`` on the axis,
-        several filled in from the bottom (:mod:`shakermill.parameters.packing`); None if they do not fit."""
+        several (or none) filled in from the bottom (:mod:`shakermill.parameters.packing`); None if they do not fit."""
         import numpy as np
 
         from shakermill.parameters.packing import placement

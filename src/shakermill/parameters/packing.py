@@ -18,7 +18,10 @@ CLEARANCE = 0.01
 
 
 def placement(radii: np.ndarray, vial_length: float, vial_diameter: float) -> np.ndarray | None:
-    """Centres (N, 3) in m of balls of ``radii``, bottom layer first, or None when they do not all fit."""
+    """Centres (N, 3) in m of balls of ``radii``, bottom layer first (none in an empty mill), or None when they do not
+    all fit."""
+    if radii.size == 0:
+        return np.zeros((0, 3))
     centres = packed(radii, vial_length, vial_diameter)
     return centres if len(centres) == radii.size else None
 

@@ -78,6 +78,8 @@ def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback
     batch = params.averaging_batch_periods * params.period
     first = engine.measured()
     sources, balls = first.heat.size, first.terms.size
+    if balls == 0:
+        return _nothing_moves(engine, first), REACHED_STOP
     cumulative = [_flat(first)]
     heartbeat = None if progress is None else lambda t: progress(t, params.averaging_max_time)
     status, converged, cut, message = REACHED_STOP, False, 0, ""
@@ -132,6 +134,16 @@ def _means(engine: Engine, rates: np.ndarray, sources: int, balls: int, transien
     )
     load = engine.load(*(np.array([_mean(column) for column in part.T]) for part in (heat, terms, conductances)))
     return Means(load, averages)
+
+
+def _nothing_moves(engine: Engine, first: Measured) -> Means:
+    """The means of an empty mill (n_balls = 0): no contact heats anything, so there is nothing to average."""
+    averages = MechanicsAverages(
+        heat_power=0.0, heat_power_stderr=0.0, dissipated_power=0.0, velocity_term=math.nan, velocity_term_stderr=0.0,
+        transient=0.0, window=0.0, batches=0, impact_interval=math.inf, converged=True,
+        message="no balls: no mechanics to average",
+    )
+    return Means(engine.load(np.zeros_like(first.heat), np.zeros(0), np.zeros_like(first.conduction)), averages)
 
 
 def _mean(values: np.ndarray) -> float:

@@ -181,7 +181,8 @@ def mean_path_flows(network: ThermalNetwork, history: StateHistory, drives: np.n
 def physical_bounds_problem(result: Result) -> str | None:
     """Why the temperatures of a run cannot be physical, or None."""
     series = result.history
-    hottest_ball = float(np.nanmax(series[BALL_TEMPERATURES if BALL_TEMPERATURES in series.variables else "theta_ball"]))
+    balls = series[BALL_TEMPERATURES if BALL_TEMPERATURES in series.variables else "theta_ball"]
+    hottest_ball = float(np.nanmax(balls, initial=-np.inf))  # -inf in an empty mill
     limit = result.params.ball_temperature_limit
     if hottest_ball > limit:
         return (
@@ -189,7 +190,7 @@ def physical_bounds_problem(result: Result) -> str | None:
             f"({kelvin_to_celsius(limit):.4g} °C): the model does not hold there. Check omega, amplitude and the "
             "units of the inputs (bare numbers are SI)."
         )
-    coldest = min(float(np.nanmin(series[name])) for name in ("theta_ball", "theta_vial", "theta_air"))
+    coldest = min(float(np.nanmin(series[name], initial=np.inf)) for name in ("theta_ball", "theta_vial", "theta_air"))
     if coldest < 0.0:
         return f"A temperature fell to {coldest:.4g} K, below absolute zero: the thermal network is not physical here."
     return None
@@ -211,7 +212,7 @@ def energy_audit_problem(result: Result) -> str | None:
 def fit_warning(result: Result) -> str | None:
     """A line when the exponential fit of the ball temperature failed: the summary's θ∞, τ and θ̇₀ then mean nothing."""
     fit = result.ball_fit
-    if fit.success:
+    if fit.success or result.params.n_balls == 0:  # an empty mill has no ball to fit
         return None
     return (
         f"the exponential fit of the ball temperature failed ({fit.message}): theta_inf_C, tau_min and "
@@ -223,7 +224,7 @@ def steady_state_bound_warning(result: Result) -> str | None:
     """A line when the run stays in range but its steady state would not."""
     steady = result.steady
     limit = result.params.ball_temperature_limit
-    if steady is None or not steady.solved or steady.ball <= limit:
+    if steady is None or not steady.solved or not steady.ball > limit:  # NaN in an empty mill
         return None
     return (
         f"the ball's steady state ({kelvin_to_celsius(steady.ball):.4g} °C) is above ball_temperature_limit "
@@ -337,7 +338,7 @@ def several_ball_summary(result: Result) -> dict[str, Any]:
         "wall_impacts": int(round(wall * scale)),
         "ball_ball_impacts": int(round((result.impact_count - wall) * scale)),
         "ball_temperatures_C": [kelvin_to_celsius(float(value)) for value in temperatures],
-        "hottest_ball_C": kelvin_to_celsius(float(np.nanmax(temperatures))),
+        "hottest_ball_C": kelvin_to_celsius(float(np.nanmax(temperatures))) if temperatures.size else math.nan,
         "work_gravity_J": result.energy.work_by_gravity,
         "work_stiffening_J": result.energy.work_by_stiffening,
     }

@@ -5,7 +5,7 @@ Experiments are data files in ``experiments/``: a title, the source, how it was 
 differ from the preset (``n_balls``, ``duration``, ...) and the measured rises above the start (K) of a node at a
 time; a file with ``predicted`` points instead names what is predicted and what would falsify it. An experiment
 whose curve the presets' calibrations fit is "fitted" for a preset fitted to that curve, every other measurement
-"held out". With no balls (``n_balls = 0``) there is no mechanics: the network alone runs, on the drive's heat.
+"held out". With no balls (``n_balls = 0``) nothing moves that makes heat: the network runs on the drive's heat alone.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from shakermill.engines.registry import engine_named
-from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork, build_network
+from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import PRESETS, default_parameters, preset_values
 from shakermill.solvers.averaged import integrate_network
@@ -54,10 +54,6 @@ class Experiment:
     conditions: Mapping[str, Any]
     points: tuple[Point, ...]
     falsifies: str = ""
-
-    @property
-    def n_balls(self) -> int:
-        return int(self.conditions.get("n_balls", 1))
 
     def role(self, preset: str) -> str:
         """'fitted' (a calibration of ``preset`` fitted it), 'held out' (measured, not fitted) or 'prediction'."""
@@ -132,11 +128,6 @@ class ValidationMatrix:
         }
 
 
-def empty_network(params: Parameters) -> ThermalNetwork:
-    """The network of ``params``' vial and air (and mill head) with no balls in it."""
-    return build_network(params, (), (), (), "")
-
-
 def node_rises(points: tuple[Point, ...], network_of: Callable[[Parameters], ThermalNetwork]) -> Callable[[Parameters, NetworkLoad], dict[str, float]]:
     """The rises (K) of ``points`` of the network ``network_of`` builds, under a mean load, as named quantities."""
 
@@ -153,26 +144,18 @@ def node_rises(points: tuple[Point, ...], network_of: Callable[[Parameters], The
     return rises
 
 
-NO_LOAD = NetworkLoad(np.zeros(2), np.zeros(0), 0.0, math.nan)
-
-
 def predict(preset: str, experiment: Experiment, run_for: Callable[[Parameters], Any],
             overrides: Mapping[str, Any] | None = None) -> list[MatrixRow]:
     """``preset`` under ``experiment``'s conditions (and ``overrides``), each point with its interval; ``run_for(params)``
     runs it (the averaged solver's mechanics shared between presets that differ in thermal keys alone)."""
     uncertainty = uncertainty_of(PRESETS[preset]) or Uncertainty(())
-    conditions = {key: value for key, value in experiment.conditions.items() if key != "n_balls"}
-    balls = experiment.n_balls
-    settings = {"solver": "averaged", "record_windows": (), "attractor_starts": 1, **conditions, **(overrides or {})}
-    params = default_parameters(preset, n_balls=max(balls, 1), **settings)
-    if balls == 0:
-        load, heat_error, network_of = NO_LOAD, 0.0, empty_network
-    else:
-        result = run_for(params)
-        load, heat_error, network_of = result.load, heat_error_of(result), engine_named(params.engine).network_for
-    quantities = node_rises(experiment.points, network_of)
-    found = propagated(params, load, uncertainty, heat_error, quantities)
-    values = found.centre if found is not None else quantities(params, load)
+    settings = {"solver": "averaged", "record_windows": (), "attractor_starts": 1, **experiment.conditions,
+                **(overrides or {})}
+    params = default_parameters(preset, **settings)
+    result = run_for(params)
+    quantities = node_rises(experiment.points, engine_named(params.engine).network_for)
+    found = propagated(params, result.load, uncertainty, heat_error_of(result), quantities)
+    values = found.centre if found is not None else quantities(params, result.load)
     rows = []
     for point, (key, value) in zip(experiment.points, values.items(), strict=True):
         low, high = found.bounds(key) if found is not None else (math.nan, math.nan)

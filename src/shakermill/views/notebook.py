@@ -84,6 +84,8 @@ def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitt
     """
     v = {key: number(summary.get(key), spec) for key, _, _, spec in ANSWER_KEYS}
     minutes = number(_number(summary.get("simulated_s")) / 60.0, ".3g")
+    if summary.get("n_balls") == 0:
+        return empty_mill_sentences(summary, v, minutes)
     if _number(summary.get("n_balls")) > 1:
         # The experiment had one ball: several balls are not compared with it.
         return several_ball_sentences(summary, v, minutes)
@@ -102,6 +104,17 @@ def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitt
         if comparison:
             sentences.append(comparison)
     return sentences
+
+
+def empty_mill_sentences(summary: Mapping[str, Any], v: Mapping[str, str], minutes: str) -> list[str]:
+    """The answer of a run with no balls (MODEL.md §13.4): the vial warmed by what does not depend on them."""
+    drive = number(_number(summary.get("drive_heat_W")), ".3g")
+    return [
+        f"An empty mill (no balls): after {minutes} min the vial is at {v['vial_C']} °C and the air at {v['air_C']} °C, "
+        f"warmed by the drive's {drive} W alone.",
+        f"Run on, the vial would settle at {v['vial_steady_C']} °C (air {v['air_steady_C']} °C); the slowest time "
+        f"constant of the thermal network is {v['slowest_time_constant_min']} min.",
+    ]
 
 
 def several_ball_sentences(summary: Mapping[str, Any], v: Mapping[str, str], minutes: str) -> list[str]:

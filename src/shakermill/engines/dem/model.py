@@ -218,7 +218,9 @@ def constants_from(params: Parameters) -> Constants:
     harmonics = harmonics_of(params)
     angular_bound, acceleration_bound = _motion_bounds(harmonics, params.omega, math.hypot(0.5 * params.vial_length, bore))
     rayleigh = min(
-        contact.rayleigh_time(r, rho, e, nu) for r, rho, e, nu in zip(radius, density, youngs, poisson, strict=True)
+        (contact.rayleigh_time(r, rho, e, nu) for r, rho, e, nu in zip(radius, density, youngs, poisson, strict=True)),
+        # An empty mill (n_balls = 0) has no contact to resolve: it takes flight steps, short for its thermal network.
+        default=params.max_flight_step / params.contact_step_fraction,
     )
     fastest_node = min(value for value, _ in params.thermal_time_constants_at_rest.values())
     return Constants(
@@ -259,7 +261,7 @@ def constants_from(params: Parameters) -> Constants:
         period_step_fraction=params.contact_step_fraction / RAYLEIGH_TIMES_PER_PERIOD,
         longest_contact_step=0.9 * rayleigh,
         max_flight_step=params.max_flight_step,
-        max_overlap=MAX_OVERLAP_FRACTION * float(radius.min()),
+        max_overlap=MAX_OVERLAP_FRACTION * float(radius.min(initial=math.inf)),
         thermal_step=min(THERMAL_STEP, THERMAL_STEP_FRACTION * fastest_node),
     )
 
@@ -293,7 +295,8 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
     rotation_matrix(centre[3], centre[4], centre[5], orientation)
     position = centre[:3] + params.initial_positions() @ orientation.T
     velocity = np.zeros((n, 3))
-    velocity[0, 0] = params.ball_momentum / k.mass[0] if n == 1 else 0.0
+    if n == 1:
+        velocity[0, 0] = params.ball_momentum / k.mass[0]
     drives = kernel.drive_count(n)
     return State(
         clock=np.zeros(2),

@@ -86,6 +86,10 @@ class ThermalNetwork:
     def ambient(self) -> float:
         return self.arrays.ambient
 
+    def mean_ball(self, theta: np.ndarray) -> float:
+        """The balls' mean of node temperatures ``theta`` (K); NaN in an empty mill (``n_balls = 0``)."""
+        return float(np.mean(theta[: self.n_balls])) if self.n_balls else math.nan
+
     @property
     def free(self) -> np.ndarray:
         """Indices of the nodes whose temperatures evolve (not held)."""

@@ -151,14 +151,16 @@ def temperature_figure(run: RunLike) -> Figure:
         axis.axhline(steady, color="tab:red", ls=":", lw=1, label=steady_label(run.summary, balls))
         low, high = axis.get_ylim()
         axis.set_ylim(low, max(high, steady + 0.05 * (steady - low)))
-    axis.text(
-        0.98, 0.55, f"exponential fitted over {window}:\n{_fit_text(fit)}", transform=axis.transAxes, ha="right",
-        va="bottom", bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
-    )
+    if run.params.n_balls:
+        axis.text(
+            0.98, 0.55, f"exponential fitted over {window}:\n{_fit_text(fit)}", transform=axis.transAxes, ha="right",
+            va="bottom", bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
+        )
     axis.set_xlabel("time (min)")
     axis.set_ylabel("temperature (°C)")
     named = f"the {run.params.n_balls} balls" if balls else "ball"
-    axis.set_title(f"Temperatures of {named}, vial and inner air (cf. paper Fig. 5a)")
+    axis.set_title(f"Temperatures of {named}, vial and inner air (cf. paper Fig. 5a)" if run.params.n_balls
+                   else "Temperatures of an empty mill's vial and inner air (no balls)")
     if balls:
         legend_below(figure, bodies)
         lines = [line for line in axis.get_lines() if line not in bodies]

@@ -1,0 +1,61 @@
+"""An empty mill (``n_balls = 0``, MODEL.md §13.4): nothing moves that makes heat, so the vial warms on the drive's
+heat alone; the 1-D engine, which moves one ball, refuses it."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from shakermill import cli
+from shakermill.engines.registry import engine_named
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.presets import default_parameters
+from shakermill.solvers.simulate import simulate
+
+runner = CliRunner()
+
+
+@pytest.mark.parametrize("solver", ["averaged", "full"])
+def test_the_drive_alone_warms_an_empty_mill_and_its_heat_is_accounted_for(solver):
+    params = default_parameters("spex8000m-3d-calibrated", n_balls=0, duration=600.0, solver=solver)
+    result = simulate(params)
+    summary = result.summary
+    assert result.success and summary["impacts"] == 0 and summary["heat_power_W"] == 0.0
+    assert math.isnan(summary["ball_C"]) and math.isnan(summary["ball_steady_C"]) and summary["ball_temperatures_C"] == []
+    assert summary["drive_heat_W"] == pytest.approx(params.drive_heat)
+    assert 20.0 < summary["vial_C"] < summary["clamp_C"] < summary["vial_steady_C"]
+    assert summary["energy_audit_residual"] < 1e-9
+    # At the steady state everything the drive puts in leaves to the room.
+    steady = result.steady
+    network = engine_named(params.engine).network_for(params)
+    theta = np.array([steady.vial, steady.air, dict(steady.others)["clamp"]])
+    flows = dict(zip((path.name for path in network.paths), network.flows(theta, np.zeros(0)), strict=True))
+    to_room = flows["clamp → room"] + flows["vial → room, convection"] + flows["vial → room, radiation"]
+    assert to_room == pytest.approx(params.drive_heat, rel=1e-6)
+    assert not any("ball" in warning for warning in result.warnings)
+
+
+def test_an_empty_mill_of_the_paper_network_stays_at_the_ambient():
+    result = simulate(default_parameters("spex8000m-3d-calibrated-paper", n_balls=0, duration=600.0))
+    assert result.summary["vial_C"] == pytest.approx(20.0, abs=1e-12)
+    assert result.summary["vial_steady_C"] == pytest.approx(20.0, abs=1e-9)
+
+
+def test_the_one_dimensional_engine_refuses_an_empty_mill():
+    with pytest.raises(ParameterError, match=r"n_balls: the 1-D engine moves one ball; allowed n_balls = 1 .* engine = 'dem'"):
+        default_parameters("spex8000m", n_balls=0)
+
+
+def test_run_prints_and_stores_an_empty_mill(tmp_path):
+    out = tmp_path / "empty"
+    outcome = runner.invoke(cli.app, ["run", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0",
+                                      "--set", "duration=600", "--out", str(out), "--no-plots"])
+    assert outcome.exit_code == 0, outcome.output
+    assert "none" in outcome.stdout and "drive heat into the clamp" in outcome.stdout
+    stored = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    summary = stored.get("summary", stored)
+    assert summary["n_balls"] == 0 and summary["ball_C"] is None and summary["vial_C"] > 20.0
