@@ -90,3 +90,7 @@ def test_a_report_that_exists_is_refused_before_the_study_runs(tmp_path, monkeyp
     assert page.read_text(encoding="utf-8") == "mine"
     outcome = runner.invoke(cli.app, ["validate", "--report", str(tmp_path)])
     assert outcome.exit_code == 2 and "a folder" in outcome.output
+    outcome = runner.invoke(cli.app, ["validate", "--report", str(page / "under-a-file.html")])
+    assert outcome.exit_code == 2 and "is not a folder; choose another --report" in outcome.output
+    outcome = runner.invoke(cli.app, ["validate", "--no-three-d", "--report", str(tmp_path / "new.html")])
+    assert outcome.exit_code == 2 and "allowed --report with --three-d" in outcome.output

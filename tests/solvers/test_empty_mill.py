@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -29,7 +30,9 @@ def test_the_drive_alone_warms_an_empty_mill_and_its_heat_is_accounted_for(solve
     assert math.isnan(summary["ball_C"]) and math.isnan(summary["ball_steady_C"]) and summary["ball_temperatures_C"] == []
     assert summary["drive_heat_W"] == pytest.approx(params.drive_heat)
     assert 20.0 < summary["vial_C"] < summary["clamp_C"] < summary["vial_steady_C"]
-    assert summary["energy_audit_residual"] < 1e-9
+    # The drive's heat is the only flow of the balance, and all of it is accounted for.
+    assert abs(result.energy.thermal_residual) < 1e-9 * result.energy.drive_heat
+    assert summary["energy_audit_residual"] == pytest.approx(abs(result.energy.residual) / result.energy.drive_heat)
     # At the steady state everything the drive puts in leaves to the room.
     steady = result.steady
     network = engine_named(params.engine).network_for(params)
@@ -56,7 +59,16 @@ def test_run_prints_and_stores_an_empty_mill(tmp_path):
     outcome = runner.invoke(cli.app, ["run", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0",
                                       "--set", "duration=600", "--out", str(out), "--no-plots"])
     assert outcome.exit_code == 0, outcome.output
-    assert "none" in outcome.stdout and "drive heat into the clamp" in outcome.stdout
-    stored = json.loads((out / "summary.json").read_text(encoding="utf-8"))
-    summary = stored.get("summary", stored)
+    assert re.search(r"amplitude; ball radius\s*│\s*25; none", outcome.stdout) and "drive heat into the clamp" in outcome.stdout
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))["summary"]
     assert summary["n_balls"] == 0 and summary["ball_C"] is None and summary["vial_C"] > 20.0
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [(["--target", "theta_inf_C=40"], "target: the targets are the balls' temperatures"),
+     (["--free", "drive_heat"], "curve: experiment (Takacs & McHenry 2006")],
+)
+def test_a_fit_to_the_balls_of_an_empty_mill_is_refused(option, message):
+    outcome = runner.invoke(cli.app, ["calibrate", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0", *option])
+    assert outcome.exit_code == 2 and message in outcome.output and "vial_C" in outcome.output

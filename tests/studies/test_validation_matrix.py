@@ -71,10 +71,10 @@ def test_the_bar_needs_the_curve_within_two_kelvin_no_edge_and_computed_paths(pr
 def test_every_structure_fits_only_keys_with_a_stated_range_or_beta():
     for structure in STRUCTURES:
         assert set(structure.free) <= set(DEFENSIBLE_RANGES)
-        at_correlation = structure.fixed.get("beta", 1.0) == 1.0 and "beta" not in structure.free
+        at_correlation = dict(structure.fixed).get("beta", 1.0) == 1.0 and "beta" not in structure.free
         assert structure.physical == (at_correlation and structure.preset == "spex8000m-3d-mill-head")
     # β fixed away from Whitaker's correlation is not physical, however it was set.
-    assert not Structure("s", "spex8000m-3d-mill-head", ("drive_heat",), {"beta": 1.3}).physical
-    assert Structure("s", "spex8000m-3d-mill-head", ("drive_heat",), {"beta": 1.0}).physical
+    assert not Structure("s", "spex8000m-3d-mill-head", ("drive_heat",), (("beta", 1.3),)).physical
+    assert Structure("s", "spex8000m-3d-mill-head", ("drive_heat",), (("beta", 1.0),)).physical
     # A mill-head network whose convection is not Whitaker's as published is not physical either.
     assert not Structure("s", "spex8000m-3d-calibrated-paper", ("drive_heat",)).physical

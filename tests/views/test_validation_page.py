@@ -17,6 +17,7 @@ from shakermill.studies.validation_matrix import (
     ValidationMatrix,
 )
 from shakermill.studies.validation_report import ValidationReport
+from shakermill.views import validation_page
 from shakermill.views.validation_page import matrix_rows, render_validation_page, save_validation_page, structure_rows
 
 FIVE = Experiment("five", "Five balls", "a paper", "a calorimeter", False, {"n_balls": 5},
@@ -61,6 +62,7 @@ def test_the_page_holds_the_matrix_its_figure_and_the_verdict(tmp_path):
     assert target.read_text(encoding="utf-8") == page
 
 
-def test_a_folder_is_refused_before_the_page_is_drawn(tmp_path):
+def test_a_folder_is_refused_before_the_page_is_drawn(tmp_path, monkeypatch):
+    monkeypatch.setattr(validation_page, "render_validation_page", lambda report: pytest.fail("the page was drawn"))
     with pytest.raises(IsADirectoryError):
         save_validation_page(REPORT, tmp_path)

@@ -140,13 +140,14 @@ def run_length_warning(duration: float, steady: SteadyState) -> str | None:
         return None
     return (
         f"the run ({duration / 60:.3g} min) is shorter than {SETTLED_TIME_CONSTANTS:g} slowest time constants "
-        f"({SETTLED_TIME_CONSTANTS:g} x {slowest / 60:.3g} min): the exponential fitted over it (theta_inf_C) is not "
-        f"the steady state; {settles(steady)}"
+        f"({SETTLED_TIME_CONSTANTS:g} x {slowest / 60:.3g} min): {settles(steady)}"
     )
 
 
 def settles(steady: SteadyState) -> str:
-    """Where the balls settle, or the vial in an empty mill."""
+    """What the end of a short run is not, and where it settles: the balls', or the vial's in an empty mill (which
+    fits no exponential)."""
     if steady.balls:
-        return f"the ball settles at {steady.ball - 273.15:.1f} °C (ball_steady_C)"
-    return f"the vial settles at {steady.vial - 273.15:.1f} °C (vial_steady_C)"
+        return (f"the exponential fitted over it (theta_inf_C) is not the steady state; the ball settles at "
+                f"{steady.ball - 273.15:.1f} °C (ball_steady_C)")
+    return f"its end is not the steady state; the vial settles at {steady.vial - 273.15:.1f} °C (vial_steady_C)"

@@ -68,25 +68,34 @@ def validate(
     calibrated parameters, which free sets of a calibration can follow the curve, and (3-D) the validation matrix of
     the thermal models, the structures that follow the one-ball curve and the five-ball experiment no fit has seen."""
     from shakermill.io.runs import to_jsonable
-    from shakermill.studies.validation import TABLE5
     from shakermill.studies.validation_report import SOLVERS, validation_report
 
     if solver not in SOLVERS:
         fail(f"solver: {solver!r} is not allowed; allowed: one of {', '.join(map(repr, SOLVERS))}")
     if html is not None:
+        if not three_d:
+            fail("report: the page holds the three-dimensional studies; allowed --report with --three-d (the default)")
         check_report_target(html, overwrite)
     with progress_bar("3-D validation", "{task.completed}/{task.total} runs", None) as update:
         show = None if update is None else lambda done, total: update(done, total=total)
         report = validation_report(solver, study, three_d, progress=show)
+    # Printed before the page is written: a page that cannot be written loses nothing the study found.
+    if json_output:
+        typer.echo(json.dumps(to_jsonable(report.as_dict()), sort_keys=True, allow_nan=False))
+    else:
+        print_report(report)
     if html is not None:
         from shakermill.views.validation_page import save_validation_page
 
         with writing(html, "the validation report"):
             save_validation_page(report, html)
         typer.echo(f"validation report written to {html}", err=True)
-    if json_output:
-        typer.echo(json.dumps(to_jsonable(report.as_dict()), sort_keys=True, allow_nan=False))
-        return
+
+
+def print_report(report: Any) -> None:
+    """The tables of ``validate`` on the terminal."""
+    from shakermill.studies.validation import TABLE5
+
     console = stdout_console()
     console.print(validation_table(report.runs))
     for run in report.runs:
@@ -138,7 +147,7 @@ def check_report_target(target: Path, overwrite: bool) -> None:
     if target.exists() and not overwrite:
         fail(f"{target}: exists; choose another --report, or add --overwrite to replace it")
     with user_errors():
-        check_writable_place(target)
+        check_writable_place(target, "--report")
 
 
 def print_held_out(console: Console, held_out: Any) -> None:

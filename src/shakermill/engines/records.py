@@ -122,10 +122,11 @@ class EnergyAudit:
 
     @property
     def relative_residual(self) -> float:
-        """|residual| over the largest flow in the balance (0 when nothing flowed, NaN when a term is not finite)."""
+        """|residual| over the largest flow in the balance (0 when nothing flowed, NaN when a term is not finite).
+        The drive's heat counts: in an empty mill it is the only flow."""
         if not math.isfinite(self.residual):
             return math.nan
-        scale = max(abs(self.work_by_vial), abs(self.dissipated), abs(self.heat_generated))
+        scale = max(abs(self.work_by_vial), abs(self.dissipated), abs(self.heat_generated), abs(self.drive_heat))
         return abs(self.residual) / scale if scale > 0.0 else 0.0
 
     def as_dict(self) -> dict[str, float]:

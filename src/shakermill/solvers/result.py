@@ -182,7 +182,8 @@ def physical_bounds_problem(result: Result) -> str | None:
     """Why the temperatures of a run cannot be physical, or None."""
     series = result.history
     balls = series[BALL_TEMPERATURES if BALL_TEMPERATURES in series.variables else "theta_ball"]
-    hottest_ball = float(np.nanmax(balls, initial=-np.inf))  # -inf in an empty mill
+    # With no balls (an empty mill) there is nothing to reduce: the initial value keeps nanmax from raising.
+    hottest_ball = float(np.nanmax(balls, initial=-np.inf))
     limit = result.params.ball_temperature_limit
     if hottest_ball > limit:
         return (
@@ -224,7 +225,8 @@ def steady_state_bound_warning(result: Result) -> str | None:
     """A line when the run stays in range but its steady state would not."""
     steady = result.steady
     limit = result.params.ball_temperature_limit
-    if steady is None or not steady.solved or not steady.ball > limit:  # NaN in an empty mill
+    # Written as "not above" so that the NaN ball of an empty mill gives no warning.
+    if steady is None or not steady.solved or not steady.ball > limit:
         return None
     return (
         f"the ball's steady state ({kelvin_to_celsius(steady.ball):.4g} °C) is above ball_temperature_limit "

@@ -384,10 +384,17 @@ def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float]
     if not targets and not curves:
         curves = (experiment_curve(),)
     free = tuple(free)
+    if targets and base.n_balls == 0:
+        raise ParameterError("target: the targets are the balls' temperatures, and an empty mill (n_balls = 0) has no "
+                             "balls; allowed a vial_C curve (--curve) for it")
     for measured in curves:
-        clash = sorted(set(parse_overrides(measured.conditions)) & set(free))
+        conditions = parse_overrides(measured.conditions)
+        clash = sorted(set(conditions) & set(free))
         if clash:
             raise ParameterError(f"curve: the conditions of {measured.source} set {', '.join(clash)}, which the fit moves")
+        if measured.node == "ball" and str(conditions.get("n_balls", base.n_balls)).strip() == "0":
+            raise ParameterError(f"curve: {measured.source or 'the curve'} is of the balls, and its run has none "
+                                 "(n_balls = 0); allowed a vial_C curve for an empty mill")
     _check_free_for_engine(base, free)
     for key in free:
         if getattr(base, key) <= 0:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
@@ -195,15 +195,16 @@ class Structure:
     label: str
     preset: str
     free: tuple[str, ...]
-    # Keys set away from the preset and not fitted: how far a computed path must move before the bar is met.
-    fixed: Mapping[str, float] = field(default_factory=dict)
+    # Keys set away from the preset and not fitted, as (key, value) pairs: how far a computed path must move before
+    # the bar is met.
+    fixed: tuple[tuple[str, float], ...] = ()
 
     @property
     def physical(self) -> bool:
         """Whether every computed path stays at its correlation's value and only what no source gives is fitted
         (MODEL.md §13.2): the mill-head network (outer paths from the vial's speed, conduction from the contacts)
         with Whitaker's correlation as published (β = 1), β not fitted."""
-        values = {**preset_values(self.preset), **self.fixed}
+        values = {**preset_values(self.preset), **dict(self.fixed)}
         return values["thermal_model"] == "mill-head" and values["beta"] == 1.0 and "beta" not in self.free
 
 
@@ -220,7 +221,7 @@ STRUCTURES: tuple[Structure, ...] = (
     # How much stronger than Whitaker's correlation the balls' convection must be before the curve is followed:
     # 1.3 is the correlation's own stated accuracy; Kramers' (1946) lies 1.1-1.2x above it at Re of 10³-3·10³.
     *(Structure(f"mill-head with β fixed at {beta:g} (not at its correlation)", "spex8000m-3d-mill-head", MILL_HEAD_FREE,
-                {"beta": beta}) for beta in (1.3, 1.6, 2.0)),
+                (("beta", beta),)) for beta in (1.3, 1.6, 2.0)),
     Structure("mill-head with β free (β not at its correlation)", "spex8000m-3d-mill-head", (*MILL_HEAD_FREE, "beta")),
 )
 # The one-ball curve is an exponential fitted to intermittent calorimetric measurements: a structure that follows it
@@ -259,7 +260,7 @@ def structure_study(structures: tuple[Structure, ...] = STRUCTURES, overrides: M
     settings = {"solver": "averaged", "record_windows": (), "attractor_starts": 1, **(overrides or {})}
     outcomes = []
     for index, structure in enumerate(structures):
-        base = default_parameters(structure.preset, **settings, **structure.fixed)
+        base = default_parameters(structure.preset, **{**settings, **dict(structure.fixed)})
         calibration = calibrate(base, structure.free, sample_posterior=False)
         five_balls = base.replace(n_balls=FIVE_BALLS, duration=3600.0, **calibration.fitted)
         summary = thermal_variants(five_balls)(five_balls).summary

@@ -140,17 +140,18 @@ def _create_in_place(path: Path, data: bytes) -> None:
         raise
 
 
-def check_writable_place(path: Path) -> None:
+def check_writable_place(path: Path, option: str = "--out") -> None:
     """Raise :class:`StorageError` where ``path`` surely cannot be created: under a file, or in a
-    read-only or forbidden folder. Checked before long work, so that the work is not lost at the end."""
+    read-only or forbidden folder. Checked before long work, so that the work is not lost at the end; the message
+    names the ``option`` that gave the path."""
     ancestor = path.absolute().parent
     while not ancestor.exists() and ancestor != ancestor.parent:
         ancestor = ancestor.parent
     if not ancestor.is_dir():
-        raise StorageError(f"{path}: cannot be created, {ancestor} is not a folder; choose another --out")
+        raise StorageError(f"{path}: cannot be created, {ancestor} is not a folder; choose another {option}")
     if not os.access(ancestor, os.W_OK | os.X_OK):
         reason = os.strerror(errno.EROFS if _read_only(ancestor) else errno.EACCES)
-        raise StorageError(f"{path}: cannot write in {ancestor} ({reason}); choose another --out")
+        raise StorageError(f"{path}: cannot write in {ancestor} ({reason}); choose another {option}")
 
 
 def _read_only(folder: Path) -> bool:

@@ -78,7 +78,12 @@ def matrix_figure(matrix: ValidationMatrix) -> Figure:
 
     points = list(dict.fromkeys((row.experiment.name, row.point.node, row.point.time_s) for row in matrix.rows))
     presets = list(dict.fromkeys(row.preset for row in matrix.rows))
-    roles = {(row.experiment.name, row.point.node, row.point.time_s): row.role for row in matrix.rows}
+    roles: dict[tuple[str, str, float], list[str]] = {}
+    for row in matrix.rows:
+        # A preset fitted to another curve gives the same point another role: the label names each.
+        point_roles = roles.setdefault((row.experiment.name, row.point.node, row.point.time_s), [])
+        if row.role not in point_roles:
+            point_roles.append(row.role)
     figure, (axes,) = new_figure(height=1.0 + 0.45 * len(points) * max(1, len(presets)) / 2, width=10.0)
     offsets = {preset: 0.3 * (index - (len(presets) - 1) / 2) / max(1, len(presets)) for index, preset in enumerate(presets)}
     for preset in presets:
@@ -92,7 +97,7 @@ def matrix_figure(matrix: ValidationMatrix) -> Figure:
     measured = [(index, rises[point]) for index, point in enumerate(points) if rises[point] is not None]
     if measured:
         axes.plot([rise for _, rise in measured], [index for index, _ in measured], "k*", markersize=11, label="measured")
-    axes.set_yticks(range(len(points)), [f"{name}: {node}, {time / 60:g} min ({roles[name, node, time]})"
+    axes.set_yticks(range(len(points)), [f"{name}: {node}, {time / 60:g} min ({' / '.join(roles[name, node, time])})"
                                          for name, node, time in points])
     axes.invert_yaxis()
     axes.set_xlabel("rise above the start [K]")
@@ -106,7 +111,11 @@ def render_validation_page(report: ValidationReport) -> str:
     """The whole page: the matrix, its figure and its experiments, the structures, the five balls held out."""
     from shakermill.views.report import STYLE
 
-    sections = [f"<h1>shakermill validation ({esc(report.solver)} solver)</h1>"]
+    sections = [
+        "<h1>shakermill validation: the thermal networks in three dimensions</h1>",
+        paragraph("Every run on this page uses the averaged solver; the mechanics of one ball and of five are each "
+                  "measured once and shared by the thermal networks.", "note"),
+    ]
     if report.matrix is not None:
         experiments = [
             paragraph(f"{experiment.name}: {experiment.title}. Source: {experiment.source}. Measured: "
