@@ -72,3 +72,20 @@ def test_run_prints_and_stores_an_empty_mill(tmp_path):
 def test_a_fit_to_the_balls_of_an_empty_mill_is_refused(option, message):
     outcome = runner.invoke(cli.app, ["calibrate", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0", *option])
     assert outcome.exit_code == 2 and message in outcome.output and "vial_C" in outcome.output
+
+
+def test_an_empty_mill_draws_its_temperatures_alone_and_refuses_an_animation(tmp_path):
+    from shakermill.io.runs import load_run
+    from shakermill.views.figures.run import paper_figures, write_animation
+    from shakermill.views.report import render_report
+
+    out = tmp_path / "empty"
+    outcome = runner.invoke(cli.app, ["run", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0", "--set", "solver=full",
+                                      "--set", "duration=2", "--out", str(out), "--no-plots"])
+    assert outcome.exit_code == 0, outcome.output
+    run = load_run(out)
+    assert list(paper_figures(run)) == ["temperatures"]
+    with pytest.raises(ParameterError, match="an empty mill"):
+        write_animation(run, tmp_path / "balls.gif")
+    page = render_report(run)
+    assert "An empty mill (no balls)" in page and "<h2>Balls</h2>" not in page

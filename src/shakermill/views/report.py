@@ -144,7 +144,7 @@ def render_report(run: RunData, other: RunData | None = None) -> str:
     sections = [
         header_section(run, preset),
         results_section(run),
-        *([balls_section(run)] if several_balls(run.params) else []),
+        *([balls_section(run)] if several_balls(run.params) and run.params.n_balls else []),
         table5_section(run, preset),
         paper_figures_section(run, figure_numbers),
         configuration_section(run, preset),

@@ -93,6 +93,8 @@ def _paper_figures(run: RunLike, window: int) -> dict[str, Figure]:
     params = run.params
     balls = several_balls(params)
     figures = {"temperatures": temperature_figure(run)}
+    if params.n_balls == 0:
+        return figures  # an empty mill has no motion and no contact to draw
     motion = window_data(run, window)
     if motion is not None:
         name, draw = ("trajectories", trajectory_figure) if balls else ("ball_motion", motion_figure)
@@ -115,6 +117,8 @@ def write_animation(
     params = run.params
     if not several_balls(params):
         raise ParameterError("animate: the animation shows the balls of a 'dem' run; this run is 1-D (engine = '1d')")
+    if params.n_balls == 0:
+        raise ParameterError("animate: the animation shows the balls of a 'dem' run; this run is an empty mill (n_balls = 0)")
     check_window(params, window)
     motion = window_data(run, window)
     if motion is None:
