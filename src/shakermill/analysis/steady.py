@@ -81,7 +81,7 @@ def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:
     temperatures = network.with_free(theta)
     balls = tuple(float(value) for value in temperatures[: network.n_balls])
     return SteadyState(
-        network.mean_ball(temperatures), float(temperatures[network.vial]), float(temperatures[network.air]), time_constants,
+        float(network.mean_ball(temperatures)), float(temperatures[network.vial]), float(temperatures[network.air]), time_constants,
         load.heat_power, load.velocity_term, True, "solved", balls,
         tuple((node.name, float(temperatures[index])) for index, node in enumerate(network.nodes) if index > network.air),
     )

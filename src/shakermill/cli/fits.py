@@ -152,11 +152,12 @@ def check_report_target(target: Path, overwrite: bool) -> None:
 
 def print_held_out(console: Console, held_out: Any) -> None:
     from shakermill.studies.held_out import COMPARED_KEYS, FIVE_BALL_SOURCE
+    from shakermill.views.validation_page import HELD_OUT_HEADERS, held_out_rows
 
     prediction, comparison, sensitivity = held_out.prediction, held_out.comparison, held_out.sensitivity
-    table = Table("quantity", "unit", "experiment", "predicted", "error", title=f"Held out: five balls ({FIVE_BALL_SOURCE})")
-    for row in prediction.rows:
-        add_plain_row(table, row.label, row.unit, f"{row.experiment:g}", f"{row.predicted:.3g}", f"{100 * row.relative_error:+.0f} %")
+    table = Table(*HELD_OUT_HEADERS, title=f"Held out: five balls ({FIVE_BALL_SOURCE})")
+    for row in held_out_rows(prediction):
+        add_plain_row(table, *row)
     console.print(table)
     console.print(Text(prediction.statement))
     table = Table("one ball", *(f"{label} [{unit}]" for _, label, unit in COMPARED_KEYS), title="One ball: what the third dimension, gravity and friction change")

@@ -297,9 +297,8 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
     }
     summary.update(understood_inputs(params))
     summary.update(several_ball_summary(result))
-    for node in ("clamp",):
-        if f"theta_{node}" in series.variables:
-            summary[f"{node}_C"] = kelvin_to_celsius(float(series[f"theta_{node}"][-1]))
+    if "theta_clamp" in series.variables:
+        summary["clamp_C"] = kelvin_to_celsius(float(series["theta_clamp"][-1]))
     if result.steady is not None:
         summary.update(result.steady.as_summary())
     summary["heat_paths_W"] = dict(result.heat_paths)

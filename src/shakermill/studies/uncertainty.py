@@ -89,7 +89,7 @@ def headline_temperatures(params: Parameters, load: NetworkLoad) -> dict[str, fl
     end = thermal.y[:, -1]
     steady = steady_state(network, load)
     return {
-        "ball_C": network.mean_ball(end) - 273.15,
+        "ball_C": float(network.mean_ball(end)) - 273.15,
         "vial_C": float(end[network.vial]) - 273.15,
         "ball_steady_C": steady.ball - 273.15,
         "vial_steady_C": steady.vial - 273.15,

@@ -15,6 +15,7 @@ from shakermill.views.notebook import esc
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+    from shakermill.studies.held_out import HeldOutPrediction
     from shakermill.studies.validation_matrix import StructureOutcome, ValidationMatrix
     from shakermill.studies.validation_report import ValidationReport
 
@@ -47,18 +48,29 @@ def structure_headers() -> tuple[str, ...]:
 def structure_rows(outcomes: Sequence[StructureOutcome]) -> list[tuple[str, ...]]:
     """Each structure fitted to the one-ball curve: its fit, whether it meets the bar, its five-ball prediction."""
     from shakermill.studies.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
+    from shakermill.studies.validation import relative_error
 
-    rows = []
-    for outcome in outcomes:
-        ball, vial = outcome.ball_rise_K, outcome.vial_rise_K
-        rows.append((
+    def against(rise: float, measured: float) -> str:
+        return f"{rise:.3g} ({100 * relative_error(rise, measured):+.0f} %)"
+
+    return [
+        (
             outcome.structure.label, ", ".join(f"{key} {value:.3g}" for key, value in outcome.fitted.items()),
             f"{outcome.curve_rms_K:.2f}", ", ".join(outcome.edges) or "none",
             "yes" if outcome.structure.physical else "no", "yes" if outcome.meets_point_7 else "no",
-            f"{ball:.3g} ({100 * (ball / FIVE_BALL_BALL_RISE_K - 1):+.0f} %)",
-            f"{vial:.3g} ({100 * (vial / FIVE_BALL_VIAL_RISE_K - 1):+.0f} %)",
-        ))
-    return rows
+            against(outcome.ball_rise_K, FIVE_BALL_BALL_RISE_K), against(outcome.vial_rise_K, FIVE_BALL_VIAL_RISE_K),
+        )
+        for outcome in outcomes
+    ]
+
+
+HELD_OUT_HEADERS = ("quantity", "unit", "experiment", "predicted", "error")
+
+
+def held_out_rows(prediction: HeldOutPrediction) -> list[tuple[str, ...]]:
+    """The five balls held out: each quantity measured and predicted, and the error."""
+    return [(row.label, row.unit, f"{row.experiment:g}", f"{row.predicted:.3g}", f"{100 * row.relative_error:+.0f} %")
+            for row in prediction.rows]
 
 
 def structure_verdict(outcomes: Sequence[StructureOutcome]) -> str:
@@ -137,10 +149,8 @@ def render_validation_page(report: ValidationReport) -> str:
         ))
     if report.held_out is not None:
         prediction = report.held_out.prediction
-        rows = [(row.label, row.unit, f"{row.experiment:g}", f"{row.predicted:.3g}", f"{100 * row.relative_error:+.0f} %")
-                for row in prediction.rows]
-        sections.append(section("Held out: five balls", table(("quantity", "unit", "experiment", "predicted", "error"), rows,
-                                                              numeric=(2, 3, 4)), paragraph(prediction.statement, "statement")))
+        sections.append(section("Held out: five balls", table(HELD_OUT_HEADERS, held_out_rows(prediction), numeric=(2, 3, 4)),
+                                paragraph(prediction.statement, "statement")))
     return (
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
         f"<title>shakermill validation</title>\n<style>{STYLE}</style>\n</head>\n<body>\n"

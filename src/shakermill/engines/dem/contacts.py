@@ -330,26 +330,26 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
     if w.touching[slot]:
         return count
     row = records[count]
-    row[0], row[1], row[2] = c.started[slot], i, j if pair else -1 - (slot - n * n) % N_WALLS
+    wall = -1 if pair else (slot - n * n) % N_WALLS
+    row[0], row[1], row[2] = c.started[slot], i, j if pair else -1 - wall
     row[3], row[4] = c.normal_speed_in[slot], c.tangential_speed_in[slot]
     row[5:9] = c.dissipated[slot]
     row[9], row[10], row[11] = c.peak_force[slot], c.max_overlap[slot], t - c.started[slot]
     total = k.eta * (c.dissipated[slot, 0] + c.dissipated[slot, 1] + c.dissipated[slot, 2] + c.dissipated[slot, 3])
     row[12], row[13] = share * total, (1.0 - share) * total
-    row[14] = _conduct(slot, i, j, row[11], k, s)
+    row[14] = _conduct(slot, i, j, wall, row[11], k, s)
     c.spring[slot, :] = 0.0
     return count + 1
 
 
 @njit(cache=True, inline="always")
-def _conduct(slot: int, i: int, j: int, duration: float, k: Constants, s: State) -> float:
+def _conduct(slot: int, i: int, j: int, wall: int, duration: float, k: Constants, s: State) -> float:
     """The heat per kelvin (J/K) the contact that ended in ``slot`` conducted between ball ``i`` and ball ``j``
-    (or the vial, ``j`` = −1) over its ``duration`` (MODEL.md §13.1), gathered for the thermal network; returned
-    for its record. Counted when the contact ends, so that a lasting one adds all its conduction at once."""
+    (or ``wall`` of the vial, ``j`` = −1) over its ``duration`` (MODEL.md §13.1), gathered for the thermal network;
+    returned for its record. Counted when the contact ends, so that a lasting one adds all its conduction at once."""
     if j >= 0:
         radius, effusivity, conductivity = k.pair_radius[i, j], k.effusivity[j], k.conductivity[j]
     else:
-        wall = (slot - k.n_balls * k.n_balls) % N_WALLS
         radius, effusivity, conductivity = k.wall_radius[i, wall], k.vial_effusivity, k.vial_conductivity
     contact_radius = heat_paths.hertz_contact_radius(radius, s.contacts.max_overlap[slot])
     conducted = heat_paths.contact_conduction(

@@ -270,11 +270,6 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
     }
 
 
-def mean_over_balls(values: np.ndarray) -> np.ndarray:
-    """The mean over the balls (columns) at each time; NaN in an empty mill, which has none."""
-    return values.mean(axis=1) if values.shape[1] else np.full(values.shape[0], np.nan)
-
-
 def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Constants, network: ThermalNetwork) -> StateHistory:
     """The states with units: temperatures of each ball (and their mean, ``theta_ball``), vial and air (and any
     further node of ``network``, ``theta_<name>``), the balls' motion in the lab frame (axis x, y, z; z up), the
@@ -283,7 +278,7 @@ def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Consta
     theta, totals, heat_into = fields["temperature"], fields["totals"], fields["heat_into"]
     terms, vial = fields["drive_integrals"][:, :n], fields["vial"]
     variables: dict[str, tuple[np.ndarray, dict[str, str]]] = {
-        "theta_ball": (mean_over_balls(theta[:, :n]), attributes("K", "mean ball temperature")),
+        "theta_ball": (network.mean_ball(theta), attributes("K", "mean ball temperature")),
         "theta_vial": (theta[:, n], attributes("K", "vial temperature")),
         "theta_air": (theta[:, n + 1], attributes("K", "inner air temperature")),
         BALL_TEMPERATURES: (theta[:, :n], attributes("K", "temperature of each ball")),
@@ -307,7 +302,7 @@ def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Consta
     variables["heat_into_balls"] = (heat_into[:, :n], attributes("J", "cumulative impact heat into each ball"))
     variables["heat_into_vial"] = (heat_into[:, n], attributes("J", "cumulative impact heat into the vial"))
     variables["velocity_term_integrals"] = (terms, attributes("s", "time integral of each ball's Whitaker velocity term"))
-    variables["velocity_term_integral"] = (mean_over_balls(terms), attributes("s", "the balls' mean of velocity_term_integrals"))
+    variables["velocity_term_integral"] = (network.mean_ball(terms), attributes("s", "the balls' mean of velocity_term_integrals"))
     variables["contact_conduction"] = (
         fields["drive_integrals"][:, n:],
         attributes("J K-1", "heat per kelvin conducted by the contacts of each ball with the vial, then of each pair"),

@@ -86,9 +86,12 @@ class ThermalNetwork:
     def ambient(self) -> float:
         return self.arrays.ambient
 
-    def mean_ball(self, theta: np.ndarray) -> float:
-        """The balls' mean of node temperatures ``theta`` (K); NaN in an empty mill (``n_balls = 0``)."""
-        return float(np.mean(theta[: self.n_balls])) if self.n_balls else math.nan
+    def mean_ball(self, values: np.ndarray) -> np.ndarray:
+        """The balls' mean of per-node ``values`` (nodes on the last axis, e.g. time × node); NaN in an empty mill
+        (``n_balls = 0``)."""
+        if self.n_balls:
+            return np.mean(values[..., : self.n_balls], axis=-1)
+        return np.full(np.shape(values)[:-1], np.nan)
 
     @property
     def free(self) -> np.ndarray:
