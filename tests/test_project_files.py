@@ -66,3 +66,11 @@ def test_changelog_has_the_current_version_and_unreleased_changes():
     changelog = (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
     assert "## [Unreleased]" in changelog
     assert f"## [{version()}]" in changelog
+
+
+def test_the_readme_is_what_a_newcomer_needs_first():
+    # Everything else lives in the documentation site (docs/, tests/test_docs.py builds it).
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(readme.splitlines()) <= 200
+    for needed in ("make run", "make test", "make docs", "site/index.html", "make notebook", "10 minutes"):
+        assert needed in readme, needed

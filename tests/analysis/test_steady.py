@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.analysis.steady import SETTLED_TIME_CONSTANTS, run_length_warning, settled_rates, steady_state
+from shakermill.views.notebook import answer_sentences
+from shakermill.analysis.steady import SETTLED_TIME_CONSTANTS, run_length_note, settled_rates, steady_state
 from shakermill.engines.registry import engine_named
 
 
@@ -102,8 +103,8 @@ def test_steady_state_is_where_a_ten_hour_averaged_run_ends():
     last = result.timeseries.isel(time=-1)
     for node in ("ball", "vial", "air"):
         assert float(last[f"theta_{node}"]) - 273.15 == pytest.approx(result.summary[f"{node}_steady_C"], abs=0.5)
-    # Ten hours are more than three slowest time constants, so no warning about the run's length.
-    assert not any("slowest time constants" in line for line in result.warnings)
+    # Ten hours are more than three slowest time constants, so no note about the run's length.
+    assert not any("slowest time constants" in line for line in result.notes)
 
 
 @pytest.mark.slow
@@ -116,18 +117,21 @@ def test_steady_state_is_where_a_long_full_resolution_run_ends():
         assert float(last[f"theta_{node}"]) - 273.15 == pytest.approx(result.summary[f"{node}_steady_C"], abs=0.5)
 
 
-def test_an_hour_of_the_calibrated_preset_warns_that_its_fit_is_not_the_steady_state():
+def test_an_hour_of_the_calibrated_preset_notes_that_its_fit_is_not_the_steady_state():
     result = sm.simulate(sm.default_parameters("spex8000m-calibrated", solver="averaged", record_windows=()))
     slowest = result.summary["slowest_time_constant_min"]
     assert 60.0 < SETTLED_TIME_CONSTANTS * slowest
-    lines = [line for line in result.warnings if "slowest time constants" in line]
+    # Advice, not a problem: the steady state is reported beside it, so it is a note of the answer, not a warning.
+    lines = [line for line in result.notes if "slowest time constants" in line]
     assert len(lines) == 1
-    assert f"{result.summary['ball_steady_C']:.1f} °C" in lines[0]
-    assert result.summary["warnings"] == result.warnings
+    assert f"{SETTLED_TIME_CONSTANTS:g} x {slowest:.3g} min" in lines[0]
+    assert not any("slowest time constants" in line for line in result.warnings)
+    assert result.summary["notes"] == result.notes
+    assert lines[0] in answer_sentences(result.summary)
 
 
-def test_run_length_warning_only_for_short_runs():
+def test_run_length_note_only_for_short_runs():
     steady = _steady(sm.default_parameters(), 1.0, 30.0)
     slowest = steady.slowest_time_constant
-    assert run_length_warning(2.9 * slowest, steady) is not None
-    assert run_length_warning(3.1 * slowest, steady) is None
+    assert run_length_note(2.9 * slowest, steady) is not None
+    assert run_length_note(3.1 * slowest, steady) is None

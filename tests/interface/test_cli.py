@@ -5,6 +5,8 @@ from __future__ import annotations
 import importlib
 import io
 import json
+import os
+import re
 import signal
 import subprocess
 import sys
@@ -21,11 +23,15 @@ from typer.testing import CliRunner
 import shakermill as sm
 from shakermill import cli
 from shakermill.cli import common as cli_common
+from shakermill.cli import scans
 from shakermill.io.runs import RUN_FILES, load_run
 from shakermill.parameters.config import load_config
+from shakermill.parameters.engine_keys import reads
 from shakermill.parameters.keys import FIELD_NAMES
+from shakermill.parameters.presets import PRESETS
 from shakermill.solvers.result import INTERRUPTED
 from shakermill.studies.calibrate import DEFAULT_FREE
+from shakermill.studies.sweep_plan import plan_sweep
 from shakermill.studies.sweep_storage import load_sweep
 
 # Short runs with small windows keep every invocation well under a second once Numba's cache is warm.
@@ -118,7 +124,10 @@ def test_config_file_and_set_overrides_end_up_in_the_stored_configuration(tmp_pa
         ("ball_radius=40 mm", ("ball_radius", "does not fit", "allowed ball_radius < vial_length/2 = 0.029 m")),
         ("vial_mass=-1", ("vial_mass", "allowed [0.001, 100] kg")),
         ("omega=0", ("omega", "allowed [1, 10000] rad/s")),
-        ("amplitude=3 kg", ("amplitude", "'3 kg'", "expected m")),
+        ("amplitude=3 kg", ("amplitude", "'3 kg' has the wrong dimension; expected a length such as m or mm")),
+        ("omega=3 kg", ("omega: '3 kg' has the wrong dimension; expected a frequency such as rad/s, Hz or rpm",)),
+        ("omega=1060 rmp", ("omega: cannot parse '1060 rmp': unknown unit 'rmp'; expected a frequency",)),
+        ("ambient_temperature=25 kg", ("ambient_temperature", "expected a temperature such as K, degC or degF")),
         ("restitutoin=0.5", ("restitutoin", "did you mean 'restitution'")),
         ("duration=abc", ("duration", "'abc'")),
         ("duration", ("'duration'", "expected KEY=VALUE")),
@@ -132,6 +141,18 @@ def test_bad_setting_exits_2_with_one_line_naming_the_key(tmp_path, setting, fra
     assert_one_error_line(result.stderr, *fragments)
     assert result.stdout == ""
     assert not out.exists()
+
+
+def test_temperatures_in_degrees_celsius_and_rates_in_rpm_of_any_case_are_read(tmp_path):
+    out = tmp_path / "run"
+    settings = ["ambient_temperature=25 C", "initial_temperature=68 °F", "omega=1060 RPM", "atol_temperature=1e-6 degC"]
+    result = invoke("run", *SHORT, *(part for setting in settings for part in ("--set", setting)), "--out", str(out), "--json", "--no-plots")
+    assert result.exit_code == 0, result.stderr
+    params = load_config(out / "config.toml").params
+    assert params.ambient_temperature == pytest.approx(298.15)  # 25 °C, not 25 coulombs
+    assert params.initial_temperature == pytest.approx(293.15)
+    assert params.omega == pytest.approx(1060 * 2 * np.pi / 60)
+    assert params.atol_temperature == pytest.approx(1e-6)  # a difference: one degree Celsius is one kelvin
 
 
 def test_malformed_toml_exits_2_naming_file_and_line(tmp_path):
@@ -264,6 +285,77 @@ def test_keys_lists_every_key_with_its_allowed_range():
     restitution = next(line for line in lines if " restitution " in line)
     assert "(0, 1]" in restitution and "0.7" in restitution
     assert "one of 'relative', 'paper'" in result.stdout
+
+
+def keys_listed(stdout: str) -> list[str]:
+    """The keys of a `keys` table, one per row (a row's later lines leave the key's cell empty)."""
+    cells = [line.split("│")[1].strip() for line in stdout.splitlines() if line.count("│") == 5]
+    return [cell for cell in cells if cell]
+
+
+def test_keys_with_a_pattern_lists_the_keys_whose_name_or_description_has_it():
+    omega = invoke("keys", "OMEGA")
+    assert omega.exit_code == 0, omega.stderr
+    assert keys_listed(omega.stdout) == ["omega", "kinematics"]  # kinematics: its description names omega
+    assert f"parameter keys matching 'OMEGA': 2 of {len(FIELD_NAMES)}" in omega.stdout
+    radii = invoke("keys", "ball_r*")
+    assert keys_listed(radii.stdout) == ["ball_radius", "ball_radii"]
+    none = invoke("keys", "tempreature")
+    assert none.exit_code == 0
+    assert none.stdout == f"no parameter key matching 'tempreature'; `shakermill keys` lists all {len(FIELD_NAMES)}\n"
+
+
+@pytest.mark.parametrize("engine", ["1d", "dem"])
+def test_keys_of_an_engine_are_those_it_reads(engine):
+    result = invoke("keys", "--engine", engine)
+    assert result.exit_code == 0, result.stderr
+    assert keys_listed(result.stdout) == [key for key in FIELD_NAMES if reads(engine, key)]
+    one_d_only, dem_only = ("rtol", "energy_projection"), ("friction", "n_balls", "kinematics", "clamp_loss")
+    listed = set(keys_listed(result.stdout))
+    assert listed >= set(one_d_only if engine == "1d" else dem_only)
+    assert not listed & set(dem_only if engine == "1d" else one_d_only)
+
+
+def test_keys_of_an_unknown_engine_is_refused():
+    result = invoke("keys", "--engine", "one_d")
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, "--engine: 'one_d' is no engine; allowed '1d', 'dem'")
+
+
+def test_help_shows_switches_as_flags_without_a_value():
+    assert invoke("--help").exit_code == 0  # every command registered by now
+    commands = [command.name for command in cli_common.app.registered_commands]
+    assert len(commands) >= 12
+    for command in commands:
+        result = invoke(command, "--help")
+        assert result.exit_code == 0, command
+        # typer's rich help shows a switch as `--json <bool>`, as if it took a value.
+        assert "<bool>" not in result.stdout, command
+        assert "--json" not in result.stdout or re.search(r"^  --json  +\S", result.stdout, flags=re.MULTILINE), command
+
+
+def test_sweep_table_shows_swept_values_in_the_units_they_were_written_in(tmp_path):
+    plan = plan_sweep(["amplitude=5mm,10mm", "omega=1000 RPM:1100 rpm:2", "n_balls=1"])
+    assert plan.units == (("amplitude", "mm"), ("omega", "RPM"))
+    assert [point["amplitude"] for point in plan.points[::2]] == pytest.approx([0.005, 0.01])  # stored in SI
+    table = pd.DataFrame(
+        {"amplitude": [0.005, 0.01], "omega": [1000 * np.pi / 30, 1100 * np.pi / 30], "n_balls": [1, 1], "error": [None, None]}
+    )
+    drawn = io.StringIO()
+    Console(file=drawn, width=250).print(scans.sweep_preview(table, plan.keys, tmp_path, dict(plan.units)))
+    rows = [[cell.strip() for cell in line.split("│")[1:4]] for line in drawn.getvalue().splitlines() if "│" in line]
+    assert "amplitude (mm) ┃ omega (RPM) ┃ n_balls" in drawn.getvalue()
+    assert rows == [["5", "1000", "1"], ["10", "1100", "1"]]
+
+
+@pytest.mark.parametrize("command", ["report", "plot"])
+def test_a_run_folder_that_does_not_exist_is_named_so(tmp_path, command):
+    (tmp_path / "default").mkdir()
+    result = invoke(command, str(tmp_path / "defualt"))
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, f"{tmp_path / 'defualt'}: no such folder; did you mean {tmp_path / 'default'}?")
+    result = invoke(command, str(tmp_path / "default"))
+    assert_one_error_line(result.stderr, f"{tmp_path / 'default'}: not a shakermill run folder (no summary.json)")
 
 
 def test_version_option():
@@ -486,6 +578,8 @@ def test_report_of_a_dem_run_has_the_balls_and_their_figures(dem_run, tmp_path):
     assert outcome.exit_code == 0, outcome.stderr
     document = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert "<h2>Balls</h2>" in document and document.count("<figure>") == len(DEM_FIGURES) + len(DEM_IMPACT_FIGURES)
+    # Its configuration lists the keys of the 'dem' engine, not the tolerances of the 1-D integrator.
+    assert "<td>friction</td>" in document and "<td>n_balls</td>" in document and "<td>atol_position</td>" not in document
 
 
 @pytest.mark.slow
@@ -603,6 +697,64 @@ def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up
     stderr = interrupt_after([*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0)
     assert stderr.startswith("error: interrupted; nothing was written")
     assert list(tmp_path.iterdir()) == []
+
+
+def cpu_seconds(pid: int) -> float:
+    """The CPU time a running process has used (Linux: utime + stime of /proc/PID/stat)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads a process's CPU time from /proc (Linux)")
+@pytest.mark.parametrize(
+    "settings",
+    [["--set", "solver=full", "--set", "duration=600 min"], ["--preset", "spex8000m-3d", "--set", "solver=full", "--set", "duration=60"]],
+    ids=["1-D", "3-D"],
+)
+def test_real_ctrl_c_exits_within_a_second_with_the_data_written(tmp_path, start_up_s, settings):
+    # Numba's cache of the 3-D engine warm too: a compilation is no run to interrupt.
+    warm = subprocess.run([str(SHAKERMILL), "run", *settings, "--set", "duration=0.01", "--no-plots", "--out", str(tmp_path / "warm")],
+                          capture_output=True, text=True, timeout=300)
+    assert warm.returncode == 0, warm.stderr
+    out = tmp_path / "run"
+    # Figures asked for: they are what an interrupted run leaves to `plot`.
+    process = subprocess.Popen([str(SHAKERMILL), "run", *settings, "--out", str(out)], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    time.sleep(start_up_s + 3.0)
+    assert process.poll() is None, "the run ended before it could be interrupted"
+    used = cpu_seconds(process.pid)
+    signalled = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    _, status, usage = os.wait4(process.pid, 0)
+    waited = time.monotonic() - signalled
+    after = usage.ru_utime + usage.ru_stime - used
+    stderr = process.stderr.read()
+    assert os.waitstatus_to_exitcode(status) == 130, stderr
+    # What Ctrl-C costs: under a second of work. On a machine shared with the rest of the suite the wall clock
+    # stretches it, so its bound is looser; benchmarks/bench_interrupt.py measures it on a quiet one.
+    assert after <= 1.0, f"{after:.2f} CPU-s after the signal"
+    assert waited <= 3.0, f"{waited:.2f} s after the signal"
+    assert len(stderr.strip().splitlines()) == 1 and stderr.startswith("interrupted:"), stderr
+    assert f"shakermill plot {out}" in stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == INTERRUPTED and 0 < summary["summary"]["simulated_s"]
+    assert not (out / "figures").exists()
+    assert load_run(out).timeseries.sizes["time"] >= 1
+
+
+@pytest.mark.slow
+def test_real_ctrl_c_in_validate_says_so_in_one_line(start_up_s):
+    process = subprocess.Popen([str(SHAKERMILL), "validate", "--no-three-d"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True)
+    time.sleep(start_up_s + 2.0)
+    assert process.poll() is None, "validate ended before it could be interrupted"
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=30)
+    assert process.returncode == 130 and stdout == ""
+    said, interrupted = stderr.strip().splitlines()  # what it is about to do, then the Ctrl-C
+    assert said.startswith("validate: quick")
+    assert interrupted.startswith("error: interrupted; nothing was written") and "Traceback" not in stderr
 
 
 TINY_STEPS = [*(f"--set={key}={value}" for key, value in TIGHTEST_TOLERANCES.items()), "--set", "record_windows="]
@@ -754,9 +906,15 @@ def test_a_run_without_figures_writes_its_files_without_the_heavy_libraries(tmp_
 
 def test_a_run_of_a_calibrated_preset_reports_intervals_and_where_its_heat_goes(tmp_path):
     out = tmp_path / "calibrated"
-    result = invoke("run", "--preset", "spex8000m-calibrated", *SHORT, "--set", "solver=averaged", "--out", str(out), "--no-plots")
+    # A minute: longer than the least mechanics that averaging needs (18 s), so the run is averaged.
+    averaged = ("--set", "solver=averaged", "--set", "duration=60")
+    result = invoke("run", "--preset", "spex8000m-calibrated", *SHORT, *averaged, "--out", str(out), "--no-plots")
     assert result.exit_code == 0, result.stderr
     summary = load_run(out).summary
+    assert summary["solver"] == "averaged"
+    # Its held-out test is stored with the preset, and every run of it says what it found.
+    assert summary["validation_caveat"] == PRESETS["spex8000m-calibrated"].caveat
+    assert f"Caveat (spex8000m-calibrated): {PRESETS['spex8000m-calibrated'].caveat}" in " ".join(result.stdout.split())
     for key in ("ball_C", "vial_C", "ball_steady_C", "vial_steady_C"):
         assert summary[f"{key}_low"] < summary[key] < summary[f"{key}_high"], key
     assert "covariance" in summary["interval_note"] and "averaging error" in summary["interval_note"]

@@ -30,7 +30,7 @@ def quick_runs_fixture(monkeypatch):
 
 @pytest.mark.slow
 def test_validate_prints_the_five_ball_prediction_the_engines_and_the_sensitivity(quick_runs):
-    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-study"])
+    outcome = runner.invoke(cli.app, ["validate", "--full", "--solver", "averaged", "--no-study"])
     assert outcome.exit_code == 0, outcome.output
     text = outcome.stdout
     assert "Held out: five balls" in text and "nothing was refitted" in text
@@ -47,7 +47,7 @@ def test_validate_prints_the_five_ball_prediction_the_engines_and_the_sensitivit
 @pytest.mark.slow
 def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_runs, tmp_path):
     page = tmp_path / "validation.html"
-    outcome = runner.invoke(cli.app, ["validate", "--solver", "averaged", "--no-study", "--json", "--report", str(page)])
+    outcome = runner.invoke(cli.app, ["validate", "--full", "--solver", "averaged", "--no-study", "--json", "--report", str(page)])
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
     html = page.read_text(encoding="utf-8")
@@ -79,6 +79,25 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
             assert row["relative_error"] == pytest.approx(row["predicted_K"] / row["measured_K"] - 1.0)
             low, high = row["interval_90_K"]
             assert row["inside_interval"] == (low <= row["measured_K"] <= high)
+
+
+@pytest.mark.slow
+def test_validate_is_quick_by_default_and_says_each_run_when_piped(quick_runs):
+    outcome = runner.invoke(cli.app, ["validate", "--no-study", "--json"])
+    assert outcome.exit_code == 0, outcome.output
+    payload = json.loads(outcome.stdout)
+    assert payload["solver"] == "averaged"
+    # The experiments of five balls and of none: no lone ball, whose mechanics take minutes, and no held-out studies.
+    quick = {experiment.name for experiment in load_experiments() if experiment.conditions.get("n_balls", 1) != 1}
+    assert set(payload["validation_matrix"]["experiments"]) == quick == {"takacs-mchenry-five-balls", "empty-mill"}
+    assert "five_balls" not in payload and "structure_study" not in payload
+    held_out_rows = [row for row in payload["validation_matrix"]["rows"] if row["role"] == "held out"]
+    assert {row["experiment"] for row in held_out_rows} == {"takacs-mchenry-five-balls"}
+    # Not a terminal: a plain line for each run, so a log shows the study moving.
+    runs = len(quick) * len(THERMAL_MODEL_PRESETS)
+    lines = [line for line in outcome.stderr.splitlines() if line.startswith("3-D validation: ")]
+    assert [line.split(",")[0] for line in lines] == [f"3-D validation: {done}/{runs} runs" for done in range(1, runs + 1)]
+    assert outcome.stderr.startswith("validate: quick, ~2 min; --full for everything")
 
 
 def test_a_report_that_exists_is_refused_before_the_study_runs(tmp_path, monkeypatch):

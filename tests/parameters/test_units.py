@@ -7,7 +7,9 @@ import time
 
 import pytest
 
-from shakermill.parameters.units import UnitError, to_si
+from shakermill.parameters.guards import USER_TEMPERATURE_KEYS
+from shakermill.parameters.keys import FIELD_NAMES, field_unit
+from shakermill.parameters.units import TEMPERATURE_DIFFERENCE_KEYS, UnitError, from_si, to_si, unit_written
 
 
 @pytest.mark.parametrize(
@@ -57,10 +59,13 @@ def test_dimensionless_quantities() -> None:
 @pytest.mark.parametrize(
     "value, unit, fragment",
     [
-        ("3 kg", "m", "expected m"),
-        ("3 kg", "", "dimensionless"),
-        ("1 m", "rad/s", "expected rad/s"),
-        ("abc xyz", "m", "cannot parse"),
+        ("3 kg", "m", "'3 kg' has the wrong dimension; expected a length such as m or mm"),
+        ("3 kg", "", "wrong dimension; expected a dimensionless number"),
+        ("1 m", "rad/s", "'1 m' has the wrong dimension; expected a frequency such as rad/s, Hz or rpm"),
+        ("25 C", "rad/s", "wrong dimension"),  # °C only where a temperature is expected: here it is coulombs
+        ("3 N", "J/(kg*K)", "wrong dimension; expected a quantity in J/(kg*K)"),
+        ("abc xyz", "m", "cannot parse 'abc xyz': unknown unit 'abc'; expected a length"),
+        ("1060 rmp", "rad/s", "cannot parse '1060 rmp': unknown unit 'rmp'; expected a frequency such as rad/s, Hz or rpm"),
         (True, "m", "expected a number"),
         (None, "m", "expected a number"),
         ([1.0], "m", "expected a number"),
@@ -119,3 +124,49 @@ def test_a_value_longer_than_any_number_is_refused_before_it_is_parsed() -> None
 def test_non_finite_values_are_refused(value: object) -> None:
     with pytest.raises(UnitError, match="^k: .* is not a finite number$"):
         to_si(value, "m", key="k")
+
+
+@pytest.mark.parametrize("spelling", ["C", "c", "degC", "deg C", "°C", "° C", "ºC", "℃", "celsius", "Celsius", "degree_Celsius", "degrees celsius"])
+def test_a_temperature_in_degrees_celsius_is_read_in_any_spelling(spelling: str) -> None:
+    assert to_si(f"25 {spelling}", "K", key="ambient_temperature") == pytest.approx(298.15, rel=1e-15)
+    assert to_si(f"25{spelling}", "K", key="initial_temperature") == pytest.approx(298.15, rel=1e-15)
+
+
+@pytest.mark.parametrize("spelling", ["F", "degF", "°F", "℉", "fahrenheit"])
+def test_a_temperature_in_degrees_fahrenheit_is_read(spelling: str) -> None:
+    assert to_si(f"77 {spelling}", "K", key="ambient_temperature") == pytest.approx(298.15, rel=1e-12)
+    assert to_si(f"-40 {spelling}", "K", key="ambient_temperature") == pytest.approx(233.15, rel=1e-12)  # -40 °F = -40 °C
+
+
+def test_a_temperature_difference_in_degrees_takes_no_offset() -> None:
+    assert to_si("1e-3 degC", "K", key="atol_temperature") == pytest.approx(1e-3, rel=1e-15)
+    assert to_si("1 °C", "K", key="sutherland") == 1.0
+    assert to_si("9 F", "K", key="sutherland") == pytest.approx(5.0, rel=1e-15)
+
+
+def test_every_key_in_kelvin_is_a_temperature_or_a_difference_of_temperatures() -> None:
+    # A new key in K must be placed: '25 C' is 298.15 K for a temperature, 25 K for a difference.
+    in_kelvin = {key for key in FIELD_NAMES if field_unit(key) == "K"}
+    temperatures = {*USER_TEMPERATURE_KEYS, "air_reference_temperature"}
+    assert in_kelvin == temperatures | TEMPERATURE_DIFFERENCE_KEYS
+    assert not temperatures & TEMPERATURE_DIFFERENCE_KEYS
+
+
+@pytest.mark.parametrize("value", ["1060 rpm", "1060 RPM", "1060 Rpm", "1060rpm", "17.666666666666668 Hz", "17.666666666666668 hz", "17.666666666666668 HZ"])
+def test_rpm_and_hertz_are_read_in_any_case(value: str) -> None:
+    assert to_si(value, "rad/s", key="omega") == pytest.approx(1060 * 2 * math.pi / 60, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("written", "unit", "si_unit", "key"),
+    [("5 mm", "mm", "m", "amplitude"), ("25 C", "C", "K", "ambient_temperature"), ("77 degF", "degF", "K", "initial_temperature"),
+     ("1060 RPM", "RPM", "rad/s", "omega"), ("15 Hz", "Hz", "rad/s", "omega"), ("60 min", "min", "s", "duration")],
+)
+def test_a_value_read_back_in_the_unit_it_was_written_in_is_the_number_written(written: str, unit: str, si_unit: str, key: str) -> None:
+    assert unit_written(written) == unit
+    assert from_si(to_si(written, si_unit, key=key), unit, si_unit, key=key) == pytest.approx(float(written.split()[0]), rel=1e-12)
+
+
+@pytest.mark.parametrize("value", ["0.005", 0.005, "steel", ""])
+def test_a_bare_number_or_a_name_has_no_unit_written(value: object) -> None:
+    assert unit_written(value) == ""

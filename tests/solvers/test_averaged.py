@@ -7,7 +7,7 @@ import pytest
 
 import shakermill as sm
 from shakermill.analysis.batch_means import mser_truncation
-from shakermill.solvers.averaged import AVERAGING_FAILED
+from shakermill.solvers.averaged import AVERAGING_FAILED, full_resolution_instead, least_mechanics
 
 NUDGE_SPEED = 1.0  # m/s: with amplitudes below the free gap a ball at rest is never hit
 
@@ -79,6 +79,36 @@ def test_statistics_that_do_not_converge_are_refused() -> None:
     assert result.solver == "full"
     assert "did not converge" in result.message
     assert result.summary["averaging_converged"] is False
+
+
+@pytest.mark.slow
+def test_a_run_no_longer_than_the_least_mechanics_runs_at_full_resolution_from_the_start() -> None:
+    # 10 s against 2 x 10 batches of 16 periods (18.1 s at 111 rad/s): averaging could only cost more.
+    params = sm.default_parameters(duration=10.0, solver="averaged", record_windows=())
+    assert least_mechanics(params) == pytest.approx(2 * 10 * 16 * 2 * np.pi / 111.0)
+    reports: list[tuple[float, float]] = []
+    result = sm.simulate(params, progress=lambda done, total: reports.append((done, total)))
+    assert result.solver == "full" and result.success and result.averages is None
+    assert result.message.startswith(full_resolution_instead(params))
+    assert {total for _, total in reports} == {params.duration}  # no mechanics phase
+    full = sm.simulate(params.replace(solver="full"))
+    assert result.summary["ball_C"] == full.summary["ball_C"]
+    assert result.summary["impacts"] == full.summary["impacts"]
+    assert full_resolution_instead(params.replace(duration=20.0)) is None
+    assert full_resolution_instead(params.replace(solver="full")) is None
+
+
+@pytest.mark.slow
+def test_the_mechanics_never_outlast_the_run() -> None:
+    params = sm.default_parameters(
+        duration=25.0, solver="averaged", averaging_rel_error=1e-15, averaging_max_time=120.0, record_windows=()
+    )
+    reports: list[tuple[float, float]] = []
+    result = sm.simulate(params, progress=lambda done, total: reports.append((done, total)))
+    assert result.solver == "full" and result.success
+    # Stopped at the run's 25 s, not at averaging_max_time's 120 s: longer mechanics would cost more than the run.
+    assert "within duration = 25 s" in result.message
+    assert not any(total == params.averaging_max_time for _, total in reports)
 
 
 def test_mser_cuts_the_transient() -> None:

@@ -51,13 +51,18 @@ def test_both_solvers_give_each_ball_its_own_temperature_and_a_steady_state(pair
 
 @pytest.mark.slow
 def test_the_averaged_solver_falls_back_when_the_means_do_not_converge():
+    # Batches of one period make the least mechanics (8 periods, 0.45 s) shorter than the run, so averaging is tried.
     params = sm.default_parameters(
-        **BALLS, duration=3.0, solver="averaged", dem_averaging_rel_error=1e-6, averaging_max_time=2.0
+        **BALLS, duration=3.0, solver="averaged", dem_averaging_rel_error=1e-6, averaging_max_time=2.0,
+        averaging_batch_periods=1, averaging_min_batches=4,
     )
     result = sm.simulate(params)
     assert result.success
     assert result.solver == "full" and result.t_end == 3.0
-    assert result.message.startswith("Averaging is not valid (the averages did not converge")
-    assert "(dem_averaging_rel_error)" in result.message
+    fell_back = "Averaging is not valid (the averages did not converge"
+    assert result.message.startswith(fell_back)
+    assert "(dem_averaging_rel_error)" in result.message and "averaging_max_time = 2 s" in result.message
+    # A fall-back is a warning, said once.
+    assert [line for line in result.warnings if line.startswith(fell_back)] == [result.warnings[0]]
     failed = sm.simulate(params.replace(averaging_fallback="fail"))
     assert not failed.success and "averaging_fallback" in failed.message

@@ -305,7 +305,8 @@ def test_plot_command_refuses_a_folder_that_is_not_a_run(tmp_path, existing):
     outcome = runner.invoke(cli.app, ["plot", str(folder)])
     assert outcome.exit_code == 2
     lines = outcome.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: ") and "not a shakermill run folder" in lines[0]
+    expected = "not a shakermill run folder (no summary.json)" if existing else "no such folder"
+    assert len(lines) == 1 and lines[0].startswith("error: ") and expected in lines[0]
     assert not (folder / "figures").exists()
 
 

@@ -20,6 +20,7 @@ from shakermill import cli
 from shakermill.analysis.regime import classify_impacts, settled_run_impacts
 from shakermill.io.runs import RunData, load_run, write_run
 from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.engine_keys import reads
 from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.parameters.presets import PRESETS
 from shakermill.studies.validation import TABLE5
@@ -79,9 +80,12 @@ def rows_of_table_after(document: str, heading: str) -> list[str]:
     return re.findall(r"<tr[^>]*>.*?</tr>", table, flags=re.DOTALL)
 
 
-def test_report_lists_every_configuration_key_with_its_source(report_html):
-    for key in FIELD_NAMES:
-        assert f"<td>{key}</td>" in report_html, key
+def test_report_lists_every_configuration_key_its_engine_reads_with_its_source(report_html):
+    rows = rows_of_table_after(report_html, "Configuration")
+    listed = [re.search(r"<td>(\w+)</td>", row).group(1) for row in rows[1:]]
+    assert listed == [key for key in FIELD_NAMES if reads("1d", key)]
+    assert "friction" not in listed and "n_balls" not in listed and "omega" in listed  # the 'dem' engine's keys are left out
+    assert f"The {len(FIELD_NAMES) - len(listed)} keys the engine of this run does not read are left out." in report_html
     assert html.escape(PRESETS[DEFAULT_PRESET].values["omega"].source) in report_html
     # duration and record_windows were changed for this short run: marked as differing from the preset.
     marked = [row for row in rows_of_table_after(report_html, "Configuration") if 'class="differs"' in row]
@@ -230,7 +234,8 @@ def test_report_command_refuses_a_folder_that_is_not_a_run(tmp_path, make_folder
     result = runner.invoke(cli.app, ["report", str(folder)])
     assert result.exit_code == 2
     lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: ") and "not a shakermill run folder" in lines[0]
+    expected = "no such folder" if make_folder == "missing" else "not a shakermill run folder (no summary.json)"
+    assert len(lines) == 1 and lines[0].startswith("error: ") and expected in lines[0]
     assert not (folder / REPORT_FILE).exists()
 
 
@@ -301,8 +306,11 @@ def test_report_renders_in_headless_chromium(run_folder, tmp_path):
 
 def test_report_shows_the_runs_warnings_and_its_steady_state(run_folder, report_html):
     summary = load_run(run_folder).summary
-    # 30 s is far shorter than three slowest time constants: the run says so, and so does its report.
-    assert any("slowest time constants" in line for line in summary["warnings"])
+    # 30 s is far shorter than three slowest time constants: the run says so in its answer, not as a warning.
+    assert any("slowest time constants" in line for line in summary["notes"])
+    assert not any("slowest time constants" in line for line in summary["warnings"])
+    answer = re.search(r'<p class="statement answer">(.*?)</p>', report_html).group(1)
+    assert all(html.escape(note) in answer for note in summary["notes"])
     for line in summary["warnings"]:
         assert html.escape("Warning: " + line) in report_html
     results = "".join(rows_of_table_after(report_html, "Results"))

@@ -133,21 +133,15 @@ def settled_rates(times: np.ndarray, cumulative: np.ndarray) -> np.ndarray:
     return ((columns[-1] - halfway) / (end - middle)).reshape(np.shape(cumulative)[1:])
 
 
-def run_length_warning(duration: float, steady: SteadyState) -> str | None:
-    """A line for runs too short for their exponential fit to mean the steady state, else None."""
+def run_length_note(duration: float, steady: SteadyState) -> str | None:
+    """A sentence for runs too short for their end (and the balls' fitted exponential) to be the steady state, else
+    None. Advice, not a warning: the steady state is reported beside it."""
     slowest = steady.slowest_time_constant
     if not math.isfinite(slowest) or duration >= SETTLED_TIME_CONSTANTS * slowest:
         return None
+    # An empty mill fits no exponential.
+    what = "its end and the exponential fitted over it (theta_inf_C) are" if steady.balls else "its end is"
     return (
-        f"the run ({duration / 60:.3g} min) is shorter than {SETTLED_TIME_CONSTANTS:g} slowest time constants "
-        f"({SETTLED_TIME_CONSTANTS:g} x {slowest / 60:.3g} min): {settles(steady)}"
+        f"The run ({duration / 60:.3g} min) is shorter than {SETTLED_TIME_CONSTANTS:g} slowest time constants "
+        f"({SETTLED_TIME_CONSTANTS:g} x {slowest / 60:.3g} min), so {what} not the steady state."
     )
-
-
-def settles(steady: SteadyState) -> str:
-    """What the end of a short run is not, and where it settles: the balls', or the vial's in an empty mill (which
-    fits no exponential)."""
-    if steady.balls:
-        return (f"the exponential fitted over it (theta_inf_C) is not the steady state; the ball settles at "
-                f"{steady.ball - 273.15:.1f} °C (ball_steady_C)")
-    return f"its end is not the steady state; the vial settles at {steady.vial - 273.15:.1f} °C (vial_steady_C)"

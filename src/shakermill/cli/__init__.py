@@ -12,34 +12,30 @@ libraries it uses inside its commands, so that ``shakermill --help`` loads none 
 from __future__ import annotations
 
 import gc
-
-from shakermill.cli import fits, listing, plots, run, scans
-from shakermill.cli.common import app
-
-# The commands, in the order `shakermill --help` lists them, with the line it shows for each.
-COMMANDS = (
-    ("run", run.run, "Run one simulation and write its run folder."),
-    ("compare-solvers", run.compare_solvers, "Run one configuration with the full and the averaged solver."),
-    ("impact", run.impact, "One impact on its own: restitution, rebound, spin, dissipation."),
-    ("presets", listing.presets, "List the presets, or one preset's values and sources."),
-    ("materials", listing.materials_command, "List the materials library, or one material."),
-    ("keys", listing.keys, "List the parameter keys with units, ranges and defaults."),
-    ("plot", plots.plot, "Draw the figures of a run folder or a sweep folder."),
-    ("report", plots.report, "Write the HTML report of a run folder."),
-    ("sweep", scans.sweep, "Run one simulation per point of a grid or a list."),
-    ("bifurcation", scans.bifurcation, "Scan one key: regimes, impact phases, attractors."),
-    ("validate", fits.validate, "This model against the experiment and the paper."),
-    ("calibrate", fits.calibrate, "Fit free keys to a measured curve or targets."),
-)
-for name, command, short_help in COMMANDS:
-    app.command(name, short_help=short_help)(command)
+import sys
 
 
 def main() -> None:
-    """Entry point of the ``shakermill`` console script."""
+    """Entry point of the ``shakermill`` console script.
+
+    The commands are imported here, not when this package is: so Ctrl-C during start-up is one line too."""
     try:
+        from shakermill.cli.commands import app
+
         app()
+    except KeyboardInterrupt:
+        print("error: interrupted by the user (Ctrl-C)", file=sys.stderr)
+        sys.exit(130)
     finally:
         # Everything is written by now. Tearing down NumPy, SciPy, Numba and pandas at exit collects
         # every object they made, about 0.4 s of a short run; frozen objects are left to the OS instead.
         gc.freeze()
+
+
+def __getattr__(name: str) -> object:
+    # ``shakermill.cli.app``, the application with its commands, for those who drive it in-process (tests, notebooks).
+    if name == "app":
+        from shakermill.cli.commands import app
+
+        return app
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -13,6 +13,7 @@ import time
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
+from types import SimpleNamespace
 from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, NoReturn, Sequence
 
 import typer
@@ -74,6 +75,13 @@ class OneLineUsageErrors(TyperGroup):
             echo_error(exc.format_message())
             sys.exit(EXIT_USAGE)
         sys.exit(outcome if isinstance(outcome, int) else 0)
+
+    def invoke(self, ctx: Any) -> Any:
+        # typer turns a Ctrl-C that no command caught into exit code 130 without a word.
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            fail("interrupted by the user (Ctrl-C)", EXIT_INTERRUPTED)
 
 
 app = typer.Typer(
@@ -197,6 +205,12 @@ def echo_warnings(warnings: Sequence[str]) -> None:
         typer.echo(f"warning: {' '.join(warning.splitlines())}", err=True)
 
 
+def echo_notes(notes: Sequence[str]) -> None:
+    """One ``note: ...`` line on stderr each: what a user should know that is not a problem (how a solver was chosen)."""
+    for note in notes:
+        typer.echo(f"note: {' '.join(note.splitlines())}", err=True)
+
+
 @contextmanager
 def warnings_as_lines() -> Iterator[None]:
     """The library's warnings (an unreadable point file) as ``warning: ...`` lines, like a run's own."""
@@ -233,16 +247,17 @@ def simulate_with_progress(params: Parameters) -> Result:
 
 @contextmanager
 def progress_bar(
-    verb: str, counter: str, total: float | None, delay_s: float = 0.0, **fields: Any
+    verb: str, counter: str, total: float | None, delay_s: float = 0.0, lines_when_piped: bool = False, **fields: Any
 ) -> Iterator[Callable[..., None] | None]:
     """``update(completed, **fields)`` of a transient progress bar with an ETA on stderr; None when stderr is not a terminal.
 
     The bar shows from the first update ``delay_s`` seconds after the start, or at once without a delay.
-    Pipes and logs stay clean: a bar redrawn many times a second would fill them.
+    Pipes and logs stay clean: a bar redrawn many times a second would fill them. A study whose steps take minutes
+    (``lines_when_piped``) says each step there in a plain line instead, or a log would show nothing for half an hour.
     """
     console = Console(stderr=True)
     if not console.is_terminal:
-        yield None
+        yield piped_lines(verb, counter) if lines_when_piped else None
         return
     columns = (TextColumn(verb), BarColumn(), TextColumn(counter), TimeRemainingColumn())
     bar = Progress(*columns, console=console, transient=True)
@@ -263,6 +278,23 @@ def progress_bar(
     finally:
         if bar.live.is_started:
             bar.stop()
+
+
+def piped_lines(verb: str, counter: str) -> Callable[..., None]:
+    """``update(completed, total=...)`` printing one plain line on stderr each time ``completed`` changes: the
+    ``counter`` of a progress bar (``{task.completed}``, ``{task.total}``) and the time elapsed."""
+    started = time.monotonic()
+    said: list[float] = []
+
+    def update(completed: float, total: float | None = None, **_: Any) -> None:
+        if said and said[-1] == completed:
+            return
+        said.append(completed)
+        task = SimpleNamespace(completed=completed, total=total)
+        elapsed = time.monotonic() - started
+        typer.echo(f"{verb}: {counter.format(task=task)}, {elapsed // 60:.0f} min {elapsed % 60:02.0f} s", err=True)
+
+    return update
 
 
 def number(value: Any, spec: str) -> str:

@@ -42,9 +42,17 @@ if TYPE_CHECKING:
 
 
 def validate(
+    full: Annotated[
+        bool,
+        typer.Option("--full", help="Everything (~17 min on two cores): Table 5 at full resolution, the matrix's "
+                     "experiments of one ball, the structure study, the engines' one-ball comparison and the "
+                     "sensitivity to the assumed SPEX kinematics. Without it, a quick validation (~2 min)."),
+    ] = False,
     solver: Annotated[
-        str, typer.Option("--solver", help="'full' (default, as the paper) or 'averaged' (seconds instead of minutes).")
-    ] = "full",
+        str | None,
+        typer.Option("--solver", show_default="averaged; full with --full",
+                     help="Solver of the Table 5 runs: 'full' (as the paper) or 'averaged' (seconds instead of a minute)."),
+    ] = None,
     study: Annotated[
         bool, typer.Option(help="Also fit several free sets to the experiment's curve and say which follow it (~15 s).")
     ] = True,
@@ -66,24 +74,34 @@ def validate(
 ) -> None:
     """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
     calibrated parameters, which free sets of a calibration can follow the curve, and (3-D) the validation matrix of
-    the thermal models, the structures that follow the one-ball curve and the five-ball experiment no fit has seen."""
+    the thermal models against the five-ball experiment no fit has seen and the empty mill; with --full also the
+    one-ball experiments, the structures that follow the one-ball curve and the held-out studies."""
     from shakermill.io.runs import to_jsonable
     from shakermill.studies.validation_report import SOLVERS, validation_report
 
+    solver = solver if solver is not None else "full" if full else "averaged"
     if solver not in SOLVERS:
-        fail(f"solver: {solver!r} is not allowed; allowed: one of {', '.join(map(repr, SOLVERS))}")
+        fail(f"--solver: {solver!r} is not allowed; allowed: one of {', '.join(map(repr, SOLVERS))}")
     if html is not None:
         if not three_d:
             fail("report: the page holds the three-dimensional studies; allowed --report with --three-d (the default)")
         check_report_target(html, overwrite)
-    with progress_bar("3-D validation", "{task.completed}/{task.total} runs", None) as update:
+    typer.echo(f"validate: {'everything (--full), ~17 min' if full else 'quick, ~2 min; --full for everything (~17 min)'}; "
+               f"Table 5 with the {solver} solver" + (", then the 3-D validation matrix" if three_d else ""), err=True)
+    with (nothing_written_when_interrupted("validate prints and writes once every run has ended"),
+          progress_bar("3-D validation", "{task.completed}/{task.total} runs", None, lines_when_piped=True) as update):
         show = None if update is None else lambda done, total: update(done, total=total)
-        report = validation_report(solver, study, three_d, progress=show)
+        report = validation_report(solver, study, three_d, progress=show, everything=full)
     # Printed before the page is written: a page that cannot be written loses nothing the study found.
     if json_output:
         typer.echo(json.dumps(to_jsonable(report.as_dict()), sort_keys=True, allow_nan=False))
     else:
         print_report(report)
+        if three_d and not full:
+            stdout_console().print(Text(
+                "Quick validation: the matrix holds the experiments of five balls and of none. `shakermill validate "
+                "--full` adds those of one ball, the structure study, the engines' one-ball comparison and the "
+                "sensitivity to the assumed SPEX kinematics (~17 min on two cores)."))
     if html is not None:
         from shakermill.views.validation_page import save_validation_page
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import fnmatch
 import json
 from typing import Annotated, Any, Sequence
 
@@ -89,13 +90,47 @@ def material_table(found: Any) -> Table:
     return table
 
 
-def keys() -> None:
+def keys(
+    pattern: Annotated[
+        str | None,
+        typer.Argument(
+            metavar="PATTERN",
+            help="Only the keys whose name or description contains this, case ignored, or matches it as a glob ('ball_*').",
+        ),
+    ] = None,
+    engine: Annotated[
+        str | None, typer.Option("--engine", metavar="NAME", help="Only the keys this engine reads: '1d' or 'dem'.")
+    ] = None,
+) -> None:
     """List the canonical parameter keys with unit, allowed values, default and description."""
+    from shakermill.parameters.engine_keys import ENGINE_KEYS, reads
     from shakermill.parameters.keys import FIELD_NAMES, allowed_range, field_description
     from shakermill.parameters.presets import preset_values
+
+    if engine is not None and engine not in ENGINE_KEYS:
+        fail(f"--engine: {engine!r} is no engine; allowed {', '.join(map(repr, ENGINE_KEYS))}")
+    chosen = [
+        key for key in FIELD_NAMES
+        if (engine is None or reads(engine, key)) and (pattern is None or _matches(pattern, key, field_description(key)))
+    ]
+    narrowed = [f"matching {pattern!r}"] if pattern is not None else []
+    if engine is not None:
+        narrowed.append(f"read by {ENGINE_KEYS[engine].title}")
+    which = " ".join(narrowed)
+    if not chosen:
+        typer.echo(f"no parameter key {which}; `shakermill keys` lists all {len(FIELD_NAMES)}")
+        return
     defaults = preset_values(DEFAULT_PRESET)
-    table = Table("key", "allowed (SI)", f"default ({DEFAULT_PRESET})", "description", title="parameter keys")
-    for key in FIELD_NAMES:
+    title = f"parameter keys {which}: {len(chosen)} of {len(FIELD_NAMES)}" if which else "parameter keys"
+    table = Table("key", "allowed (SI)", f"default ({DEFAULT_PRESET})", "description", title=title)
+    for key in chosen:
         default = format_value(key, defaults[key]) if key in defaults else ""
         add_plain_row(table, key, allowed_range(key), default, field_description(key))
     stdout_console().print(table)
+
+
+def _matches(pattern: str, *texts: str) -> bool:
+    """Whether any of ``texts`` contains ``pattern`` or, with a wildcard in it, matches it as a glob; case ignored."""
+    wanted = pattern.lower()
+    globbed = any(wildcard in wanted for wildcard in "*?[")
+    return any(fnmatch.fnmatchcase(text.lower(), wanted) if globbed else wanted in text.lower() for text in texts)

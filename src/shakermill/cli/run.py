@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, Mapping, NoReturn, Sequence
 
 import typer
 from rich.table import Table
@@ -21,8 +22,8 @@ from shakermill.cli.common import (
     PresetOption,
     SettingsOption,
     add_plain_row,
+    echo_notes,
     echo_warnings,
-    fail,
     nothing_written_when_interrupted,
     number,
     simulate_with_progress,
@@ -31,6 +32,7 @@ from shakermill.cli.common import (
     user_errors,
     writing,
 )
+from shakermill.engines.budget import interrupts_held
 from shakermill.parameters.defaults import HIT_SPEED
 
 if TYPE_CHECKING:
@@ -54,7 +56,7 @@ def run(
     overwrite: OverwriteOption = False,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
-    from shakermill.io.runs import check_target, to_jsonable
+    from shakermill.io.runs import check_target, import_writers, to_jsonable
     from shakermill.parameters.config import load_config
     from shakermill.parameters.keys import unit_slip_warnings
     from shakermill.solvers.result import INTERRUPTED
@@ -64,65 +66,102 @@ def run(
         run_config = load_config(config, preset=preset, overrides=overrides)
         target = out if out is not None else timestamped_folder("run")
         check_target(target, overwrite=overwrite)
-    # Unit slips are said before a possibly long run, the rest once it is known.
+    import_writers()
+    # Unit slips and the solver's choice are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)
     echo_warnings(said_first)
+    echo_notes(solver_choice(run_config.params))
     # A run returns what it computed when interrupted; Ctrl-C in the attractor probe or the thermal network leaves none.
     with nothing_written_when_interrupted("the run had no results to keep yet"):
         result = simulate_with_progress(run_config.params)
-        with_intervals(result, run_config.preset)
-    if result.status != INTERRUPTED:
-        # An interrupted run is short by choice: its warnings (run length, steady state) stay in summary.json.
-        echo_warnings([line for line in result.warnings if line not in said_first])
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
-    target = _write(result, target, run_config.preset, provenance, with_figures=not no_plots, overwrite=overwrite)
+    # What was computed is written whole; a Ctrl-C meanwhile takes effect after, and the figures are left to `plot`.
+    with interrupts_held(deliver=False) as interrupted:
+        if result.status != INTERRUPTED:  # intervals of a stretch cut short mean nothing, and take a second to import
+            with_preset_findings(result, run_config.preset)
+        target = _write(result, target, run_config.preset, provenance, overwrite=overwrite)
+    if result.status == INTERRUPTED or interrupted:
+        _exit_interrupted(result, target)
+    # An interrupted run is short by choice: its warnings (steady state, fit) stay in summary.json, unsaid.
+    echo_warnings([line for line in result.summary["warnings"] if line not in said_first])
+    if not no_plots and not _draw_figures(result, target):
+        _exit_interrupted(result, target)
     if json_output:
         summary = to_jsonable({**result.summary, "output_dir": str(target)})
         typer.echo(json.dumps(summary, sort_keys=True, allow_nan=False))
     else:
-        stdout_console().print(summary_table(result, target))
+        console = stdout_console()
+        console.print(summary_table(result, target))
+        console.print(Text(answer_text(result.summary, run_config.preset)))
     _exit_for_status(result, target)
 
 
-def with_intervals(result: Result, preset: str | None) -> None:
+def solver_choice(params: Parameters) -> list[str]:
+    """The line that says an averaged run is run at full resolution from the start, and why (none otherwise)."""
+    from shakermill.solvers.averaged import full_resolution_instead
+
+    reason = full_resolution_instead(params)
+    return [] if reason is None else [reason + "."]
+
+
+def with_preset_findings(result: Result, preset: str | None) -> None:
     """Add to the summary of a run of a calibrated preset the 90 % intervals of its headline temperatures
-    (``studies.uncertainty``), which carry the calibration's uncertainty and the averaging error."""
+    (``studies.uncertainty``), which carry the calibration's uncertainty and the averaging error, and to any preset's
+    run what its validation found where it failed or is missing (``validation_caveat``)."""
     from shakermill.parameters.presets import PRESETS
     from shakermill.studies.uncertainty import intervals, uncertainty_of
 
-    uncertainty = uncertainty_of(PRESETS[preset]) if preset in PRESETS else None
+    known = PRESETS.get(preset) if preset is not None else None
+    uncertainty = uncertainty_of(known) if known is not None else None
     found = intervals(result, uncertainty) if uncertainty is not None else None
     if found is not None:
         result.summary.update(found.as_summary())
+    if known is not None and known.caveat:
+        result.summary["validation_caveat"] = known.caveat
 
 
-def _write(
-    result: Result, target: Path, preset: str, provenance: dict[str, Any], *, with_figures: bool, overwrite: bool
-) -> Path:
-    """Write the run folder (with figures unless told not to); return its absolute path."""
+def answer_text(summary: Mapping[str, Any], preset: str | None) -> str:
+    """The run's answer under its table: the report's sentences (with the run's notes), then the preset's caveat."""
+    from shakermill.views.notebook import answer_sentences
+
+    text = " ".join(answer_sentences(summary))
+    caveat = summary.get("validation_caveat")
+    return text + (f"\nCaveat ({preset}): {caveat}" if caveat else "")
+
+
+def _write(result: Result, target: Path, preset: str, provenance: dict[str, Any], *, overwrite: bool) -> Path:
+    """Write the run folder's data and status; return its absolute path."""
     from shakermill.io.runs import write_run
 
-    def add_figures(folder: Path) -> None:
-        from shakermill.views.figures.run import plot_run
+    with user_errors(), writing(target, "the run folder"):
+        return write_run(result, target, preset=preset, extra_provenance=provenance, overwrite=overwrite)
 
-        plot_run(result, folder / FIGURES_FOLDER)
 
+def _draw_figures(result: Result, target: Path) -> bool:
+    """Draw the figures into the written run folder; False, with none left half drawn, when Ctrl-C stops them."""
+    from shakermill.views.figures.run import plot_run
+
+    folder = target / FIGURES_FOLDER
     try:
-        with user_errors(), writing(target, "the run folder"):
-            return write_run(
-                result, target, preset=preset, extra_provenance=provenance, add_files=add_figures if with_figures else None,
-                overwrite=overwrite,
-            )
+        with writing(folder, "the figures"):
+            plot_run(result, folder)
     except KeyboardInterrupt:
-        fail(f"interrupted while writing {target}; no partial folder was left there", EXIT_INTERRUPTED)
+        shutil.rmtree(folder, ignore_errors=True)
+        return False
+    return True
+
+
+def _exit_interrupted(result: Result, target: Path) -> NoReturn:
+    """One line for Ctrl-C, once the data and status are written, and exit code 130."""
+    from shakermill.solvers.result import INTERRUPTED
+
+    what = result.message if result.status == INTERRUPTED else "Interrupted by the user after the run had finished."
+    typer.echo(f"interrupted: {what} Data and status written to {target}; draw its figures with: shakermill plot {target}",
+               err=True)
+    raise typer.Exit(EXIT_INTERRUPTED)
 
 
 def _exit_for_status(result: Result, target: Path) -> None:
-    from shakermill.solvers.result import INTERRUPTED
-
-    if result.status == INTERRUPTED:
-        typer.echo(f"interrupted: {result.message} Partial results in {target}", err=True)
-        raise typer.Exit(EXIT_INTERRUPTED)
     if not result.success:
         typer.echo(f"error: {result.message} Results so far in {target}", err=True)
         raise typer.Exit(EXIT_FAILED_RUN)

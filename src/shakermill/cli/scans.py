@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, Mapping, Sequence
 
 import typer
 from rich.table import Table
@@ -111,11 +111,14 @@ def sweep(
     except OSError as exc:
         resume = f"; re-run with --out {target} to finish" if is_sweep_folder(target) else ""
         fail(f"{target}: cannot write the sweep ({exc.strerror or exc}){resume}")
-    report_sweep(table, plan.keys, target, json_output)
+    report_sweep(table, plan.keys, target, json_output, dict(plan.units))
 
 
-def report_sweep(table: pd.DataFrame, keys: Sequence[str], target: Path, json_output: bool) -> None:
-    """Print the sweep's table (a preview, or where it is as JSON); exit with EXIT_FAILED_RUN if a point failed."""
+def report_sweep(
+    table: pd.DataFrame, keys: Sequence[str], target: Path, json_output: bool, units: Mapping[str, str]
+) -> None:
+    """Print the sweep's table (a preview, with the swept values in ``units`` where given, or where it is as JSON);
+    exit with EXIT_FAILED_RUN if a point failed."""
     from shakermill.studies.sweep_storage import TABLE_CSV, TABLE_PARQUET, failed_points
 
     failed = failed_points(table)
@@ -130,7 +133,7 @@ def report_sweep(table: pd.DataFrame, keys: Sequence[str], target: Path, json_ou
         }
         typer.echo(json.dumps(payload, sort_keys=True))
     else:
-        stdout_console().print(sweep_preview(table, keys, target))
+        stdout_console().print(sweep_preview(table, keys, target, units))
     if not failed.empty:
         first = failed.iloc[0]
         typer.echo(
@@ -141,20 +144,19 @@ def report_sweep(table: pd.DataFrame, keys: Sequence[str], target: Path, json_ou
         raise typer.Exit(EXIT_FAILED_RUN)
 
 
-def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path) -> Table:
-    """The first rows of a sweep table: swept values, regime and the main results."""
+def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path, units: Mapping[str, str]) -> Table:
+    """The first rows of a sweep table: swept values (in ``units`` where given, else SI), regime and the main results."""
     import pandas as pd
 
-    from shakermill.parameters.keys import field_unit
     from shakermill.studies.sweep_storage import TABLE_CSV, TABLE_PARQUET, failed_points
 
     preview = Table(title=f"shakermill sweep: {len(table)} points, {len(failed_points(table))} failed")
     for key in keys:
-        preview.add_column(f"{key} ({field_unit(key)})" if field_unit(key) else key, justify="right")
+        preview.add_column(key_header(key, units.get(key)), justify="right")
     for _, label, unit in SWEEP_PREVIEW_COLUMNS:
         preview.add_column(f"{label} ({unit})" if unit else label, justify="right")
     for _, row in table.head(SWEEP_PREVIEW_ROWS).iterrows():
-        values = [_cell(row[key], ".4g") for key in keys]
+        values = [_cell(in_unit(row[key], key, units.get(key)), ".4g") for key in keys]
         if pd.notna(row["error"]):
             results = ["failed", *([""] * (len(SWEEP_PREVIEW_COLUMNS) - 1))]
         else:
@@ -163,6 +165,22 @@ def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path) -> Tab
     more = len(table) - SWEEP_PREVIEW_ROWS
     preview.caption = (f"{more} more rows; " if more > 0 else "") + f"table: {target / TABLE_PARQUET} and {TABLE_CSV}"
     return preview
+
+
+def key_header(key: str, unit: str | None) -> str:
+    """'amplitude (mm)': a swept key with the unit its values were written in, else its SI unit."""
+    from shakermill.parameters.keys import field_unit
+
+    shown = unit or field_unit(key)
+    return f"{key} ({shown})" if shown else key
+
+
+def in_unit(value: Any, key: str, unit: str | None) -> Any:
+    """A swept value (SI) in the ``unit`` it was written in: 5 for the 0.005 m of '5 mm'; as stored without one."""
+    from shakermill.parameters.keys import field_unit
+    from shakermill.parameters.units import from_si
+
+    return from_si(value, unit, field_unit(key), key=key) if unit else value
 
 
 def _cell(value: Any, spec: str) -> str:
@@ -191,10 +209,9 @@ def bifurcation(
 ) -> None:
     """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
     from shakermill.io.runs import check_target, write_folder
-    from shakermill.parameters.keys import field_unit
     from shakermill.studies.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
     from shakermill.studies.bifurcation import bifurcation as regime_scan
-    from shakermill.studies.sweep_plan import parse_grid, sweep_parameters
+    from shakermill.studies.sweep_plan import grid_unit, parse_grid, sweep_parameters
     from shakermill.views.figures.common import plot_figures
     from shakermill.views.figures.sweeps import bifurcation_figure, sweep_context
 
@@ -222,13 +239,14 @@ def bifurcation(
     with user_errors(), writing(target, "the results"):
         written = write_folder(target, fill, overwrite=overwrite, kind=BIFURCATION_FOLDER)
     counts = scan.regimes["regime"].value_counts()
-    table = Table("regime", "runs", f"{key} ({field_unit(key)})", title=f"bifurcation scan over {key}: {len(values)} runs")
+    unit = grid_unit(grid)
+    table = Table("regime", "runs", key_header(key, unit), title=f"bifurcation scan over {key}: {len(values)} runs")
     for label, count in counts.items():
-        inside = scan.regimes.loc[scan.regimes["regime"] == label, key]
+        inside = in_unit(scan.regimes.loc[scan.regimes["regime"] == label, key], key, unit)
         add_plain_row(table, str(label), str(count), f"{inside.min():.5g} – {inside.max():.5g}")
     console = stdout_console()
     console.print(table)
-    console.print(coexisting_attractors_table(scan.attractors, key, run_config.params.attractor_starts))
+    console.print(coexisting_attractors_table(scan.attractors, key, run_config.params.attractor_starts, unit))
     console.print(Text(f"{len(list(written.iterdir()))} files written to {target}"))
 
 
@@ -245,22 +263,21 @@ def _require_attractor_starts(engine: str) -> None:
 COEXISTING_PREVIEW_ROWS = 20
 
 
-def coexisting_attractors_table(attractors: pd.DataFrame, key: str, starts: int) -> Table | Text:
-    """The values with more than one attractor: each attractor's regime, basin fraction and heat power."""
-    from shakermill.parameters.keys import field_unit
+def coexisting_attractors_table(attractors: pd.DataFrame, key: str, starts: int, unit: str) -> Table | Text:
+    """The values with more than one attractor: each attractor's regime, basin fraction and heat power; the values of
+    ``key`` in the ``unit`` its grid was written in, else SI."""
     counts = attractors.groupby(key, sort=False)["attractor"].transform("size")
     several = attractors[counts > 1]
     values = several[key].unique()
     if not len(values):
         return Text(f"coexisting attractors: none; all {starts} starts reach one attractor at each of {attractors[key].nunique()} values")
-    unit = field_unit(key)
     table = Table(
-        f"{key} ({unit})" if unit else key, "attractor", "regime", "basin fraction", "heat power (W)", "impact rate (Hz)",
+        key_header(key, unit), "attractor", "regime", "basin fraction", "heat power (W)", "impact rate (Hz)",
         title=f"coexisting attractors ({starts} starts per value): at {len(values)} of {attractors[key].nunique()} values",
     )
     for _, row in several[several[key].isin(values[:COEXISTING_PREVIEW_ROWS])].iterrows():
         add_plain_row(
-            table, f"{row[key]:.5g}", str(row["attractor"]), str(row["regime"]), f"{row['basin_fraction']:.2f}",
+            table, f"{in_unit(row[key], key, unit):.5g}", str(row["attractor"]), str(row["regime"]), f"{row['basin_fraction']:.2f}",
             f"{row['heat_power_W']:.4g}", f"{row['impact_rate_hz']:.4g}",
         )
     more = len(values) - COEXISTING_PREVIEW_ROWS

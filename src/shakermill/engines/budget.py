@@ -79,22 +79,24 @@ class RunBudget:
 
 
 @contextmanager
-def interrupt_after_compiled_code() -> Iterator[None]:
-    """Hold a SIGINT that arrives while compiled code runs and deliver it to the previous handler afterwards.
+def interrupts_held(deliver: bool = True) -> Iterator[list[object]]:
+    """Hold a SIGINT that arrives inside the block; deliver it to the previous handler afterwards (``deliver``), or
+    leave it in the list the block is given, for the caller to act on.
 
-    A KeyboardInterrupt raised inside a Numba call surfaces as ``SystemError: CPUDispatcher(...) returned a
-    result with an exception set``, which no caller can tell from a crash. Only the main thread can set
-    handlers; elsewhere, and where SIGINT is ignored (sweep workers) or default, nothing changes.
+    Two uses. A KeyboardInterrupt raised inside a Numba call surfaces as ``SystemError: CPUDispatcher(...) returned a
+    result with an exception set``, which no caller can tell from a crash. And a finished run's data files must be
+    written whole however Ctrl-C falls. Only the main thread can set handlers; elsewhere, and where SIGINT is ignored
+    (sweep workers) or default, nothing is held.
     """
     previous = signal.getsignal(signal.SIGINT)
-    if threading.current_thread() is not threading.main_thread() or not callable(previous):
-        yield
-        return
     received: list[object] = []
+    if threading.current_thread() is not threading.main_thread() or not callable(previous):
+        yield received
+        return
     signal.signal(signal.SIGINT, lambda signum, frame: received.append(frame))
     try:
-        yield
+        yield received
     finally:
         signal.signal(signal.SIGINT, previous)
-    if received:
+    if received and deliver:
         previous(signal.SIGINT, received[0])

@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from typing import Callable, ClassVar
 
-from shakermill.engines.budget import RunBudget, interrupt_after_compiled_code
+from shakermill.engines.budget import RunBudget, interrupts_held
 from shakermill.engines.status import BUDGET_EXCEEDED
 
 # Not outcomes, what a call returns besides a status: it took the steps it was allowed (PAUSED), or it stopped
@@ -58,7 +58,7 @@ class CompiledRun:
         while (limit := self.limit_reached()) is None:
             before = self.steps_taken()
             started = time.perf_counter()
-            with interrupt_after_compiled_code():
+            with interrupts_held():
                 status = self.compiled_call(t_stop, min(self._pace or self.first_steps_per_call, self.budget.steps_left))
             steps = self.steps_taken() - before
             self.budget.steps += steps

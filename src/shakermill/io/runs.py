@@ -17,6 +17,7 @@ at the target path that looks like a finished run (:func:`write_folder`).
 
 from __future__ import annotations
 
+import difflib
 import errno
 import io
 import json
@@ -253,6 +254,13 @@ def _mark_averaged_variables(history: StateHistory, description: EngineDescripti
     return history.with_attributes(marks)
 
 
+def import_writers() -> None:
+    """Import the libraries that write a run folder's data files before the run: its files must be written at once
+    when Ctrl-C ends it, and importing them takes ~0.4 s that a run writing its folder spends anyway."""
+    import h5netcdf  # noqa: F401
+    import pyarrow.parquet  # noqa: F401
+
+
 def netcdf_bytes(history: StateHistory, *, title: str, **attributes: Any) -> bytes:
     """``history`` as a NetCDF4 file over the dimension ``time``, with global attributes and each variable's own.
 
@@ -287,8 +295,11 @@ def impacts_parquet(columns: Mapping[str, np.ndarray], units: Mapping[str, str],
     if coverage is not None:
         metadata[COVERAGE_KEY.encode()] = coverage.encode()
     arrays = [arrow_array(np.asarray(values)) for values in columns.values()]
+    # Dictionary encoding pays for the few names of a string column (what a ball hit), not for floats: on them it
+    # takes five times as long (0.26 s against 0.05 s for the 180 000 impacts of a 1-D hour), all of it after Ctrl-C.
+    named = [column for column, values in columns.items() if np.asarray(values).dtype.kind in "US"]
     sink = pa.BufferOutputStream()
-    pq.write_table(pa.Table.from_arrays(arrays, names=list(columns), metadata=metadata), sink)
+    pq.write_table(pa.Table.from_arrays(arrays, names=list(columns), metadata=metadata), sink, use_dictionary=named)
     return memoryview(sink.getvalue())
 
 
@@ -354,6 +365,10 @@ def load_run(path: Path | str) -> RunData:
     """
     folder = Path(path)
     summary_path = folder / SUMMARY_FILE
+    if not folder.exists():
+        raise StorageError(no_such_folder(folder))
+    if not folder.is_dir():
+        raise StorageError(f"{folder}: a file, not a shakermill run folder")
     if not summary_path.is_file():
         raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
     document = _read_part(summary_path, _summary_document)
@@ -374,6 +389,16 @@ def load_run(path: Path | str) -> RunData:
         ball_fit=_fit_from_dict(document["ball_fit"]),
         counters=document["counters"],
     )
+
+
+def no_such_folder(folder: Path) -> str:
+    """'results/defualt: no such folder', with the folder beside it likely meant: a typo is the usual reason."""
+    try:
+        beside = [entry.name for entry in folder.parent.iterdir() if entry.is_dir()]
+    except OSError:  # no parent folder, or one that cannot be listed
+        beside = []
+    close = difflib.get_close_matches(folder.name, beside, n=1)
+    return f"{folder}: no such folder" + (f"; did you mean {folder.parent / close[0]}?" if close else "")
 
 
 # What summary.json must hold, and of which JSON type, for the tools that read a run folder back.

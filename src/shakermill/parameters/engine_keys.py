@@ -30,6 +30,9 @@ class EngineKeys:
     # Whether the air moves with the vial, so that convection takes the ball's speed relative to it by default
     # (``convection_velocity = 'auto'``, MODEL.md §§4, 12.5).
     air_moves_with_vial: bool
+    # Keys of ``Parameters`` the engine never reads, or only at the one value it takes (n_balls = 1): `shakermill keys
+    # --engine` and a run's report leave them out.
+    unread: frozenset[str] = frozenset()
 
     @property
     def several_balls(self) -> bool:
@@ -46,6 +49,16 @@ ONE_DIMENSIONAL = EngineKeys(
     # Its right-hand side writes the paper's three nodes out for speed (engines/one_d/model.py).
     networks=("paper",),
     air_moves_with_vial=False,
+    unread=frozenset(
+        {
+            "n_balls", "fill", "ball_radii", "ball_densities", "ball_youngs_moduli", "ball_poisson_ratios",
+            "ball_heat_capacities", "ball_conductivities", "ball_materials", "ball_conductivity", "gravity", "friction",
+            "rolling_friction", "kinematics", "lateral_amplitude", "yaw_amplitude", "swing_radius", "motion",
+            "contact_step_fraction", "max_flight_step", "dem_averaging_rel_error", "thermal_model", "outer_diameter",
+            "outer_length", "emissivity", "vial_conductivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss",
+            "drive_heat",
+        }
+    ),
 )
 THREE_DIMENSIONAL = EngineKeys(
     name="dem",
@@ -56,10 +69,19 @@ THREE_DIMENSIONAL = EngineKeys(
     thermal_models=("three_node",),
     networks=("paper", "mill-head"),
     air_moves_with_vial=True,
+    # It steps by velocity Verlet at its own contact step, and its heat is η times what each contact dissipates.
+    unread=frozenset(
+        {"rtol", "atol_position", "atol_momentum", "atol_temperature", "energy_projection", "heat_model", "averaging_rel_error"}
+    ),
 )
 
 BUILT_IN = (ONE_DIMENSIONAL.name, THREE_DIMENSIONAL.name)
 ENGINE_KEYS: dict[str, EngineKeys] = {keys.name: keys for keys in (ONE_DIMENSIONAL, THREE_DIMENSIONAL)}
+
+
+def reads(engine: str, key: str) -> bool:
+    """Whether the engine named ``engine`` reads ``key`` (see :attr:`EngineKeys.unread`)."""
+    return key not in ENGINE_KEYS[engine].unread
 
 
 def declare(keys: EngineKeys) -> None:

@@ -609,7 +609,7 @@ def check_known_keys(keys: list[str] | tuple[str, ...], *, extra_allowed: tuple[
         if key not in known:
             # A key longer than any known one is no typo of one; it is quoted short so the line stays readable.
             close = difflib.get_close_matches(key, known, n=1) if len(key) <= QUOTED_LENGTH else []
-            hint = f"; did you mean {close[0]!r}?" if close else "; `shakermill keys` lists the allowed keys"
+            hint = f"; did you mean {close[0]!r}?" if close else "; `shakermill keys WORD` finds the keys about WORD"
             shown = key if len(key) <= QUOTED_LENGTH else quoted(key)
             raise ParameterError(f"{shown}: unknown parameter{hint}")
 

@@ -46,6 +46,12 @@ class Preset:
         return self.provenance.get("covariance_log")
 
     @property
+    def caveat(self) -> str | None:
+        """What the validation of this preset's temperatures found, where they failed a held-out test or were never
+        tested (``[provenance.validation] caveat`` of its file): every run and report of the preset says it."""
+        return self.provenance.get("validation", {}).get("caveat")
+
+    @property
     def posterior(self) -> list[list[float]] | None:
         """The calibration's posterior samples of the logarithms of ``fitted``, if it recorded them."""
         return self.provenance.get("posterior_log")

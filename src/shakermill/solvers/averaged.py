@@ -10,7 +10,9 @@ the contacts put into its nodes and each ball's Whitaker velocity term w = 0.4 R
    (LSODA). Sutherland's factor is evaluated at the current ball temperatures, so the temperature dependence of
    the convection stays exact; only the velocity dependence is averaged, which is exact because Nu is linear in w.
 
-Averaging is refused when the means do not converge within ``averaging_max_time`` or when a heated node's
+A run no longer than the least mechanics averaging needs runs at full resolution from the start
+(:func:`full_resolution_instead`): averaging would cost more than the run. Averaging is refused when the means do
+not converge within ``averaging_max_time`` (or the duration, when shorter) or when a heated node's
 thermal time constant is not well separated from the time between the impacts that heat it; the run then falls
 back to full resolution (or fails, with ``averaging_fallback = "fail"``) and says why.
 """
@@ -89,6 +91,12 @@ def simulate_averaged(params: Parameters, engine_class: type[Engine], progress: 
     than 1 %. ``progress(done, total)`` is told the simulated seconds of each phase in turn.
     """
     budget = budget if budget is not None else RunBudget.of(params)
+    reason = full_resolution_instead(params)
+    if reason is not None and mechanics is None:
+        result = simulate_full(params, engine_class, progress, budget)
+        result.message = f"{reason}. {result.message}"
+        result.summary = summarize(result)
+        return result
     started = time.perf_counter()
     if mechanics is None:
         mechanics = settle_mechanics(params, engine_class, progress, budget)
@@ -99,6 +107,26 @@ def simulate_averaged(params: Parameters, engine_class: type[Engine], progress: 
     if engine_class.description.attractor_starts and params.attractor_starts > 1 and not stopped_by_the_user_or_the_budget:
         probe_attractors(result, budget, progress)
     return result
+
+
+def least_mechanics(params: Parameters) -> float:
+    """The least mechanics (s) an averaged run can end with: twice ``averaging_min_batches`` batches, since the
+    start-up transient cut off (MSER) may take up to half of them (``solvers.driver.measure_means``)."""
+    return 2 * params.averaging_min_batches * params.averaging_batch_periods * params.period
+
+
+def full_resolution_instead(params: Parameters) -> str | None:
+    """Why an averaged run of ``params`` runs at full resolution from the start, or None: its duration is no longer
+    than the least mechanics averaging needs, so averaging could only cost more (a user's 10-s run would otherwise
+    take two minutes of mechanics and then fall back)."""
+    needed = least_mechanics(params)
+    if params.solver != "averaged" or params.duration > needed:
+        return None
+    return (
+        f"Full resolution instead of the averaged solver: duration = {params.duration:g} s is no longer than the "
+        f"{needed:.3g} s of mechanics that averaging needs at least (2 x averaging_min_batches x "
+        "averaging_batch_periods drive periods)"
+    )
 
 
 def _from_mechanics(params: Parameters, engine_class: type[Engine], mechanics: Mechanics,
@@ -240,7 +268,9 @@ def _refuse(params: Parameters, engine_class: type[Engine], mechanics: Mechanics
         result.message, result.averages = reason, averages
     else:
         result = simulate_full(params, engine_class, progress, budget)
-        result.message = f"Averaging is not valid ({averages.message}); ran at full resolution instead. {result.message}"
+        fell_back = f"Averaging is not valid ({averages.message}); ran at full resolution instead."
+        result.message = f"{fell_back} {result.message}"
+        result.warnings.insert(0, fell_back)
         result.averages = averages
         result.wall_time = time.perf_counter() - started
     result.summary = summarize(result)

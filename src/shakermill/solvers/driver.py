@@ -66,8 +66,8 @@ def _flat(measured: Measured) -> np.ndarray:
 
 
 def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback | None) -> tuple[Means, int]:
-    """Run the mechanics batch by batch until the means converge (or ``averaging_max_time``); returns the means and
-    the engine's last status. ``progress(t, averaging_max_time)`` is told how far the mechanics has got.
+    """Run the mechanics batch by batch until the means converge (or :func:`mechanics_limit`); returns the means and
+    the engine's last status. ``progress(t, mechanics_limit)`` is told how far the mechanics has got.
 
     Converged: after the start-up transient (MSER on the total heat power and the balls' mean velocity term),
     at least ``averaging_min_batches`` batches, and every total, source and ball mean known to the engine's
@@ -81,7 +81,8 @@ def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback
     if balls == 0:
         return _nothing_moves(engine, first), REACHED_STOP
     cumulative = [_flat(first)]
-    heartbeat = None if progress is None else lambda t: progress(t, params.averaging_max_time)
+    limit, limit_name = mechanics_limit(params)
+    heartbeat = None if progress is None else lambda t: progress(t, limit)
     status, converged, cut, message = REACHED_STOP, False, 0, ""
     while True:
         status = engine.advance(engine.t + batch, heartbeat)
@@ -100,14 +101,22 @@ def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback
                 converged = True
                 message = f"converged after {engine.t:.3g} s of mechanics ({len(kept)} batches of {batch:.3g} s)"
                 break
-        if engine.t + batch > params.averaging_max_time:
+        if engine.t + batch > limit:
             message = (
                 f"the averages did not converge to a relative standard error of {target:g} ({key}) within "
-                f"averaging_max_time = {params.averaging_max_time:g} s (irregular or slowly settling motion)"
+                f"{limit_name} = {limit:g} s (irregular or slowly settling motion)"
             )
             break
     rates = batch_rates(np.array(cumulative), batch)[cut:]
     return _means(engine, rates, sources, balls, cut * batch, batch, converged, message), status
+
+
+def mechanics_limit(params: Parameters) -> tuple[float, str]:
+    """The longest mechanics an averaged run may take (s) and the key that sets it: ``averaging_max_time``, or the
+    run's ``duration`` when shorter, since mechanics longer than the run cost more than the run at full resolution."""
+    if params.duration < params.averaging_max_time:
+        return params.duration, "duration"
+    return params.averaging_max_time, "averaging_max_time"
 
 
 def _means(engine: Engine, rates: np.ndarray, sources: int, balls: int, transient: float, batch: float,

@@ -13,7 +13,7 @@ import numpy as np
 
 from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
-from shakermill.analysis.steady import SteadyState, run_length_warning, steady_state
+from shakermill.analysis.steady import SteadyState, run_length_note, steady_state
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
     CELSIUS_VARIABLES,
@@ -103,6 +103,9 @@ class Result:
     attractors: AttractorScan | None = None  # the settled motions of other starts, where they were probed
     # One line each, for things a user should know that do not stop the run (stderr and summary.json).
     warnings: list[str] = field(default_factory=list)
+    # Sentences of advice that is not a problem (how the solver was chosen, a run shorter than its time to steady
+    # state): they belong to the run's answer, not to its warnings.
+    notes: list[str] = field(default_factory=list)
     summary: dict[str, float | int | str | bool | list[str]] = field(default_factory=dict)
 
     @property
@@ -146,11 +149,12 @@ def conclude(result: Result, network: ThermalNetwork, load: NetworkLoad) -> Resu
     result.steady = steady_state(network, load)
     result.load = load
     result.heat_paths = mean_path_flows(network, result.history, load.drives)
-    result.warnings.extend(unit_slip_warnings(params))
-    lines = (run_length_warning(result.t_end, result.steady), steady_state_bound_warning(result), fit_warning(result))
-    for line in lines:
-        if line is not None:
+    for line in (*unit_slip_warnings(params), steady_state_bound_warning(result), fit_warning(result)):
+        if line is not None and line not in result.warnings:
             result.warnings.append(line)
+    length_note = run_length_note(result.t_end, result.steady)
+    if length_note is not None:
+        result.notes.append(length_note)
     checks = ((OUT_OF_PHYSICAL_BOUNDS, physical_bounds_problem), (ENERGY_AUDIT_FAILED, energy_audit_problem))
     for status, problem_of in checks:
         problem = problem_of(result) if result.status == REACHED_STOP else None
@@ -307,7 +311,8 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         summary.update(result.averages.as_summary())
     if result.attractors is not None:
         summary.update(result.attractors.as_summary())
-    summary["warnings"] = list(result.warnings)
+    summary["warnings"] = list(dict.fromkeys(result.warnings))
+    summary["notes"] = list(dict.fromkeys(result.notes))
     return summary
 
 

@@ -10,7 +10,7 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -20,7 +20,7 @@ from shakermill.parameters.csvinput import read_csv_rows
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.guards import whole_number
 from shakermill.parameters.keys import Parameters, check_known_keys, checked_name, field_unit, takes_names
-from shakermill.parameters.units import UnitError, to_si
+from shakermill.parameters.units import UnitError, to_si, unit_written
 from shakermill.support.limits import MAX_SWEEP_POINTS, quoted
 
 # 64 bits of SHA-256: collisions are out of reach for any sweep that fits on a disk.
@@ -42,6 +42,9 @@ class SweepPlan:
     points: tuple[dict[str, Any], ...]
     grids: tuple[str, ...] = ()
     points_file: str | None = None
+    # The unit each real key's values were first written in ('mm' for amplitude=5mm,10mm), that tables show them in;
+    # the points hold SI.
+    units: tuple[tuple[str, str], ...] = ()
 
 
 def normalize_value(key: str, value: Any) -> Any:
@@ -132,8 +135,23 @@ def check_point_count(count: int) -> None:
         raise ParameterError(f"sweep: {count:,} points; allowed at most {MAX_SWEEP_POINTS:,} in one sweep")
 
 
+def grid_unit(spec: str) -> str:
+    """The unit the values of one ``--grid`` are first written in ('mm' for amplitude=20mm:30mm:6); '' for none."""
+    match = GRID_PATTERN.match(spec)
+    return first_unit(re.split("[:,]", match["range"])) if match else ""
+
+
+def first_unit(values: Iterable[Any]) -> str:
+    return next((unit for unit in map(unit_written, values) if unit), "")
+
+
 def read_points(path: Path | str) -> list[dict[str, Any]]:
     """The points of a CSV file: a header of canonical keys, one point per row, values with or without units."""
+    return _points_of(*_point_rows(path))
+
+
+def _point_rows(path: Path | str) -> tuple[Path, list[str], list[list[str]]]:
+    """A points file's header and rows of values, checked as far as they go without the keys' units."""
     source = Path(path)
     rows = read_csv_rows(source, f"points {source}", MAX_SWEEP_POINTS)
     rows = [row for row in rows if any(cell.strip() for cell in row)]
@@ -145,7 +163,11 @@ def read_points(path: Path | str) -> list[dict[str, Any]]:
         _check_distinct(header, "column")
     except ParameterError as exc:
         raise ParameterError(f"points {source}: {exc}") from None
-    return [_point_from_row(source, number, header, row) for number, row in enumerate(rows[1:], start=2)]
+    return source, header, rows[1:]
+
+
+def _points_of(source: Path, header: list[str], rows: list[list[str]]) -> list[dict[str, Any]]:
+    return [_point_from_row(source, number, header, row) for number, row in enumerate(rows, start=2)]
 
 
 def _point_from_row(source: Path, line: int, header: list[str], row: list[str]) -> dict[str, Any]:
@@ -171,14 +193,23 @@ def _check_distinct(keys: Sequence[str], what: str) -> None:
 def plan_sweep(grids: Sequence[str] = (), points_file: Path | str | None = None) -> SweepPlan:
     """The points of ``--grid`` specifications and/or a ``--points`` file (each row times the grid's product)."""
     parsed = [grid_values(spec) for spec in grids]
-    listed = read_points(points_file) if points_file is not None else [{}]
+    table = _point_rows(points_file) if points_file is not None else None
+    listed = _points_of(*table) if table is not None else [{}]
     grid_points = product_points(parsed, len(listed)) if parsed else [{}]
     keys = [*listed[0], *(key for key, _ in parsed)]
     if not keys:
         raise ParameterError("sweep: nothing to sweep; give --grid KEY=START:STOP:N or --points FILE.csv")
     _check_distinct(keys, "grid or points column")
     points = tuple({**row, **values} for row in listed for values in grid_points)
-    return SweepPlan(tuple(keys), points, tuple(grids), str(points_file) if points_file is not None else None)
+    units = _units_written(table, {key: spec for (key, _), spec in zip(parsed, grids)})
+    return SweepPlan(tuple(keys), points, tuple(grids), str(points_file) if points_file is not None else None, units)
+
+
+def _units_written(table: tuple[Path, list[str], list[list[str]]] | None, grids: Mapping[str, str]) -> tuple[tuple[str, str], ...]:
+    """(key, unit) for each real key whose values a points file's column or a ``--grid`` writes with a unit."""
+    written = {key: first_unit(row[index] for row in table[2]) for index, key in enumerate(table[1])} if table else {}
+    written |= {key: grid_unit(spec) for key, spec in grids.items()}
+    return tuple((key, unit) for key, unit in written.items() if unit and Parameters.model_fields[key].annotation is float)
 
 
 def as_plan(grid_points: SweepPlan | Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]]) -> SweepPlan:

@@ -80,15 +80,17 @@ def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitt
     """The run's answer in plain sentences: where it ends, where it would settle, how fast, driven by what.
 
     For a preset that nothing was fitted to (``fitted`` False), one more sentence compares the
-    steady state with the experiment and points to the calibrated preset.
+    steady state with the experiment and points to the calibrated preset. The run's notes (advice that is not a
+    problem, such as a run shorter than its time to steady state) end it.
     """
     v = {key: number(summary.get(key), spec) for key, _, _, spec in ANSWER_KEYS}
     minutes = number(_number(summary.get("simulated_s")) / 60.0, ".3g")
+    notes = list(summary.get("notes") or ())
     if summary.get("n_balls") == 0:
-        return empty_mill_sentences(summary, v, minutes)
+        return empty_mill_sentences(summary, v, minutes) + notes
     if _number(summary.get("n_balls")) > 1:
         # The experiment had one ball: several balls are not compared with it.
-        return several_ball_sentences(summary, v, minutes)
+        return several_ball_sentences(summary, v, minutes) + notes
     sentences = [
         f"After {minutes} min the ball is at {v['ball_C']} °C, the vial at {v['vial_C']} °C and the air at "
         f"{v['air_C']} °C.",
@@ -103,7 +105,7 @@ def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitt
         comparison = experiment_comparison(summary, preset)
         if comparison:
             sentences.append(comparison)
-    return sentences
+    return sentences + notes
 
 
 def empty_mill_sentences(summary: Mapping[str, Any], v: Mapping[str, str], minutes: str) -> list[str]:

@@ -20,6 +20,7 @@ from typing import Any, Iterator, Sequence
 
 from shakermill.io.runs import CONFIG_FILE, RunData, load_run
 from shakermill.parameters.defaults import DEFAULT_PRESET, REPORT_FILE
+from shakermill.parameters.engine_keys import reads
 from shakermill.parameters.keys import field_description, field_unit, material_sources
 from shakermill.parameters.presets import PRESETS, Preset
 from shakermill.studies.validation import (
@@ -264,7 +265,9 @@ def answer_html(run: RunData, preset: Preset | None) -> str:
     """The run's answer in sentences, the first thing the report says."""
     fitted = preset is None or bool(preset.fitted)
     sentences = answer_sentences(run.summary, run.preset, fitted=fitted)
-    return paragraph(" ".join(sentences), "statement answer") + "\n"
+    caveat = preset.caveat if preset is not None else None
+    said = paragraph(" ".join(sentences), "statement answer") + "\n"
+    return said + (paragraph(f"Caveat ({run.preset}): {caveat}", "status failed") + "\n" if caveat else "")
 
 
 def results_section(run: RunData) -> str:
@@ -382,8 +385,9 @@ def paper_figures_section(run: RunData, numbers: Iterator[int]) -> str:
 def configuration_section(run: RunData, preset: Preset | None) -> str:
     rows = []
     differs = {}
-    values = run.params.model_dump()
-    from_materials = material_sources(values)
+    everything = run.params.model_dump()
+    from_materials = material_sources(everything)
+    values = {key: value for key, value in everything.items() if reads(run.params.engine, key)}
     for index, (key, value) in enumerate(values.items()):
         cited = preset.values.get(key) if preset else None
         if cited is None:
@@ -399,8 +403,10 @@ def configuration_section(run: RunData, preset: Preset | None) -> str:
         unit = pretty_unit(field_unit(key))
         rows.append((key, format_parameter(value), unit, preset_value, source, field_description(key)))
     changed = f"highlighted: the {len(differs)} keys whose value differs" if differs else "no key differs"
+    unread = len(everything) - len(values)
+    left_out = f" The {unread} keys the engine of this run does not read are left out." if unread else ""
     intro = (
-        f"The resolved configuration of this run (SI units); {changed} from preset {run.preset}. "
+        f"The resolved configuration of this run (SI units); {changed} from preset {run.preset}.{left_out} "
         "The source column cites the value's material where a material of the library gave it, else the preset's value."
     )
     headers = ("key", "value", "unit", "preset value", "source", "meaning")

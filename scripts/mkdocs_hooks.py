@@ -1,0 +1,43 @@
+"""MkDocs hooks of the documentation site (mkdocs.yml, `hooks:`).
+
+* The docstrings use Sphinx's cross-reference roles (:func:`~shakermill.solvers.full.simulate_full`), which
+  mkdocstrings shows as written: the role is dropped and, for a ``~`` target, the module path too, so the API
+  reference reads ``simulate_full``.
+* Some pages, docs/MODEL.md among them (kept byte-equal to the shared specification, so never edited here), start a
+  list right under a paragraph, as GitHub allows; Python-Markdown would run it into the paragraph. A blank line is
+  put before such a list when the page is read.
+"""
+
+from __future__ import annotations
+
+import re
+
+ROLE = re.compile(r":(?:py:)?(?:func|class|meth|mod|attr|data|exc|obj|const):<code>(~?)([^<]*)</code>")
+LIST_ITEM = re.compile(r"^(?:[-*+]|\d+\.) ")
+FENCE = re.compile(r"^\s*(```|~~~)")
+
+
+def _shown(match: re.Match[str]) -> str:
+    target = match.group(2)
+    return f"<code>{target.rsplit('.', 1)[-1] if match.group(1) else target}</code>"
+
+
+def _opens_list_under_paragraph(previous: str, line: str) -> bool:
+    return bool(LIST_ITEM.match(line)) and bool(previous.strip()) and not (
+        LIST_ITEM.match(previous) or previous[:1].isspace() or previous.startswith(("#", "|", ">", "!!!"))
+    )
+
+
+def on_page_markdown(markdown: str, **_: object) -> str:
+    lines, fenced = [], False
+    for line in markdown.split("\n"):
+        if FENCE.match(line):
+            fenced = not fenced
+        elif not fenced and lines and _opens_list_under_paragraph(lines[-1], line):
+            lines.append("")
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def on_page_content(html: str, **_: object) -> str:
+    return ROLE.sub(_shown, html)
