@@ -124,8 +124,8 @@ def test_config_file_and_set_overrides_end_up_in_the_stored_configuration(tmp_pa
         ("ball_radius=40 mm", ("ball_radius", "does not fit", "allowed ball_radius < vial_length/2 = 0.029 m")),
         ("vial_mass=-1", ("vial_mass", "allowed [0.001, 100] kg")),
         ("omega=0", ("omega", "allowed [1, 10000] rad/s")),
-        ("amplitude=3 kg", ("amplitude", "'3 kg' has the wrong dimension; expected a length such as m or mm")),
-        ("omega=3 kg", ("omega: '3 kg' has the wrong dimension; expected a frequency such as rad/s, Hz or rpm",)),
+        ("amplitude=3 kg", ("amplitude", "'3 kg' has the wrong dimension (read as kilogram); expected a length such as m or mm")),
+        ("omega=3 kg", ("omega: '3 kg' has the wrong dimension (read as kilogram); expected a frequency such as rad/s, Hz or rpm",)),
         ("omega=1060 rmp", ("omega: cannot parse '1060 rmp': unknown unit 'rmp'; expected a frequency",)),
         ("ambient_temperature=25 kg", ("ambient_temperature", "expected a temperature such as K, degC or degF")),
         ("restitutoin=0.5", ("restitutoin", "did you mean 'restitution'")),
@@ -718,8 +718,8 @@ def test_real_ctrl_c_exits_within_a_second_with_the_data_written(tmp_path, start
                           capture_output=True, text=True, timeout=300)
     assert warm.returncode == 0, warm.stderr
     out = tmp_path / "run"
-    # Figures asked for: they are what an interrupted run leaves to `plot`.
-    process = subprocess.Popen([str(SHAKERMILL), "run", *settings, "--out", str(out)], stdout=subprocess.PIPE,
+    # Figures asked for: they are what an interrupted run leaves to `plot`. --json: its summary all the same.
+    process = subprocess.Popen([str(SHAKERMILL), "run", *settings, "--json", "--out", str(out)], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
     time.sleep(start_up_s + 3.0)
     assert process.poll() is None, "the run ended before it could be interrupted"
@@ -731,8 +731,10 @@ def test_real_ctrl_c_exits_within_a_second_with_the_data_written(tmp_path, start
     after = usage.ru_utime + usage.ru_stime - used
     stderr = process.stderr.read()
     assert os.waitstatus_to_exitcode(status) == 130, stderr
+    printed = json.loads(process.stdout.read())
+    assert printed["status"] == INTERRUPTED and printed["output_dir"] == str(out.absolute())
     # What Ctrl-C costs: under a second of work. On a machine shared with the rest of the suite the wall clock
-    # stretches it, so its bound is looser; benchmarks/bench_interrupt.py measures it on a quiet one.
+    # stretches it, so its bound is looser; benchmarks/bench_first_hour.py measures it on a quiet one.
     assert after <= 1.0, f"{after:.2f} CPU-s after the signal"
     assert waited <= 3.0, f"{waited:.2f} s after the signal"
     assert len(stderr.strip().splitlines()) == 1 and stderr.startswith("interrupted:"), stderr
@@ -765,7 +767,8 @@ TINY_STEPS = [*(f"--set={key}={value}" for key, value in TIGHTEST_TOLERANCES.ite
     "command, first_words",
     [
         (["run", "--set", "solver=full", "--no-plots", "--out", "{out}"], "interrupted:"),
-        (["run", "--set", "solver=averaged", "--no-plots", "--out", "{out}"], "error: interrupted; nothing was written"),
+        # Its mechanics settle at once; the probe of its attractors, stuck on tiny steps, is stopped and the run kept.
+        (["run", "--set", "solver=averaged", "--no-plots", "--out", "{out}"], "interrupted: Interrupted by the user while probing attractors"),
         (["bifurcation", "--grid", "omega=100:120:2", "--out", "{out}"], "error: interrupted; nothing was written"),
         (["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", "{out}.toml"], "error: interrupted; nothing was written"),
     ],
@@ -924,6 +927,23 @@ def test_a_run_of_a_calibrated_preset_reports_intervals_and_where_its_heat_goes(
     assert "heat path vial → room" in result.stdout
     # At the end of the run what the contacts give the vial and the ball has gone to the air, the room or stays.
     assert paths["vial → room"] > 0.0 and paths["ball → air"] > 0.0
+
+
+def test_a_short_averaged_run_says_before_it_starts_that_it_runs_at_full_resolution(tmp_path):
+    result = invoke("run", "--preset", "spex8000m-calibrated", *SHORT, "--set", "solver=averaged", "--no-plots",
+                    "--out", str(tmp_path / "short"))
+    assert result.exit_code == 0, result.stderr
+    first = result.stderr.splitlines()[0]
+    assert first.startswith("note: Full resolution instead of the averaged solver: duration = 2 s is no longer than")
+    assert result.stderr.count("Full resolution instead") == 1
+    summary = load_run(tmp_path / "short").summary
+    assert summary["solver"] == "full" and summary["message"].startswith("Full resolution instead")
+    # How the solver was chosen is a note of the run, said once on the terminal: before the run, not again under it.
+    reason, length = summary["notes"]
+    assert first == f"note: {reason}" and reason not in " ".join(result.stdout.split())
+    # Advice, not a problem: the run's length is a sentence of the answer under the table, not a warning.
+    assert not any("slowest time constants" in line for line in result.stderr.splitlines())
+    assert "slowest time constants" in length and length in " ".join(result.stdout.split())
 
 
 def test_a_run_of_an_uncalibrated_preset_reports_no_intervals(tmp_path):

@@ -4,6 +4,7 @@ and the sensitivity to the assumed SPEX motion, through the command (short runs 
 from __future__ import annotations
 
 import functools
+import html
 import json
 
 import pytest
@@ -12,6 +13,7 @@ from typer.testing import CliRunner
 from shakermill import cli
 from shakermill.studies import held_out, validation_report
 from shakermill.studies.validation_matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
+from shakermill.views.validation_page import QUICK_NOTE
 
 runner = CliRunner()
 # A few drive periods at full resolution for every run: the command's shape, not its numbers.
@@ -82,11 +84,12 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
 
 
 @pytest.mark.slow
-def test_validate_is_quick_by_default_and_says_each_run_when_piped(quick_runs):
-    outcome = runner.invoke(cli.app, ["validate", "--no-study", "--json"])
+def test_validate_is_quick_by_default_and_says_each_run_when_piped(quick_runs, tmp_path):
+    page = tmp_path / "quick.html"
+    outcome = runner.invoke(cli.app, ["validate", "--no-study", "--json", "--report", str(page)])
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
-    assert payload["solver"] == "averaged"
+    assert payload["solver"] == "averaged" and payload["full"] is False
     # The experiments of five balls and of none: no lone ball, whose mechanics take minutes, and no held-out studies.
     quick = {experiment.name for experiment in load_experiments() if experiment.conditions.get("n_balls", 1) != 1}
     assert set(payload["validation_matrix"]["experiments"]) == quick == {"takacs-mchenry-five-balls", "empty-mill"}
@@ -98,6 +101,8 @@ def test_validate_is_quick_by_default_and_says_each_run_when_piped(quick_runs):
     lines = [line for line in outcome.stderr.splitlines() if line.startswith("3-D validation: ")]
     assert [line.split(",")[0] for line in lines] == [f"3-D validation: {done}/{runs} runs" for done in range(1, runs + 1)]
     assert outcome.stderr.startswith("validate: quick, ~2 min; --full for everything")
+    # Its page says it is the quick one, and what --full adds.
+    assert html.escape(QUICK_NOTE) in page.read_text(encoding="utf-8")
 
 
 def test_a_report_that_exists_is_refused_before_the_study_runs(tmp_path, monkeypatch):

@@ -170,13 +170,9 @@ def test_to_jsonable_makes_numpy_values_plain_and_non_finite_values_null():
 
 def test_writing_again_replaces_the_old_run_completely(run_folder, short_result):
     (run_folder / "stale.txt").write_text("from the old run")
-
-    def add_extra(folder: Path) -> None:
-        (folder / "extra.txt").write_text("new")
-
-    write_run(short_result, run_folder, preset=DEFAULT_PRESET, add_files=add_extra, overwrite=True)
+    write_run(short_result, run_folder, preset=DEFAULT_PRESET, overwrite=True)
     assert not (run_folder / "stale.txt").exists()
-    assert (run_folder / "extra.txt").read_text() == "new"
+    assert sorted(entry.name for entry in run_folder.iterdir()) == sorted(storage.RUN_FILES)
     assert [entry.name for entry in run_folder.parent.iterdir()] == ["run"]
 
 
@@ -210,16 +206,6 @@ def test_interrupted_write_leaves_no_folder_at_all(short_result, tmp_path, monke
     monkeypatch.setattr(storage, "impacts_parquet", fail_midway)
     with pytest.raises(KeyboardInterrupt):
         write_run(short_result, tmp_path / "run", preset=DEFAULT_PRESET)
-    assert list(tmp_path.iterdir()) == []
-
-
-def test_failure_in_added_files_leaves_no_folder(short_result, tmp_path):
-    def broken_figures(folder: Path) -> None:
-        (folder / "figures").mkdir()
-        raise RuntimeError("plotting failed")
-
-    with pytest.raises(RuntimeError):
-        write_run(short_result, tmp_path / "run", preset=DEFAULT_PRESET, add_files=broken_figures)
     assert list(tmp_path.iterdir()) == []
 
 

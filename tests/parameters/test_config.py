@@ -97,7 +97,7 @@ def test_unknown_key_in_file_suggests_the_right_one(tmp_path):
 
 
 def test_window_with_wrong_unit_in_file_names_the_key(tmp_path):
-    with pytest.raises(ParameterError, match="record_windows: .*wrong dimension; expected a time such as s"):
+    with pytest.raises(ParameterError, match="record_windows: .*wrong dimension \\(read as .*\\); expected a time such as s"):
         load_config(write_toml(tmp_path, 'record_windows = [[0, "1 kg"]]\n'))
 
 

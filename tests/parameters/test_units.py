@@ -59,11 +59,11 @@ def test_dimensionless_quantities() -> None:
 @pytest.mark.parametrize(
     "value, unit, fragment",
     [
-        ("3 kg", "m", "'3 kg' has the wrong dimension; expected a length such as m or mm"),
-        ("3 kg", "", "wrong dimension; expected a dimensionless number"),
-        ("1 m", "rad/s", "'1 m' has the wrong dimension; expected a frequency such as rad/s, Hz or rpm"),
-        ("25 C", "rad/s", "wrong dimension"),  # °C only where a temperature is expected: here it is coulombs
-        ("3 N", "J/(kg*K)", "wrong dimension; expected a quantity in J/(kg*K)"),
+        ("3 kg", "m", "'3 kg' has the wrong dimension (read as kilogram); expected a length such as m or mm"),
+        ("3 kg", "", "wrong dimension (read as kilogram); expected a dimensionless number"),
+        ("1 m", "rad/s", "'1 m' has the wrong dimension (read as meter); expected a frequency such as rad/s, Hz or rpm"),
+        ("25 C", "rad/s", "wrong dimension (read as coulomb)"),  # °C only where a temperature is expected: here it is coulombs
+        ("3 N", "J/(kg*K)", "wrong dimension (read as newton); expected a quantity in J/(kg*K)"),
         ("abc xyz", "m", "cannot parse 'abc xyz': unknown unit 'abc'; expected a length"),
         ("1060 rmp", "rad/s", "cannot parse '1060 rmp': unknown unit 'rmp'; expected a frequency such as rad/s, Hz or rpm"),
         (True, "m", "expected a number"),

@@ -8,7 +8,8 @@ from scipy.integrate import solve_ivp
 
 import shakermill as sm
 from shakermill.engines.one_d import model
-from shakermill.solvers.result import INTERRUPTED
+from shakermill.engines.registry import engine_named
+from shakermill.solvers.result import INTERRUPTED, conclude
 
 RESTING_WALL_AMPLITUDE = 1e-12
 
@@ -150,3 +151,14 @@ def test_ball_only_model_holds_air_and_vial_at_ambient(solver: str) -> None:
     assert audit.relative_residual < 1e-6
     three_node = sm.simulate(params.replace(model="three_node"))
     assert three_node.summary["ball_C"] > result.summary["ball_C"]
+
+
+def test_each_warning_and_note_is_kept_once_however_often_a_run_is_concluded() -> None:
+    # 1060 bare is 1060 rad/s, far outside the plausible drive frequencies: a unit-slip warning the run keeps; two
+    # seconds are far shorter than the network's time constants: a note.
+    result = sm.simulate(sm.default_parameters(duration=2.0, omega=1060.0, record_windows=()))
+    assert any("1060" in line for line in result.warnings) and len(result.notes) == 1
+    warnings, notes = list(result.warnings), list(result.notes)
+    conclude(result, engine_named(result.params.engine).network_for(result.params), result.load)
+    assert result.warnings == warnings and result.notes == notes
+    assert result.summary["warnings"] == warnings and result.summary["notes"] == notes

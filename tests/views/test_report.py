@@ -108,6 +108,22 @@ def at_the_experiments_operating_point(run: RunData, **changes) -> RunData:
     return dataclasses.replace(run, params=params, summary={**run.summary, "simulated_s": 3600.0})
 
 
+def test_the_report_of_a_preset_whose_validation_failed_says_what_it_found(run_folder):
+    preset = PRESETS["spex8000m-calibrated"]
+    assert preset.caveat and "+70 %" in preset.caveat  # its held-out ratio, as stored with the preset
+    shipped = dataclasses.replace(load_run(run_folder), preset=preset.name, params=sm.default_parameters(preset.name))
+    caveats = re.compile(r'<p class="status failed">Caveat \(spex8000m-calibrated\): (.*?)</p>')
+    report_html = render_report(shipped)
+    said = caveats.search(report_html)
+    assert said is not None and said.group(1) == html.escape(preset.caveat)
+    assert said.start() > report_html.index('<p class="statement answer">')
+    # A run that changes what the calibration fitted gets the finding of the preset as shipped, and is told so.
+    changed = render_report(dataclasses.replace(shipped, params=shipped.params.replace(beta=1.0)))
+    assert "This run changes beta, which the calibration fitted" in caveats.search(changed).group(1)
+    # The paper's preset has nothing to confess beyond its comparison with the experiment.
+    assert "Caveat (" not in render_report(load_run(run_folder))
+
+
 def test_table5_of_the_published_preset_is_all_predicted(run_folder):
     report_html = render_report(at_the_experiments_operating_point(load_run(run_folder)))
     rows = rows_of_table_after(report_html, "Table 5")

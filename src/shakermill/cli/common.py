@@ -76,12 +76,23 @@ class OneLineUsageErrors(TyperGroup):
             sys.exit(EXIT_USAGE)
         sys.exit(outcome if isinstance(outcome, int) else 0)
 
+    # typer turns a Ctrl-C that no command caught into exit code 130 without a word, while it reads the command line
+    # (which imports pydantic) as while a command runs.
+    def make_context(self, *args: Any, **kwargs: Any) -> Any:
+        with _interrupt_in_one_line():
+            return super().make_context(*args, **kwargs)
+
     def invoke(self, ctx: Any) -> Any:
-        # typer turns a Ctrl-C that no command caught into exit code 130 without a word.
-        try:
+        with _interrupt_in_one_line():
             return super().invoke(ctx)
-        except KeyboardInterrupt:
-            fail("interrupted by the user (Ctrl-C)", EXIT_INTERRUPTED)
+
+
+@contextmanager
+def _interrupt_in_one_line() -> Iterator[None]:
+    try:
+        yield
+    except KeyboardInterrupt:
+        fail("interrupted by the user (Ctrl-C)", EXIT_INTERRUPTED)
 
 
 app = typer.Typer(
@@ -236,7 +247,8 @@ def simulate_with_progress(params: Parameters) -> Result:
     """``simulate``, with a transient progress bar on stderr once the run takes a while, when stderr is a terminal.
 
     The bar counts the simulated seconds of each phase in turn: the averaged solver's mechanics (out of
-    averaging_max_time), the whole duration, then its attractor probe (all starts together).
+    averaging_max_time, or the duration when shorter), the whole duration, then its attractor probe (all starts
+    together).
     """
     from shakermill.solvers.simulate import simulate
 
@@ -291,8 +303,8 @@ def piped_lines(verb: str, counter: str) -> Callable[..., None]:
             return
         said.append(completed)
         task = SimpleNamespace(completed=completed, total=total)
-        elapsed = time.monotonic() - started
-        typer.echo(f"{verb}: {counter.format(task=task)}, {elapsed // 60:.0f} min {elapsed % 60:02.0f} s", err=True)
+        minutes, seconds = divmod(round(time.monotonic() - started), 60)
+        typer.echo(f"{verb}: {counter.format(task=task)}, {minutes} min {seconds:02d} s", err=True)
 
     return update
 

@@ -98,10 +98,9 @@ def validate(
     else:
         print_report(report)
         if three_d and not full:
-            stdout_console().print(Text(
-                "Quick validation: the matrix holds the experiments of five balls and of none. `shakermill validate "
-                "--full` adds those of one ball, the structure study, the engines' one-ball comparison and the "
-                "sensitivity to the assumed SPEX kinematics (~17 min on two cores)."))
+            from shakermill.views.validation_page import QUICK_NOTE
+
+            stdout_console().print(Text(QUICK_NOTE))
     if html is not None:
         from shakermill.views.validation_page import save_validation_page
 

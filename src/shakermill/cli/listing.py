@@ -8,6 +8,7 @@ from typing import Annotated, Any, Sequence
 
 import typer
 from rich.table import Table
+from rich.text import Text
 
 from shakermill.cli.common import JsonOption, add_plain_row, fail, format_value, stdout_console, user_errors
 from shakermill.parameters.defaults import DEFAULT_PRESET
@@ -33,6 +34,8 @@ def presets(
     for key, cited in preset.values.items():
         add_plain_row(table, key, format_value(key, cited.value), cited.source)
     console.print(table)
+    if preset.caveat:
+        console.print(Text(f"Caveat ({preset.name}): {preset.caveat}"))
 
 
 # The library's table: property, header with its unit, scale from SI.

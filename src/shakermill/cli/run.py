@@ -71,60 +71,74 @@ def run(
     said_first = unit_slip_warnings(run_config.params)
     echo_warnings(said_first)
     echo_notes(solver_choice(run_config.params))
-    # A run returns what it computed when interrupted; Ctrl-C in the attractor probe or the thermal network leaves none.
+    # A run returns what it computed when interrupted; Ctrl-C in the thermal network leaves none.
     with nothing_written_when_interrupted("the run had no results to keep yet"):
         result = simulate_with_progress(run_config.params)
+    stopped = result.status == INTERRUPTED or not preset_findings_added(result, run_config.preset)
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
-    # What was computed is written whole; a Ctrl-C meanwhile takes effect after, and the figures are left to `plot`.
-    with interrupts_held(deliver=False) as interrupted:
-        if result.status != INTERRUPTED:  # intervals of a stretch cut short mean nothing, and take a second to import
-            with_preset_findings(result, run_config.preset)
+    # What was computed is written whole: a Ctrl-C meanwhile takes effect once it is.
+    with interrupts_held(deliver=False) as held:
         target = _write(result, target, run_config.preset, provenance, overwrite=overwrite)
-    if result.status == INTERRUPTED or interrupted:
-        _exit_interrupted(result, target)
-    # An interrupted run is short by choice: its warnings (steady state, fit) stay in summary.json, unsaid.
-    echo_warnings([line for line in result.summary["warnings"] if line not in said_first])
-    if not no_plots and not _draw_figures(result, target):
-        _exit_interrupted(result, target)
+    finished = not stopped and not held
+    if finished:
+        # An interrupted run is short by choice: its warnings (steady state, fit) stay in summary.json, unsaid.
+        echo_warnings([line for line in result.summary["warnings"] if line not in said_first])
+        # After a Ctrl-C the figures are left to `plot`, so that it exits within a second.
+        finished = no_plots or _draw_figures(result, target)
     if json_output:
-        summary = to_jsonable({**result.summary, "output_dir": str(target)})
-        typer.echo(json.dumps(summary, sort_keys=True, allow_nan=False))
-    else:
+        typer.echo(json.dumps(to_jsonable({**result.summary, "output_dir": str(target)}), sort_keys=True, allow_nan=False))
+    elif finished:
         console = stdout_console()
         console.print(summary_table(result, target))
-        console.print(Text(answer_text(result.summary, run_config.preset)))
+        console.print(Text(answer_text(result.summary, run_config.preset, said=solver_choice(run_config.params))))
+    if not finished:
+        _exit_interrupted(result, target)
     _exit_for_status(result, target)
 
 
 def solver_choice(params: Parameters) -> list[str]:
-    """The line that says an averaged run is run at full resolution from the start, and why (none otherwise)."""
+    """The sentence that says an averaged run is run at full resolution from the start, and why (none otherwise)."""
     from shakermill.solvers.averaged import full_resolution_instead
 
     reason = full_resolution_instead(params)
-    return [] if reason is None else [reason + "."]
+    return [] if reason is None else [reason]
+
+
+def preset_findings_added(result: Result, preset: str | None) -> bool:
+    """:func:`with_preset_findings`; False when Ctrl-C stopped it (the run is then written without them)."""
+    try:
+        with_preset_findings(result, preset)
+    except KeyboardInterrupt:
+        return False
+    return True
 
 
 def with_preset_findings(result: Result, preset: str | None) -> None:
-    """Add to the summary of a run of a calibrated preset the 90 % intervals of its headline temperatures
-    (``studies.uncertainty``), which carry the calibration's uncertainty and the averaging error, and to any preset's
-    run what its validation found where it failed or is missing (``validation_caveat``)."""
+    """Add to the summary of any preset's run what its validation found where it failed or is missing
+    (``validation_caveat``), and of a calibrated preset's run the 90 % intervals of its headline temperatures
+    (``studies.uncertainty``), which carry the calibration's uncertainty and the averaging error."""
     from shakermill.parameters.presets import PRESETS
     from shakermill.studies.uncertainty import intervals, uncertainty_of
 
     known = PRESETS.get(preset) if preset is not None else None
+    caveat = known.caveat_for(result.params.model_dump()) if known is not None else None
+    if caveat:
+        result.summary["validation_caveat"] = caveat
     uncertainty = uncertainty_of(known) if known is not None else None
     found = intervals(result, uncertainty) if uncertainty is not None else None
     if found is not None:
         result.summary.update(found.as_summary())
-    if known is not None and known.caveat:
-        result.summary["validation_caveat"] = known.caveat
 
 
-def answer_text(summary: Mapping[str, Any], preset: str | None) -> str:
-    """The run's answer under its table: the report's sentences (with the run's notes), then the preset's caveat."""
+def answer_text(summary: Mapping[str, Any], preset: str | None, said: Sequence[str] = ()) -> str:
+    """The run's answer under its table: the report's sentences with the run's notes (but those ``said`` before the
+    run), then the preset's caveat."""
+    from shakermill.parameters.presets import PRESETS
     from shakermill.views.notebook import answer_sentences
 
-    text = " ".join(answer_sentences(summary))
+    known = PRESETS.get(preset) if preset is not None else None
+    unsaid = {**summary, "notes": [note for note in summary.get("notes") or () if note not in said]}
+    text = " ".join(answer_sentences(unsaid, preset, fitted=known is None or bool(known.fitted)))
     caveat = summary.get("validation_caveat")
     return text + (f"\nCaveat ({preset}): {caveat}" if caveat else "")
 
@@ -138,16 +152,21 @@ def _write(result: Result, target: Path, preset: str, provenance: dict[str, Any]
 
 
 def _draw_figures(result: Result, target: Path) -> bool:
-    """Draw the figures into the written run folder; False, with none left half drawn, when Ctrl-C stops them."""
+    """Draw the figures into the written run folder, whole or not at all (they are drawn in a hidden sibling and
+    renamed into place); False when Ctrl-C stops them."""
+    from shakermill.support.atomic import partial_path
     from shakermill.views.figures.run import plot_run
 
     folder = target / FIGURES_FOLDER
+    drawing = partial_path(folder)
     try:
         with writing(folder, "the figures"):
-            plot_run(result, folder)
+            plot_run(result, drawing)
+            drawing.rename(folder)
     except KeyboardInterrupt:
-        shutil.rmtree(folder, ignore_errors=True)
         return False
+    finally:
+        shutil.rmtree(drawing, ignore_errors=True)
     return True
 
 

@@ -8,7 +8,7 @@ A run folder holds
 * ``summary.json``    summary, energy audit, exponential fit, counters, status and message,
 * ``config.toml``     the resolved parameters with provenance; ``shakermill run config.toml`` repeats the run,
 
-plus whatever ``add_files`` puts there (the command line adds ``figures/``).
+and, once it is in place, the figures the command line draws into it (``figures/``, in a folder of its own).
 
 The folder is built in a hidden sibling ``.<name>.partial-<machine>-<pid>-<random>`` and
 moved into place only when complete, so an interrupted write or a full disk never leaves a folder
@@ -169,19 +169,13 @@ def write_run(
     *,
     preset: str,
     extra_provenance: Mapping[str, Any] | None = None,
-    add_files: Callable[[Path], object] | None = None,
     overwrite: bool = False,
 ) -> Path:
     """Write ``result`` as a run folder at ``path``; a previous run folder there is replaced only with ``overwrite``.
-
-    ``add_files(folder)`` may add more files (figures) before the folder is
-    moved into place. Returns the folder's absolute path.
-    """
+    Returns the folder's absolute path."""
 
     def fill(folder: Path) -> None:
         _write_contents(result, folder, preset=preset, extra_provenance=extra_provenance or {})
-        if add_files is not None:
-            add_files(folder)
 
     return write_folder(path, fill, overwrite=overwrite)
 

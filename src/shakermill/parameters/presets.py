@@ -51,6 +51,17 @@ class Preset:
         tested (``[provenance.validation] caveat`` of its file): every run and report of the preset says it."""
         return self.provenance.get("validation", {}).get("caveat")
 
+    def caveat_for(self, values: Mapping[str, Any]) -> str | None:
+        """:attr:`caveat`, said of a run with ``values``: where the run changed keys a calibration fitted, what was
+        found is of the preset as shipped."""
+        if not self.caveat:
+            return None
+        changed = [key for key in self.fitted if key in values and values[key] != self.values[key].value]
+        if not changed:
+            return self.caveat
+        return (f"{self.caveat} (This run changes {', '.join(changed)}, which the calibration fitted: what was found "
+                "is of the preset as shipped.)")
+
     @property
     def posterior(self) -> list[list[float]] | None:
         """The calibration's posterior samples of the logarithms of ``fitted``, if it recorded them."""

@@ -176,4 +176,6 @@ def _quantity_to_si(text: str, value: str, unit: str, key: str) -> float:
     try:
         return float(quantity.to(target).magnitude)
     except pint.DimensionalityError:
-        raise UnitError(f"{key}: {quoted(value)} has the wrong dimension; expected {expected_quantity(unit)}") from None
+        raise UnitError(
+            f"{key}: {quoted(value)} has the wrong dimension (read as {quantity.units}); expected {expected_quantity(unit)}"
+        ) from None

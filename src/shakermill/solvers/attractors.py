@@ -26,7 +26,7 @@ from shakermill.engines.interface import ProgressCallback
 from shakermill.engines.registry import engine_named
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.parameters.keys import Parameters
-from shakermill.solvers.result import Result, summarize
+from shakermill.solvers.result import INTERRUPTED, Result, summarize
 
 
 def settle(
@@ -92,8 +92,16 @@ def find_attractors(
 
 
 def probe_attractors(result: Result, budget: RunBudget, progress: ProgressCallback | None) -> None:
-    """Attach the attractors of the run's parameters; a probe that used up the budget makes the run stopped."""
-    scan = find_attractors(result.params, budget, progress)
+    """Attach the attractors of the run's parameters; a probe that used up the budget makes the run stopped, and one
+    that Ctrl-C stopped makes it interrupted, with everything the run itself computed kept."""
+    try:
+        scan = find_attractors(result.params, budget, progress)
+    except KeyboardInterrupt:
+        result.status = INTERRUPTED
+        result.message = ("Interrupted by the user while probing attractors; the run itself finished, its attractors "
+                          "were not probed.")
+        result.summary = summarize(result)
+        return
     attach(result, scan)
     if budget.reason is not None and result.success:
         result.status = BUDGET_EXCEEDED

@@ -94,7 +94,8 @@ def simulate_averaged(params: Parameters, engine_class: type[Engine], progress: 
     reason = full_resolution_instead(params)
     if reason is not None and mechanics is None:
         result = simulate_full(params, engine_class, progress, budget)
-        result.message = f"{reason}. {result.message}"
+        result.message = f"{reason} {result.message}"
+        result.notes.insert(0, reason)
         result.summary = summarize(result)
         return result
     started = time.perf_counter()
@@ -125,7 +126,7 @@ def full_resolution_instead(params: Parameters) -> str | None:
     return (
         f"Full resolution instead of the averaged solver: duration = {params.duration:g} s is no longer than the "
         f"{needed:.3g} s of mechanics that averaging needs at least (2 x averaging_min_batches x "
-        "averaging_batch_periods drive periods)"
+        "averaging_batch_periods drive periods)."
     )
 
 

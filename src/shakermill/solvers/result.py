@@ -153,7 +153,7 @@ def conclude(result: Result, network: ThermalNetwork, load: NetworkLoad) -> Resu
         if line is not None and line not in result.warnings:
             result.warnings.append(line)
     length_note = run_length_note(result.t_end, result.steady)
-    if length_note is not None:
+    if length_note is not None and length_note not in result.notes:
         result.notes.append(length_note)
     checks = ((OUT_OF_PHYSICAL_BOUNDS, physical_bounds_problem), (ENERGY_AUDIT_FAILED, energy_audit_problem))
     for status, problem_of in checks:

@@ -10,7 +10,7 @@ from shakermill.engines.interface import ProgressCallback
 from shakermill.engines.registry import engine_named
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.parameters.keys import Parameters
-from shakermill.solvers.averaged import Mechanics, settle_mechanics, simulate_averaged
+from shakermill.solvers.averaged import Mechanics, full_resolution_instead, settle_mechanics, simulate_averaged
 from shakermill.solvers.full import simulate_full
 from shakermill.solvers.result import INTERRUPTED, Result
 
@@ -52,7 +52,8 @@ def thermal_variants(params: Parameters) -> Callable[[Parameters], Result]:
     here, and each run then integrates only its network: a three-dimensional run's means take tens of seconds,
     its network milliseconds."""
     engine = engine_named(params.engine)
-    if not engine.description.thermal_only_keys or params.solver != "averaged":
+    # A run too short to average is at full resolution, each variant its own.
+    if not engine.description.thermal_only_keys or params.solver != "averaged" or full_resolution_instead(params):
         return simulate_whole
     mechanics = next((settled for settled in _SETTLED.values() if settled.serves(params)), None)
     if mechanics is None:

@@ -58,8 +58,10 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
             raise PointInterrupted(str(exc)) from None
         return PointOutcome(failed_row(swept, f"{type(exc).__name__}: {exc}"))
     summary = {(f"{key}{USED_SUFFIX}" if key in swept else key): value for key, value in result.summary.items()}
-    # A table cell holds one value: the warnings become one string, or none (CSV cannot tell "" from missing).
-    summary["warnings"] = "; ".join(result.warnings) or None
+    # A table cell holds one value: the warnings and notes become one string each, or none (CSV cannot tell "" from
+    # missing).
+    summary["warnings"] = "; ".join(summary["warnings"]) or None
+    summary["notes"] = " ".join(summary["notes"]) or None
     row = {
         **swept,
         "regime": regime,

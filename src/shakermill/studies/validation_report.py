@@ -39,12 +39,15 @@ class ValidationReport:
     held_out: HeldOutStudies | None
     matrix: ValidationMatrix | None = None
     structures: tuple[StructureOutcome, ...] = ()
+    # False for the quick validation: the matrix holds only the experiments of quick_experiments.
+    everything: bool = True
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON object of ``validate --json``."""
         return {
             "experiment_source": EXPERIMENT,
             "solver": self.solver,
+            "full": self.everything,
             "quantities": {
                 entry.key: {"label": entry.label, "unit": entry.unit, "experiment": entry.experiment, "paper_model": entry.paper_model}
                 for entry in TABLE5
@@ -102,7 +105,7 @@ def validation_report(solver: str, study: bool = True, three_d: bool = True,
     pairs = len(experiments) * len(THERMAL_MODEL_PRESETS)
     matrix = validation_matrix(experiments=experiments, progress=show)
     if not everything:
-        return ValidationReport(solver, runs, outcomes, None, matrix)
+        return ValidationReport(solver, runs, outcomes, None, matrix, everything=False)
     structures = structure_study(progress=lambda done, total: show(pairs + done, pairs + total))
     before = pairs + len(STRUCTURES)
     held_out = held_out_studies(lambda done, total: show(before + done, before + total))

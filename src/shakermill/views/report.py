@@ -265,7 +265,7 @@ def answer_html(run: RunData, preset: Preset | None) -> str:
     """The run's answer in sentences, the first thing the report says."""
     fitted = preset is None or bool(preset.fitted)
     sentences = answer_sentences(run.summary, run.preset, fitted=fitted)
-    caveat = preset.caveat if preset is not None else None
+    caveat = preset.caveat_for(run.params.model_dump()) if preset is not None else None
     said = paragraph(" ".join(sentences), "statement answer") + "\n"
     return said + (paragraph(f"Caveat ({run.preset}): {caveat}", "status failed") + "\n" if caveat else "")
 

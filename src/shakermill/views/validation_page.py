@@ -119,15 +119,22 @@ def matrix_figure(matrix: ValidationMatrix) -> Figure:
     return figure
 
 
+QUICK_NOTE = ("A quick validation: the matrix holds the experiments of five balls and of none. `shakermill validate "
+              "--full` adds those of one ball, the structure study, the engines' one-ball comparison and the "
+              "sensitivity to the assumed SPEX kinematics (~17 min on two cores).")
+
+
 def render_validation_page(report: ValidationReport) -> str:
     """The whole page: the matrix, its figure and its experiments, the structures, the five balls held out."""
     from shakermill.views.report import STYLE
 
     sections = [
         "<h1>shakermill validation: the thermal networks in three dimensions</h1>",
-        paragraph("Every run on this page uses the averaged solver; the mechanics of one ball and of five are each "
-                  "measured once and shared by the thermal networks.", "note"),
+        paragraph("Every run on this page uses the averaged solver; the mechanics of each experiment's conditions "
+                  "are measured once and shared by the thermal networks.", "note"),
     ]
+    if not report.everything:
+        sections.append(paragraph(QUICK_NOTE, "status failed"))
     if report.matrix is not None:
         experiments = [
             paragraph(f"{experiment.name}: {experiment.title}. Source: {experiment.source}. Measured: "
