@@ -99,6 +99,38 @@ def test_bad_input_exits_2_with_one_line_naming_the_option(args, fragments):
     assert_one_error_line(result.stderr, *fragments)
 
 
+@pytest.mark.parametrize(
+    "setting, fragments",
+    [
+        # Issue 25: computed steel (578 N for 1007 N) and made 9154 balls for the impact's own vial.
+        ("ball_materials=wc", ("ball_materials:", "scalar ball keys", "per-ball lists apply to runs")),
+        ("fill=0.3", ("fill:", "one ball against its --target")),
+        ("engine=1d", ("engine:", "'dem' engine's contact law")),
+        ("yaw_amplitude=0.1", ("yaw_amplitude:", "vial at rest")),
+        ("duration=5", ("duration:", "one contact")),
+    ],
+)
+def test_keys_a_lone_impact_does_not_read_are_refused_with_why(setting, fragments):
+    result = invoke("--speed", "2", "--set", setting)
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, *fragments)
+
+
+def test_the_scalar_ball_material_reaches_the_impact_and_a_bound_with_a_unit_is_accepted():
+    steel, carbide = (invoke("--speed", "2", "--json", "--set", f"ball_material={name}") for name in ("steel", "wc"))
+    assert json.loads(carbide.stdout)["max_normal_force_N"] > 1.5 * json.loads(steel.stdout)["max_normal_force_N"]
+    smallest = invoke("--speed", "0.01", "--json", "--set", "ball_radius=25um")
+    assert smallest.exit_code == 0, smallest.stderr
+    assert json.loads(smallest.stdout)["max_overlap_m"] > 0.0
+
+
+def test_a_speed_too_slow_to_resolve_is_refused_at_once_with_numbers():
+    result = invoke("--speed", "1e-300")
+    assert result.exit_code == 2
+    assert_one_error_line(result.stderr, "--speed: 1e-300 m/s is too slow to resolve", "allowed speed·cos(angle) >= ")
+    assert "(0 s)" not in result.stderr
+
+
 def test_an_impact_the_engine_cannot_resolve_exits_2_naming_the_cause():
     result = invoke("--speed", "30", "--set", "ball_youngs_modulus=1e8")
     assert result.exit_code == 2

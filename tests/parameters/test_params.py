@@ -369,11 +369,13 @@ def test_values_beyond_the_hard_bounds_get_one_line_with_the_range(key: str, val
     assert str(info.value).startswith(message)
 
 
-def test_a_value_on_a_closed_bound_is_allowed_and_just_past_it_is_not() -> None:
+def test_a_value_on_a_closed_bound_is_allowed_and_past_its_tolerance_is_not() -> None:
     assert default_parameters(beta=100.0).beta == 100.0
     assert default_parameters(omega="1 rad/s").omega == 1.0
+    # A rounding step past the bound is the bound (issue 25: 25 um); a relative 1e-8 is a value of its own.
+    assert default_parameters(beta=100.0 * (1 + 1e-15)).beta == 100.0
     with pytest.raises(ParameterError, match="beta"):
-        default_parameters(beta=100.0 * (1 + 1e-15))
+        default_parameters(beta=100.0 * (1 + 1e-8))
 
 
 def test_bounds_read_open_and_closed_ends() -> None:

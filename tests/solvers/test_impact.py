@@ -15,7 +15,8 @@ from shakermill.physics.contact import (
     hertz_force,
     hertz_max_overlap,
 )
-from shakermill.solvers.impact import single_impact
+from shakermill.parameters.keys import FIELD_NAMES
+from shakermill.solvers.impact import UNREAD_KEYS, check_keys_read, restitution_warning, single_impact
 
 # A contact step of 2 % of the Rayleigh time: ~250 steps a contact, restitution within 4e-4 of e, contact
 # time within 0.4 % (one step). The default 0.05 leaves restitution errors up to ~8e-4.
@@ -278,3 +279,57 @@ def test_inputs_out_of_range_are_refused_naming_the_option(inputs, fragments):
 def test_an_impact_too_fast_for_the_material_is_refused_in_one_line():
     with pytest.raises(ParameterError, match="overlap exceeded 5 %"):
         single_impact(sm.default_parameters(ball_youngs_modulus=1e8), 30.0)
+
+
+@pytest.mark.parametrize("speed", [1e-11, 1e-30, 1e-300])
+def test_an_impact_too_slow_to_resolve_is_refused_at_once_with_its_least_speed(speed):
+    with pytest.raises(ParameterError) as caught:
+        single_impact(sm.default_parameters(), speed)
+    message = str(caught.value)
+    assert message.startswith("--speed:") and "too slow to resolve" in message
+    least = float(message.rpartition(">= ")[2].split()[0])
+    overlap = float(message.split("largest overlap, ")[1].split()[0])
+    # An overlap computed at the speed itself underflows to 0 at 1e-300 m/s.
+    assert 0.0 < overlap and 1e-11 < least < 1e-8
+
+
+def test_the_least_speed_resolved_is_computed_and_true_to_its_restitution():
+    params = sm.default_parameters()
+    with pytest.raises(ParameterError) as caught:
+        single_impact(params, 1e-12)
+    least = float(str(caught.value).rpartition(">= ")[2].split()[0])
+    assert single_impact(params, 1.01 * least).normal_restitution == pytest.approx(params.restitution, rel=1e-3)
+
+
+def test_a_near_grazing_impact_is_refused_by_its_normal_speed():
+    with pytest.raises(ParameterError, match=r"the normal speed, speed·cos\(angle\), is 1.75e-12 m/s"):
+        single_impact(sm.default_parameters(), 1.0, 89.9999999999)
+
+
+def test_the_keys_a_lone_impact_does_not_read_are_keys_and_refused_with_why():
+    for key in ("ball_materials", "fill", "n_balls", "engine", "gravity", "motion", "yaw_amplitude", "solver"):
+        assert key in UNREAD_KEYS
+    assert set(UNREAD_KEYS) <= set(FIELD_NAMES)
+    # What the contact law reads stays readable.
+    assert not {"ball_radius", "ball_material", "restitution", "friction", "contact_step_fraction"} & set(UNREAD_KEYS)
+    with pytest.raises(ParameterError, match="^ball_materials: a lone impact takes the scalar ball keys"):
+        check_keys_read(["restitution", "ball_materials", "fill"])
+    check_keys_read(["restitution", "ball_material"])
+
+
+def test_a_coarse_contact_step_is_warned_of_and_the_default_one_is_not():
+    coarse = sm.default_parameters(engine="dem", contact_step_fraction=0.9)
+    warning = restitution_warning(coarse)
+    assert warning is not None and "contact_step_fraction = 0.9" in warning and "% off" in warning
+    achieved = float(warning.split("restitution of ")[1].split(",")[0])
+    assert abs(achieved - coarse.restitution) > 0.01 * coarse.restitution
+    assert restitution_warning(sm.default_parameters(engine="dem")) is None
+    # The 1-D engine has no contact step.
+    assert restitution_warning(sm.default_parameters(contact_step_fraction=0.9)) is None
+
+
+@pytest.mark.slow
+def test_a_dem_run_with_a_coarse_contact_step_carries_the_warning_once():
+    coarse = sm.simulate(sm.default_parameters(engine="dem", contact_step_fraction=0.9, duration=0.2, solver="full"))
+    assert sum("contact_step_fraction = 0.9" in line for line in coarse.warnings) == 1
+    assert sum("contact_step_fraction" in line for line in coarse.summary["warnings"]) == 1

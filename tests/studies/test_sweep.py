@@ -25,7 +25,7 @@ from pandas.testing import assert_frame_equal
 
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.presets import default_parameters
-from shakermill.studies.sweep import SweepFailed, sweep
+from shakermill.studies.sweep import SweepFailed, SweepInterrupted, sweep
 from shakermill.studies.sweep_backends import connect
 from shakermill.studies.sweep_plan import SweepPlan, parse_grid, plan_sweep, point_ids, read_points, sweep_parameters
 from shakermill.studies.sweep_storage import (
@@ -736,9 +736,9 @@ def test_ctrl_c_keeps_the_finished_points_in_the_table_and_exits_130(tmp_path):
     os.killpg(process.pid, signal.SIGINT)
     _, stderr = process.communicate(timeout=120)
     assert process.returncode == 130, stderr
-    assert_one_error_line(stderr, "interrupted", f"--out {folder}")
     table = pd.read_parquet(folder / TABLE_PARQUET)
     finished = table["error"].isna()
+    assert_one_error_line(stderr, "interrupted", f"kept {finished.sum()} of 64 points", f"--out {folder}", f"the other {64 - finished.sum()}")
     assert finished.sum() == len(point_files(folder)) and 3 <= finished.sum() < 64
     assert table.loc[~finished, "error"].str.startswith("not finished").all()
     assert table["point_id"].is_unique and len(table) == 64
@@ -746,6 +746,87 @@ def test_ctrl_c_keeps_the_finished_points_in_the_table_and_exits_130(tmp_path):
     completed = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert completed.returncode == 0, completed.stderr
     assert load_sweep(folder).table["error"].isna().all()
+
+
+def _alive(processes: list) -> list[int]:
+    return [process.pid for process in processes if _live(process)]
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_a_3d_sweeps_workers_within_2_s_and_the_resume_computes_only_the_running_points(tmp_path):
+    import psutil
+
+    folder = tmp_path / "three_d"
+    # The 3-D engine at full resolution takes ~10 s of wall time per simulated second: the 0.2-s point ends while
+    # the 0.7-s and 1.2-s points run, and those would run for seconds more.
+    command = [str(SHAKERMILL), "sweep", "--preset", "spex8000m-3d", "--set", "solver=full", "--set", "record_windows=",
+               "--grid", "duration=0.2:1.2:3", "--out", str(folder), "--workers", "2"]  # fmt: skip
+    process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    descendants = []
+    try:
+        deadline = time.monotonic() + 180
+        while not ((folder / POINTS_FOLDER).is_dir() and point_files(folder)):
+            assert process.poll() is None and time.monotonic() < deadline, "the sweep ended or stalled before Ctrl-C"
+            time.sleep(0.01)
+        descendants = psutil.Process(process.pid).children(recursive=True)
+        assert len(descendants) >= 3  # two workers and the forkserver that started them
+        os.killpg(process.pid, signal.SIGINT)
+        signalled = time.monotonic()
+        while (process.poll() is None or _alive(descendants)) and time.monotonic() - signalled < 10:
+            time.sleep(0.01)
+        gone_after = time.monotonic() - signalled
+        assert process.poll() is not None and _alive(descendants) == [], f"still running {gone_after:.1f} s after Ctrl-C"
+        print(f"the sweep and its {len(descendants)} helper processes gone {gone_after:.2f} s after Ctrl-C")
+        assert gone_after < 2.0
+    finally:
+        for descendant in descendants:
+            if _live(descendant):
+                descendant.kill()
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+        stderr = process.communicate(timeout=30)[1]
+    assert process.returncode == 130, stderr
+    kept = {path.stem: path.stat().st_mtime_ns for path in point_files(folder)}
+    table = pd.read_parquet(folder / TABLE_PARQUET)
+    not_done = table.loc[table["error"].notna(), "point_id"].tolist()
+    assert 1 <= len(kept) < 3 and sorted(kept) == sorted(table.loc[table["error"].isna(), "point_id"])
+    assert table.set_index("point_id").loc[not_done, "error"].str.startswith("not finished").all()
+    assert_one_error_line(stderr, f"kept {len(kept)} of 3 points in {folder}", f"--out {folder} to compute the other {len(not_done)}")
+
+    resumed = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert resumed.returncode == 0, resumed.stderr
+    after = {path.stem: path.stat().st_mtime_ns for path in point_files(folder)}
+    # The resume ran exactly the points that were running: the kept point files are untouched, the others new.
+    assert {identifier: after[identifier] for identifier in kept} == kept
+    assert sorted(set(after) - set(kept)) == sorted(not_done)
+    assert load_sweep(folder).table["error"].isna().all()
+
+
+@pytest.mark.slow
+def test_ctrl_c_on_a_dask_sweep_cancels_the_points_not_finished(base, local_cluster, tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    cancelled: list[str] = []
+    cancel = distributed.Client.cancel
+
+    def recording_cancel(client, futures, *args, **kwargs):
+        cancelled.extend(future.key for future in futures)
+        return cancel(client, futures, *args, **kwargs)
+
+    monkeypatch.setattr(distributed.Client, "cancel", recording_cancel)
+
+    def ctrl_c_after_the_first_point(state) -> None:
+        if state.done >= 1:
+            raise KeyboardInterrupt
+
+    plan = plan_sweep(GRID)
+    with pytest.raises(SweepInterrupted) as interrupted:
+        # Full runs of ten simulated minutes: the other points still run when the first one is stored.
+        sweep(base.replace(solver="full", duration=600.0), plan, tmp_path / "dask", scheduler=local_cluster.scheduler_address,
+              progress=ctrl_c_after_the_first_point)
+    table = interrupted.value.table
+    assert interrupted.value.kept == 1 == table["error"].isna().sum() == len(point_files(tmp_path / "dask"))
+    # Every point not stored was cancelled, unless it finished between Ctrl-C and the cancel.
+    assert 0 < len(cancelled) <= len(plan.points) - 1
 
 
 README_SWEEP = """\

@@ -277,7 +277,9 @@ def calibrate(
     from shakermill.studies.validation import curve_from_option
 
     with user_errors():
-        run_config = load_config(config, preset=preset, overrides=settings or [])
+        # The fit evaluates with its own solver, not the one the parameters name.
+        reader = "full" if full_resolution else "averaged"
+        run_config = load_config(config, preset=preset, overrides=settings or [], reader=reader)
         targets = parse_targets(target or [])
         free_keys = parse_free(free or [], default_free(run_config.params))
         measured = [curve_from_option(item) for item in curve or ()]

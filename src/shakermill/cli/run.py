@@ -60,17 +60,19 @@ def run(
     from shakermill.parameters.config import load_config
     from shakermill.parameters.keys import unit_slip_warnings
     from shakermill.solvers.result import INTERRUPTED
+    from shakermill.solvers.simulate import preflight
 
     overrides = settings or []
     with user_errors():
         run_config = load_config(config, preset=preset, overrides=overrides)
         target = out if out is not None else timestamped_folder("run")
         check_target(target, overwrite=overwrite)
+        preflight(run_config.params)
     import_writers()
     # Unit slips and the solver's choice are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)
     echo_warnings(said_first)
-    echo_notes(solver_choice(run_config.params))
+    echo_notes([*run_config.notes, *solver_choice(run_config.params)])
     # A run returns what it computed when interrupted; Ctrl-C in the thermal network leaves none.
     with nothing_written_when_interrupted("the run had no results to keep yet"):
         result = simulate_with_progress(run_config.params)
@@ -300,7 +302,8 @@ def compare_solvers(
     from shakermill.studies.compare import compare_solvers as compare
 
     with user_errors(), nothing_written_when_interrupted("compare-solvers writes no files"):
-        params = load_config(config, preset=preset, overrides=settings or []).params
+        # Both solvers run: a key of the averaged one is read.
+        params = load_config(config, preset=preset, overrides=settings or [], reader="averaged").params
         comparison = compare(params, simulate_with_progress)
     if json_output:
         typer.echo(json.dumps(to_jsonable(comparison.as_dict()), sort_keys=True, allow_nan=False))
@@ -359,12 +362,15 @@ def impact(
 ) -> None:
     """One impact on its own, through the 'dem' engine: restitution, rebound, spin, contact time, peak force and
     the dissipated energy by channel. Materials, restitution, friction and the contact step come from --set."""
-    from shakermill.parameters.config import load_config
+    from shakermill.parameters.config import load_config, parse_overrides
     from shakermill.parameters.keys import unit_slip_warnings
-    from shakermill.solvers.impact import single_impact
+    from shakermill.solvers.impact import check_keys_read, single_impact
 
     with user_errors(), nothing_written_when_interrupted("impact writes no files"):
-        params = load_config(config, preset=preset, overrides=[*IMPACT_VIAL, *(settings or [])]).params
+        # Before the parameters are built: a fill would make balls for the impact's own large vial.
+        check_keys_read(parse_overrides(settings or []))
+        # A lone impact reads the keys its own way (solvers/impact.py), whatever engine the preset names.
+        params = load_config(config, preset=preset, overrides=[*IMPACT_VIAL, *(settings or [])], reader=None).params
         echo_warnings(unit_slip_warnings(params))
         outcome = single_impact(params, speed, angle, target, spin).as_dict()
     if json_output:

@@ -86,14 +86,15 @@ def sweep(
     json_output: JsonOption = False,
 ) -> None:
     """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
-    from shakermill.studies.sweep import SweepFailed
+    from shakermill.studies.sweep import SweepFailed, SweepInterrupted
     from shakermill.studies.sweep import sweep as run_sweep
-    from shakermill.studies.sweep_plan import plan_sweep, sweep_parameters
+    from shakermill.studies.sweep_plan import check_keys_read, plan_sweep, sweep_parameters
     from shakermill.studies.sweep_storage import is_sweep_folder
 
     with user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
         plan = plan_sweep(grid or [], points)
+        check_keys_read(run_config.params, plan)
     target = out if out is not None else timestamped_folder("sweep")
     try:
         counter = "{task.completed}/{task.total} points · {task.fields[running]} running · {task.fields[failed]} failed"
@@ -106,8 +107,17 @@ def sweep(
     except SweepFailed as exc:
         # Said below like any failed point, after the table's preview.
         table = exc.table
+    except SweepInterrupted as exc:
+        left = len(exc.table) - exc.kept
+        fail(
+            f"interrupted; kept {exc.kept} of {len(exc.table)} points in {target}; "
+            f"re-run the same command with --out {target} to compute the other {left}",
+            EXIT_INTERRUPTED,
+        )
     except KeyboardInterrupt:
-        fail(f"interrupted; the finished points are stored in {target}; re-run with --out {target} to finish", EXIT_INTERRUPTED)
+        # Before the sweep took its folder (or after it finished), there is nothing to resume.
+        resume = f"; re-run with --out {target} to finish" if is_sweep_folder(target) else "; no point was computed"
+        fail(f"interrupted{resume}", EXIT_INTERRUPTED)
     except OSError as exc:
         resume = f"; re-run with --out {target} to finish" if is_sweep_folder(target) else ""
         fail(f"{target}: cannot write the sweep ({exc.strerror or exc}){resume}")
@@ -211,6 +221,7 @@ def bifurcation(
     from shakermill.io.runs import check_target, write_folder
     from shakermill.studies.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
     from shakermill.studies.bifurcation import bifurcation as regime_scan
+    from shakermill.parameters.engine_keys import reader_of
     from shakermill.studies.sweep_plan import grid_unit, parse_grid, sweep_parameters
     from shakermill.views.figures.common import plot_figures
     from shakermill.views.figures.sweeps import bifurcation_figure, sweep_context
@@ -219,6 +230,9 @@ def bifurcation(
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
         _require_attractor_starts(run_config.params.engine)
         key, values = parse_grid(grid, most=MAX_BIFURCATION_VALUES)
+        unread = reader_of(run_config.params).unread_problem([key], "scanned")
+        if unread is not None:
+            fail(unread)
         # Checked before the scan: a value out of range would otherwise stop it midway.
         for value in (values[0], values[-1]):
             run_config.params.replace(**{key: float(value)})

@@ -21,6 +21,7 @@ from typing import Any, Mapping, Sequence
 import tomli_w
 
 from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import (
     Parameters,
@@ -47,6 +48,8 @@ class RunConfig:
     params: Parameters
     preset: str
     source: Path | None
+    # Sentences for the user that are no problem: the preset's keys that this run does not read.
+    notes: tuple[str, ...] = ()
 
 
 def load_config(
@@ -54,27 +57,52 @@ def load_config(
     *,
     preset: str | None = None,
     overrides: Sequence[str] = (),
+    reader: str | None = "run",
 ) -> RunConfig:
     """Resolve ``preset`` < file at ``path`` < ``overrides`` ("KEY=VALUE" strings) into parameters.
 
     Raises :class:`ParameterError` with one line for any bad input: a missing or
-    malformed file, a bad override, an unknown key or a value out of range.
+    malformed file, a bad override, an unknown key or a value out of range, and a key set explicitly (an override,
+    or a key of a file written by hand) that the run would not read: by its engine, or, with ``reader`` "run", by its
+    solver ("averaged": the solver of the command, whatever the parameters name; None: no check, for a command that
+    reads the keys its own way). The preset's keys that it would not read are ignored, and said in ``notes``.
     """
     file_values: dict[str, Any] = {}
     file_preset: str | None = None
     source = Path(path) if path is not None else None
+    written_by_hand = False
     if source is not None:
-        file_values = read_config_file(source)
+        document = _config_document(source)
+        written_by_hand = PROVENANCE_TABLE not in document
+        file_values = {key: value for key, value in document.items() if key != PROVENANCE_TABLE}
         file_preset = _file_preset(file_values, source)
     chosen_preset = preset or file_preset or DEFAULT_PRESET
     # Each layer completed by its own materials first: a file's material replaces the preset's values.
-    base = layered(with_materials(preset_values(chosen_preset)), with_materials(file_values))
-    params = build_parameters(base, parse_overrides(overrides))
-    return RunConfig(params=params, preset=chosen_preset, source=source)
+    preset_layer = preset_values(chosen_preset)
+    base = layered(with_materials(preset_layer), with_materials(file_values))
+    asked = parse_overrides(overrides)
+    params = build_parameters(base, asked)
+    if reader is None:
+        return RunConfig(params=params, preset=chosen_preset, source=source)
+    run = reader_of(params, None if reader == "run" else reader)
+    explicit = [*(key for key in file_values if written_by_hand and key != PRESET_KEY), *asked]
+    problem = run.unread_problem(explicit)
+    if problem is not None:
+        raise ParameterError(problem)
+    inherited = {key: value for key, value in preset_layer.items() if key not in explicit}
+    note = run.ignored_note(inherited, preset_values(DEFAULT_PRESET))
+    return RunConfig(params=params, preset=chosen_preset, source=source, notes=(note,) if note else ())
 
 
 def read_config_file(path: Path) -> dict[str, Any]:
     """The parameter entries of a TOML configuration (``preset`` included, ``[provenance]`` dropped)."""
+    document = _config_document(path)
+    document.pop(PROVENANCE_TABLE, None)
+    return document
+
+
+def _config_document(path: Path) -> dict[str, Any]:
+    """The whole TOML document of a configuration, ``[provenance]`` included where it has one."""
     text = _config_text(path)
     try:
         document = tomllib.loads(text)
@@ -83,7 +111,6 @@ def read_config_file(path: Path) -> dict[str, Any]:
         raise ParameterError(f"{path}: malformed TOML: {exc}") from None
     except ValueError:  # an integer of more digits than Python converts
         raise ParameterError(f"{path}: malformed TOML: a number too long to read") from None
-    document.pop(PROVENANCE_TABLE, None)
     return document
 
 

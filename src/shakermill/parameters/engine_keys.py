@@ -8,7 +8,7 @@ in this layer, below the engines; each engine carries its own as part of its des
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Iterable, Mapping
 
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 
@@ -82,6 +82,62 @@ ENGINE_KEYS: dict[str, EngineKeys] = {keys.name: keys for keys in (ONE_DIMENSION
 def reads(engine: str, key: str) -> bool:
     """Whether the engine named ``engine`` reads ``key`` (see :attr:`EngineKeys.unread`)."""
     return key not in ENGINE_KEYS[engine].unread
+
+
+# Keys only the averaged solver reads: a full-resolution run integrates every impact. (``attractor_starts`` too, but
+# its 1, "no probe", is what a full run does anyway, and scripts set it for either solver.)
+AVERAGED_ONLY = frozenset(
+    {"averaging_rel_error", "dem_averaging_rel_error", "averaging_batch_periods", "averaging_min_batches",
+     "averaging_max_time", "averaging_fallback"}
+)
+# Keys only the 'mill-head' network reads (engines/thermal/network.py): the vial's outside and the clamp.
+MILL_HEAD_ONLY = frozenset(
+    {"outer_diameter", "outer_length", "emissivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss", "drive_heat"}
+)
+
+
+@dataclass(frozen=True)
+class Reader:
+    """What decides whether a run reads a key: its engine, its solver and its thermal network."""
+
+    engine: str
+    solver: str
+    thermal_model: str
+
+    def not_read(self, key: str) -> str | None:
+        """Why a run would not read ``key`` (a phrase naming where it applies), or None."""
+        if not reads(self.engine, key):
+            readers = [name for name in ENGINE_KEYS if reads(name, key)]
+            where = f"engine = {readers[0]!r}" if len(readers) == 1 else "another engine"
+            return f"{ENGINE_KEYS[self.engine].title} (engine = {self.engine!r}) does not read it; it applies to {where}"
+        if self.solver != "averaged" and key in AVERAGED_ONLY:
+            return f"the {self.solver!r} solver does not read it; it applies to solver = 'averaged'"
+        if self.thermal_model != "mill-head" and key in MILL_HEAD_ONLY:
+            return f"the {self.thermal_model!r} network does not read it; it applies to thermal_model = 'mill-head'"
+        return None
+
+    def unread_problem(self, keys: Iterable[str], how: str = "set explicitly") -> str | None:
+        """One line for the first of ``keys``, given as ``how`` says, that the run would ignore, or None: a key set
+        and silently ignored gives wrong numbers with exit code 0."""
+        for key in keys:
+            why = self.not_read(key)
+            if why is not None:
+                return f"{key}: {how}, but {why}"
+        return None
+
+    def ignored_note(self, values: Mapping[str, Any], defaults: Mapping[str, Any]) -> str | None:
+        """A sentence naming the keys of a preset (``values``) that differ from ``defaults`` and that the run does
+        not read, or None: inherited, not asked for, so ignored, but said."""
+        ignored = [key for key, value in values.items()
+                   if key in defaults and value != defaults[key] and self.not_read(key) is not None]
+        if not ignored:
+            return None
+        return f"Ignored, as this run does not read them: the preset's {', '.join(ignored)}."
+
+
+def reader_of(params: Any, solver: str | None = None) -> Reader:
+    """The :class:`Reader` of a run of ``params`` (a ``Parameters``), with ``solver`` instead of its own if given."""
+    return Reader(params.engine, solver or params.solver, params.thermal_model)
 
 
 def declare(keys: EngineKeys) -> None:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import difflib
 import math
 import typing
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping
 
 import annotated_types
@@ -19,6 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from pydantic_core import PydanticCustomError
 
 from shakermill.parameters import consistency, guards, materials
+from shakermill.parameters.bounds import Bounds
 from shakermill.parameters.engine_keys import ENGINE_KEYS, MAX_BALLS
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.geometry import DENSEST_PACKING, ball_volume, balls_for_fill, end_faces_area, vial_volume
@@ -471,7 +471,8 @@ def _check_per_ball(key: str, values: tuple[float, ...], n_balls: int) -> None:
     scalar = SCALAR_KEY_OF[key]
     for number, value in enumerate(values, start=1):
         if not bounds(scalar).contains(value):
-            raise ValueError(f"{key}: value {number} ({value:g}) is out of range; allowed {allowed_range(scalar)}")
+            shown = _shown_value(value)
+            raise ValueError(f"{key}: value {number} ({shown}) is out of range; allowed {allowed_range(scalar, value)}")
 
 
 def field_unit(key: str) -> str:
@@ -482,24 +483,6 @@ def field_unit(key: str) -> str:
 def field_description(key: str) -> str:
     extra = Parameters.model_fields[key].json_schema_extra or {}
     return str(extra.get("description", ""))
-
-
-@dataclass(frozen=True)
-class Bounds:
-    """The hard bounds of a numeric key in its SI unit; ``str`` gives them in interval notation."""
-
-    low: float
-    high: float
-    low_open: bool
-    high_open: bool
-
-    def __str__(self) -> str:
-        return f"{'(' if self.low_open else '['}{self.low:g}, {self.high:g}{')' if self.high_open else ']'}"
-
-    def contains(self, value: float) -> bool:
-        above = value > self.low if self.low_open else value >= self.low
-        below = value < self.high if self.high_open else value <= self.high
-        return above and below
 
 
 def bounds(key: str) -> Bounds:
@@ -517,8 +500,9 @@ def bounds(key: str) -> Bounds:
     return Bounds(float(low), float(high), low_open, high_open)
 
 
-def allowed_range(key: str) -> str:
-    """Human-readable allowed values of ``key`` from its field constraints, e.g. '(0, 1]'."""
+def allowed_range(key: str, refused: Any = None) -> str:
+    """Human-readable allowed values of ``key`` from its field constraints, e.g. '(0, 1]', its bounds in
+    enough digits to tell them from the ``refused`` value."""
     field = Parameters.model_fields[key]
     choices = choices_of(key)
     if choices:
@@ -531,7 +515,7 @@ def allowed_range(key: str) -> str:
             f"{MAX_RECORDED_SECONDS:g} s of the run in all"
         )
     if key in PER_BALL_KEYS:
-        return f"an empty list or n_balls values, each in {allowed_range(SCALAR_KEY_OF[key])}"
+        return f"an empty list or n_balls values, each in {allowed_range(SCALAR_KEY_OF[key], refused)}"
     if key in MATERIAL_KEYS:
         return materials.allowed_for(key)
     if key == "motion":
@@ -539,9 +523,10 @@ def allowed_range(key: str) -> str:
             f"at most {MAX_HARMONICS} (coordinate, k, cos, sin) terms: coordinate one of {', '.join(MOTION_COORDINATES)}, "
             f"k in [0, {MAX_MOTION_HARMONIC}], translations in m, angles in rad"
         )
+    shown = bounds(key).shown(refused if isinstance(refused, float) else None)
     if field.annotation is int:
-        return f"a whole number in {bounds(key)}"
-    return f"{bounds(key)} {field_unit(key)}".rstrip()
+        return f"a whole number in {shown}"
+    return f"{shown} {field_unit(key)}".rstrip()
 
 
 def layered(lower: Mapping[str, Any], upper: Mapping[str, Any]) -> dict[str, Any]:
@@ -632,7 +617,7 @@ def _coerce(key: str, value: Any) -> Any:
     annotation = Parameters.model_fields[key].annotation
     try:
         if annotation is float:
-            return guards.quantity(key, value, field_unit(key))
+            return bounds(key).snapped(guards.quantity(key, value, field_unit(key)))
         if annotation is int:
             return guards.whole_number(key, value)
         if annotation is bool:
@@ -640,7 +625,8 @@ def _coerce(key: str, value: Any) -> Any:
         if key == "record_windows":
             return guards.windows(value)
         if key in PER_BALL_KEYS:
-            return guards.per_ball(key, value, field_unit(SCALAR_KEY_OF[key]))
+            scalar = SCALAR_KEY_OF[key]
+            return tuple(map(bounds(scalar).snapped, guards.per_ball(key, value, field_unit(scalar))))
         if key == "motion":
             return guards.motion(value)
         if key in MATERIAL_KEYS:
@@ -669,7 +655,7 @@ def _one_line(error: ValidationError) -> str:
     value = _shown_value(first.get("input"))
     message = str(first["msg"])
     problem = f"{value} is out of range" if first.get("type") in RANGE_ERRORS else f"{message[:1].lower()}{message[1:]} (got {value})"
-    return f"{key}: {problem}; allowed {allowed_range(key)}"
+    return f"{key}: {problem}; allowed {allowed_range(key, first.get('input'))}"
 
 
 def build_parameters(base: Mapping[str, Any], overrides: Mapping[str, Any] | None = None) -> Parameters:

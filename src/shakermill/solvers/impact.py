@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Iterable
 
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import PER_BALL_KEYS, Parameters
@@ -35,6 +35,62 @@ START_GAP_FRACTION = 0.1
 # The engine advances in chunks of one Hertz contact time; an impact whose record has not appeared after
 # this many has gone wrong (a damped contact lasts at most a few Hertz times).
 MAX_CHUNKS = 100
+# The largest overlap must span this many representable positions of the incoming ball's centre: fewer, and
+# rounding moves the restitution by per cents (the 6.35-mm steel ball at 1e-11 m/s, 450 of them: 0.713 for
+# 0.7); far fewer, and the ball never moves and the engine steps in flight for ever (1e-20 m/s: 31 s).
+MIN_OVERLAP_POSITIONS = 1e4
+# A head-on impact at the vial's peak speed stands for a run's impacts, within speeds that mills reach.
+GUARD_SPEEDS = (0.1, 20.0)  # m/s
+RESTITUTION_TOLERANCE = 0.01  # relative
+
+# What a lone impact does not read, each group with why: impact_parameters sets these keys itself, or the
+# impact has no use for them. A key set explicitly would otherwise be ignored without a word.
+_UNREAD_GROUPS = (
+    (
+        (*PER_BALL_KEYS, "ball_materials"),
+        "a lone impact takes the scalar ball keys (ball_material, ball_radius, ...); per-ball lists apply to runs "
+        "of several balls",
+    ),
+    (("n_balls", "fill"), "a lone impact is one ball against its --target; the number of balls applies to runs"),
+    (("engine",), "a lone impact always runs the 'dem' engine's contact law"),
+    (
+        ("gravity", "kinematics", "motion", "amplitude", "omega", "phase", "lateral_amplitude", "yaw_amplitude",
+         "swing_radius"),
+        "a lone impact happens in a vial at rest without gravity; the vial's motion applies to runs",
+    ),
+    (
+        ("vial_length", "vial_diameter"),
+        "the vial's size plays no part in a lone impact, only its material (vial_material, vial_youngs_modulus, ...)",
+    ),
+    (
+        ("ball_position", "ball_momentum"),
+        "a lone impact starts the ball at its target with --speed, --angle and --spin",
+    ),
+    (
+        ("solver", "duration", "output_interval", "record_windows", "max_wall_time", "max_steps", "rtol",
+         "atol_position", "atol_momentum", "atol_temperature", "energy_projection", "averaging_rel_error",
+         "dem_averaging_rel_error", "averaging_batch_periods", "averaging_min_batches", "averaging_max_time",
+         "averaging_fallback", "attractor_starts"),
+        "a lone impact lasts one contact; how long and how a run is integrated applies to runs",
+    ),
+    (
+        ("ball_heat_capacity", "vial_heat_capacity", "vial_mass", "vial_density", "ball_conductivity",
+         "vial_conductivity", "air_density", "air_viscosity_ref", "air_reference_temperature", "air_conductivity",
+         "air_cp", "air_heat_capacity_ratio", "sutherland", "h_inner", "h_outer", "inner_area", "outer_area",
+         "thermal_model", "outer_diameter", "outer_length", "emissivity", "clamp_heat_capacity", "clamp_conductance",
+         "clamp_loss", "drive_heat", "eta", "lam", "beta", "ambient_temperature", "initial_temperature",
+         "ball_temperature_limit", "model", "heat_model", "convection_velocity"),
+        "a lone impact reports mechanics and dissipated energy, no heat or temperatures",
+    ),
+)
+UNREAD_KEYS: dict[str, str] = {key: why for keys, why in _UNREAD_GROUPS for key in keys}
+
+
+def check_keys_read(keys: Iterable[str]) -> None:
+    """Raise :class:`ParameterError` naming the first of ``keys`` (set explicitly) that a lone impact does not read."""
+    for key in keys:
+        if key in UNREAD_KEYS:
+            raise ParameterError(f"{key}: {UNREAD_KEYS[key]}")
 
 
 @dataclass(frozen=True)
@@ -137,11 +193,63 @@ def single_impact(
     from shakermill.engines.dem.engine import DemEngine
 
     engine = DemEngine(impact_parameters(params, target), None, np.zeros(1), 0.0)
+    _check_resolved(engine, target, speed, angle_deg)
     contact_time, gap = _hertz_scales(engine, target, speed * math.cos(math.radians(angle_deg)))
     incoming = _launch(engine, target, speed, math.radians(angle_deg), spin, gap)
     kinetic_in = engine.kinetic_energy()
     record = _first_record(engine, contact_time)
     return _outcome(engine, record, incoming, speed, math.radians(angle_deg), kinetic_in)
+
+
+def restitution_warning(params: Parameters) -> str | None:
+    """A warning where the 'dem' engine's contact step misses the configured restitution by more than
+    :data:`RESTITUTION_TOLERANCE`, measured on one head-on impact of a ball on the end face at the vial's peak
+    speed (within :data:`GUARD_SPEEDS`); None for another engine, or where the impact is within it."""
+    if params.engine != "dem":
+        return None
+    low, high = GUARD_SPEEDS
+    speed = min(max(params.amplitude * params.omega, low), high)
+    try:
+        achieved = single_impact(params, speed).normal_restitution
+    except ParameterError:
+        return None  # too fast for the materials: the run's own status says so
+    error = abs(achieved - params.restitution) / params.restitution
+    if error <= RESTITUTION_TOLERANCE:
+        return None
+    return (
+        f"contact_step_fraction = {params.contact_step_fraction:g} resolves a head-on impact at {speed:.3g} m/s with a "
+        f"restitution of {achieved:.3f}, {100 * error:.1f} % off the configured restitution = {params.restitution:g}; "
+        f"a smaller contact_step_fraction (0.05 is the default) keeps it within {100 * RESTITUTION_TOLERANCE:g} %"
+    )
+
+
+def _check_resolved(engine: DemEngine, target: str, speed: float, angle_deg: float) -> None:
+    """Raise :class:`ParameterError` where the impact's largest overlap spans fewer than
+    :data:`MIN_OVERLAP_POSITIONS` representable positions of the incoming ball's centre, with the least speed."""
+    import numpy as np
+
+    from shakermill.engines.dem.model import LEFT_END
+    from shakermill.physics.contact import hertz_max_overlap
+
+    k = engine.constants
+    if target == "wall":
+        mass, radius, modulus, where = k.mass[0], k.wall_radius[0, LEFT_END], k.wall_modulus[0], k.half_length
+    else:
+        mass, radius, modulus, where = k.pair_mass[0, 1], k.pair_radius[0, 1], k.pair_modulus[0, 1], 0.0
+    # Scaled from 1 m/s, as the overlap grows as v^(4/5): computed at 1e-300 m/s it would underflow to 0.
+    per_speed = hertz_max_overlap(mass, radius, modulus, 1.0)
+    normal_speed = speed * math.cos(math.radians(angle_deg))
+    overlap = per_speed * normal_speed**0.8
+    resolution = float(np.spacing(where + k.radius[0]))
+    if overlap >= MIN_OVERLAP_POSITIONS * resolution:
+        return
+    least = (MIN_OVERLAP_POSITIONS * resolution / per_speed) ** 1.25
+    head_on = "" if angle_deg == 0.0 else f" (the normal speed, speed·cos(angle), is {normal_speed:.3g} m/s)"
+    raise ParameterError(
+        f"--speed: {speed:.3g} m/s{head_on} is too slow to resolve: its largest overlap, {overlap:.3g} m, spans "
+        f"{overlap / resolution:.3g} of the {resolution:.3g}-m steps in which the engine places the ball, fewer than "
+        f"the {MIN_OVERLAP_POSITIONS:g} an impact needs; allowed speed·cos(angle) >= {least:.3g} m/s here"
+    )
 
 
 def _hertz_scales(engine: DemEngine, target: str, normal_speed: float) -> tuple[float, float]:

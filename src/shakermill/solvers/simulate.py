@@ -9,19 +9,55 @@ from shakermill.engines.budget import BudgetExceeded, RunBudget
 from shakermill.engines.interface import ProgressCallback
 from shakermill.engines.registry import engine_named
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
+from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.averaged import Mechanics, full_resolution_instead, settle_mechanics, simulate_averaged
+from shakermill.solvers.driver import sample_times
 from shakermill.solvers.full import simulate_full
-from shakermill.solvers.result import INTERRUPTED, Result
+from shakermill.solvers.impact import restitution_warning
+from shakermill.solvers.result import INTERRUPTED, Result, summarize
 
 
 def simulate(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
     """Run ``params`` with the engine and solver it names, within ``budget`` (``params``' own if None): see
-    :func:`~shakermill.solvers.full.simulate_full` and :func:`~shakermill.solvers.averaged.simulate_averaged`."""
+    :func:`~shakermill.solvers.full.simulate_full` and :func:`~shakermill.solvers.averaged.simulate_averaged`.
+    Raises :class:`ParameterError` before anything is allocated for a run that would not fit (:func:`preflight`)."""
+    preflight(params)
+    # Measured before the run, so that a Ctrl-C is not kept waiting for it (its first call loads compiled code).
+    caution = restitution_warning(params)
     engine = engine_named(params.engine)
     if params.solver == "averaged":
-        return simulate_averaged(params, engine, progress, budget)
-    return simulate_full(params, engine, progress, budget)
+        result = simulate_averaged(params, engine, progress, budget)
+    else:
+        result = simulate_full(params, engine, progress, budget)
+    if caution is not None and caution not in result.warnings:
+        result.warnings.append(caution)
+        result.summary = summarize(result)
+    return result
+
+
+# Of the memory the machine has free, what a run's records may take: the rest is for the run itself and the OS.
+MEMORY_SHARE = 0.8
+
+
+def preflight(params: Parameters) -> None:
+    """Raise :class:`ParameterError` with the estimate and the keys to change where the records and windows a run of
+    ``params`` allocates at its start exceed the memory free on this machine (an engine that declares
+    ``memory_needed``; the 1-D engine's windows are capped instead)."""
+    import psutil
+
+    needed_by = getattr(engine_named(params.engine), "memory_needed", None)
+    if needed_by is None:
+        return
+    needed = needed_by(params, sample_times(params).size)
+    free = psutil.virtual_memory().available
+    if needed > MEMORY_SHARE * free:
+        raise ParameterError(
+            f"record_windows: the run would keep {needed / 2**30:.3g} GiB of records ({params.n_balls} balls, "
+            f"{sum(length for _, length in params.record_windows):g} s of record windows, a sample every "
+            f"{params.output_interval:g} s), more than the {MEMORY_SHARE * free / 2**30:.3g} GiB it may take of the "
+            f"{free / 2**30:.3g} GiB free; allowed shorter record_windows or a longer output_interval"
+        )
 
 
 def simulate_whole(params: Parameters) -> Result:

@@ -302,6 +302,8 @@ def calibrate(
     lower, upper = (np.array(side) for side in zip(*(log_bounds(key, start[key]) for key in free)))
     # The fit needs the configured motion only: probing other attractors would cost every evaluation.
     longest = max((float(measured.times.max()) for measured in curves), default=0.0)
+    if full_resolution:
+        check_full_resolution_work(base, max(base.duration, longest))
     fitting = base.replace(solver=solver, attractor_starts=1, duration=max(base.duration, longest))
     evaluate, cache = _evaluator(fitting, free, targets, curves, progress)
     solution = least_squares(
@@ -371,6 +373,25 @@ def _evaluator(fitting: Parameters, free: Sequence[str], targets: Mapping[str, f
         return cache[key]
 
     return evaluate, cache
+
+
+# The longest run a full-resolution fit of an engine of several balls may evaluate (s): one of its simulated seconds
+# takes 1-20 s of wall time here (benchmarks/README.md), and a fit evaluates hundreds to thousands of runs.
+LONGEST_FULL_RESOLUTION_FIT_S = 60.0
+# Model evaluations of the 3-D calibrations shipped (benchmarks/README.md).
+TYPICAL_EVALUATIONS = 2000
+
+
+def check_full_resolution_work(base: Parameters, duration: float) -> None:
+    """Refuse, with the estimate, a full-resolution fit that could not end in reasonable time: each evaluation a
+    run of the 'dem' engine over the whole curve."""
+    if not describe(base.engine).several_balls or duration <= LONGEST_FULL_RESOLUTION_FIT_S:
+        return
+    raise ParameterError(
+        f"--full-resolution: each of the fit's ~{TYPICAL_EVALUATIONS} evaluations would run {duration:g} s of "
+        f"engine = {base.engine!r} at full resolution (1-20 s of wall time a simulated second here), days in all; "
+        f"allowed the averaged solver (the default) for it, or runs of at most {LONGEST_FULL_RESOLUTION_FIT_S:g} s"
+    )
 
 
 def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float] | None,

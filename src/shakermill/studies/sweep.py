@@ -27,6 +27,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import pandas as pd
 
+from shakermill.engines.budget import interrupts_held
 from shakermill.parameters.defaults import DEFAULT_PRESET, DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
@@ -73,6 +74,15 @@ class SweepFailed(RuntimeError):
         self.table = table
 
 
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a sweep: ``kept`` of its points are stored (the table says which), the others are marked not
+    finished, and running the same sweep into ``folder`` again computes only those."""
+
+    def __init__(self, table: pd.DataFrame, folder: Path, kept: int) -> None:
+        super().__init__(f"interrupted; kept {kept} of {len(table)} points in {folder}")
+        self.table, self.folder, self.kept = table, folder, kept
+
+
 # The sweep ----------------------------------------------------------------------------------------
 
 
@@ -99,7 +109,8 @@ def sweep(
     earlier run of the same sweep are skipped. Raises :class:`ParameterError` (one line) for bad
     input, a folder that holds another sweep, or an unreachable scheduler,
     :class:`~shakermill.atomic.StorageError` for a place where the folder cannot be created, and
-    :class:`SweepFailed` (naming the first failure) when no point succeeded.
+    :class:`SweepFailed` (naming the first failure) when no point succeeded. Ctrl-C stops the workers at once and
+    raises :class:`SweepInterrupted` (a ``KeyboardInterrupt``) once the table holds the finished points.
     """
     plan = as_plan(grid_points)
     _check_execution(workers, scheduler)
@@ -110,6 +121,14 @@ def sweep(
     stored = stored_rows(folder, ids, warn=True)
     pending = [(identifier, values) for identifier, values in zip(ids, plan.points) if identifier not in stored]
     unfinished: dict[str, str] = {}
+    kept = len(stored)
+
+    def tabulate() -> pd.DataFrame:
+        # Also on Ctrl-C: the table then holds the finished points, the others marked not finished.
+        table = build_table(folder, plan.keys, ids, plan.points, unfinished)
+        write_table(table, folder)
+        return table
+
     # The backend first: an unreachable scheduler leaves no folder behind.
     with backend_for(workers, scheduler, scheduler_timeout, len(pending)) as backend:
         claim_folder(folder, manifest)
@@ -121,11 +140,18 @@ def sweep(
                     tracker.finished(failed=True)
                     continue
                 row = store_point(folder, identifier, outcome, preset)
+                kept += 1
                 tracker.finished(failed=row.get("error") is not None)
-        finally:
-            # Also on Ctrl-C: the table then holds the finished points, the others marked not finished.
-            table = build_table(folder, plan.keys, ids, plan.points, unfinished)
-            write_table(table, folder)
+        except BaseException as stopped:
+            # The workers stop before the table is written, not after their points end; a second Ctrl-C
+            # meanwhile must leave neither workers running nor the table unwritten.
+            with interrupts_held(deliver=False):
+                backend.stop()
+                table = tabulate()
+            if isinstance(stopped, KeyboardInterrupt):
+                raise SweepInterrupted(table, folder, kept) from None
+            raise
+        table = tabulate()
     if len(failed_points(table)) == len(table):
         raise SweepFailed(table, folder)
     return table

@@ -8,7 +8,7 @@ import logging
 import os
 import sys
 import warnings
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterator, Mapping, Sequence
@@ -40,11 +40,32 @@ class _InProcess:
             except PointInterrupted:
                 raise KeyboardInterrupt from None
 
+    def stop(self) -> None:
+        """Nothing runs elsewhere: the interrupted point stopped with this process's own run."""
+
+
+# How long a terminated worker may take to exit before it is killed (s); the sweep promises to stop within 2 s.
+WORKER_EXIT_WAIT_S = 0.5
+
 
 @dataclass
 class _LocalPool:
     slots: int
     executor: Any = field(default=None)
+
+    def stop(self) -> None:
+        """Terminate the workers rather than wait for their points: those results would be thrown away, and a
+        3-D point can run for minutes. Workers only compute (the sweep's process stores every point), so nothing
+        of theirs is left half-written."""
+        # No public handle on the workers before Python 3.14 (ProcessPoolExecutor.terminate_workers).
+        processes = list((self.executor._processes or {}).values())
+        for process in processes:
+            process.terminate()
+        self.executor.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            process.join(WORKER_EXIT_WAIT_S)
+            if process.is_alive():
+                process.kill()
 
     def outcomes(self, base: Parameters, tasks: Sequence[Task], keep_runs: bool) -> Outcomes:
         from concurrent.futures import as_completed
@@ -59,15 +80,24 @@ class _LocalPool:
 class _Cluster:
     client: Client
     slots: int
+    submitted: list[Any] = field(default_factory=list)
 
     def outcomes(self, base: Parameters, tasks: Sequence[Task], keep_runs: bool) -> Outcomes:
         from distributed import as_completed
 
         # pure=False: a point is a computation to run, not a value Dask may deduplicate or cache.
         futures = {self.client.submit(run_point, base, values, keep_runs, pure=False): identifier for identifier, values in tasks}
+        self.submitted = list(futures)
         # The client is not Dask's default one (set_as_default=False), so as_completed is told its loop.
         for future in as_completed(futures, loop=self.client.loop):
             yield futures[future], future.result() if future.status == "finished" else _cluster_error(future)
+
+    def stop(self) -> None:
+        """Cancel the points not yet finished: the cluster's workers drop them instead of computing them for nobody."""
+        pending = [future for future in self.submitted if not future.done()]
+        if pending:
+            with suppress(Exception):  # a scheduler already gone has nothing left to cancel
+                self.client.cancel(pending)
 
 
 def _cluster_error(future: Any) -> BaseException:
@@ -81,8 +111,12 @@ def _cluster_error(future: Any) -> BaseException:
 def backend_for(workers: int | None, scheduler: str | None, timeout: float, pending: int) -> Iterator[Any]:
     if scheduler is not None:
         client = connect(scheduler, timeout)
+        cluster = _Cluster(client, max(1, sum(client.nthreads().values())))
         try:
-            yield _Cluster(client, max(1, sum(client.nthreads().values())))
+            yield cluster
+        except BaseException:
+            cluster.stop()
+            raise
         finally:
             client.close()
         return
@@ -100,11 +134,12 @@ def backend_for(workers: int | None, scheduler: str | None, timeout: float, pend
         yield _InProcess()
         return
     executor = _process_pool(size, context)
+    pool = _LocalPool(size, executor)
     try:
-        yield _LocalPool(size, executor)
+        yield pool
     except BaseException:
-        # Ctrl-C or an error while storing: queued points are dropped; running ones end with the pool.
-        executor.shutdown(wait=False, cancel_futures=True)
+        # Ctrl-C or an error while storing: queued points are dropped, running ones stopped.
+        pool.stop()
         raise
     executor.shutdown()
 

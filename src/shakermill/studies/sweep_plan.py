@@ -17,6 +17,7 @@ import numpy as np
 from shakermill.io.runs import to_jsonable
 from shakermill.parameters.config import RunConfig, load_config, parse_overrides, read_config_file
 from shakermill.parameters.csvinput import read_csv_rows
+from shakermill.parameters.engine_keys import Reader
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.guards import whole_number
 from shakermill.parameters.keys import Parameters, check_known_keys, checked_name, field_unit, takes_names
@@ -229,6 +230,16 @@ def as_plan(grid_points: SweepPlan | Mapping[str, Sequence[Any]] | Sequence[Mapp
         if tuple(point) != keys:
             raise ParameterError(f"sweep: point {number} sets {sorted(point)}, the first point {sorted(keys)}")
     return SweepPlan(keys, tuple({key: normalize_value(key, value) for key, value in point.items()} for point in points))
+
+
+def check_keys_read(base: Parameters, plan: SweepPlan) -> None:
+    """Refuse, in one line, a swept key that a point's run would not read (its engine, or its solver): every point
+    would give the same numbers under different labels."""
+    for point in plan.points:
+        run = Reader(*(point.get(key, getattr(base, key)) for key in ("engine", "solver", "thermal_model")))
+        problem = run.unread_problem(plan.keys, "swept")
+        if problem is not None:
+            raise ParameterError(problem)
 
 
 def point_id(base: Parameters, values: Mapping[str, Any]) -> str:

@@ -77,6 +77,14 @@ class DemEngine(CompiledRun):
     def network_for(cls, params: Parameters) -> ThermalNetwork:
         return model.network_of(params)
 
+    @classmethod
+    def memory_needed(cls, params: Parameters, samples: int) -> int:
+        """Bytes of the state rows a run of ``params`` allocates at its start: one at each of its ``samples`` and every
+        WINDOW_INTERVAL of its record windows (50 balls over 600 s of windows: ~28 GiB)."""
+        windows = sum(max(0.0, min(length, params.duration - start)) for start, length in params.record_windows)
+        rows = samples + windows / WINDOW_INTERVAL
+        return int(rows * model.row_width(params.n_balls, len(cls.network_for(params).nodes)) * 8)
+
     @property
     def node_count(self) -> int:
         return len(self.network.nodes)
