@@ -29,6 +29,7 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
+import shakermill as sm
 from shakermill import cli
 
 CORPUS = Path(__file__).resolve().parents[1] / "hostile"
@@ -71,9 +72,20 @@ def test_the_corpus_is_large_and_its_names_unique():
     assert {case["expect"] for case in CASES} <= set(EXIT_CODES)
 
 
+@pytest.fixture(name="compiled_engines", scope="module")
+def compiled_engines_fixture() -> None:
+    """Each engine's compiled code loaded in this process once, before any case is timed: on a fresh clone Numba
+    compiles it on the first call (a minute on a busy machine), which no case's bound is about."""
+    from shakermill.solvers.impact import single_impact
+
+    single_impact(sm.default_parameters(), 1.0)
+    for preset in ("spex8000m", "spex8000m-3d"):
+        sm.simulate(sm.default_parameters(preset, duration=0.01, solver="full", record_windows=()))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=[f"{case['corpus']}: {case['name']}" for case in CASES])
-def test_hostile_input_ends_cleanly_and_in_time(case, tmp_path):
+def test_hostile_input_ends_cleanly_and_in_time(case, tmp_path, compiled_engines):
     runner = CliRunner()
     for command in case.get("before", []):
         prepared = runner.invoke(cli.app, [expand(argument, tmp_path) for argument in command])
