@@ -752,7 +752,8 @@ def test_real_ctrl_c_in_validate_says_so_in_one_line(start_up_s):
     time.sleep(start_up_s + 2.0)
     assert process.poll() is None, "validate ended before it could be interrupted"
     process.send_signal(signal.SIGINT)
-    stdout, stderr = process.communicate(timeout=30)
+    # Heard between bytecodes: on a fresh clone a compilation still running (Numba's, tens of seconds) comes first.
+    stdout, stderr = process.communicate(timeout=120)
     assert process.returncode == 130 and stdout == ""
     said, interrupted = stderr.strip().splitlines()  # what it is about to do, then the Ctrl-C
     assert said.startswith("validate: quick")
@@ -767,8 +768,8 @@ TINY_STEPS = [*(f"--set={key}={value}" for key, value in TIGHTEST_TOLERANCES.ite
     "command, first_words",
     [
         (["run", "--set", "solver=full", "--no-plots", "--out", "{out}"], "interrupted:"),
-        # Its mechanics settle at once; the probe of its attractors, stuck on tiny steps, is stopped and the run kept.
-        (["run", "--set", "solver=averaged", "--no-plots", "--out", "{out}"], "interrupted: Interrupted by the user while probing attractors"),
+        # Stopped in its mechanics or in the probe of its attractors (as the machine's load has it), the run is kept.
+        (["run", "--set", "solver=averaged", "--no-plots", "--out", "{out}"], "interrupted: Interrupted by the user"),
         (["bifurcation", "--grid", "omega=100:120:2", "--out", "{out}"], "error: interrupted; nothing was written"),
         (["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", "{out}.toml"], "error: interrupted; nothing was written"),
     ],
