@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
+from shakermill.solvers import simulate as simulate_module
+from shakermill.solvers.result import INTERRUPTED
 from shakermill.studies.validation import (
     CURVE_QUANTITIES,
     CURVE_TOLERANCE_K,
@@ -69,3 +73,10 @@ def test_curve_residuals_interpolate_the_model_at_the_curve_times() -> None:
     theta_K = np.array([293.15, 294.15, 298.65])  # 295.65 K = 22.5 °C at 60 s
     np.testing.assert_allclose(curve.residuals_K(times, theta_K), [0.0, 0.5])
     assert curve.rms_K(times, theta_K) == pytest.approx(np.sqrt(0.125))
+
+
+def test_a_run_of_table5_cut_short_by_ctrl_c_stops_the_validation(monkeypatch):
+    # An interrupted run returns what it computed: Table 5 must not take it for the hour.
+    monkeypatch.setattr(simulate_module, "simulate", lambda params, **_: SimpleNamespace(status=INTERRUPTED))
+    with pytest.raises(KeyboardInterrupt):
+        validate(solver="averaged")

@@ -89,6 +89,7 @@ def validate(
     typer.echo(f"validate: {'everything (--full), ~17 min' if full else 'quick, ~2 min; --full for everything (~17 min)'}; "
                f"Table 5 with the {solver} solver" + (", then the 3-D validation matrix" if three_d else ""), err=True)
     with (nothing_written_when_interrupted("validate prints and writes once every run has ended"),
+          nothing_written_when_a_run_is_stopped("validate"),
           progress_bar("3-D validation", "{task.completed}/{task.total} runs", None, lines_when_piped=True) as update):
         show = None if update is None else lambda done, total: update(done, total=total)
         report = validation_report(solver, study, three_d, progress=show, everything=full)
