@@ -72,7 +72,8 @@ def run(
     # Unit slips and the solver's choice are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)
     echo_warnings(said_first)
-    echo_notes([*run_config.notes, *solver_choice(run_config.params)])
+    said_notes = solver_choice(run_config.params)
+    echo_notes([*run_config.notes, *said_notes])
     # A run returns what it computed when interrupted; Ctrl-C in the thermal network leaves none.
     with nothing_written_when_interrupted("the run had no results to keep yet"):
         result = simulate_with_progress(run_config.params)
@@ -92,7 +93,7 @@ def run(
     elif finished:
         console = stdout_console()
         console.print(summary_table(result, target))
-        console.print(Text(answer_text(result.summary, run_config.preset, said=solver_choice(run_config.params))))
+        console.print(Text(answer_text(result.summary, run_config.preset, said=said_notes)))
     if not finished:
         _exit_interrupted(result, target)
     _exit_for_status(result, target)

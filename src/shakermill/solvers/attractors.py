@@ -122,5 +122,5 @@ def probed(result: Result) -> AttractorScan:
 def attach(result: Result, scan: AttractorScan) -> None:
     """Give ``result`` the scan, its warnings, and its summary keys (``n_attractors``, ``heat_power_spread_W``, ...)."""
     result.attractors = scan
-    result.warnings.extend(line for line in scan.warnings() if line not in result.warnings)
+    result.warn(*scan.warnings())
     result.summary = summarize(result)

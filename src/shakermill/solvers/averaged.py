@@ -35,7 +35,7 @@ from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.attractors import probe_attractors
-from shakermill.solvers.driver import Means, measure_means, sample_times
+from shakermill.solvers.driver import Means, least_batches, measure_means, sample_times
 from shakermill.solvers.full import concluded, simulate_full
 from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages, Result, conclude, summarize
 
@@ -95,7 +95,7 @@ def simulate_averaged(params: Parameters, engine_class: type[Engine], progress: 
     if reason is not None and mechanics is None:
         result = simulate_full(params, engine_class, progress, budget)
         result.message = f"{reason} {result.message}"
-        result.notes.insert(0, reason)
+        result.note(reason, first=True)
         result.summary = summarize(result)
         return result
     started = time.perf_counter()
@@ -111,9 +111,9 @@ def simulate_averaged(params: Parameters, engine_class: type[Engine], progress: 
 
 
 def least_mechanics(params: Parameters) -> float:
-    """The least mechanics (s) an averaged run can end with: twice ``averaging_min_batches`` batches, since the
-    start-up transient cut off (MSER) may take up to half of them (``solvers.driver.measure_means``)."""
-    return 2 * params.averaging_min_batches * params.averaging_batch_periods * params.period
+    """The least mechanics (s) an averaged run can end with: :func:`~solvers.driver.least_batches` batches of
+    ``averaging_batch_periods`` drive periods."""
+    return least_batches(params) * params.averaging_batch_periods * params.period
 
 
 def full_resolution_instead(params: Parameters) -> str | None:
@@ -271,7 +271,7 @@ def _refuse(params: Parameters, engine_class: type[Engine], mechanics: Mechanics
         result = simulate_full(params, engine_class, progress, budget)
         fell_back = f"Averaging is not valid ({averages.message}); ran at full resolution instead."
         result.message = f"{fell_back} {result.message}"
-        result.warnings.insert(0, fell_back)
+        result.warn(fell_back, first=True)
         result.averages = averages
         result.wall_time = time.perf_counter() - started
     result.summary = summarize(result)

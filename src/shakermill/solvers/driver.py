@@ -93,7 +93,7 @@ def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback
             heartbeat(engine.t)
         cumulative.append(_flat(engine.measured()))
         rates = batch_rates(np.array(cumulative), batch)  # (batches, sources, balls' terms, conductances, dissipated)
-        if len(rates) >= 2 * params.averaging_min_batches:
+        if len(rates) >= least_batches(params):
             totals = np.column_stack([rates[:, :sources].sum(axis=1), rates[:, sources : sources + balls].mean(axis=1)])
             cut = max(mser_truncation(normalised(column)) for column in totals.T)
             kept = np.column_stack([totals[cut:], rates[cut:, : sources + balls]])
@@ -109,6 +109,12 @@ def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback
             break
     rates = batch_rates(np.array(cumulative), batch)[cut:]
     return _means(engine, rates, sources, balls, cut * batch, batch, converged, message), status
+
+
+def least_batches(params: Parameters) -> int:
+    """The fewest batches :func:`measure_means` tests for convergence: twice ``averaging_min_batches``, since the
+    start-up transient that MSER cuts off may take up to half of them."""
+    return 2 * params.averaging_min_batches
 
 
 def mechanics_limit(params: Parameters) -> tuple[float, str]:

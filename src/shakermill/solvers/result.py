@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
@@ -112,6 +112,15 @@ class Result:
     def success(self) -> bool:
         return self.status == REACHED_STOP
 
+    def warn(self, *lines: str | None, first: bool = False) -> None:
+        """Add each of ``lines`` (None is skipped) to the warnings once: a run concluded again, or a scan attached
+        again, must not repeat one. ``first``: before the others."""
+        _add_once(self.warnings, lines, first)
+
+    def note(self, *lines: str | None, first: bool = False) -> None:
+        """Add each of ``lines`` (None is skipped) to the notes once, as :meth:`warn` does the warnings."""
+        _add_once(self.notes, lines, first)
+
     @property
     def impact_count(self) -> int:
         return int(self.impact_columns["time"].size)
@@ -142,6 +151,12 @@ class Result:
         return present("result html", self)
 
 
+def _add_once(said: list[str], lines: Sequence[str | None], first: bool) -> None:
+    new = [line for line in dict.fromkeys(lines) if line is not None and line not in said]
+    position = 0 if first else len(said)
+    said[position:position] = new
+
+
 def conclude(result: Result, network: ThermalNetwork, load: NetworkLoad) -> Result:
     """The steady state of ``network`` under ``load`` (MODEL.md §11), the mean flow of each heat path over the run,
     physical bounds, energy audit and warnings of a finished run, then its summary."""
@@ -149,12 +164,8 @@ def conclude(result: Result, network: ThermalNetwork, load: NetworkLoad) -> Resu
     result.steady = steady_state(network, load)
     result.load = load
     result.heat_paths = mean_path_flows(network, result.history, load.drives)
-    for line in (*unit_slip_warnings(params), steady_state_bound_warning(result), fit_warning(result)):
-        if line is not None and line not in result.warnings:
-            result.warnings.append(line)
-    length_note = run_length_note(result.t_end, result.steady)
-    if length_note is not None and length_note not in result.notes:
-        result.notes.append(length_note)
+    result.warn(*unit_slip_warnings(params), steady_state_bound_warning(result), fit_warning(result))
+    result.note(run_length_note(result.t_end, result.steady))
     checks = ((OUT_OF_PHYSICAL_BOUNDS, physical_bounds_problem), (ENERGY_AUDIT_FAILED, energy_audit_problem))
     for status, problem_of in checks:
         problem = problem_of(result) if result.status == REACHED_STOP else None
@@ -311,8 +322,8 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         summary.update(result.averages.as_summary())
     if result.attractors is not None:
         summary.update(result.attractors.as_summary())
-    summary["warnings"] = list(dict.fromkeys(result.warnings))
-    summary["notes"] = list(dict.fromkeys(result.notes))
+    summary["warnings"] = list(result.warnings)
+    summary["notes"] = list(result.notes)
     return summary
 
 

@@ -30,8 +30,8 @@ def simulate(params: Parameters, progress: ProgressCallback | None = None, budge
         result = simulate_averaged(params, engine, progress, budget)
     else:
         result = simulate_full(params, engine, progress, budget)
-    if caution is not None and caution not in result.warnings:
-        result.warnings.append(caution)
+    if caution is not None:
+        result.warn(caution)
         result.summary = summarize(result)
     return result
 
