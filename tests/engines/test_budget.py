@@ -9,7 +9,8 @@ import pytest
 from conftest import TIGHTEST_TOLERANCES
 
 import shakermill as sm
-from shakermill.engines.budget import BudgetExceeded
+from shakermill.engines import budget as budget_module
+from shakermill.engines.budget import PACE_JUDGED_AFTER_S, BudgetExceeded, RunBudget
 from shakermill.engines.one_d import integrator as integrate
 from shakermill.engines.one_d.engine import OneDimensionalEngine, integrator_for
 from shakermill.engines.one_d.integrator import WINDOWS_FULL
@@ -41,6 +42,33 @@ def test_a_wall_clock_budget_stops_a_long_run_between_chunks() -> None:
     assert "max_wall_time = 0.05 s" in result.message and "--set max_wall_time=0.1" in result.message
     assert 0.0 < result.t_end < 36000.0
     assert result.impact_count > 0
+
+
+def test_a_run_whose_pace_cannot_reach_its_end_within_the_budget_is_stopped_with_the_estimate() -> None:
+    budget = RunBudget(max_wall_time=100.0, max_steps=10**9)
+    assert not budget.outpaced(t=0.0, end=1000.0)  # starts the clock
+    budget.started -= 20.0
+    budget.paced_from = (budget.paced_from[0] - 15.0, 0.0)
+    # 15 s for 1 s simulated: 4 more seconds need 20 + 60 = 80 s <= 1.5 x 100 s, 99 more ~1505 s.
+    assert not budget.outpaced(t=1.0, end=5.0) and budget.reason is None
+    assert budget.outpaced(t=1.0, end=100.0)
+    assert "would need ~25 min of computing to reach t = 100 s" in budget.reason
+    assert f"--set max_wall_time={math.ceil(1.5 * (20.0 + 15.0 * 99.0))}" in budget.reason.replace("\n", "")
+
+
+def test_the_pace_is_judged_only_after_a_while_past_the_first_call() -> None:
+    budget = RunBudget(max_wall_time=1.0, max_steps=10**9)
+    budget.paced_from = (budget.started - (PACE_JUDGED_AFTER_S - 1.0), 0.0)
+    assert not budget.outpaced(t=1e-3, end=1e6)  # a hopeless pace, but not yet judged
+
+
+def test_a_3d_run_that_cannot_end_within_its_budget_stops_at_its_pace_not_at_the_budget(monkeypatch) -> None:
+    monkeypatch.setattr(budget_module, "PACE_JUDGED_AFTER_S", 0.3)
+    params = sm.default_parameters("spex8000m-3d", duration=600.0, solver="full", record_windows=(), max_wall_time=30.0)
+    result = sm.simulate(params)
+    assert result.status == BUDGET_EXCEEDED and "stopped early" in result.message and "max_wall_time = 30 s" in result.message
+    assert 0.0 < result.t_end < 600.0 and result.summary["wall_time_s"] < 10.0
+    assert result.history.times[-1] == result.t_end
 
 
 def test_pauses_of_the_compiled_loop_leave_a_run_bit_for_bit_unchanged(monkeypatch) -> None:

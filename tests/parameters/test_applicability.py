@@ -11,7 +11,8 @@ import shakermill as sm
 from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import WINDOW_INTERVAL, DemEngine
 from shakermill.parameters.config import load_config, write_config_toml
-from shakermill.parameters.engine_keys import AVERAGED_ONLY, ENGINE_KEYS, MILL_HEAD_ONLY, Reader
+from shakermill.parameters.engine_keys import AVERAGED_ONLY, ENGINE_KEYS, MILL_HEAD_ONLY, MOTION_KEYS, Reader
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.parameters.errors import ParameterError
 from shakermill.solvers import simulate as simulate_module
 from shakermill.studies.calibrate import LONGEST_FULL_RESOLUTION_FIT_S, check_full_resolution_work
@@ -28,8 +29,9 @@ def test_a_reader_names_where_a_key_applies():
     assert dem.not_read("drive_heat") == "the 'paper' network does not read it; it applies to thermal_model = 'mill-head'"
     assert Reader("dem", "averaged", "mill-head").not_read("drive_heat") is None
     # Every key of these sets is one some run reads: none is dead.
-    for key in AVERAGED_ONLY | MILL_HEAD_ONLY | ENGINE_KEYS["1d"].unread | ENGINE_KEYS["dem"].unread:
-        assert Reader("dem", "averaged", "mill-head").not_read(key) is None or Reader("1d", "averaged", "paper").not_read(key) is None
+    readers = [Reader("1d", "averaged", "paper"), *(Reader("dem", "averaged", "mill-head", motion) for motion in KINEMATIC_MODELS)]
+    for key in AVERAGED_ONLY | MILL_HEAD_ONLY | MOTION_KEYS | ENGINE_KEYS["1d"].unread | ENGINE_KEYS["dem"].unread:
+        assert any(reader.not_read(key) is None for reader in readers), key
 
 
 @pytest.mark.parametrize(
@@ -67,6 +69,27 @@ def test_the_keys_a_preset_sets_and_the_run_does_not_read_are_said_in_a_note():
     assert load_config(overrides=["ball_materials=wc"], reader=None).params.ball_materials == ("tungsten-carbide",)
 
 
+def test_a_key_of_the_vial_motion_is_read_only_by_the_kinematic_models_that_take_it():
+    spex = Reader("dem", "full", "paper", "spex8000m")
+    assert spex.not_read("lateral_amplitude") is None and spex.not_read("amplitude") is None
+    assert spex.not_read("swing_radius") == "kinematics = 'spex8000m' does not read it; it applies to kinematics = 'mixer-mill-arc'"
+    assert Reader("dem", "full", "paper", "fourier").not_read("amplitude") == (
+        "kinematics = 'fourier' does not read it; it applies to kinematics = 'axial' or 'spex8000m' or 'mixer-mill-arc'")
+    with pytest.raises(ParameterError, match="motion: set explicitly, but kinematics = 'spex8000m' does not read it"):
+        load_config(preset="spex8000m-3d", overrides=["motion=x:1:0.001:0"])
+
+
+def test_a_preset_on_the_command_line_over_a_files_is_said(tmp_path):
+    path = tmp_path / "c.toml"
+    path.write_text('preset = "spex8000m-3d"\nduration = 2\n')
+    config = load_config(path, preset="mm400")
+    assert config.preset == "mm400" and config.params.kinematics == "mixer-mill-arc"
+    assert f"The preset is 'mm400' (--preset), not the 'spex8000m-3d' that {path} names." in config.notes
+    assert not any("--preset" in note for note in load_config(path).notes)
+    with pytest.raises(ParameterError, match="unknown preset ''"):
+        load_config(preset="")
+
+
 def test_a_swept_key_a_point_would_not_read_is_refused():
     base = sm.default_parameters()
     with pytest.raises(ParameterError, match="friction: swept, but the 1-D engine"):
@@ -86,9 +109,42 @@ def test_the_records_of_a_dem_run_are_counted_before_they_are_allocated(monkeypa
     simulate_module.preflight(sm.default_parameters(duration=2.0))
 
 
+def test_a_dem_run_that_needs_more_steps_than_its_budget_allows_is_refused_before_it_starts():
+    # No step of the 'dem' engine is longer than max_flight_step: 100 s take at least 1e6 steps at the default 1e-4 s.
+    full = sm.default_parameters("spex8000m-3d", duration=100.0, solver="full", max_steps=999_999)
+    assert DemEngine.least_steps(full, 100.0) == pytest.approx(1e6)
+    with pytest.raises(ParameterError, match=r"max_steps: 100 s of the run .* at least 1e\+06 steps .*allowed max_steps >= 1000000, "
+                                             "a shorter duration or solver = 'averaged'"):
+        simulate_module.preflight(full)
+    simulate_module.preflight(full.model_copy(update={"max_steps": 1_000_000}))
+    # An averaged run needs at least its least mechanics at full resolution, whatever its duration.
+    averaged = sm.default_parameters("spex8000m-3d", max_steps=1000)
+    with pytest.raises(ParameterError, match=r"max_steps: .* of the least mechanics of the averaged solver"):
+        simulate_module.preflight(averaged)
+
+
 def test_a_full_resolution_fit_of_the_dem_engine_over_the_hour_is_refused():
     dem = sm.default_parameters("spex8000m-3d")
     with pytest.raises(ParameterError, match="--full-resolution: each of the fit's ~2000 evaluations would run 3600 s"):
         check_full_resolution_work(dem, 3600.0)
     check_full_resolution_work(dem, LONGEST_FULL_RESOLUTION_FIT_S)
     check_full_resolution_work(sm.default_parameters(), 3600.0)  # a 1-D hour is seconds
+
+
+def test_the_fifty_balls_of_the_issue_are_refused_in_one_line_before_any_memory_is_taken(monkeypatch, tmp_path):
+    from typer.testing import CliRunner
+
+    from shakermill import cli
+
+    # Issue 25: 50 balls with a 600-s record window asked for 27.7 GiB at start-up and ended in a traceback. The
+    # machine here is told it has 8 GiB free, so that the case is the same on any machine.
+    monkeypatch.setattr("psutil.virtual_memory", lambda: SimpleNamespace(available=8 * 2**30))
+    outcome = CliRunner().invoke(cli.app, [
+        "run", "--preset", "spex8000m-3d", "--set", "n_balls=50", "--set", "ball_radius=3mm", "--set", "solver=full",
+        "--set", "duration=600", "--set", "record_windows=0:600", "--no-plots", "--out", str(tmp_path / "run"),
+    ])
+    assert outcome.exit_code == 2 and "Traceback" not in outcome.stderr
+    line, = outcome.stderr.strip().splitlines()
+    assert line.startswith("error: record_windows: the run would keep ") and "of the 8 GiB free" in line
+    assert "GiB of records (50 balls, 600 s of record windows" in line
+    assert not (tmp_path / "run").exists()

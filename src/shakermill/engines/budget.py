@@ -9,6 +9,7 @@ hands control back to Python, several times a second.
 
 from __future__ import annotations
 
+import math
 import signal
 import sys
 import threading
@@ -37,6 +38,8 @@ class RunBudget:
     started: float = field(default_factory=time.monotonic)
     # Set once, by the first check that finds the budget spent: which limit, and how to raise it.
     reason: str | None = None
+    # Wall clock (monotonic) and simulated time when the pace began to be measured (:meth:`outpaced`).
+    paced_from: tuple[float, float] | None = None
 
     @classmethod
     def of(cls, params: Parameters) -> RunBudget:
@@ -62,6 +65,28 @@ class RunBudget:
         and how to raise it."""
         return str(self.reason) if status == BUDGET_EXCEEDED else messages[status]
 
+    def outpaced(self, t: float, end: float) -> bool:
+        """Whether a run at ``t`` (s) on its way to ``end`` would, at its pace since this was first asked, spend more
+        than PACE_MARGIN x ``max_wall_time`` in all; the first time it would, ``reason`` says so, with the estimate
+        and how to ask for less or allow more. Ask after each compiled call: the first answer only starts the clock,
+        as the first call may have loaded or compiled the engine's code."""
+        now = time.monotonic()
+        if self.paced_from is None:
+            self.paced_from = (now, t)
+        wall, simulated = now - self.paced_from[0], t - self.paced_from[1]
+        if self.reason is not None or wall < PACE_JUDGED_AFTER_S or simulated <= 0.0:
+            return self.reason is not None
+        needed = now - self.started + wall * (end - t) / simulated
+        if needed <= PACE_MARGIN * self.max_wall_time:
+            return False
+        self.reason = (
+            f"The run was stopped early: at its pace so far ({simulated:.3g} s simulated in {wall:.3g} s) it would need "
+            f"~{_hours_or_minutes(needed)} of computing to reach t = {end:g} s, beyond its wall-clock budget "
+            f"(max_wall_time = {self.max_wall_time:g} s). Ask for less work (a shorter duration, fewer balls, "
+            f"solver = 'averaged') or allow it, e.g. --set max_wall_time={math.ceil(needed * PACE_MARGIN):d}."
+        )
+        return True
+
     def _overrun(self) -> str | None:
         if self.steps >= self.max_steps:
             return (
@@ -76,6 +101,19 @@ class RunBudget:
                 f"elapsed). If the run is meant to take that long, raise it, e.g. --set max_wall_time={2 * self.max_wall_time:g}."
             )
         return None
+
+
+# A run's pace is judged only after this much wall time (s) past its first compiled call, which may load or compile
+# the engine's code: earlier, the pace of a few calls says little.
+PACE_JUDGED_AFTER_S = 10.0
+# A run is stopped once its pace so far says it needs more than this many times its max_wall_time to reach its end:
+# unless its pace then quickens more than that, its budget would stop it anyway, only hours later (a 3-D hour at
+# full resolution takes ~8 h here, benchmarks/README.md).
+PACE_MARGIN = 1.5
+
+
+def _hours_or_minutes(seconds: float) -> str:
+    return f"{seconds / 3600:.2g} h" if seconds >= 5400 else f"{seconds / 60:.2g} min"
 
 
 @contextmanager

@@ -76,7 +76,8 @@ def load_config(
         written_by_hand = PROVENANCE_TABLE not in document
         file_values = {key: value for key, value in document.items() if key != PROVENANCE_TABLE}
         file_preset = _file_preset(file_values, source)
-    chosen_preset = preset or file_preset or DEFAULT_PRESET
+    # An empty --preset names no preset: refused as unknown, not read as "the default".
+    chosen_preset = preset if preset is not None else file_preset or DEFAULT_PRESET
     # Each layer completed by its own materials first: a file's material replaces the preset's values.
     preset_layer = preset_values(chosen_preset)
     base = layered(with_materials(preset_layer), with_materials(file_values))
@@ -90,8 +91,10 @@ def load_config(
     if problem is not None:
         raise ParameterError(problem)
     inherited = {key: value for key, value in preset_layer.items() if key not in explicit}
-    note = run.ignored_note(inherited, preset_values(DEFAULT_PRESET))
-    return RunConfig(params=params, preset=chosen_preset, source=source, notes=(note,) if note else ())
+    notes = [run.ignored_note(inherited, preset_values(DEFAULT_PRESET))]
+    if file_preset is not None and chosen_preset != file_preset:
+        notes.append(f"The preset is {chosen_preset!r} (--preset), not the {file_preset!r} that {source} names.")
+    return RunConfig(params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note))
 
 
 def read_config_file(path: Path) -> dict[str, Any]:

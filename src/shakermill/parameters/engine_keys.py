@@ -96,13 +96,19 @@ MILL_HEAD_ONLY = frozenset(
 )
 
 
+# Keys of the vial's motion each kinematic model reads (its ``keys``): the others are read by none of its runs.
+MOTION_KEYS = frozenset(key for model in KINEMATIC_MODELS.values() for key in model.keys)
+READER_FIELDS = ("engine", "solver", "thermal_model", "kinematics")
+
+
 @dataclass(frozen=True)
 class Reader:
-    """What decides whether a run reads a key: its engine, its solver and its thermal network."""
+    """What decides whether a run reads a key: its engine, its solver, its thermal network and its vial motion."""
 
     engine: str
     solver: str
     thermal_model: str
+    kinematics: str = "axial"
 
     def not_read(self, key: str) -> str | None:
         """Why a run would not read ``key`` (a phrase naming where it applies), or None."""
@@ -114,6 +120,9 @@ class Reader:
             return f"the {self.solver!r} solver does not read it; it applies to solver = 'averaged'"
         if self.thermal_model != "mill-head" and key in MILL_HEAD_ONLY:
             return f"the {self.thermal_model!r} network does not read it; it applies to thermal_model = 'mill-head'"
+        if key in MOTION_KEYS and key not in KINEMATIC_MODELS[self.kinematics].keys:
+            readers = " or ".join(repr(name) for name, model in KINEMATIC_MODELS.items() if key in model.keys)
+            return f"kinematics = {self.kinematics!r} does not read it; it applies to kinematics = {readers}"
         return None
 
     def unread_problem(self, keys: Iterable[str], how: str = "set explicitly") -> str | None:
@@ -137,7 +146,7 @@ class Reader:
 
 def reader_of(params: Any, solver: str | None = None) -> Reader:
     """The :class:`Reader` of a run of ``params`` (a ``Parameters``), with ``solver`` instead of its own if given."""
-    return Reader(params.engine, solver or params.solver, params.thermal_model)
+    return Reader(params.engine, solver or params.solver, params.thermal_model, params.kinematics)
 
 
 def declare(keys: EngineKeys) -> None:

@@ -11,7 +11,7 @@ import numpy as np
 
 from shakermill.analysis.batch_means import batch_rates, mser_truncation, normalised, relative_error, standard_error
 from shakermill.engines.interface import Engine, Measured, ProgressCallback
-from shakermill.engines.status import REACHED_STOP
+from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages
@@ -31,18 +31,30 @@ def sample_times(params: Parameters) -> np.ndarray:
 
 
 def run_until(engine: Engine, end: float, progress: ProgressCallback | None) -> int:
-    """Advance ``engine`` to ``end`` (s) in chunks, telling ``progress(t, end)``; the engine's status, or
-    INTERRUPTED for Ctrl-C, with everything computed so far kept in the engine."""
-    heartbeat = None if progress is None else lambda t: progress(t, end)
+    """Advance ``engine`` to ``end`` (s) in chunks, telling ``progress(t, end)``; the engine's status, INTERRUPTED for
+    Ctrl-C, or BUDGET_EXCEEDED as soon as its pace says it cannot end within its wall-clock budget
+    (:meth:`~shakermill.engines.budget.RunBudget.outpaced`), with everything computed so far kept in the engine."""
+
+    def heartbeat(t: float) -> None:
+        if engine.budget.outpaced(t, end):
+            raise _Outpaced
+        if progress is not None:
+            progress(t, end)
+
     status = REACHED_STOP
     try:
         while engine.t < end and status == REACHED_STOP:
             status = engine.advance(min(end, engine.t + CHUNK_SECONDS), heartbeat)
-            if heartbeat is not None:
-                heartbeat(engine.t)
+            heartbeat(engine.t)
     except KeyboardInterrupt:
         status = INTERRUPTED
+    except _Outpaced:
+        status = BUDGET_EXCEEDED
     return status
+
+
+class _Outpaced(Exception):
+    """Raised between two compiled calls, where the engine's state is whole, to stop a run that cannot end in time."""
 
 
 def stop_message(engine: Engine, status: int) -> str:

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 from shakermill.engines.budget import BudgetExceeded, RunBudget
@@ -11,7 +12,13 @@ from shakermill.engines.registry import engine_named
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
-from shakermill.solvers.averaged import Mechanics, full_resolution_instead, settle_mechanics, simulate_averaged
+from shakermill.solvers.averaged import (
+    Mechanics,
+    full_resolution_instead,
+    least_mechanics,
+    settle_mechanics,
+    simulate_averaged,
+)
 from shakermill.solvers.driver import sample_times
 from shakermill.solvers.full import simulate_full
 from shakermill.solvers.impact import restitution_warning
@@ -41,14 +48,36 @@ MEMORY_SHARE = 0.8
 
 
 def preflight(params: Parameters) -> None:
-    """Raise :class:`ParameterError` with the estimate and the keys to change where the records and windows a run of
-    ``params`` allocates at its start exceed the memory free on this machine (an engine that declares
-    ``memory_needed``; the 1-D engine's windows are capped instead)."""
+    """Raise :class:`ParameterError` with the estimate and the keys to change where a run of ``params`` could not end
+    within its step budget or the records and windows it allocates at its start exceed the memory free on this
+    machine (an engine that declares ``least_steps`` and ``memory_needed``; the 1-D engine's work and windows are
+    capped instead). Its wall-clock budget is judged by the run's pace once it runs (``RunBudget.outpaced``)."""
+    engine = engine_named(params.engine)
+    least_steps = getattr(engine, "least_steps", None)
+    if least_steps is not None:
+        _check_step_budget(params, least_steps)
+    needed_by = getattr(engine, "memory_needed", None)
+    if needed_by is not None:
+        _check_memory(params, needed_by)
+
+
+def _check_step_budget(params: Parameters, least_steps: Callable[[Parameters, float], float]) -> None:
+    at_full_resolution = params.solver == "full" or full_resolution_instead(params) is not None
+    simulated = params.duration if at_full_resolution else least_mechanics(params)
+    steps = least_steps(params, simulated)
+    if steps > params.max_steps:
+        what, or_less = ("the run", ", a shorter duration or solver = 'averaged'") if at_full_resolution else (
+            "the least mechanics of the averaged solver", "")
+        raise ParameterError(
+            f"max_steps: {simulated:.4g} s of {what} at full resolution take at least {steps:.3g} steps of engine = "
+            f"{params.engine!r} (none is longer than max_flight_step = {params.max_flight_step:g} s), more than "
+            f"max_steps = {params.max_steps}; allowed max_steps >= {math.ceil(steps)}{or_less}"
+        )
+
+
+def _check_memory(params: Parameters, needed_by: Callable[[Parameters, int], int]) -> None:
     import psutil
 
-    needed_by = getattr(engine_named(params.engine), "memory_needed", None)
-    if needed_by is None:
-        return
     needed = needed_by(params, sample_times(params).size)
     free = psutil.virtual_memory().available
     if needed > MEMORY_SHARE * free:

@@ -33,10 +33,11 @@ from scipy.optimize import least_squares
 from shakermill.engines.registry import describe
 from shakermill.parameters.config import parse_overrides
 from shakermill.parameters.defaults import DEFAULT_FREE
+from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters, bounds, check_known_keys
 from shakermill.solvers.result import Result
-from shakermill.solvers.simulate import thermal_variants
+from shakermill.solvers.simulate import preflight, thermal_variants
 from shakermill.studies.validation import (
     CURVE_TOLERANCE_K,
     TARGET_KEYS,
@@ -305,6 +306,7 @@ def calibrate(
     if full_resolution:
         check_full_resolution_work(base, max(base.duration, longest))
     fitting = base.replace(solver=solver, attractor_starts=1, duration=max(base.duration, longest))
+    preflight(fitting)  # once, before the first evaluation: every evaluation has the same needs
     evaluate, cache = _evaluator(fitting, free, targets, curves, progress)
     solution = least_squares(
         lambda x: evaluate(x)[0], x0, bounds=(lower, upper), diff_step=JACOBIAN_STEP, x_scale=1.0, method="trf"
@@ -424,8 +426,12 @@ def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float]
 
 
 def _check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
-    """An engine with thermal-only keys (the 'dem' engine) has its calibration measure the mechanics once: only keys
-    of the thermal network may move."""
+    """A free key must be one the run reads (a fit of a key it ignores would wander its whole range), and an engine
+    with thermal-only keys (the 'dem' engine) has its calibration measure the mechanics once: only keys of the
+    thermal network may move."""
+    problem = reader_of(base).unread_problem(free, how="fitted")
+    if problem is not None:
+        raise ParameterError(f"free: {problem}")
     thermal_only = describe(base.engine).thermal_only_keys
     moving = [key for key in free if key not in thermal_only]
     if thermal_only and moving:

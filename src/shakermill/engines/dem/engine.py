@@ -85,6 +85,12 @@ class DemEngine(CompiledRun):
         rows = samples + windows / WINDOW_INTERVAL
         return int(rows * model.row_width(params.n_balls, len(cls.network_for(params).nodes)) * 8)
 
+    @classmethod
+    def least_steps(cls, params: Parameters, simulated: float) -> float:
+        """The fewest steps ``simulated`` seconds of a run of ``params`` can take: no step is longer than
+        ``max_flight_step`` (MODEL.md §12.6); in contact they are far shorter."""
+        return simulated / params.max_flight_step
+
     @property
     def node_count(self) -> int:
         return len(self.network.nodes)

@@ -192,6 +192,16 @@ def network_of(params: Parameters) -> ThermalNetwork:
     return build_network(params, radius, capacity, names, share)
 
 
+def smallest_rayleigh_time(params: Parameters) -> float:
+    """The shortest Rayleigh time of the balls (s), which sets the contact step (MODEL.md §12.6)."""
+    return min(
+        (contact.rayleigh_time(*values) for values in zip(*(params.ball_values(key) for key in (
+            "ball_radius", "ball_density", "ball_youngs_modulus", "ball_poisson_ratio")), strict=True)),
+        # An empty mill (n_balls = 0) has no contact to resolve: it takes flight steps, short for its thermal network.
+        default=params.max_flight_step / params.contact_step_fraction,
+    )
+
+
 def constants_from(params: Parameters) -> Constants:
     """Everything the stepping needs but the thermal network (:func:`network_of`)."""
     n = params.n_balls
@@ -217,11 +227,7 @@ def constants_from(params: Parameters) -> Constants:
     e_v, nu_v = params.vial_youngs_modulus, params.vial_poisson_ratio
     harmonics = harmonics_of(params)
     angular_bound, acceleration_bound = _motion_bounds(harmonics, params.omega, math.hypot(0.5 * params.vial_length, bore))
-    rayleigh = min(
-        (contact.rayleigh_time(r, rho, e, nu) for r, rho, e, nu in zip(radius, density, youngs, poisson, strict=True)),
-        # An empty mill (n_balls = 0) has no contact to resolve: it takes flight steps, short for its thermal network.
-        default=params.max_flight_step / params.contact_step_fraction,
-    )
+    rayleigh = smallest_rayleigh_time(params)
     fastest_node = min(value for value, _ in params.thermal_time_constants_at_rest.values())
     return Constants(
         relative_convection=params.relative_convection,
