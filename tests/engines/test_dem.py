@@ -122,6 +122,30 @@ def test_a_ball_resting_on_the_bore_sinks_in_by_the_hertz_overlap_of_the_concave
 
 
 @pytest.mark.slow
+def test_an_enduring_contact_steps_at_its_own_period_and_rests_where_the_finest_steps_put_it():
+    """A ball resting on the bore outlasts two of its contact periods T: it steps at enduring_step_fraction x T
+    (within 0.9 t_R), not at the impact's 0.05/9.5 x T, and comes to rest at the same depth."""
+    base = sm.default_parameters(engine="dem", **RESTING_VIAL, duration=0.3, record_windows=())
+    runs, resting_steps = {}, {}
+    for fraction in (0.001, 0.05):  # 0.001: below the impact's fraction, every step as an impact's
+        engine = DemEngine(base.replace(enduring_step_fraction=fraction))
+        engine.advance(0.2)  # fallen from the axis and settled
+        settled = engine.steps_taken()
+        engine.advance(0.3)
+        runs[fraction], resting_steps[fraction] = engine, engine.steps_taken() - settled
+    k = runs[0.05].constants
+    slot = model.slot_count(1) - model.N_WALLS + model.SIDE  # the ball's slot against the bore
+    overlap = runs[0.05].state.contacts.max_overlap[slot]
+    period = contact.contact_period(k.mass[0], k.wall_radius[0, model.SIDE], k.wall_modulus[0], k.wall_shear_modulus[0],
+                                    overlap, 0.0)
+    step = min(0.05 * period, k.longest_contact_step)
+    assert resting_steps[0.05] == pytest.approx(0.1 / step, rel=0.05)
+    assert resting_steps[0.001] > 5 * resting_steps[0.05]
+    depths = [engine.state.position[0, 2] for engine in runs.values()]
+    assert depths[0] == pytest.approx(depths[1], abs=0.01 * overlap)
+
+
+@pytest.mark.slow
 def test_a_ball_ball_contact_splits_its_heat_by_effusivity():
     """MODEL.md §12.4: in proportion to √(kρc); here the second ball conducts four times as well."""
     params = sm.default_parameters(

@@ -330,6 +330,11 @@ class Parameters(BaseModel):
     contact_step_fraction: float = _quantity(
         "", "contact step of the 'dem' engine as a fraction of the smallest Rayleigh time", ge=1e-3, le=0.9
     )
+    # An enduring contact (rolling, sliding or resting, not an impact) steps at this fraction of its own period,
+    # within the same 0.9 t_R bound; Verlet is stable below 1/π of a period (engines/dem/model.py, ENDURING_AFTER).
+    enduring_step_fraction: float = _quantity(
+        "", "step of the 'dem' engine inside an enduring contact as a fraction of its oscillation period", ge=1e-3, le=0.1
+    )
     # A free-flight step never lets a contact begin inside it; this caps it further (1 s: no cap in practice).
     max_flight_step: float = _quantity("s", "longest step of the 'dem' engine in free flight", ge=1e-7, le=1.0)
     record_windows: tuple[Window, ...] = Field(

@@ -209,6 +209,11 @@ SPEX_8000M = Preset(
             "numerical choice: restitution within 1e-3, the 1-D limit's heat power within 0.25 % of the converged "
             "value, five balls' within the ~1 % their statistics resolve (benchmarks/README.md, dem engine)",
         ),
+        "enduring_step_fraction": Cited(
+            0.05,
+            "numerical choice: 20 steps a period of a contact that outlasted two of its periods; heat power and hit "
+            "statistics within their statistical errors of finer steps (benchmarks/README.md, enduring contacts)",
+        ),
         "max_flight_step": Cited(1e-4, "numerical choice: ~1/60 of a drive period, so the wall's motion is resolved"),
         "record_windows": Cited(
             ((0.0, 1.0), (600.0, 0.1)),

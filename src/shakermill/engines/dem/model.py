@@ -91,6 +91,7 @@ class Constants(NamedTuple):
     # Steps
     contact_step: float  # s: contact_step_fraction × the smallest Rayleigh time
     period_step_fraction: float  # a contact's step at most this fraction of its period (MODEL.md §12.6)
+    enduring_step_fraction: float  # the same for a contact older than ENDURING_AFTER of its periods
     longest_contact_step: float  # s: 0.9 × the smallest Rayleigh time, MODEL.md §7's bound inside contacts
     max_flight_step: float  # s
     max_overlap: float  # m: beyond it the step control failed
@@ -265,6 +266,7 @@ def constants_from(params: Parameters) -> Constants:
         gravity=np.array([0.0, 0.0, -STANDARD_GRAVITY if params.gravity else 0.0]),
         contact_step=params.contact_step_fraction * rayleigh,
         period_step_fraction=params.contact_step_fraction / RAYLEIGH_TIMES_PER_PERIOD,
+        enduring_step_fraction=max(params.enduring_step_fraction, params.contact_step_fraction / RAYLEIGH_TIMES_PER_PERIOD),
         longest_contact_step=0.9 * rayleigh,
         max_flight_step=params.max_flight_step,
         max_overlap=MAX_OVERLAP_FRACTION * float(radius.min(initial=math.inf)),
@@ -280,6 +282,11 @@ def constants_from(params: Parameters) -> Constants:
 # finer fraction refines every contact alike), while a ball resting under gravity on the bore (T ≈ 25 t_R) or
 # hopping on it at mm/s steps 1.5–2.7 times longer.
 RAYLEIGH_TIMES_PER_PERIOD = 9.5
+# An impact is over within about one of its periods (T above is the tangential period, ~0.6 of the normal one, and a
+# Hertz impact lasts about half a normal period, ~0.85 T); a contact that has lasted ENDURING_AFTER periods rolls,
+# slides or rests. Its restitution is no longer at stake, only its forces and the heat of its slip, which Verlet
+# resolves at enduring_step_fraction of T (20 steps a period at the default, stable below 1/π), still within 0.9 t_R.
+ENDURING_AFTER = 2.0
 # A contact overlap beyond this fraction of the smallest radius means the step control failed.
 MAX_OVERLAP_FRACTION = 0.05
 # The thermal network moves over ~0.1 s (the air) to hours (the vial): explicit Euler steps of a millisecond,

@@ -3,8 +3,9 @@
 One step: half kick with the last forces, drift, forces at the new positions (with the velocities
 predicted to the step's end), second half kick with the new forces. Inside contacts the step is
 ``contact_step_fraction`` of the smallest Rayleigh time, or of the touching contacts' shortest oscillation
-period over 9.5 where that is longer (model.RAYLEIGH_TIMES_PER_PERIOD: a ball resting, rolling or hopping on
-the bore steps longer; impacts of 0.1 m/s and faster keep the Rayleigh step), never beyond 0.9 t_R. In free
+period over 9.5 where that is longer (model.RAYLEIGH_TIMES_PER_PERIOD: a ball hopping on the bore steps longer;
+impacts of 0.1 m/s and faster keep the Rayleigh step); a contact that outlasted model.ENDURING_AFTER of its periods
+(rolling, sliding, resting) steps at ``enduring_step_fraction`` of its period; never beyond 0.9 t_R. In free
 flight, and for the slots not touching when a contact's step is the longer one, it is as long as no contact
 can begin inside it (each gap over its largest closing speed and acceleration), but never shorter than the
 Rayleigh step nor longer than ``max_flight_step``.
@@ -27,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from shakermill.engines.dem.contacts import pair_contacts, settle, sum_forces, wall_contacts, wall_gap
-from shakermill.engines.dem.model import HEAT_LOST, LEFT_END, N_WALLS, SIDE, WORK_GRAVITY, Constants, Scratch, State
+from shakermill.engines.dem.model import ENDURING_AFTER, HEAT_LOST, LEFT_END, N_WALLS, SIDE, WORK_GRAVITY, Constants, Scratch, State
 from shakermill.engines.dem.vectors import cross_into, distance, dot, norm
 from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.engines.thermal import kernel
@@ -162,16 +163,24 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
 
 
 @njit(cache=True, inline="always")
-def _step_length(touching: int, period: float, k: Constants, s: State, w: Scratch) -> float:
-    """The next step (MODEL.md §12.6). In flight, :func:`_flight_step`. Inside contacts, contact_step_fraction
-    of the longer of the smallest Rayleigh time and 1/9.5 of ``period``, the shortest period of the touching
-    contacts (:func:`contact.contact_period`, from each one's overlap and normal speed at its last evaluation),
-    so that impacts keep the Rayleigh step and slow, lasting contacts take longer ones (never beyond 0.9 t_R,
-    MODEL.md §7); a step longer than the Rayleigh one is also bounded as a flight step by the slots not
-    touching, so that no contact begins inside it."""
+def _contact_limit(slot: int, t: float, k: Constants, s: State) -> float:
+    """The longest step the touching contact in ``slot`` allows at ``t`` (s): a fraction of its period
+    (:func:`contact.contact_period`, from its overlap and normal speed at its last evaluation), the enduring
+    fraction once it has lasted ENDURING_AFTER periods."""
+    period = s.contacts.period[slot]
+    enduring = t - s.contacts.started[slot] >= ENDURING_AFTER * period
+    return (k.enduring_step_fraction if enduring else k.period_step_fraction) * period
+
+
+@njit(cache=True, inline="always")
+def _step_length(touching: int, limit: float, k: Constants, s: State, w: Scratch) -> float:
+    """The next step (MODEL.md §12.6). In flight, :func:`_flight_step`. Inside contacts, the shortest of the touching
+    contacts' limits (``limit``, :func:`_contact_limit`) but not below the Rayleigh step, so that impacts keep it and
+    slow or lasting contacts take longer ones (never beyond 0.9 t_R, MODEL.md §7); a step longer than the Rayleigh
+    one is also bounded as a flight step by the slots not touching, so that no contact begins inside it."""
     if not touching:
         return _flight_step(k, s, w)
-    step = max(k.contact_step, min(k.period_step_fraction * period, k.longest_contact_step))
+    step = max(k.contact_step, min(limit, k.longest_contact_step))
     if step <= k.contact_step:
         return k.contact_step
     return min(step, _flight_step(k, s, w))
@@ -205,7 +214,7 @@ def _final_kick(dt: float, k: Constants, s: State, w: Scratch) -> None:
 def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.ndarray,
           count: int) -> tuple[int, int, float, float]:
     """One velocity-Verlet step of length ``dt`` ending at ``t``; returns (record count, contacts touching,
-    deepest overlap, shortest period of the touching contacts)."""
+    deepest overlap, the longest next step the touching contacts allow)."""
     w.angular_before[:] = w.angular
     _kick_and_drift(dt, k, s, w)
     vial_frame(t, k, w)
@@ -214,17 +223,17 @@ def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.n
     sum_forces(live, k, s, w)
     _final_kick(dt, k, s, w)
     touching = 0
-    period = math.inf
+    limit = math.inf
     for index in range(live):
         slot = w.live[index]
         count = settle(slot, t, dt, k, s, w, records, count)
         if w.touching[slot]:
             touching += 1
-            period = min(period, s.contacts.period[slot])
+            limit = min(limit, _contact_limit(slot, t, k, s))
     _convect(dt, k, s, w)
     s.clock[0] = t
     s.clock[1] += dt
-    return count, touching, max(deepest_pair, deepest_wall), period
+    return count, touching, max(deepest_pair, deepest_wall), limit
 
 
 @njit(cache=True)
@@ -250,11 +259,11 @@ def advance(t_stop: float, max_steps: int, k: Constants, net: NetworkArrays, s: 
     slots = s.contacts.active.size
     vial_frame(s.clock[0], k, w)
     touching = 0
-    period = math.inf
+    limit = math.inf
     for slot in range(slots):
         if s.contacts.active[slot]:
             touching += 1
-            period = min(period, s.contacts.period[slot])
+            limit = min(limit, _contact_limit(slot, s.clock[0], k, s))
     status = REACHED_STOP
     steps = 0
     while s.clock[0] < t_stop:
@@ -264,13 +273,13 @@ def advance(t_stop: float, max_steps: int, k: Constants, net: NetworkArrays, s: 
         if count + slots > records.shape[0]:
             status = RECORDS_FULL
             break
-        dt = _step_length(touching, period, k, s, w)
+        dt = _step_length(touching, limit, k, s, w)
         mark = counters[ROWS_WRITTEN]
         end = min(t_stop, marks[mark]) if mark < marks.size else t_stop
         remaining = end - s.clock[0]
         t = end if dt >= remaining else s.clock[0] + dt
         before = count
-        count, touching, deepest, period = _step(t, min(dt, remaining), k, s, w, records, count)
+        count, touching, deepest, limit = _step(t, min(dt, remaining), k, s, w, records, count)
         steps += 1
         counters[STEPS] += 1
         counters[CONTACT_STEPS if touching else FLIGHT_STEPS] += 1
