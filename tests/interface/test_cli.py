@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib
 import io
 import json
+import math
 import os
 import re
 import signal
@@ -424,17 +425,20 @@ def test_validate_prints_table5_with_fitted_and_predicted_roles():
 
 
 @pytest.mark.slow
-def test_calibrate_writes_a_preset_that_run_accepts(tmp_path):
+def test_calibrate_writes_a_preset_that_run_accepts_with_the_settings_it_was_fitted_under(tmp_path):
     preset_file = tmp_path / "fitted.toml"
     outcome = runner.invoke(
         cli.app,
-        ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", str(preset_file), "--json"],
+        ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--set", "omega=1200 rpm", "--out", str(preset_file),
+         "--json"],
     )
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
     assert abs(payload["relative_residuals"]["theta_inf_C"]) < 0.005
     params = load_config(preset_file).params
     assert params.beta == pytest.approx(payload["fitted"]["beta"])
+    # The fit's --set is in the preset: without it the fitted beta would describe another drive.
+    assert params.omega == pytest.approx(1200 * 2 * math.pi / 60)
     run = runner.invoke(cli.app, ["run", str(preset_file), "--set", "solver=averaged", "--json", "--no-plots", "--out", str(tmp_path / "run")])
     assert run.exit_code == 0, run.output
     assert json.loads(run.stdout)["theta_inf_C"] == pytest.approx(100.0, rel=0.005)

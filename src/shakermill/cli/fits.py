@@ -272,7 +272,7 @@ def calibrate(
 ) -> None:
     """Fit free parameters to measured curves (the experiment's by default) and/or Table 5 targets by bounded least squares."""
     from shakermill.io.runs import to_jsonable
-    from shakermill.parameters.config import load_config
+    from shakermill.parameters.config import load_config, values_beyond_preset
     from shakermill.studies.calibrate import calibrate as fit_parameters
     from shakermill.studies.calibrate import default_free, parse_free, parse_targets
     from shakermill.studies.validation import curve_from_option
@@ -294,7 +294,8 @@ def calibrate(
                 run_config.params, free_keys, targets, measured, full_resolution=full_resolution, progress=update
             )
     if out is not None:
-        write_fitted_preset(calibration, out, run_config.preset, free_keys, targets)
+        settings = values_beyond_preset(run_config.params, run_config.preset)
+        write_fitted_preset(calibration, out, run_config.preset, free_keys, targets, settings)
     if json_output:
         typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False))
     else:
@@ -314,9 +315,10 @@ def check_preset_target(out: Path, overwrite: bool) -> None:
 
 
 def write_fitted_preset(
-    calibration: Calibration, out: Path, base_preset: str, free_keys: Sequence[str], targets: Mapping[str, float]
+    calibration: Calibration, out: Path, base_preset: str, free_keys: Sequence[str], targets: Mapping[str, float],
+    settings: Mapping[str, Any],
 ) -> None:
-    """Write the fitted preset TOML, saying in it which command fitted which keys to what."""
+    """Write the fitted preset TOML, saying in it which command fitted which keys to what, under which settings."""
     from shakermill.studies.calibrate import write_preset
 
     command = "shakermill calibrate " + " ".join(sys.argv[2:])
@@ -326,7 +328,7 @@ def write_fitted_preset(
         f"{', '.join(calibration.predictions)} are predictions"
     )
     with writing(out, "the preset"):
-        write_preset(calibration, out, base_preset=base_preset, command=command, description=description)
+        write_preset(calibration, out, base_preset=base_preset, command=command, description=description, settings=settings)
 
 
 def print_calibration(

@@ -31,7 +31,7 @@ from shakermill.parameters.keys import (
     layered,
     with_materials,
 )
-from shakermill.parameters.presets import preset_values
+from shakermill.parameters.presets import default_parameters, preset_values
 from shakermill.support.atomic import write_text_atomically
 from shakermill.support.limits import MAX_CONFIG_BYTES, quoted
 from shakermill.support.version import __version__
@@ -176,6 +176,14 @@ def config_toml_text(
         entries.append(comment + "\n" + tomli_w.dumps({key: value}))
     entries.append(tomli_w.dumps({PROVENANCE_TABLE: _provenance(preset, extra_provenance or {})}))
     return "\n".join(entries)
+
+
+def values_beyond_preset(params: Parameters, preset: str) -> dict[str, Any]:
+    """The values of ``params`` that differ from those of ``preset``, as a configuration file writes them (SI);
+    ``n_balls`` is left out where ``fill`` sets it."""
+    ours, theirs = params.model_dump(), default_parameters(preset).model_dump()
+    return {key: value for key, value in ours.items()
+            if value != theirs[key] and not (key == "n_balls" and params.fill > 0)}
 
 
 def _provenance(preset: str, extra: Mapping[str, Any]) -> dict[str, Any]:

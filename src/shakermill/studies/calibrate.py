@@ -24,7 +24,7 @@ import math
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 import tomli_w
@@ -579,12 +579,16 @@ def _sensitivities(
     return values
 
 
-def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str, command: str, description: str) -> Path:
-    """Write a preset TOML usable with ``shakermill run FILE`` and as a shipped preset, with provenance."""
+def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str, command: str, description: str,
+                 settings: Mapping[str, Any] | None = None) -> Path:
+    """Write a preset TOML usable with ``shakermill run FILE`` and as a shipped preset, with provenance: the fitted
+    values over ``base_preset`` and the ``settings`` (SI values) under which they were fitted, without which the
+    fitted values would describe another mill."""
     path = Path(path)
     values = {key: calibration.fitted[key] for key in calibration.free}
     document = {
         "preset": base_preset,
+        **{key: value for key, value in (settings or {}).items() if key not in values},
         **values,
         "provenance": {
             "description": description,
