@@ -79,6 +79,12 @@ def test_the_answer_says_when_an_uncalibrated_steady_state_is_far_above_the_expe
         assert len(far_above) == 1 and "3.7 times" in far_above[0] and CALIBRATED_PRESET in far_above[0]
 
 
+def test_a_3d_run_far_above_the_experiment_is_pointed_to_the_3d_calibrated_preset():
+    summary = {"ball_steady_C": 124.6, "initial_temperature_C": 20.0, "engine": "dem"}
+    far_above, = (sentence for sentence in answer_sentences(summary, "spex8000m-3d") if "far above" in sentence)
+    assert "Preset spex8000m-3d-calibrated is fitted to that experiment" in far_above
+
+
 def test_the_answer_of_a_run_close_to_the_experiment_makes_no_comparison():
     summary = {"ball_steady_C": 50.0, "initial_temperature_C": 20.0}
     assert not any("experiment" in sentence for sentence in answer_sentences(summary, "spex8000m"))

@@ -24,6 +24,8 @@ EXPERIMENT_BALL_C = 48.0
 # A prediction whose temperature rise is this much larger than the experiment's is "far above" it.
 FAR_ABOVE_RATIO = 1.5
 CALIBRATED_PRESET = "spex8000m-calibrated"
+# The preset fitted to the experiment for each engine: a run is pointed to the one of its own engine.
+CALIBRATED_PRESETS = {"1d": CALIBRATED_PRESET, "dem": "spex8000m-3d-calibrated"}
 NOTEBOOK_PNG_DPI = 80
 
 # (summary key, label, unit, format) of a run's answer, in the order the sentences give them.
@@ -163,8 +165,9 @@ def experiment_comparison(summary: Mapping[str, Any], preset: str) -> str:
     return (
         f"With preset {preset}, which uses the published parameters and fits nothing, this is far above the "
         f"experiment: the ball's temperature rise is {ratio:.1f} times the experiment's, which approached "
-        f"{EXPERIMENT_BALL_C:g} °C within the hour (Takacs & McHenry 2006). Preset {CALIBRATED_PRESET} is fitted to that "
-        "experiment; use it for predictions near it."
+        f"{EXPERIMENT_BALL_C:g} °C within the hour (Takacs & McHenry 2006). Preset "
+        f"{CALIBRATED_PRESETS.get(str(summary.get('engine')), CALIBRATED_PRESET)} is fitted to that experiment; use it "
+        "for predictions near it."
     )
 
 
