@@ -20,16 +20,16 @@ from shakermill.studies.sweep_plan import check_keys_read, plan_sweep
 
 
 def test_a_reader_names_where_a_key_applies():
-    one_d = Reader("1d", "full", "paper")
+    one_d = Reader("1d", "full", "paper", "axial")
     assert one_d.not_read("ball_materials") == "the 1-D engine (engine = '1d') does not read it; it applies to engine = 'dem'"
     assert one_d.not_read("averaging_max_time") == "the 'full' solver does not read it; it applies to solver = 'averaged'"
-    assert one_d.not_read("omega") is None and Reader("1d", "averaged", "paper").not_read("averaging_max_time") is None
-    dem = Reader("dem", "averaged", "paper")
+    assert one_d.not_read("omega") is None and Reader("1d", "averaged", "paper", "axial").not_read("averaging_max_time") is None
+    dem = Reader("dem", "averaged", "paper", "axial")
     assert "it applies to engine = '1d'" in dem.not_read("heat_model")
     assert dem.not_read("drive_heat") == "the 'paper' network does not read it; it applies to thermal_model = 'mill-head'"
-    assert Reader("dem", "averaged", "mill-head").not_read("drive_heat") is None
+    assert Reader("dem", "averaged", "mill-head", "axial").not_read("drive_heat") is None
     # Every key of these sets is one some run reads: none is dead.
-    readers = [Reader("1d", "averaged", "paper"), *(Reader("dem", "averaged", "mill-head", motion) for motion in KINEMATIC_MODELS)]
+    readers = [Reader("1d", "averaged", "paper", "axial"), *(Reader("dem", "averaged", "mill-head", motion) for motion in KINEMATIC_MODELS)]
     for key in AVERAGED_ONLY | MILL_HEAD_ONLY | MOTION_KEYS | ENGINE_KEYS["1d"].unread | ENGINE_KEYS["dem"].unread:
         assert any(reader.not_read(key) is None for reader in readers), key
 

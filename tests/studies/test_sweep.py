@@ -752,6 +752,14 @@ def _alive(processes: list) -> list[int]:
     return [process.pid for process in processes if _live(process)]
 
 
+def wait_for_a_stored_point(process: subprocess.Popen, folder: Path, seconds: float, before: str) -> None:
+    """Wait until the sweep ``process`` has stored a point in ``folder``; fail if it ends or stalls first."""
+    deadline = time.monotonic() + seconds
+    while not ((folder / POINTS_FOLDER).is_dir() and point_files(folder)):
+        assert process.poll() is None and time.monotonic() < deadline, f"the sweep ended or stalled before {before}"
+        time.sleep(0.01)
+
+
 @pytest.mark.slow
 def test_ctrl_c_stops_a_3d_sweeps_workers_within_2_s_and_the_resume_computes_only_the_running_points(tmp_path):
     import psutil
@@ -764,10 +772,7 @@ def test_ctrl_c_stops_a_3d_sweeps_workers_within_2_s_and_the_resume_computes_onl
     process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     descendants = []
     try:
-        deadline = time.monotonic() + 180
-        while not ((folder / POINTS_FOLDER).is_dir() and point_files(folder)):
-            assert process.poll() is None and time.monotonic() < deadline, "the sweep ended or stalled before Ctrl-C"
-            time.sleep(0.01)
+        wait_for_a_stored_point(process, folder, 180, "Ctrl-C")
         descendants = psutil.Process(process.pid).children(recursive=True)
         assert len(descendants) >= 3  # two workers and the forkserver that started them
         os.killpg(process.pid, signal.SIGINT)
@@ -1058,10 +1063,7 @@ def test_workers_stop_when_the_sweep_is_killed_and_not_yet_reaped(tmp_path):
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     descendants = []
     try:
-        deadline = time.monotonic() + 120
-        while not ((folder / POINTS_FOLDER).is_dir() and point_files(folder)):
-            assert process.poll() is None and time.monotonic() < deadline, "the sweep ended or stalled before the kill"
-            time.sleep(0.01)
+        wait_for_a_stored_point(process, folder, 120, "the kill")
         descendants = psutil.Process(process.pid).children(recursive=True)
         assert len(descendants) >= 2  # the two workers, and the processes that start them
         # SIGKILL to the sweep alone, not its group; this test, its parent, reaps it only at the end,

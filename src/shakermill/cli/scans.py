@@ -219,9 +219,9 @@ def bifurcation(
 ) -> None:
     """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
     from shakermill.io.runs import check_target, write_folder
+    from shakermill.parameters.engine_keys import reader_of
     from shakermill.studies.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
     from shakermill.studies.bifurcation import bifurcation as regime_scan
-    from shakermill.parameters.engine_keys import reader_of
     from shakermill.studies.sweep_plan import grid_unit, parse_grid, sweep_parameters
     from shakermill.views.figures.common import plot_figures
     from shakermill.views.figures.sweeps import bifurcation_figure, sweep_context

@@ -54,9 +54,9 @@ ONE_DIMENSIONAL = EngineKeys(
             "n_balls", "fill", "ball_radii", "ball_densities", "ball_youngs_moduli", "ball_poisson_ratios",
             "ball_heat_capacities", "ball_conductivities", "ball_materials", "ball_conductivity", "gravity", "friction",
             "rolling_friction", "kinematics", "lateral_amplitude", "yaw_amplitude", "swing_radius", "motion",
-            "contact_step_fraction", "enduring_step_fraction", "max_flight_step", "dem_averaging_rel_error", "thermal_model", "outer_diameter",
-            "outer_length", "emissivity", "vial_conductivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss",
-            "drive_heat",
+            "contact_step_fraction", "enduring_step_fraction", "max_flight_step", "dem_averaging_rel_error",
+            "thermal_model", "outer_diameter", "outer_length", "emissivity", "vial_conductivity", "clamp_heat_capacity",
+            "clamp_conductance", "clamp_loss", "drive_heat",
         }
     ),
 )
@@ -108,7 +108,7 @@ class Reader:
     engine: str
     solver: str
     thermal_model: str
-    kinematics: str = "axial"
+    kinematics: str
 
     def not_read(self, key: str) -> str | None:
         """Why a run would not read ``key`` (a phrase naming where it applies), or None."""

@@ -193,16 +193,6 @@ def network_of(params: Parameters) -> ThermalNetwork:
     return build_network(params, radius, capacity, names, share)
 
 
-def smallest_rayleigh_time(params: Parameters) -> float:
-    """The shortest Rayleigh time of the balls (s), which sets the contact step (MODEL.md §12.6)."""
-    return min(
-        (contact.rayleigh_time(*values) for values in zip(*(params.ball_values(key) for key in (
-            "ball_radius", "ball_density", "ball_youngs_modulus", "ball_poisson_ratio")), strict=True)),
-        # An empty mill (n_balls = 0) has no contact to resolve: it takes flight steps, short for its thermal network.
-        default=params.max_flight_step / params.contact_step_fraction,
-    )
-
-
 def constants_from(params: Parameters) -> Constants:
     """Everything the stepping needs but the thermal network (:func:`network_of`)."""
     n = params.n_balls
@@ -228,7 +218,12 @@ def constants_from(params: Parameters) -> Constants:
     e_v, nu_v = params.vial_youngs_modulus, params.vial_poisson_ratio
     harmonics = harmonics_of(params)
     angular_bound, acceleration_bound = _motion_bounds(harmonics, params.omega, math.hypot(0.5 * params.vial_length, bore))
-    rayleigh = smallest_rayleigh_time(params)
+    rayleigh = min(
+        (contact.rayleigh_time(r, rho, e, nu) for r, rho, e, nu in zip(radius, density, youngs, poisson, strict=True)),
+        # An empty mill (n_balls = 0) has no contact to resolve: it takes flight steps, short for its thermal network.
+        default=params.max_flight_step / params.contact_step_fraction,
+    )
+    impact_fraction = params.contact_step_fraction / RAYLEIGH_TIMES_PER_PERIOD
     fastest_node = min(value for value, _ in params.thermal_time_constants_at_rest.values())
     return Constants(
         relative_convection=params.relative_convection,
@@ -265,8 +260,8 @@ def constants_from(params: Parameters) -> Constants:
         wall_acceleration_bound=acceleration_bound,
         gravity=np.array([0.0, 0.0, -STANDARD_GRAVITY if params.gravity else 0.0]),
         contact_step=params.contact_step_fraction * rayleigh,
-        period_step_fraction=params.contact_step_fraction / RAYLEIGH_TIMES_PER_PERIOD,
-        enduring_step_fraction=max(params.enduring_step_fraction, params.contact_step_fraction / RAYLEIGH_TIMES_PER_PERIOD),
+        period_step_fraction=impact_fraction,
+        enduring_step_fraction=max(params.enduring_step_fraction, impact_fraction),
         longest_contact_step=0.9 * rayleigh,
         max_flight_step=params.max_flight_step,
         max_overlap=MAX_OVERLAP_FRACTION * float(radius.min(initial=math.inf)),

@@ -28,7 +28,17 @@ import numpy as np
 from numba import njit
 
 from shakermill.engines.dem.contacts import pair_contacts, settle, sum_forces, wall_contacts, wall_gap
-from shakermill.engines.dem.model import ENDURING_AFTER, HEAT_LOST, LEFT_END, N_WALLS, SIDE, WORK_GRAVITY, Constants, Scratch, State
+from shakermill.engines.dem.model import (
+    ENDURING_AFTER,
+    HEAT_LOST,
+    LEFT_END,
+    N_WALLS,
+    SIDE,
+    WORK_GRAVITY,
+    Constants,
+    Scratch,
+    State,
+)
 from shakermill.engines.dem.vectors import cross_into, distance, dot, norm
 from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.engines.thermal import kernel
