@@ -121,7 +121,6 @@ def sweep(
     stored = stored_rows(folder, ids, warn=True)
     pending = [(identifier, values) for identifier, values in zip(ids, plan.points) if identifier not in stored]
     unfinished: dict[str, str] = {}
-    kept = len(stored)
 
     def tabulate() -> pd.DataFrame:
         # Also on Ctrl-C: the table then holds the finished points, the others marked not finished.
@@ -140,7 +139,6 @@ def sweep(
                     tracker.finished(failed=True)
                     continue
                 row = store_point(folder, identifier, outcome, preset)
-                kept += 1
                 tracker.finished(failed=row.get("error") is not None)
         except BaseException as stopped:
             # The workers stop before the table is written, not after their points end; a second Ctrl-C
@@ -149,7 +147,8 @@ def sweep(
                 backend.stop()
                 table = tabulate()
             if isinstance(stopped, KeyboardInterrupt):
-                raise SweepInterrupted(table, folder, kept) from None
+                # Counted from the folder, not as points are stored: Ctrl-C may fall between a store and a count.
+                raise SweepInterrupted(table, folder, len(stored_rows(folder, ids))) from None
             raise
         table = tabulate()
     if len(failed_points(table)) == len(table):
