@@ -40,6 +40,8 @@ class RunBudget:
     reason: str | None = None
     # Wall clock (monotonic) and simulated time when the pace began to be measured (:meth:`outpaced`).
     paced_from: tuple[float, float] | None = None
+    # The replicas of an averaged run count their steps into one budget from several threads.
+    _counting: threading.Lock = field(default_factory=threading.Lock, repr=False, compare=False)
 
     @classmethod
     def of(cls, params: Parameters) -> RunBudget:
@@ -49,6 +51,10 @@ class RunBudget:
     @classmethod
     def unlimited(cls) -> RunBudget:
         return cls(float("inf"), sys.maxsize)
+
+    def count_steps(self, steps: int) -> None:
+        with self._counting:
+            self.steps += steps
 
     @property
     def steps_left(self) -> int:

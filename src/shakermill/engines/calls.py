@@ -61,7 +61,7 @@ class CompiledRun:
             with interrupts_held():
                 status = self.compiled_call(t_stop, min(self._pace or self.first_steps_per_call, self.budget.steps_left))
             steps = self.steps_taken() - before
-            self.budget.steps += steps
+            self.budget.count_steps(steps)
             if status == CALL_AGAIN:
                 continue
             if status != PAUSED:

@@ -47,6 +47,9 @@ class EngineDescription:
     # History variables that accumulate the heat per kelvin its contacts conducted (J/K), if it measures it: their
     # rates over the settled half of a full run are the contact conductances of the network (``kernel.contact_drive``).
     conduction_variables: tuple[str, ...] = ()
+    # The key of how many independent replicas of its mechanics the averaged solver runs and pools, if it takes any:
+    # its constructor then takes ``replica``, the number that seeds each replica's start (0: the configured start).
+    replicas_key: str | None = None
 
     @property
     def name(self) -> str:

@@ -55,7 +55,7 @@ ONE_DIMENSIONAL = EngineKeys(
             "ball_heat_capacities", "ball_conductivities", "ball_materials", "ball_conductivity", "gravity", "friction",
             "rolling_friction", "kinematics", "lateral_amplitude", "yaw_amplitude", "swing_radius", "motion",
             "contact_step_fraction", "enduring_step_fraction", "max_flight_step", "dem_averaging_rel_error",
-            "thermal_model", "outer_diameter", "outer_length", "emissivity", "vial_conductivity", "clamp_heat_capacity",
+            "dem_replicas", "thermal_model", "outer_diameter", "outer_length", "emissivity", "vial_conductivity", "clamp_heat_capacity",
             "clamp_conductance", "clamp_loss", "drive_heat",
         }
     ),
@@ -87,7 +87,7 @@ def reads(engine: str, key: str) -> bool:
 # Keys only the averaged solver reads: a full-resolution run integrates every impact. (``attractor_starts`` too, but
 # its 1, "no probe", is what a full run does anyway, and scripts set it for either solver.)
 AVERAGED_ONLY = frozenset(
-    {"averaging_rel_error", "dem_averaging_rel_error", "averaging_batch_periods", "averaging_min_batches",
+    {"averaging_rel_error", "dem_averaging_rel_error", "dem_replicas", "averaging_batch_periods", "averaging_min_batches",
      "averaging_max_time", "averaging_fallback"}
 )
 # Keys only the 'mill-head' network reads (engines/thermal/network.py): the vial's outside and the clamp.

@@ -236,6 +236,8 @@ class Parameters(BaseModel):
         gt=0,
         lt=1,
     )
+    # Each replica pays its own start-up transient, so more replicas than cores cost more than they save.
+    dem_replicas: int = _count("averaged solver of the 'dem' engine: independent replicas of the mechanics, pooled", ge=1, le=64)
     # 10 000 periods (~10 min) per batch: already past any averaging_max_time worth waiting for.
     averaging_batch_periods: int = _count("averaged solver: drive periods per batch of the batch-means estimate", ge=1, le=10_000)
     averaging_min_batches: int = _count("averaged solver: fewest batches after the transient", ge=4, le=10_000)

@@ -157,6 +157,9 @@ SPEX_8000M = Preset(
         "dem_averaging_rel_error": Cited(
             1e-2, "numerical choice: ±1 % on each ball's mean heat rate (~0.3 K on a 30 K rise) in ~40 s of mechanics"
         ),
+        "dem_replicas": Cited(
+            1, "numerical choice: one replica, as before replicas existed; set it to the cores a run may use"
+        ),
         "averaging_batch_periods": Cited(16, "numerical choice: batches of 16 drive periods (~0.9 s)"),
         "averaging_min_batches": Cited(10, "numerical choice: the usual minimum for batch means"),
         "averaging_max_time": Cited(120.0, "numerical choice: 2 simulated minutes of mechanics at most"),

@@ -37,6 +37,7 @@ from shakermill.parameters.keys import Parameters
 from shakermill.solvers.attractors import probe_attractors
 from shakermill.solvers.driver import Means, least_batches, measure_means, sample_times
 from shakermill.solvers.full import concluded, simulate_full
+from shakermill.solvers.replicas import replica_threads
 from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages, Result, conclude, summarize
 
 # The thermal time constant of each impact-heated node must exceed the mean time between the impacts that heat it
@@ -71,10 +72,14 @@ class Mechanics:
 def settle_mechanics(params: Parameters, engine_class: type[Engine], progress: ProgressCallback | None = None,
                      budget: RunBudget | None = None) -> Mechanics:
     """Run the mechanics until its means converge; Ctrl-C ends it with the status INTERRUPTED and keeps the engine,
-    so that what it integrated can still be returned. Only the start is sampled; the record windows are kept."""
+    so that what it integrated can still be returned. Only the start is sampled; the record windows are kept, by
+    the first of the replicas that an engine with a ``replicas_key`` runs (solvers/replicas.py) alone."""
     engine = engine_class(params, budget, np.zeros(1), params.averaging_max_time)
+    replicas_key = engine_class.description.replicas_key
+    count = getattr(params, replicas_key) if replicas_key else 1
+    others = [engine_class(params, budget, np.zeros(1), 0.0, replica=number) for number in range(1, count)]
     try:
-        means, status = measure_means(params, engine, progress)
+        means, status = measure_means(params, [engine, *others], progress, replica_threads(count))
     except KeyboardInterrupt:
         means, status = None, INTERRUPTED
     return Mechanics(params, engine, means, status)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Sequence
 
 import numpy as np
 
@@ -14,6 +15,7 @@ from shakermill.engines.interface import Engine, Measured, ProgressCallback
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.keys import Parameters
+from shakermill.solvers.replicas import ReplicaSet
 from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages
 
 # Simulated seconds per chunk: the granularity of progress reports (tiny steps hand back control sooner,
@@ -77,56 +79,92 @@ def _flat(measured: Measured) -> np.ndarray:
     return np.concatenate([measured.heat, measured.terms, measured.conduction, [measured.dissipated]])
 
 
-def measure_means(params: Parameters, engine: Engine, progress: ProgressCallback | None) -> tuple[Means, int]:
-    """Run the mechanics batch by batch until the means converge (or :func:`mechanics_limit`); returns the means and
-    the engine's last status. ``progress(t, mechanics_limit)`` is told how far the mechanics has got.
+def measure_means(params: Parameters, engines: Sequence[Engine], progress: ProgressCallback | None,
+                  threads: int = 1) -> tuple[Means, int]:
+    """Run the mechanics of ``engines`` (independent replicas of one run, solvers/replicas.py) batch by batch, side by
+    side on ``threads`` threads, until their pooled means converge (or :func:`mechanics_limit`); returns the means and
+    the last status. ``progress(t, mechanics_limit)`` is told how far the first replica has got.
 
-    Converged: after the start-up transient (MSER on the total heat power and the balls' mean velocity term),
-    at least ``averaging_min_batches`` batches, and every total, source and ball mean known to the engine's
-    target relative standard error (``description.averaging_error_key``).
+    Converged: after each replica's start-up transient (MSER on its total heat power and its balls' mean velocity
+    term), at least ``averaging_min_batches`` batches in all, and every total, source and ball mean of the pooled
+    batches known to the engine's target relative standard error (``description.averaging_error_key``). The
+    replicas advance in rounds to the same time, so the numbers do not depend on ``threads``.
     """
-    key = engine.description.averaging_error_key
+    key = engines[0].description.averaging_error_key
     target = getattr(params, key)
     batch = params.averaging_batch_periods * params.period
-    first = engine.measured()
+    first = engines[0].measured()
     sources, balls = first.heat.size, first.terms.size
     if balls == 0:
-        return _nothing_moves(engine, first), REACHED_STOP
-    cumulative = [_flat(first)]
+        return _nothing_moves(engines[0], first), REACHED_STOP
+    cumulative = [[_flat(engine.measured())] for engine in engines]
     limit, limit_name = mechanics_limit(params)
     heartbeat = None if progress is None else lambda t: progress(t, limit)
-    status, converged, cut, message = REACHED_STOP, False, 0, ""
-    while True:
-        status = engine.advance(engine.t + batch, heartbeat)
-        if status != REACHED_STOP:
-            message = f"the mechanics failed: {engine.explain(status)}"
-            break
-        if heartbeat is not None:
-            heartbeat(engine.t)
-        cumulative.append(_flat(engine.measured()))
-        rates = batch_rates(np.array(cumulative), batch)  # (batches, sources, balls' terms, conductances, dissipated)
-        if len(rates) >= least_batches(params):
-            totals = np.column_stack([rates[:, :sources].sum(axis=1), rates[:, sources : sources + balls].mean(axis=1)])
-            cut = max(mser_truncation(normalised(column)) for column in totals.T)
-            kept = np.column_stack([totals[cut:], rates[cut:, : sources + balls]])
-            if len(kept) >= params.averaging_min_batches and all(relative_error(column) <= target for column in kept.T):
-                converged = True
-                message = f"converged after {engine.t:.3g} s of mechanics ({len(kept)} batches of {batch:.3g} s)"
+    status, converged, cuts, message = REACHED_STOP, False, [0] * len(engines), ""
+    with ReplicaSet(engines, threads) as replicas:
+        while True:
+            t = engines[0].t + batch
+            status = next((status for status in replicas.advance(t, heartbeat) if status != REACHED_STOP), REACHED_STOP)
+            if status != REACHED_STOP:
+                message = f"the mechanics failed: {engines[0].explain(status)}"
                 break
-        if engine.t + batch > limit:
-            message = (
-                f"the averages did not converge to a relative standard error of {target:g} ({key}) within "
-                f"{limit_name} = {limit:g} s (irregular or slowly settling motion)"
-            )
-            break
-    rates = batch_rates(np.array(cumulative), batch)[cut:]
-    return _means(engine, rates, sources, balls, cut * batch, batch, converged, message), status
+            if heartbeat is not None:
+                heartbeat(t)
+            for series, engine in zip(cumulative, engines):
+                series.append(_flat(engine.measured()))
+            if len(cumulative[0]) > least_rounds(params, len(engines)):
+                kept, cuts = _pooled(cumulative, batch, sources, balls)
+                totals = _totals(kept, sources, balls)
+                columns = np.column_stack([totals, kept[:, : sources + balls]])
+                if len(kept) >= params.averaging_min_batches and all(relative_error(c) <= target for c in columns.T):
+                    converged = True
+                    message = f"converged after {t:.3g} s of mechanics{_in_each(engines)} ({len(kept)} batches of {batch:.3g} s)"
+                    break
+            if t + batch > limit:
+                message = (
+                    f"the averages did not converge to a relative standard error of {target:g} ({key}) within "
+                    f"{limit_name} = {limit:g} s{_in_each(engines)} (irregular or slowly settling motion)"
+                )
+                break
+    rates = np.concatenate([batch_rates(np.array(series), batch)[cut:] for series, cut in zip(cumulative, cuts)])
+    first_kept = len(cumulative[0]) - 1 - cuts[0]
+    return _means(engines, rates, sources, balls, (cuts[0], first_kept), cuts, batch, converged, message), status
+
+
+def _in_each(engines: Sequence[Engine]) -> str:
+    return f" in each of {len(engines)} replicas" if len(engines) > 1 else ""
+
+
+def _totals(rates: np.ndarray, sources: int, balls: int) -> np.ndarray:
+    """Each batch's total heat power and its balls' mean velocity term, from rates with the columns of ``_flat``."""
+    return np.column_stack([rates[:, :sources].sum(axis=1), rates[:, sources : sources + balls].mean(axis=1)])
+
+
+def _pooled(cumulative: list[list[np.ndarray]], batch: float, sources: int, balls: int) -> tuple[np.ndarray, list[int]]:
+    """The batch rates of every replica after its own start-up transient, stacked, and each replica's cut (batches)."""
+    kept, cuts = [], []
+    for series in cumulative:
+        rates = batch_rates(np.array(series), batch)
+        cut = max(mser_truncation(normalised(column)) for column in _totals(rates, sources, balls).T)
+        kept.append(rates[cut:])
+        cuts.append(cut)
+    return np.concatenate(kept), cuts
 
 
 def least_batches(params: Parameters) -> int:
     """The fewest batches :func:`measure_means` tests for convergence: twice ``averaging_min_batches``, since the
     start-up transient that MSER cuts off may take up to half of them."""
     return 2 * params.averaging_min_batches
+
+
+def least_rounds(params: Parameters, replicas: int) -> int:
+    """The fewest batches of each of ``replicas`` replicas before convergence is tested: :func:`least_batches`
+    shared among them, but never under LEAST_BATCHES_PER_REPLICA, so that MSER can tell each one's transient."""
+    return max(math.ceil(least_batches(params) / replicas), LEAST_BATCHES_PER_REPLICA)
+
+
+# MSER needs a few batches of a replica to tell its transient from its settled motion.
+LEAST_BATCHES_PER_REPLICA = 4
 
 
 def mechanics_limit(params: Parameters) -> tuple[float, str]:
@@ -137,29 +175,31 @@ def mechanics_limit(params: Parameters) -> tuple[float, str]:
     return params.averaging_max_time, "averaging_max_time"
 
 
-def _means(engine: Engine, rates: np.ndarray, sources: int, balls: int, transient: float, batch: float,
-           converged: bool, message: str) -> Means:
-    """The means of the kept batch ``rates`` (columns: each source's heat, each ball's term, each contact
-    conductance, the dissipation). The conductances are averaged but not held to the target error: a pair of balls
-    that rarely touch has a noisy one, and a small one."""
+def _means(engines: Sequence[Engine], rates: np.ndarray, sources: int, balls: int, first: tuple[int, int],
+           cuts: list[int], batch: float, converged: bool, message: str) -> Means:
+    """The means of the kept batch ``rates`` of every replica (columns: each source's heat, each ball's term, each
+    contact conductance, the dissipation). The conductances are averaged but not held to the target error: a pair
+    of balls that rarely touch has a noisy one, and a small one. The transient and window are the first replica's
+    (``first``: the batches it cut and kept), whose motion and impacts a result shows."""
     heat, terms, conductances = rates[:, :sources], rates[:, sources : sources + balls], rates[:, sources + balls : -1]
     total_heat, mean_terms = heat.sum(axis=1), terms.mean(axis=1)
-    window = len(rates) * batch
-    impacts = len(engine.impact_columns(since=transient)["time"])
+    impacts = sum(len(engine.impact_columns(since=cut * batch)["time"]) for engine, cut in zip(engines, cuts))
+    pooled_window = len(rates) * batch
     averages = MechanicsAverages(
         heat_power=_mean(total_heat),
         heat_power_stderr=standard_error(total_heat),
         dissipated_power=_mean(rates[:, -1]),
         velocity_term=_mean(mean_terms),
         velocity_term_stderr=standard_error(mean_terms),
-        transient=transient,
-        window=window,
+        transient=first[0] * batch,
+        window=first[1] * batch,
         batches=len(rates),
-        impact_interval=window / impacts if impacts else math.inf,
+        impact_interval=pooled_window / impacts if impacts else math.inf,
         converged=converged,
         message=message,
+        replicas=len(engines),
     )
-    load = engine.load(*(np.array([_mean(column) for column in part.T]) for part in (heat, terms, conductances)))
+    load = engines[0].load(*(np.array([_mean(column) for column in part.T]) for part in (heat, terms, conductances)))
     return Means(load, averages)
 
 

@@ -61,6 +61,8 @@ class MechanicsAverages:
     impact_interval: float  # s, mean time between impacts in the window (inf without impacts)
     converged: bool
     message: str
+    # Independent replicas of the mechanics pooled (solvers/replicas.py); transient and window are the first's.
+    replicas: int = 1
 
     def as_summary(self) -> dict[str, float | int | bool | str]:
         return {
@@ -72,6 +74,7 @@ class MechanicsAverages:
             "averaging_transient_s": self.transient,
             "averaging_window_s": self.window,
             "averaging_batches": self.batches,
+            "averaging_replicas": self.replicas,
             "averaging_converged": self.converged,
             "averaging_message": self.message,
         }

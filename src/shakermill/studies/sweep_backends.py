@@ -210,7 +210,8 @@ PARENT_CHECK_INTERVAL_S = 1.0
 
 
 def _start_worker(sweep_pid: int) -> None:
-    """Ignore Ctrl-C (the sweep handles it), and exit when the sweep's process is gone.
+    """Ignore Ctrl-C (the sweep handles it), run each point's replicas on one thread, and exit when the sweep's
+    process is gone.
 
     A sweep killed with SIGKILL (by the user, or the out-of-memory killer) cannot stop its pool;
     without this, its workers would wait for more points forever. A thread watches the sweep's
@@ -229,7 +230,11 @@ def _start_worker(sweep_pid: int) -> None:
 
     import psutil
 
+    from shakermill.solvers.replicas import THREADS_VARIABLE
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # The pool gives every core a point already: a point's replicas take turns on its worker's core.
+    os.environ.setdefault(THREADS_VARIABLE, "1")
     try:
         sweep_process = psutil.Process(sweep_pid)
     except psutil.NoSuchProcess:

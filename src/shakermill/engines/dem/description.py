@@ -61,6 +61,7 @@ DESCRIPTION = EngineDescription(
     term_variables=("velocity_term_integrals",),
     status_messages=STATUS_MESSAGES,
     averaging_error_key="dem_averaging_rel_error",
+    replicas_key="dem_replicas",
     thermal_only_keys=THERMAL_ONLY_KEYS,
     attractor_starts=False,
     conduction_variables=("contact_conduction",),

@@ -56,14 +56,17 @@ class DemEngine(CompiledRun):
     most_steps_per_call: ClassVar[int] = 50_000_000
 
     def __init__(self, params: Parameters, budget: RunBudget | None = None, samples: Sequence[float] = (0.0,),
-                 horizon: float = 0.0) -> None:
+                 horizon: float = 0.0, replica: int = 0) -> None:
         """See :class:`~shakermill.engines.interface.Engine`. The state is recorded as a row (:func:`model.row_fields`)
-        at each sample and every WINDOW_INTERVAL inside the record windows; the start before the first step."""
+        at each sample and every WINDOW_INTERVAL inside the record windows; the start before the first step.
+        A ``replica`` > 0 starts from the configured state with its balls kicked (:func:`model.kick_for_replica`)."""
         self.params = params
         self.budget = budget if budget is not None else RunBudget.of(params)
         self.network = self.network_for(params)
         self.constants = model.constants_from(params)
         self.state = model.initial_state(params, self.constants, self.network)
+        if replica:
+            model.kick_for_replica(self.state, replica)
         self.scratch = model.scratch_for(params.n_balls, model.slot_count(params.n_balls))
         self.stepper_counters = np.zeros(len(stepper.COUNTER_NAMES) + 1, dtype=np.int64)
         times, self._is_sample, self._in_window = marks(params, np.asarray(samples, dtype=float), horizon)

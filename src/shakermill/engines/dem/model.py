@@ -290,6 +290,18 @@ THERMAL_STEP = 1e-3
 THERMAL_STEP_FRACTION = 0.1
 
 
+# A replica of a run starts with every ball given this speed (m/s) in a seeded direction: a few thousandths of the
+# vial's speed, which the balls' chaotic hits on each other and the bore magnify into a motion of its own.
+REPLICA_KICK = 0.01
+
+
+def kick_for_replica(state: State, replica: int) -> None:
+    """Give each ball of ``state`` REPLICA_KICK in a direction drawn by a generator seeded with ``replica`` (> 0):
+    a replica's start depends on the configuration and its number alone."""
+    directions = np.random.default_rng(replica).normal(size=state.velocity.shape)
+    state.velocity[:] += REPLICA_KICK * directions / np.linalg.norm(directions, axis=1, keepdims=True)
+
+
 def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> State:
     """Balls at rest where :meth:`Parameters.initial_positions` puts them (one ball: ``ball_position`` and
     ``ball_momentum`` along the axis, as the 1-D engine), every node of ``network`` at the initial temperature

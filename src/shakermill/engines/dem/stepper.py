@@ -259,7 +259,8 @@ def write_row(k: Constants, net: NetworkArrays, s: State, w: Scratch, row: np.nd
         offset += block.size
 
 
-@njit(cache=True)
+# nogil: the replicas of an averaged run step side by side on threads (solvers/replicas.py).
+@njit(cache=True, nogil=True)
 def advance(t_stop: float, max_steps: int, k: Constants, net: NetworkArrays, s: State, w: Scratch, records: np.ndarray,
             count: int, counters: np.ndarray, marks: np.ndarray, rows: np.ndarray) -> tuple[int, int]:
     """Step to ``t_stop`` (s); returns (status, record count). Steps end on each time in ``marks`` (sorted),
