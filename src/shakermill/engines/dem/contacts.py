@@ -24,7 +24,7 @@ from shakermill.engines.dem.model import (
     Scratch,
     State,
 )
-from shakermill.engines.dem.vectors import cross_into, difference_into, distance, dot, norm, scaled_into
+from shakermill.engines.dem.vectors import copy_into, cross_into, difference_into, distance, dot, norm, scaled_into
 from shakermill.engines.thermal import kernel
 from shakermill.physics import contact, heat_paths
 
@@ -79,7 +79,8 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
         spring[axis] -= along * normal[axis]
     turned = norm(spring)
     if turned > 0.0:
-        spring *= length / turned
+        for axis in range(3):
+            spring[axis] *= length / turned
     stiffness = contact.tangential_stiffness(shear_modulus, radius, overlap)
     damping_t = contact.tangential_damping(k.beta_e, stiffness, mass)
     pressing = max(magnitude, 0.0)
@@ -98,8 +99,9 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
         # where k_t is tiny, in a contact's first step, when the damper gives most of the trial force.
         ratio = limit / size
         c.slip_loss[slot] = limit * (1.0 - ratio) * norm(spring)
-        w.tangential_force[slot] *= ratio
-        spring *= ratio
+        for axis in range(3):
+            w.tangential_force[slot, axis] *= ratio
+            spring[axis] *= ratio
     w.stiffness[slot] = stiffness
     w.stretch[slot] = dot(spring, spring)
     spin = norm(relative_spin)
@@ -191,7 +193,8 @@ def pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
                 w.normal[axis] = (s.position[i, axis] - s.position[j, axis]) / centres
             _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
             _contact_point_velocity(j, k.radius[j], s, w, w.other_velocity)
-            w.point_velocity[:] -= w.other_velocity
+            for axis in range(3):
+                w.point_velocity[axis] -= w.other_velocity[axis]
             difference_into(s.spin[i], s.spin[j], w.relative_spin)
             live = _engage(slot, t, overlap, k.pair_modulus[i, j], k.pair_shear_modulus[i, j], k.pair_radius[i, j],
                            k.pair_mass[i, j], k.radius[i], dt, k, s, w, live)
@@ -220,7 +223,8 @@ def wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
             for axis in range(3):
                 w.wall_velocity[slot, axis] = w.rates[axis] + w.other_velocity[axis]
             _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
-            w.point_velocity[:] -= w.wall_velocity[slot]
+            for axis in range(3):
+                w.point_velocity[axis] -= w.wall_velocity[slot, axis]
             difference_into(s.spin[i], w.angular, w.relative_spin)
             live = _engage(slot, t, overlap, k.wall_modulus[i], k.wall_shear_modulus[i], k.wall_radius[i, wall],
                            k.mass[i], k.radius[i], dt, k, s, w, live)
@@ -317,12 +321,12 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
     for node, part in ((i, share * heat), (other, (1.0 - share) * heat)):
         s.pending_heat[node] += part
         s.heat_into[node] += part
-    c.normal_force[slot] = w.normal_force[slot]
-    c.tangential_force[slot] = w.tangential_force[slot]
-    c.lever_torque_i[slot] = w.lever_torque_i[slot]
-    c.lever_torque_j[slot] = w.lever_torque_j[slot]
-    c.rolling_torque[slot] = w.rolling_torque[slot]
-    c.wall_velocity[slot] = w.wall_velocity[slot]
+    copy_into(w.normal_force[slot], c.normal_force[slot])
+    copy_into(w.tangential_force[slot], c.tangential_force[slot])
+    copy_into(w.lever_torque_i[slot], c.lever_torque_i[slot])
+    copy_into(w.lever_torque_j[slot], c.lever_torque_j[slot])
+    copy_into(w.rolling_torque[slot], c.rolling_torque[slot])
+    copy_into(w.wall_velocity[slot], c.wall_velocity[slot])
     c.elastic_energy[slot] = w.elastic_energy[slot]
     c.stiffness[slot] = w.stiffness[slot]
     c.stretch[slot] = w.stretch[slot]
@@ -333,7 +337,8 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
     wall = -1 if pair else (slot - n * n) % N_WALLS
     row[0], row[1], row[2] = c.started[slot], i, j if pair else -1 - wall
     row[3], row[4] = c.normal_speed_in[slot], c.tangential_speed_in[slot]
-    row[5:9] = c.dissipated[slot]
+    for channel in range(4):
+        row[5 + channel] = c.dissipated[slot, channel]
     row[9], row[10], row[11] = c.peak_force[slot], c.max_overlap[slot], t - c.started[slot]
     total = k.eta * (c.dissipated[slot, 0] + c.dissipated[slot, 1] + c.dissipated[slot, 2] + c.dissipated[slot, 3])
     row[12], row[13] = share * total, (1.0 - share) * total

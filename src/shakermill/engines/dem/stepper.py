@@ -105,8 +105,8 @@ def advance_thermal(k: Constants, net: NetworkArrays, s: State) -> None:
     """Advance the network (``engines.thermal``) over the time gathered since its last update, with the heat, the
     mean Whitaker terms and the mean contact conductances of that time (explicit Euler, which conserves energy
     exactly)."""
-    # Its scratch is allocated here, at most once a thermal step (1 ms), rather than kept in ``Scratch``: every
-    # array there costs reference counts at each use inside the compiled step.
+    # Its scratch is allocated here, at most once a thermal step (1 ms): a function of its own, compiled with
+    # Numba's runtime, which the stepping loop runs without (:func:`advance`).
     span = s.clock[1]
     if span <= 0.0:
         return
@@ -225,7 +225,8 @@ def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.n
           count: int) -> tuple[int, int, float, float]:
     """One velocity-Verlet step of length ``dt`` ending at ``t``; returns (record count, contacts touching,
     deepest overlap, the longest next step the touching contacts allow)."""
-    w.angular_before[:] = w.angular
+    for axis in range(3):
+        w.angular_before[axis] = w.angular[axis]
     _kick_and_drift(dt, k, s, w)
     vial_frame(t, k, w)
     live, deepest_pair = pair_contacts(t, dt, k, s, w, 0)
@@ -259,8 +260,12 @@ def write_row(k: Constants, net: NetworkArrays, s: State, w: Scratch, row: np.nd
         offset += block.size
 
 
-# nogil: the replicas of an averaged run step side by side on threads (solvers/replicas.py).
-@njit(cache=True, nogil=True)
+# nogil: the replicas of an averaged run step side by side on threads (solvers/replicas.py). _nrt=False: no
+# reference counting of the arrays inside the loop, which took three quarters of a step (each view and each array
+# taken from the tuples counted in and out with an atomic add; benchmarks/README.md, "The per-step cost"). The loop
+# allocates nothing, so it needs none of Numba's runtime. The option is Numba's own (``numba.core.options``),
+# private by its underscore: a Numba without it would refuse to compile this loop, which every 3-D test runs.
+@njit(cache=True, nogil=True, _nrt=False)
 def advance(t_stop: float, max_steps: int, k: Constants, net: NetworkArrays, s: State, w: Scratch, records: np.ndarray,
             count: int, counters: np.ndarray, marks: np.ndarray, rows: np.ndarray) -> tuple[int, int]:
     """Step to ``t_stop`` (s); returns (status, record count). Steps end on each time in ``marks`` (sorted),

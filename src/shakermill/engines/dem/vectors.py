@@ -34,6 +34,13 @@ def scaled_into(a: np.ndarray, scale: float, out: np.ndarray) -> None:
 
 
 @njit(cache=True)
+def copy_into(a: np.ndarray, out: np.ndarray) -> None:
+    """out = a, without the overlap test of a slice assignment."""
+    for axis in range(3):
+        out[axis] = a[axis]
+
+
+@njit(cache=True)
 def difference_into(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
     for axis in range(3):
         out[axis] = a[axis] - b[axis]
