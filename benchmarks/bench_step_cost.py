@@ -16,15 +16,12 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
 import statistics
-import subprocess
-import sys
-import tempfile
 import time
-from pathlib import Path
+from contextlib import ExitStack
 
-ROOT = Path(__file__).resolve().parents[1]
+from reference_tree import ROOT, measured_in, reference_tree
+
 MILLS = {
     "spex8000m-3d, 1 ball": ("spex8000m-3d", 1),
     "spex8000m-3d-calibrated, 5 balls": ("spex8000m-3d-calibrated", 5),
@@ -56,13 +53,6 @@ def measure() -> dict[str, dict[str, float | str]]:
     return figures
 
 
-def run_tree(tree: Path) -> dict[str, dict[str, float | str]]:
-    environment = {**os.environ, "PYTHONPATH": str(tree / "src")}
-    completed = subprocess.run([sys.executable, __file__, "--measure"], env=environment, capture_output=True, text=True,
-                               check=True)
-    return json.loads(completed.stdout.strip().splitlines()[-1])
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--reference", help="commit to compare with (a git worktree of it is made and removed)")
@@ -72,21 +62,14 @@ def main() -> None:
     if options.measure:
         print(json.dumps(measure()))
         return
-    with tempfile.TemporaryDirectory() as scratch:
+    with ExitStack() as stack:
         trees = {"this tree": ROOT}
         if options.reference:
-            worktree = Path(scratch) / "reference"
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(worktree), options.reference],
-                           check=True, capture_output=True)
-            trees = {f"reference {options.reference}": worktree, **trees}
-        try:
-            runs = {name: [] for name in trees}
-            for _ in range(options.repeats):
-                for name, tree in trees.items():
-                    runs[name].append(run_tree(tree))
-        finally:
-            if options.reference:
-                subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(worktree)], check=False)
+            trees = {f"reference {options.reference}": stack.enter_context(reference_tree(options.reference)), **trees}
+        runs = {name: [] for name in trees}
+        for _ in range(options.repeats):
+            for name, tree in trees.items():
+                runs[name].append(measured_in(tree, __file__, "--measure"))
     report(runs)
 
 
