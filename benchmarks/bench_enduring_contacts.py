@@ -52,22 +52,28 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--mills", nargs="*", default=list(MILLS), help="which of: " + "; ".join(MILLS))
     parser.add_argument("--no-averaged", action="store_true", help="only the cost of one simulated second")
+    parser.add_argument("--no-second", action="store_true", help="only the averaged solver's means")
+    parser.add_argument("--fractions", type=float, nargs="*", default=FRACTIONS, help="enduring_step_fraction values")
+    parser.add_argument("--rel-error", type=float, help="dem_averaging_rel_error of the averaged rows (default: the preset's)")
+    parser.add_argument("--replicas", type=int, default=1, help="dem_replicas of the averaged rows")
     options = parser.parse_args()
+    tighter = {} if options.rel_error is None else {"dem_averaging_rel_error": options.rel_error, "averaging_max_time": 3600.0}
     sm.simulate(sm.default_parameters("spex8000m-3d", duration=0.01, solver="full", record_windows=()))  # compile
     for mill in options.mills:
         preset, settings = MILLS[mill]
         print(f"\n{mill}")
-        print("  one simulated second at full resolution:")
-        for fraction in FRACTIONS:
-            cpu, summary = one_second(preset, settings, fraction)
-            print(f"    enduring_step_fraction {fraction:<5g}  {cpu:6.2f} CPU-s  {summary['steps']:>9,} steps  "
-                  f"{summary['impacts']:>5} impacts")
+        if not options.no_second:
+            print("  one simulated second at full resolution:")
+            for fraction in options.fractions:
+                cpu, summary = one_second(preset, settings, fraction)
+                print(f"    enduring_step_fraction {fraction:<5g}  {cpu:6.2f} CPU-s  {summary['steps']:>9,} steps  "
+                      f"{summary['impacts']:>5} impacts")
         if options.no_averaged:
             continue
         print("  averaged solver (the preset's hour):")
         reference = None
-        for fraction in FRACTIONS:
-            cpu, summary = averaged(preset, settings, fraction)
+        for fraction in options.fractions:
+            cpu, summary = averaged(preset, {**settings, **tighter, "dem_replicas": options.replicas}, fraction)
             power, error = summary["averaged_heat_power_W"], summary["averaged_heat_power_stderr_W"]
             rate, speed = summary["impact_rate_hz"], summary["mean_impact_speed_m_s"]
             line = (f"    enduring_step_fraction {fraction:<5g}  {cpu:6.1f} CPU-s  heat {power:.4g} ± {error:.2g} W  "

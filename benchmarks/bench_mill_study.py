@@ -48,11 +48,13 @@ MATERIALS = ("hardened-steel", "tungsten-carbide")
 HOUR_S = 3600.0
 
 
-def study_parameters(preset: str, rel_error: float | None) -> sm.Parameters:
+def study_parameters(preset: str, rel_error: float | None, max_time: float | None = None) -> sm.Parameters:
     """One simulated hour, averaged, no full-resolution fall-back and no record windows (they cost mechanics)."""
     settings = {"solver": "averaged", "duration": HOUR_S, "averaging_fallback": "fail", "record_windows": ()}
     if rel_error is not None:
         settings["dem_averaging_rel_error"] = rel_error
+    if max_time is not None:
+        settings["averaging_max_time"] = max_time
     return sm.default_parameters(preset, **settings)
 
 
@@ -165,6 +167,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="sweep folder (resumable; default results/mill-study-<preset>-<counts>-<target>)")
     parser.add_argument("--workers", type=int, default=2, help="local processes")
     parser.add_argument("--rel-error", type=float, help="dem_averaging_rel_error of the sweep (default: the preset's)")
+    parser.add_argument("--max-time", type=float, help="averaging_max_time of the sweep, s (default: the preset's)")
     parser.add_argument("--figure", type=Path, default=FIGURE, help="PNG of the study")
     parser.add_argument("--counts", default=",".join(map(str, BALL_COUNTS)), help="numbers of balls, comma-separated")
     parser.add_argument(
@@ -175,7 +178,7 @@ def main() -> None:
     counts = [int(item) for item in args.counts.split(",")]
 
     preset = PRESET
-    base = study_parameters(preset, args.rel_error)
+    base = study_parameters(preset, args.rel_error, args.max_time)
     # A folder holds one sweep: another choice of counts or target gets a folder of its own.
     out = args.out or ROOT / "results" / f"mill-study-{preset}-{'-'.join(map(str, counts))}-{base.dem_averaging_rel_error:g}"
     print(
