@@ -69,8 +69,8 @@ _UNREAD_GROUPS = (
     (
         ("solver", "duration", "output_interval", "record_windows", "max_wall_time", "max_steps", "rtol",
          "atol_position", "atol_momentum", "atol_temperature", "energy_projection", "averaging_rel_error",
-         "dem_averaging_rel_error", "averaging_batch_periods", "averaging_min_batches", "averaging_max_time",
-         "averaging_fallback", "attractor_starts"),
+         "dem_averaging_rel_error", "dem_replicas", "averaging_batch_periods", "averaging_min_batches",
+         "averaging_max_time", "averaging_fallback", "attractor_starts", "enduring_step_fraction"),
         "a lone impact lasts one contact; how long and how a run is integrated applies to runs",
     ),
     (
