@@ -11,7 +11,7 @@ import pytest
 import shakermill as sm
 from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import DemEngine
-from shakermill.solvers.averaged import settle_mechanics
+from shakermill.solvers.averaged import full_resolution_instead, least_mechanics, settle_mechanics
 from shakermill.solvers.driver import least_rounds
 from shakermill.solvers.replicas import THREADS_VARIABLE, ReplicaSet, replica_threads
 from shakermill.solvers.result import INTERRUPTED
@@ -125,3 +125,13 @@ def test_ctrl_c_in_the_mechanics_of_replicas_keeps_the_first_replica(params, mon
 
     mechanics = settle_mechanics(params, DemEngine, progress)
     assert mechanics.status == INTERRUPTED and mechanics.means is None and mechanics.engine.t > 0.0
+
+
+def test_the_least_mechanics_counts_every_replica_and_its_floor_of_batches(params):
+    batch = params.averaging_batch_periods * params.period
+    one = params.replace(dem_replicas=1)
+    # Twice averaging_min_batches in all, shared among the replicas, but never under 4 batches each.
+    assert least_mechanics(one) == pytest.approx(2 * params.averaging_min_batches * batch)
+    assert least_mechanics(params.replace(dem_replicas=8)) == pytest.approx(8 * 4 * batch)
+    short = params.replace(dem_replicas=8, duration=8 * 4 * batch * 0.99)
+    assert "4 batches of averaging_batch_periods drive periods in each of 8 replicas" in full_resolution_instead(short)

@@ -29,13 +29,14 @@ from scipy.integrate import solve_ivp
 
 from shakermill.analysis.fit import fit_exponential
 from shakermill.engines.budget import RunBudget
-from shakermill.engines.interface import Engine, ProgressCallback
+from shakermill.engines.interface import Engine, EngineDescription, ProgressCallback
 from shakermill.engines.records import EnergyAudit
+from shakermill.engines.registry import describe
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.attractors import probe_attractors
-from shakermill.solvers.driver import Means, least_batches, measure_means, sample_times
+from shakermill.solvers.driver import Means, least_rounds, measure_means, sample_times
 from shakermill.solvers.full import concluded, simulate_full
 from shakermill.solvers.replicas import replica_threads
 from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages, Result, conclude, summarize
@@ -75,8 +76,7 @@ def settle_mechanics(params: Parameters, engine_class: type[Engine], progress: P
     so that what it integrated can still be returned. Only the start is sampled; the record windows are kept, by
     the first of the replicas that an engine with a ``replicas_key`` runs (solvers/replicas.py) alone."""
     engine = engine_class(params, budget, np.zeros(1), params.averaging_max_time)
-    replicas_key = engine_class.description.replicas_key
-    count = getattr(params, replicas_key) if replicas_key else 1
+    count = replica_count(params, engine_class.description)
     others = [engine_class(params, budget, np.zeros(1), 0.0, replica=number) for number in range(1, count)]
     try:
         means, status = measure_means(params, [engine, *others], progress, replica_threads(count))
@@ -115,10 +115,18 @@ def simulate_averaged(params: Parameters, engine_class: type[Engine], progress: 
     return result
 
 
+def replica_count(params: Parameters, description: EngineDescription) -> int:
+    """How many replicas of the mechanics an averaged run of ``params`` on the engine ``description`` describes
+    runs: the value of its ``replicas_key``, or 1."""
+    key = description.replicas_key
+    return getattr(params, key) if key else 1
+
+
 def least_mechanics(params: Parameters) -> float:
-    """The least mechanics (s) an averaged run can end with: :func:`~solvers.driver.least_batches` batches of
-    ``averaging_batch_periods`` drive periods."""
-    return least_batches(params) * params.averaging_batch_periods * params.period
+    """The least mechanics (s) an averaged run can end with, all its replicas together: each runs
+    :func:`~solvers.driver.least_rounds` batches of ``averaging_batch_periods`` drive periods."""
+    replicas = replica_count(params, describe(params.engine))
+    return replicas * least_rounds(params, replicas) * params.averaging_batch_periods * params.period
 
 
 def full_resolution_instead(params: Parameters) -> str | None:
@@ -128,10 +136,12 @@ def full_resolution_instead(params: Parameters) -> str | None:
     needed = least_mechanics(params)
     if params.solver != "averaged" or params.duration > needed:
         return None
+    replicas = replica_count(params, describe(params.engine))
+    each = f" in each of {replicas} replicas" if replicas > 1 else ""
     return (
         f"Full resolution instead of the averaged solver: duration = {params.duration:g} s is no longer than the "
-        f"{needed:.3g} s of mechanics that averaging needs at least (2 x averaging_min_batches x "
-        "averaging_batch_periods drive periods)."
+        f"{needed:.3g} s of mechanics that averaging needs at least ({least_rounds(params, replicas)} batches of "
+        f"averaging_batch_periods drive periods{each})."
     )
 
 
