@@ -127,8 +127,7 @@ def measure_means(params: Parameters, engines: Sequence[Engine], progress: Progr
                 )
                 break
     rates = np.concatenate([batch_rates(np.array(series), batch)[cut:] for series, cut in zip(cumulative, cuts)])
-    first_kept = len(cumulative[0]) - 1 - cuts[0]
-    return _means(engines, rates, sources, balls, (cuts[0], first_kept), cuts, batch, converged, message), status
+    return _means(engines, rates, sources, balls, cuts, len(cumulative[0]) - 1, batch, converged, message), status
 
 
 def _in_each(engines: Sequence[Engine]) -> str:
@@ -175,12 +174,12 @@ def mechanics_limit(params: Parameters) -> tuple[float, str]:
     return params.averaging_max_time, "averaging_max_time"
 
 
-def _means(engines: Sequence[Engine], rates: np.ndarray, sources: int, balls: int, first: tuple[int, int],
-           cuts: list[int], batch: float, converged: bool, message: str) -> Means:
+def _means(engines: Sequence[Engine], rates: np.ndarray, sources: int, balls: int, cuts: list[int], rounds: int,
+           batch: float, converged: bool, message: str) -> Means:
     """The means of the kept batch ``rates`` of every replica (columns: each source's heat, each ball's term, each
     contact conductance, the dissipation). The conductances are averaged but not held to the target error: a pair
-    of balls that rarely touch has a noisy one, and a small one. The transient and window are the first replica's
-    (``first``: the batches it cut and kept), whose motion and impacts a result shows."""
+    of balls that rarely touch has a noisy one, and a small one. ``cuts``: the batches each replica cut of the
+    ``rounds`` it ran. The transient and window are the first replica's, whose motion and impacts a result shows."""
     heat, terms, conductances = rates[:, :sources], rates[:, sources : sources + balls], rates[:, sources + balls : -1]
     total_heat, mean_terms = heat.sum(axis=1), terms.mean(axis=1)
     impacts = sum(len(engine.impact_columns(since=cut * batch)["time"]) for engine, cut in zip(engines, cuts))
@@ -191,8 +190,8 @@ def _means(engines: Sequence[Engine], rates: np.ndarray, sources: int, balls: in
         dissipated_power=_mean(rates[:, -1]),
         velocity_term=_mean(mean_terms),
         velocity_term_stderr=standard_error(mean_terms),
-        transient=first[0] * batch,
-        window=first[1] * batch,
+        transient=cuts[0] * batch,
+        window=(rounds - cuts[0]) * batch,
         batches=len(rates),
         impact_interval=pooled_window / impacts if impacts else math.inf,
         converged=converged,

@@ -79,8 +79,7 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
         spring[axis] -= along * normal[axis]
     turned = norm(spring)
     if turned > 0.0:
-        for axis in range(3):
-            spring[axis] *= length / turned
+        scaled_into(spring, length / turned, spring)
     stiffness = contact.tangential_stiffness(shear_modulus, radius, overlap)
     damping_t = contact.tangential_damping(k.beta_e, stiffness, mass)
     pressing = max(magnitude, 0.0)
@@ -99,9 +98,8 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
         # where k_t is tiny, in a contact's first step, when the damper gives most of the trial force.
         ratio = limit / size
         c.slip_loss[slot] = limit * (1.0 - ratio) * norm(spring)
-        for axis in range(3):
-            w.tangential_force[slot, axis] *= ratio
-            spring[axis] *= ratio
+        scaled_into(w.tangential_force[slot], ratio, w.tangential_force[slot])
+        scaled_into(spring, ratio, spring)
     w.stiffness[slot] = stiffness
     w.stretch[slot] = dot(spring, spring)
     spin = norm(relative_spin)
@@ -193,8 +191,7 @@ def pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
                 w.normal[axis] = (s.position[i, axis] - s.position[j, axis]) / centres
             _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
             _contact_point_velocity(j, k.radius[j], s, w, w.other_velocity)
-            for axis in range(3):
-                w.point_velocity[axis] -= w.other_velocity[axis]
+            difference_into(w.point_velocity, w.other_velocity, w.point_velocity)
             difference_into(s.spin[i], s.spin[j], w.relative_spin)
             live = _engage(slot, t, overlap, k.pair_modulus[i, j], k.pair_shear_modulus[i, j], k.pair_radius[i, j],
                            k.pair_mass[i, j], k.radius[i], dt, k, s, w, live)
@@ -223,8 +220,7 @@ def wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
             for axis in range(3):
                 w.wall_velocity[slot, axis] = w.rates[axis] + w.other_velocity[axis]
             _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
-            for axis in range(3):
-                w.point_velocity[axis] -= w.wall_velocity[slot, axis]
+            difference_into(w.point_velocity, w.wall_velocity[slot], w.point_velocity)
             difference_into(s.spin[i], w.angular, w.relative_spin)
             live = _engage(slot, t, overlap, k.wall_modulus[i], k.wall_shear_modulus[i], k.wall_radius[i, wall],
                            k.mass[i], k.radius[i], dt, k, s, w, live)

@@ -39,7 +39,7 @@ from shakermill.engines.dem.model import (
     Scratch,
     State,
 )
-from shakermill.engines.dem.vectors import cross_into, distance, dot, norm
+from shakermill.engines.dem.vectors import copy_into, cross_into, distance, dot, norm
 from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.kernel import NetworkArrays
@@ -225,8 +225,7 @@ def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.n
           count: int) -> tuple[int, int, float, float]:
     """One velocity-Verlet step of length ``dt`` ending at ``t``; returns (record count, contacts touching,
     deepest overlap, the longest next step the touching contacts allow)."""
-    for axis in range(3):
-        w.angular_before[axis] = w.angular[axis]
+    copy_into(w.angular, w.angular_before)
     _kick_and_drift(dt, k, s, w)
     vial_frame(t, k, w)
     live, deepest_pair = pair_contacts(t, dt, k, s, w, 0)
