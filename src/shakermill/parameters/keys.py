@@ -11,7 +11,7 @@ from __future__ import annotations
 import difflib
 import math
 import typing
-from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping
+from typing import TYPE_CHECKING, Any, Literal, Mapping
 
 import annotated_types
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -21,6 +21,17 @@ from shakermill.parameters import consistency, guards, materials
 from shakermill.parameters.bounds import Bounds
 from shakermill.parameters.engine_keys import ENGINE_KEYS, MAX_BALLS
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.fields import (
+    LONGEST_RUN_S,
+    MAX_HARMONICS,
+    Harmonic,
+    Window,
+    choice,
+    count,
+    material_name,
+    per_ball,
+    quantity,
+)
 from shakermill.parameters.geometry import DENSEST_PACKING, ball_volume, balls_for_fill, end_faces_area, vial_volume
 from shakermill.parameters.kinematic_models import MAX_MOTION_HARMONIC, MAX_MOTION_TRANSLATION, MOTION_COORDINATES
 from shakermill.parameters.units import UnitError
@@ -31,59 +42,6 @@ if TYPE_CHECKING:
     import numpy
 
 
-def _quantity(unit: str, description: str, **bounds: float) -> Any:
-    return Field(json_schema_extra={"unit": unit, "description": description}, **bounds)
-
-
-def _count(description: str, **bounds: int) -> Any:
-    return Field(json_schema_extra={"unit": "", "description": description}, strict=True, **bounds)
-
-
-def _material_name(of: str, keys: str) -> Any:
-    return Field(
-        json_schema_extra={
-            "unit": "",
-            "description": f"material of {of} from `shakermill materials`: fills {keys} unless they are set with it or "
-            "later; '': none",
-        }
-    )
-
-
-def _choice(description: str) -> Any:
-    """A key that names one of a few alternatives (a ``Literal``), and what each means."""
-    return Field(json_schema_extra={"description": description})
-
-
-def _per_ball(scalar_key: str) -> Any:
-    return Field(
-        max_length=MAX_BALLS,
-        json_schema_extra={"unit": "", "per_ball": scalar_key, "description": f"per-ball {scalar_key} (engine = 'dem')"},
-    )
-
-
-# The most harmonics of a user-given vial motion.
-MAX_HARMONICS = 60
-Harmonic = tuple[
-    Literal["x", "y", "z", "roll", "pitch", "yaw"],
-    Annotated[int, annotated_types.Ge(0), annotated_types.Le(MAX_MOTION_HARMONIC)],
-    float,
-    float,
-]
-
-
-# Every key has hard bounds: a value outside them is refused with one line naming the key and its range.
-# They are wide enough for any real mill (PLAUSIBLE_RANGES warns about the merely unusual inside them)
-# and tight enough that the model and its integrator stay meaningful and finish; the comment above each
-# field says why its bounds are where they are. Lower bounds of 0 that stay open are physical (no
-# negative length), except where a small value makes the run misbehave.
-LONGEST_RUN_S = 1e6
-Window = tuple[
-    # A window may start anywhere in the longest run; its length is capped with the others' (MAX_RECORDED_SECONDS).
-    Annotated[float, annotated_types.Ge(0), annotated_types.Le(LONGEST_RUN_S)],
-    Annotated[float, annotated_types.Gt(0), annotated_types.Le(MAX_RECORDED_SECONDS)],
-]
-
-
 class Parameters(BaseModel):
     """One run of the one-ball shaker-mill model (MODEL.md sections 1–9)."""
 
@@ -91,129 +49,129 @@ class Parameters(BaseModel):
 
     # Geometry and drive (MODEL.md section 1)
     # 25 µm: the finest beads of bead mills (50 µm across); 0.1 m: larger than any milling ball (~50 mm).
-    ball_radius: float = _quantity("m", "milling ball radius R", ge=2.5e-5, le=0.1)
+    ball_radius: float = quantity("m", "milling ball radius R", ge=2.5e-5, le=0.1)
     # 1 mm to 1 m: from micro-vials to twice the largest vibratory mill's vessel.
-    vial_length: float = _quantity("m", "inner length of the vial l_v", ge=1e-3, le=1.0)
-    vial_diameter: float = _quantity("m", "inner diameter of the vial d_v", ge=1e-3, le=1.0)
+    vial_length: float = quantity("m", "inner length of the vial l_v", ge=1e-3, le=1.0)
+    vial_diameter: float = quantity("m", "inner diameter of the vial d_v", ge=1e-3, le=1.0)
     # Open at 0: a vanishing stroke is a resting wall, the analytic test of a single impact. 0.5 m: five
     # times the longest stroke of a shaker mill.
-    amplitude: float = _quantity(
+    amplitude: float = quantity(
         "m", "vial oscillation amplitude X_v (kinematics = 'mixer-mill-arc': along the arc, at the jar's centre)", gt=0, le=0.5
     )
     # 1 rad/s (0.16 Hz): thirty times slower than any mill. 1e4 rad/s (1.6 kHz): beyond acoustic mixers
     # (60 Hz), high enough that 1060 typed for rpm is warned about, not refused; the step count grows with ω.
-    omega: float = _quantity("rad/s", "vial angular frequency ω", ge=1.0, le=1e4)
+    omega: float = quantity("rad/s", "vial angular frequency ω", ge=1.0, le=1e4)
     # One turn either way: every phase has an equal one inside, and larger ones only cost precision in sin(ωt + φ).
-    phase: float = _quantity("rad", "vial phase φ at t = 0", ge=-2 * math.pi, le=2 * math.pi)
+    phase: float = quantity("rad", "vial phase φ at t = 0", ge=-2 * math.pi, le=2 * math.pi)
     # Materials (Table 2). A named material fills in the keys below (with_materials); '' leaves them as they are.
-    ball_material: str = _material_name(
+    ball_material: str = material_name(
         "the balls", "ball_density, ball_youngs_modulus, ball_poisson_ratio, ball_heat_capacity, ball_conductivity"
     )
-    vial_material: str = _material_name(
+    vial_material: str = material_name(
         "the vial", "vial_density, vial_youngs_modulus, vial_poisson_ratio, vial_heat_capacity, vial_conductivity"
     )
     # 500 kg/m³: below every solid milling medium (polyethylene ~950); 25 000: above osmium (22 590), the
     # densest element. A ball of 1e-6 kg/m³ has no heat capacity and made a run take hours.
-    ball_density: float = _quantity("kg/m^3", "ball density ρ_b", ge=500.0, le=25_000.0)
-    vial_density: float = _quantity("kg/m^3", "vial density ρ_v", ge=500.0, le=25_000.0)
+    ball_density: float = quantity("kg/m^3", "ball density ρ_b", ge=500.0, le=25_000.0)
+    vial_density: float = quantity("kg/m^3", "vial density ρ_v", ge=500.0, le=25_000.0)
     # 0.1 MPa: softer than rubber; such contacts overlap past what the integrator allows and the run stops
     # with its status. 1.2 TPa: diamond, the stiffest solid.
-    ball_youngs_modulus: float = _quantity("Pa", "ball Young's modulus E_b", ge=1e5, le=1.2e12)
-    vial_youngs_modulus: float = _quantity("Pa", "vial Young's modulus E_v", ge=1e5, le=1.2e12)
+    ball_youngs_modulus: float = quantity("Pa", "ball Young's modulus E_b", ge=1e5, le=1.2e12)
+    vial_youngs_modulus: float = quantity("Pa", "vial Young's modulus E_v", ge=1e5, le=1.2e12)
     # Dense solids lie in 0-0.5 (diamond 0.07, steel 0.3, rubber 0.5); -0.5 leaves room for auxetic
     # materials. As ν -> -1 the shear modulus, and the Rayleigh time that bounds contact steps, vanish.
-    ball_poisson_ratio: float = _quantity("", "ball Poisson ratio ν_b", ge=-0.5, lt=0.5)
-    vial_poisson_ratio: float = _quantity("", "vial Poisson ratio ν_v", ge=-0.5, lt=0.5)
+    ball_poisson_ratio: float = quantity("", "ball Poisson ratio ν_b", ge=-0.5, lt=0.5)
+    vial_poisson_ratio: float = quantity("", "vial Poisson ratio ν_v", ge=-0.5, lt=0.5)
     # 50 J/(kg·K): below the heaviest metals (lead, tungsten, gold ~130); 5000: above polymers (~2000)
     # and water (4186).
-    ball_heat_capacity: float = _quantity("J/(kg*K)", "ball specific heat c_b", ge=50.0, le=5000.0)
-    vial_heat_capacity: float = _quantity("J/(kg*K)", "vial specific heat c_v", ge=50.0, le=5000.0)
+    ball_heat_capacity: float = quantity("J/(kg*K)", "ball specific heat c_b", ge=50.0, le=5000.0)
+    vial_heat_capacity: float = quantity("J/(kg*K)", "vial specific heat c_v", ge=50.0, le=5000.0)
     # 1 g: less steel than one 19-mm end face 0.5 mm thick; 1e-12 kg made the vial's time constant a
     # nanosecond and a run take hours. 100 kg: a heavy vial with its clamp, many times over.
-    vial_mass: float = _quantity("kg", "thermally active vial mass m_v", ge=1e-3, le=100.0)
+    vial_mass: float = quantity("kg", "thermally active vial mass m_v", ge=1e-3, le=100.0)
     # Air (Table 3); the bounds cover the gases mills are filled with, from a rough vacuum to high pressure.
     # 0.01 kg/m³ (~10 mbar of air): below it the gas is no continuum for Whitaker's correlation and the
     # air node's time constant falls under a millisecond. 200: nitrogen at ~170 bar.
-    air_density: float = _quantity("kg/m^3", "air density ρ_a", ge=0.01, le=200.0)
+    air_density: float = quantity("kg/m^3", "air density ρ_a", ge=0.01, le=200.0)
     # Gases at 0 °C: hydrogen 8.4e-6 to neon 3e-5 Pa·s, with room either way.
-    air_viscosity_ref: float = _quantity("Pa*s", "air viscosity μ_r at the reference temperature", ge=1e-6, le=1e-4)
+    air_viscosity_ref: float = quantity("Pa*s", "air viscosity μ_r at the reference temperature", ge=1e-6, le=1e-4)
     # The reference of Sutherland's law: 50-2000 K covers every tabulated reference point.
-    air_reference_temperature: float = _quantity(
+    air_reference_temperature: float = quantity(
         "K", "reference temperature θ_r of Sutherland's law", ge=50.0, le=2000.0
     )
     # Gases: xenon 0.005 to hydrogen 0.18 W/(m·K).
-    air_conductivity: float = _quantity("W/(m*K)", "air thermal conductivity k_a", ge=1e-3, le=1.0)
+    air_conductivity: float = quantity("W/(m*K)", "air thermal conductivity k_a", ge=1e-3, le=1.0)
     # Gases: xenon 158 to hydrogen 14 300 J/(kg·K).
-    air_cp: float = _quantity("J/(kg*K)", "air specific heat at constant pressure c_p,a", ge=100.0, le=20_000.0)
+    air_cp: float = quantity("J/(kg*K)", "air specific heat at constant pressure c_p,a", ge=100.0, le=20_000.0)
     # An ideal gas has 1 < γ <= 5/3 (monatomic).
-    air_heat_capacity_ratio: float = _quantity("", "c_p/c_v of air", gt=1, le=5 / 3)
+    air_heat_capacity_ratio: float = quantity("", "c_p/c_v of air", gt=1, le=5 / 3)
     # Sutherland constants of gases: hydrogen 72 K, air 111, carbon dioxide 240; 1000 leaves room.
-    sutherland: float = _quantity("K", "Sutherland constant S", ge=0, le=1000.0)
+    sutherland: float = quantity("K", "Sutherland constant S", ge=0, le=1000.0)
     # 0 switches the exchange off; 1e4 W/(m²·K) is liquid cooling, far above gas convection (5-250).
-    h_inner: float = _quantity("W/(m^2*K)", "vial-to-inner-air convection coefficient h_i", ge=0, le=1e4)
-    h_outer: float = _quantity("W/(m^2*K)", "vial-to-surroundings convection coefficient h_o", ge=0, le=1e4)
+    h_inner: float = quantity("W/(m^2*K)", "vial-to-inner-air convection coefficient h_i", ge=0, le=1e4)
+    h_outer: float = quantity("W/(m^2*K)", "vial-to-surroundings convection coefficient h_o", ge=0, le=1e4)
     # 10 m²: the whole surface of a vial of 1 m, the largest allowed.
-    inner_area: float = _quantity("m^2", "vial surface exchanging heat with the inner air A_i", gt=0, le=10.0)
-    outer_area: float = _quantity("m^2", "vial surface exchanging heat with the surroundings A_o", gt=0, le=10.0)
+    inner_area: float = quantity("m^2", "vial surface exchanging heat with the inner air A_i", gt=0, le=10.0)
+    outer_area: float = quantity("m^2", "vial surface exchanging heat with the surroundings A_o", gt=0, le=10.0)
     # The thermal network of a real mill (MODEL.md section 13): its structure and the paths beyond the paper's.
-    thermal_model: Literal["paper", "mill-head"] = _choice(
+    thermal_model: Literal["paper", "mill-head"] = choice(
         "'paper': ball, vial and air, the vial losing h_outer·outer_area to the room (MODEL.md §5); 'mill-head': the "
         "vial's outer convection and radiation at its own speed, conduction through contacts, a clamp warmed by the drive (§13)"
     )
     # 1 mm to 1 m as the bore; the outside must hold the bore (checked below).
-    outer_diameter: float = _quantity("m", "outer diameter of the vial D_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0)
-    outer_length: float = _quantity("m", "outer length of the vial L_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0)
+    outer_diameter: float = quantity("m", "outer diameter of the vial D_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0)
+    outer_length: float = quantity("m", "outer length of the vial L_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0)
     # Polished metal ~0.05, oxidised steel ~0.8, black paint ~0.95.
-    emissivity: float = _quantity("", "emissivity ε of the vial's outside (thermal_model = 'mill-head')", ge=0, le=1)
+    emissivity: float = quantity("", "emissivity ε of the vial's outside (thermal_model = 'mill-head')", ge=0, le=1)
     # Gases' 0.005 to diamond's 2000, as the balls'.
-    vial_conductivity: float = _quantity("W/(m*K)", "vial thermal conductivity k_v", ge=0.01, le=2000.0)
+    vial_conductivity: float = quantity("W/(m*K)", "vial thermal conductivity k_v", ge=0.01, le=2000.0)
     # Up to ~50 kg of steel in a clamp and mill head; 0 is refused: the node needs a heat capacity. The joint and the
     # loss up to a soldered joint over 10 cm² (0 decouples); the drive's heat up to a mill's whole motor (~0.1-1 kW).
-    clamp_heat_capacity: float = _quantity("J/K", "heat capacity C_k of the clamp and mill head ('mill-head')", gt=0, le=1e5)
-    clamp_conductance: float = _quantity("W/K", "vial-to-clamp contact conductance G_vk ('mill-head')", ge=0, le=1e3)
-    clamp_loss: float = _quantity("W/K", "clamp-to-room conductance G_k (thermal_model = 'mill-head')", ge=0, le=1e3)
-    drive_heat: float = _quantity("W", "heat Q_m the drive puts into the clamp whatever the balls do ('mill-head')", ge=0, le=1e3)
+    clamp_heat_capacity: float = quantity("J/K", "heat capacity C_k of the clamp and mill head ('mill-head')", gt=0, le=1e5)
+    clamp_conductance: float = quantity("W/K", "vial-to-clamp contact conductance G_vk ('mill-head')", ge=0, le=1e3)
+    clamp_loss: float = quantity("W/K", "clamp-to-room conductance G_k (thermal_model = 'mill-head')", ge=0, le=1e3)
+    drive_heat: float = quantity("W", "heat Q_m the drive puts into the clamp whatever the balls do ('mill-head')", ge=0, le=1e3)
     # Collision and heat generation (Table 4)
     # A perfectly plastic contact (0) has no damping ratio. Towards 0 the ball chatters on the face and a
     # run takes more steps (20 times at 0.05, 40 at 1e-6), but it stays correct and finishes.
-    restitution: float = _quantity("", "coefficient of restitution e", gt=0, le=1)
-    eta: float = _quantity("", "fraction η of dissipated power turned into heat", ge=0, le=1)
-    lam: float = _quantity("", "fraction λ of the heat that goes to the ball", ge=0, le=1)
+    restitution: float = quantity("", "coefficient of restitution e", gt=0, le=1)
+    eta: float = quantity("", "fraction η of dissipated power turned into heat", ge=0, le=1)
+    lam: float = quantity("", "fraction λ of the heat that goes to the ball", ge=0, le=1)
     # β scales Whitaker's correlation, defensible within 0.1-3 (calibrate.DEFENSIBLE_RANGES); 100 leaves
     # room for any hand tuning, and β = 1e12 made the ball's time constant a nanosecond.
-    beta: float = _quantity("", "convection calibration factor β", ge=0, le=100.0)
+    beta: float = quantity("", "convection calibration factor β", ge=0, le=100.0)
     # Run (Table 4 and assumptions)
     # A microsecond: less than one contact step. 1e6 s (11.6 days): longer than any milling run (~100 h);
     # the stored samples are capped too (MAX_SAMPLES), and full-resolution runs by their drive periods.
-    duration: float = _quantity("s", "simulated time", ge=1e-6, le=LONGEST_RUN_S)
+    duration: float = quantity("s", "simulated time", ge=1e-6, le=LONGEST_RUN_S)
     # 50 K: below liquid-nitrogen cryomilling (77 K). 1000 K: a vial in a furnace at 700 °C.
-    ambient_temperature: float = _quantity("K", "temperature of the surroundings θ_amb", ge=50.0, le=1000.0)
-    initial_temperature: float = _quantity("K", "initial temperature θ_0 of ball, vial and air", ge=50.0, le=1000.0)
+    ambient_temperature: float = quantity("K", "temperature of the surroundings θ_amb", ge=50.0, le=1000.0)
+    initial_temperature: float = quantity("K", "initial temperature θ_0 of ball, vial and air", ge=50.0, le=1000.0)
     # Up to 4000 K: tungsten, the most refractory ball material, melts at 3695 K.
-    ball_temperature_limit: float = _quantity(
+    ball_temperature_limit: float = quantity(
         "K", "highest physical ball temperature: a run that exceeds it ends with a non-ok status", ge=50.0, le=4000.0
     )
     # Half the longest vial; the ball must also start inside this vial (checked below).
-    ball_position: float = _quantity("m", "initial ball centre, relative to the vial centre", ge=-0.5, le=0.5)
+    ball_position: float = quantity("m", "initial ball centre, relative to the vial centre", ge=-0.5, le=0.5)
     # A 100-g ball at 1000 m/s; faster starts only end in an overlap the integrator refuses.
-    ball_momentum: float = _quantity("kg*m/s", "initial ball momentum", ge=-100.0, le=100.0)
+    ball_momentum: float = quantity("kg*m/s", "initial ball momentum", ge=-100.0, le=100.0)
     # Numerics (MODEL.md section 7)
     # The method is third order: rtol 1e-8 costs ~40 times the default's steps, and the contact step limit
     # bounds the error below that anyway. Above 0.1 the error control no longer resolves a contact.
-    rtol: float = _quantity("", "relative tolerance of the integrator", ge=1e-8, le=0.1)
+    rtol: float = quantity("", "relative tolerance of the integrator", ge=1e-8, le=0.1)
     # 1e-12: far below every scale of the motion (the single-impact tests use it); the upper bounds are
     # where the tolerance would exceed the quantity itself (a ball radius, a ball's momentum, a kelvin).
-    atol_position: float = _quantity("m", "absolute tolerance on the ball position", ge=1e-12, le=1e-3)
-    atol_momentum: float = _quantity("kg*m/s", "absolute tolerance on the ball momentum", ge=1e-12, le=1e-2)
-    atol_temperature: float = _quantity("K", "absolute tolerance on temperatures", ge=1e-12, le=1.0)
+    atol_position: float = quantity("m", "absolute tolerance on the ball position", ge=1e-12, le=1e-3)
+    atol_momentum: float = quantity("kg*m/s", "absolute tolerance on the ball momentum", ge=1e-12, le=1e-2)
+    atol_temperature: float = quantity("K", "absolute tolerance on temperatures", ge=1e-12, le=1.0)
     # The sample count duration/output_interval is capped as well (MAX_SAMPLES).
-    output_interval: float = _quantity("s", "sampling interval of the stored time series", ge=1e-6, le=LONGEST_RUN_S)
+    output_interval: float = quantity("s", "sampling interval of the stored time series", ge=1e-6, le=LONGEST_RUN_S)
     energy_projection: bool = Field(
         strict=True,
         json_schema_extra={"description": "enforce the mechanical energy balance of each contact step by projection"},
     )
     # Budget of one run (shakermill.budget): beyond either limit it stops with a non-ok status, keeping its results
-    max_wall_time: float = _quantity(
+    max_wall_time: float = quantity(
         "s", "wall-clock budget of one run, its mechanics phase, fall-back and attractor probe included", gt=0,
         le=LONGEST_RUN_S,  # a budget beyond the longest simulated run is no budget
     )
@@ -223,13 +181,13 @@ class Parameters(BaseModel):
         json_schema_extra={"unit": "", "description": "step budget of one run: accepted integrator steps, all its integrations together"},
     )
     # Solver choice (full resolution, or the multiscale averaged solver)
-    solver: Literal["full", "averaged"] = _choice(
+    solver: Literal["full", "averaged"] = choice(
         "'full': every impact for the whole run; 'averaged': mechanics until its statistics converge, then the slow network"
     )
     # Any target is safe: one that is never reached ends at averaging_max_time, and the run falls back.
-    averaging_rel_error: float = _quantity("", "averaged solver: target relative standard error of the averages", gt=0, lt=1)
+    averaging_rel_error: float = quantity("", "averaged solver: target relative standard error of the averages", gt=0, lt=1)
     # The several balls' motion is chaotic: its means converge as 1/√T, and 1e-3 would take ~15 min of mechanics.
-    dem_averaging_rel_error: float = _quantity(
+    dem_averaging_rel_error: float = quantity(
         "",
         "averaged solver of the 'dem' engine: target relative standard error of the total heat power, the mean "
         "Whitaker term and each ball's own means",
@@ -237,40 +195,40 @@ class Parameters(BaseModel):
         lt=1,
     )
     # Each replica pays its own start-up transient, so more replicas than cores cost more than they save.
-    dem_replicas: int = _count("averaged solver of the 'dem' engine: independent replicas of the mechanics, pooled", ge=1, le=64)
+    dem_replicas: int = count("averaged solver of the 'dem' engine: independent replicas of the mechanics, pooled", ge=1, le=64)
     # 10 000 periods (~10 min) per batch: already past any averaging_max_time worth waiting for.
-    averaging_batch_periods: int = _count("averaged solver: drive periods per batch of the batch-means estimate", ge=1, le=10_000)
-    averaging_min_batches: int = _count("averaged solver: fewest batches after the transient", ge=4, le=10_000)
+    averaging_batch_periods: int = count("averaged solver: drive periods per batch of the batch-means estimate", ge=1, le=10_000)
+    averaging_min_batches: int = count("averaged solver: fewest batches after the transient", ge=4, le=10_000)
     # An hour of mechanics costs what a full-resolution hour does; averaging converges in ~20 s.
-    averaging_max_time: float = _quantity("s", "averaged solver: longest mechanics window before giving up", gt=0, le=3600.0)
-    averaging_fallback: Literal["full", "fail"] = _choice("averaged solver: what to do when averaging is not valid")
+    averaging_max_time: float = quantity("s", "averaged solver: longest mechanics window before giving up", gt=0, le=3600.0)
+    averaging_fallback: Literal["full", "fail"] = choice("averaged solver: what to do when averaging is not valid")
     # Each start costs a settled run at every point of a scan; 100 cover the gap far more densely than
     # the basins found so far need (the default 8 finds them).
-    attractor_starts: int = _count(
+    attractor_starts: int = count(
         "initial states settled to find coexisting attractors (bifurcation, sweeps, averaged solver); "
         "1: only the configured start",
         ge=1,
         le=100,
     )
     # Model options (MODEL.md sections 2-4: the alternatives the spec allows)
-    model: Literal["three_node", "ball_only"] = _choice(
+    model: Literal["three_node", "ball_only"] = choice(
         "'three_node': ball, vial and air (this paper); 'ball_only': air held at ambient and no vial "
         "reservoir, the author's 2023 predecessor"
     )
     no_tension: bool = Field(strict=True, json_schema_extra={"description": "clip the contact force at zero (no adhesion)"})
-    heat_model: Literal["relative", "paper"] = _choice("'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed")
-    convection_velocity: Literal["auto", "ball", "relative"] = _choice(
+    heat_model: Literal["relative", "paper"] = choice("'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed")
+    convection_velocity: Literal["auto", "ball", "relative"] = choice(
         "velocity in Re: the ball's ('ball', as the paper) or relative to the vial, which carries "
         "the air ('relative'); 'auto': 'ball' for the 1-D engine, 'relative' for 'dem' (MODEL.md §12.5)"
     )
     # The engine (engine_keys.py; engines/registry.py adds any registered): its name is checked by _known_engine.
-    engine: str = _choice(
+    engine: str = choice(
         "'1d': one ball on the vial's axis (MODEL.md sections 1-7); 'dem': n_balls spheres in three "
         "dimensions with friction and rotation (section 12)"
     )
     # 50 balls of the smallest radius still fit any vial the bounds allow; the pair search is O(N²).
-    n_balls: int = _count("number of balls (engine = 'dem', 0: an empty mill; the 1-D engine has one)", ge=0, le=MAX_BALLS)
-    fill: float = _quantity(
+    n_balls: int = count("number of balls (engine = 'dem', 0: an empty mill; the 1-D engine has one)", ge=0, le=MAX_BALLS)
+    fill: float = quantity(
         "",
         "fraction of the vial's inner volume the balls take (engine = 'dem'): > 0 sets n_balls = max(1, "
         "round(fill·V_vial/V_ball)) equal balls; 0: n_balls as given",
@@ -278,12 +236,12 @@ class Parameters(BaseModel):
         le=DENSEST_PACKING,
     )
     # Each ball's own radius and material, in ball order; empty: every ball takes the scalar key's value.
-    ball_radii: tuple[float, ...] = _per_ball("ball_radius")
-    ball_densities: tuple[float, ...] = _per_ball("ball_density")
-    ball_youngs_moduli: tuple[float, ...] = _per_ball("ball_youngs_modulus")
-    ball_poisson_ratios: tuple[float, ...] = _per_ball("ball_poisson_ratio")
-    ball_heat_capacities: tuple[float, ...] = _per_ball("ball_heat_capacity")
-    ball_conductivities: tuple[float, ...] = _per_ball("ball_conductivity")
+    ball_radii: tuple[float, ...] = per_ball("ball_radius")
+    ball_densities: tuple[float, ...] = per_ball("ball_density")
+    ball_youngs_moduli: tuple[float, ...] = per_ball("ball_youngs_modulus")
+    ball_poisson_ratios: tuple[float, ...] = per_ball("ball_poisson_ratio")
+    ball_heat_capacities: tuple[float, ...] = per_ball("ball_heat_capacity")
+    ball_conductivities: tuple[float, ...] = per_ball("ball_conductivity")
     ball_materials: tuple[str, ...] = Field(
         max_length=MAX_BALLS,
         json_schema_extra={
@@ -294,14 +252,14 @@ class Parameters(BaseModel):
     )
     # Only the ratio of two balls' effusivities √(kρc) matters (the split of ball-ball heat, MODEL.md §12.4):
     # from aerogel-like 0.01 to diamond's 2000 W/(m·K).
-    ball_conductivity: float = _quantity("W/(m*K)", "ball thermal conductivity k_b", ge=0.01, le=2000.0)
+    ball_conductivity: float = quantity("W/(m*K)", "ball thermal conductivity k_b", ge=0.01, le=2000.0)
     gravity: bool = Field(
         strict=True, json_schema_extra={"description": "gravity 9.81 m/s² downward, the vial axis horizontal (engine = 'dem')"}
     )
     # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
-    friction: float = _quantity("", "Coulomb friction coefficient μ of every contact (engine = 'dem')", ge=0, le=5.0)
-    rolling_friction: float = _quantity("", "rolling resistance coefficient μ_r (engine = 'dem')", ge=0, le=1.0)
-    kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc"] = _choice(
+    friction: float = quantity("", "Coulomb friction coefficient μ of every contact (engine = 'dem')", ge=0, le=5.0)
+    rolling_friction: float = quantity("", "rolling resistance coefficient μ_r (engine = 'dem')", ge=0, le=1.0)
+    kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc"] = choice(
         "vial motion of the 'dem' engine (parameters/kinematic_models.py): 'axial' (amplitude, "
         "omega, phase: the 1-D drive), 'fourier' (the harmonics in motion), 'spex8000m' (the clamp's figure of "
         "eight: amplitude, lateral_amplitude, yaw_amplitude) or 'mixer-mill-arc' (a jar swung on a horizontal "
@@ -309,14 +267,14 @@ class Parameters(BaseModel):
     )
     # The SPEX clamp's lateral motion and yaw (kinematics = 'spex8000m'); 0 leaves either out. Half a metre,
     # as any translation of a vial; a quarter turn, far beyond the few degrees a clamp turns.
-    lateral_amplitude: float = _quantity(
+    lateral_amplitude: float = quantity(
         "m", "kinematics = 'spex8000m': lateral amplitude Y of the vial's centre, y = Y sin 2θ", ge=0, le=MAX_MOTION_TRANSLATION
     )
-    yaw_amplitude: float = _quantity(
+    yaw_amplitude: float = quantity(
         "rad", "kinematics = 'spex8000m': yaw amplitude Ψ about the vertical, yaw = Ψ sin θ", ge=0, le=0.5 * math.pi
     )
     # 1 mm to 1 m: from a jar turning about a pivot next to it to an arm longer than any mill.
-    swing_radius: float = _quantity(
+    swing_radius: float = quantity(
         "m", "kinematics = 'mixer-mill-arc': radius R of the jar centre's arc about the vertical pivot", ge=1e-3, le=1.0
     )
     motion: tuple[Harmonic, ...] = Field(
@@ -329,16 +287,16 @@ class Parameters(BaseModel):
     )
     # The step inside a contact as a fraction of the smallest Rayleigh time, or of a slow contact's own period over
     # 9.5 where that is longer (engines/dem/model.py, RAYLEIGH_TIMES_PER_PERIOD); 0.9 is the 1-D engine's bound.
-    contact_step_fraction: float = _quantity(
+    contact_step_fraction: float = quantity(
         "", "contact step of the 'dem' engine as a fraction of the smallest Rayleigh time", ge=1e-3, le=0.9
     )
     # An enduring contact (rolling, sliding or resting, not an impact) steps at this fraction of its own period,
     # within the same 0.9 t_R bound; Verlet is stable below 1/π of a period (engines/dem/model.py, ENDURING_AFTER).
-    enduring_step_fraction: float = _quantity(
+    enduring_step_fraction: float = quantity(
         "", "step of the 'dem' engine inside an enduring contact as a fraction of its oscillation period", ge=1e-3, le=0.1
     )
     # A free-flight step never lets a contact begin inside it; this caps it further (1 s: no cap in practice).
-    max_flight_step: float = _quantity("s", "longest step of the 'dem' engine in free flight", ge=1e-7, le=1.0)
+    max_flight_step: float = quantity("s", "longest step of the 'dem' engine in free flight", ge=1e-7, le=1.0)
     record_windows: tuple[Window, ...] = Field(
         max_length=MAX_RECORD_WINDOWS,
         json_schema_extra={"unit": "s", "description": "(start, length) windows stored at full resolution"},
@@ -361,7 +319,7 @@ class Parameters(BaseModel):
         consistency.fill_sets_the_balls(self, PER_BALL_KEYS)
         consistency.engine_takes_the_keys(self)
         for key in PER_BALL_KEYS:
-            _check_per_ball(key, getattr(self, key), self.n_balls)
+            _checkper_ball(key, getattr(self, key), self.n_balls)
         consistency.motion_is_well_formed(self)
         consistency.balls_fit_side_by_side(self)
         consistency.stored_data_fit_in_memory(self)
@@ -470,7 +428,7 @@ SCALAR_KEY_OF = {per_ball: scalar for scalar, per_ball in PER_BALL_KEY_OF.items(
 MATERIAL_KEYS = ("ball_material", "vial_material", "ball_materials")
 
 
-def _check_per_ball(key: str, values: tuple[float, ...], n_balls: int) -> None:
+def _checkper_ball(key: str, values: tuple[float, ...], n_balls: int) -> None:
     if values and len(values) != n_balls:
         raise ValueError(
             f"{key}: {len(values)} values for n_balls = {n_balls}; allowed an empty list or exactly {n_balls} values"

@@ -9,7 +9,8 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 from shakermill.parameters.csvinput import read_csv_rows
 from shakermill.parameters.errors import ParameterError
-from shakermill.parameters.keys import LONGEST_RUN_S, Bounds, field_unit
+from shakermill.parameters.fields import LONGEST_RUN_S
+from shakermill.parameters.keys import Bounds, field_unit
 from shakermill.support.limits import MAX_CURVE_POINTS, quoted
 
 if TYPE_CHECKING:
