@@ -16,6 +16,12 @@ def test_forced_convection_of_the_side_and_the_ends():
     assert heat_paths.disk_nusselt(1e4, 0.7) == pytest.approx(92.351, rel=1e-4)
 
 
+def test_forced_convection_of_a_cylinder_across_the_flow():
+    # 0.62 · √1e4 · 0.71^(1/3) = 62 · 0.892112 = 55.311; [1 + (0.4/0.71)^(2/3)]^(1/4) = 1.682131^0.25 = 1.138846;
+    # [1 + (1e4/282000)^(5/8)]^(4/5) = 1.124049^0.8 = 1.098066; 0.3 + 55.311/1.138846 · 1.098066 = 53.630
+    assert heat_paths.churchill_bernstein_nusselt(1e4, 0.71) == pytest.approx(53.630, rel=1e-4)
+
+
 def test_natural_convection_of_a_horizontal_cylinder():
     # Ra = g·ΔT/θ_f·L³/(ν·α) = 9.80665 · 20/303.15 · 0.05³ / (1.5e-5 · 2.07297e-5) = 260 088
     rayleigh = heat_paths.rayleigh_number(0.05, 20.0, 303.15, 1.8e-5, 1.2, 0.025, 1005.0)

@@ -120,10 +120,22 @@ def motion_is_well_formed(params: Any) -> None:
         )
 
 
+# A steady turn of more than five radians per radian of the drive's phase describes no mill (planetary jars turn
+# at most ~3 times their sun wheel's speed), as speed_ratio's bounds say.
+MAX_STEADY_RATE = 5.0
+
+
 def _check_motion(motion: tuple[tuple[str, int, float, float], ...]) -> None:
-    """The summed harmonic amplitudes of each coordinate stay within a metre's half and a half turn."""
+    """The summed harmonic amplitudes of each coordinate stay within a metre's half and a half turn; only angles
+    turn steadily (a k = 0 sine), and at most MAX_STEADY_RATE."""
+    for name, k, _, steady in motion:
+        if k == 0 and steady != 0.0 and (name in MOTION_COORDINATES[:3] or abs(steady) > MAX_STEADY_RATE):
+            raise ValueError(
+                f"motion: a steady rate {steady:g} of {name} (its sin at k = 0); allowed only for roll, pitch and yaw, "
+                f"at most {MAX_STEADY_RATE:g} rad per radian of ωt + φ"
+            )
     for coordinate in MOTION_COORDINATES:
-        amplitude = sum(abs(a) + abs(b) for name, _, a, b in motion if name == coordinate)
+        amplitude = sum(abs(a) + abs(b) * (k > 0) for name, k, a, b in motion if name == coordinate)
         limit, unit = (math.pi, "rad") if coordinate in ("roll", "pitch", "yaw") else (MAX_MOTION_TRANSLATION, "m")
         if amplitude > limit:
             raise ValueError(

@@ -60,7 +60,7 @@ class Parameters(BaseModel):
     )
     # 1 rad/s (0.16 Hz): thirty times slower than any mill. 1e4 rad/s (1.6 kHz): beyond acoustic mixers
     # (60 Hz), high enough that 1060 typed for rpm is warned about, not refused; the step count grows with ω.
-    omega: float = quantity("rad/s", "vial angular frequency ω", ge=1.0, le=1e4)
+    omega: float = quantity("rad/s", "vial angular frequency ω (kinematics = 'planetary': the sun wheel's speed)", ge=1.0, le=1e4)
     # One turn either way: every phase has an equal one inside, and larger ones only cost precision in sin(ωt + φ).
     phase: float = quantity("rad", "vial phase φ at t = 0", ge=-2 * math.pi, le=2 * math.pi)
     # Materials (Table 2). A named material fills in the keys below (with_materials); '' leaves them as they are.
@@ -259,11 +259,12 @@ class Parameters(BaseModel):
     # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
     friction: float = quantity("", "Coulomb friction coefficient μ of every contact (engine = 'dem')", ge=0, le=5.0)
     rolling_friction: float = quantity("", "rolling resistance coefficient μ_r (engine = 'dem')", ge=0, le=1.0)
-    kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc"] = choice(
+    kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc", "planetary"] = choice(
         "vial motion of the 'dem' engine (parameters/kinematic_models.py): 'axial' (amplitude, "
         "omega, phase: the 1-D drive), 'fourier' (the harmonics in motion), 'spex8000m' (the clamp's figure of "
-        "eight: amplitude, lateral_amplitude, yaw_amplitude) or 'mixer-mill-arc' (a jar swung on a horizontal "
-        "arc: amplitude along the arc, swing_radius)"
+        "eight: amplitude, lateral_amplitude, yaw_amplitude), 'mixer-mill-arc' (a jar swung on a horizontal "
+        "arc: amplitude along the arc, swing_radius) or 'planetary' (a jar on a sun wheel turning at omega: "
+        "revolution_radius, speed_ratio, jar_tilt)"
     )
     # The SPEX clamp's lateral motion and yaw (kinematics = 'spex8000m'); 0 leaves either out. Half a metre,
     # as any translation of a vial; a quarter turn, far beyond the few degrees a clamp turns.
@@ -277,12 +278,21 @@ class Parameters(BaseModel):
     swing_radius: float = quantity(
         "m", "kinematics = 'mixer-mill-arc': radius R of the jar centre's arc about the vertical pivot", ge=1e-3, le=1.0
     )
+    # A planetary jar's sun wheel: from a laboratory mill's ~5 cm to a metre, beyond any production mill's.
+    revolution_radius: float = quantity(
+        "m", "kinematics = 'planetary': radius R_p of the jar centre's circle about the sun axis", ge=1e-2, le=1.0
+    )
+    # The jar's speed relative to the sun wheel: mills are built from −3 to −1 (Retsch, Fritsch); ±5 covers any gear.
+    speed_ratio: float = quantity("", "kinematics = 'planetary': the jar's spin relative to the sun wheel, k of 1 : k", ge=-5.0, le=5.0)
+    # Jars stand upright in most mills; tilted ones lean by tens of degrees. Past 60° a jar would lie nearly flat.
+    jar_tilt: float = quantity("rad", "kinematics = 'planetary': lean of the jar's top away from the sun axis", ge=0.0, le=math.pi / 3)
     motion: tuple[Harmonic, ...] = Field(
         max_length=MAX_HARMONICS,
         json_schema_extra={
             "unit": "m or rad",
             "description": "kinematics = 'fourier': (coordinate, k, cos, sin) terms of the vial's translations x, y, z "
-            "(m) and angles roll, pitch, yaw (rad) in the harmonics k of ωt + φ",
+            "(m) and angles roll, pitch, yaw (rad) in the harmonics k of θ = ωt + φ; an angle's sin at k = 0 turns it "
+            "steadily by that many radians per radian of θ",
         },
     )
     # The step inside a contact as a fraction of the smallest Rayleigh time, or of a slow contact's own period over

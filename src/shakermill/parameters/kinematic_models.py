@@ -4,8 +4,9 @@ A model is the Fourier terms ``(coordinate, k, cos, sin)`` of the vial's six rig
 the harmonics k of θ = ωt + φ (translations x, y, z of its centre in m; roll, pitch, yaw about the lab's
 x, y, z axes in rad), built from the keys it names. ``engines.dem.model.harmonics_of`` turns them into
 the array the compiled stepping evaluates (``physics.kinematics.fourier_coordinates``), so a new mill is
-a new entry here, not a new code path. The lab frame has z up; every model below keeps the vial's axis
-horizontal, so gravity stays along −z of the vial at rest.
+a new entry here, not a new code path. Angles may also turn steadily (a k = 0 term's sine is its rate per
+radian of θ), as a planetary mill's do. The lab frame has z up; every model below but the planetary keeps the
+vial's axis horizontal, so gravity stays along −z of the vial at rest; a planetary jar stands on its end.
 
 No source reachable here gives the SPEX clamp's lateral amplitude, yaw or their phases, nor the swing
 radius or stroke of a Retsch MM400 (docs/notes/dem-references.md, sections 2.3 and 2.4): those values
@@ -43,6 +44,11 @@ class KinematicModel:
     keys: tuple[str, ...]
     terms: Callable[..., tuple[Term, ...]]
     assumed: tuple[str, ...] = ()
+    # A jar that turns steadily starts with its balls carried along, not at rest (engines/dem/model.py).
+    balls_start_with_the_vial: bool = False
+    # The air meets the vial's outside across its axis (a planetary jar carried round the sun wheel), not along it
+    # (a shaken vial): which correlations its outside's convection takes (engines/thermal/network.py).
+    flow_across_the_axis: bool = False
 
 
 def axial_terms(amplitude: float) -> tuple[Term, ...]:
@@ -91,6 +97,25 @@ def arc_terms(amplitude: float, swing_radius: float) -> tuple[Term, ...]:
     return tuple(terms)
 
 
+def planetary_terms(revolution_radius: float, speed_ratio: float, jar_tilt: float) -> tuple[Term, ...]:
+    """A planetary mill's jar: its centre on a circle of radius R_p about the vertical sun axis, turned by the sun
+    wheel at ω (θ = ωt + φ), and the jar spinning about its own axis at k·ω relative to the wheel.
+
+    x = R_p cos θ, y = R_p sin θ; yaw = θ (the wheel), pitch = −π/2 + τ (the jar's axis, the vial frame's x,
+    stands up, its top leaning away from the sun axis by the tilt τ), roll = kθ (the jar about its axis). With
+    τ = 0 the jar turns in the lab at (1 + k)ω: the ratio k is the jar's speed relative to the wheel, as the
+    manufacturers' "1 : −2" (a Retsch PM 100's jar turns twice, the other way, for each turn of the sun wheel).
+    The angles grow in time: they are steady rates, the k = 0 sine slot (physics/kinematics.py).
+    """
+    return (
+        ("x", 1, revolution_radius, 0.0),
+        ("y", 1, 0.0, revolution_radius),
+        ("yaw", 0, 0.0, 1.0),
+        ("pitch", 0, -0.5 * math.pi + jar_tilt, 0.0),
+        ("roll", 0, 0.0, speed_ratio),
+    )
+
+
 def given_terms(motion: tuple[Term, ...]) -> tuple[Term, ...]:
     """The user's own terms (key ``motion``)."""
     return motion
@@ -110,6 +135,14 @@ KINEMATIC_MODELS: dict[str, KinematicModel] = {
         ("amplitude", "swing_radius"),
         arc_terms,
         assumed=("amplitude", "swing_radius"),
+    ),
+    "planetary": KinematicModel(
+        "planetary mill (Fritsch Pulverisette, Retsch PM type): a jar on a sun wheel turning at omega, spinning at "
+        "speed_ratio relative to it",
+        ("revolution_radius", "speed_ratio", "jar_tilt"),
+        planetary_terms,
+        balls_start_with_the_vial=True,
+        flow_across_the_axis=True,
     ),
 }
 

@@ -206,6 +206,11 @@ SPEX_8000M = Preset(
         "rolling_friction": Cited(0.0, "MODEL.md section 12.3: no rolling resistance by default"),
         "kinematics": Cited("axial", f"{PAPER}: the vial moves along its axis (MODEL.md section 12.2)"),
         "motion": Cited((), "used only with kinematics = 'fourier'"),
+        "revolution_radius": Cited(
+            0.07, "Fritsch Pulverisette 7 premium line: effective sun-disc diameter 140 mm (used only by kinematics = 'planetary')"
+        ),
+        "speed_ratio": Cited(-2.0, "Retsch PM 100 and Fritsch Pulverisette 7: jar to sun wheel 1 : −2 (kinematics = 'planetary')"),
+        "jar_tilt": Cited(0.0, "upright jars, as in the Pulverisette 7 and PM 100 (kinematics = 'planetary')"),
         **{key: Cited(value, source) for key, (value, source) in ASSUMED_DEFAULTS.items()},
         "contact_step_fraction": Cited(
             0.05,

@@ -25,6 +25,14 @@ def disk_nusselt(reynolds: float, prandtl: float) -> float:
     return 1.05 * math.sqrt(reynolds) * prandtl**0.36
 
 
+def churchill_bernstein_nusselt(reynolds: float, prandtl: float) -> float:
+    """Mean Nu = 0.3 + 0.62·Re_D^{1/2}·Pr^{1/3}/[1 + (0.4/Pr)^{2/3}]^{1/4}·[1 + (Re_D/282000)^{5/8}]^{4/5} of a
+    cylinder across a uniform flow (Churchill & Bernstein, J. Heat Transfer 99 (1977) 300; Incropera & DeWitt,
+    Eq. 7.54: Re_D·Pr > 0.2). A planetary jar's side, carried round the sun wheel across its axis."""
+    correction = (1.0 + (reynolds / 282000.0) ** 0.625) ** 0.8
+    return 0.3 + 0.62 * math.sqrt(reynolds) * prandtl ** (1.0 / 3.0) / (1.0 + (0.4 / prandtl) ** (2.0 / 3.0)) ** 0.25 * correction
+
+
 def churchill_chu_cylinder_nusselt(rayleigh: float, prandtl: float) -> float:
     """Mean Nu = {0.60 + 0.387·Ra_D^{1/6}/[1 + (0.559/Pr)^{9/16}]^{8/27}}² of a long horizontal cylinder in
     natural convection (Churchill & Chu, Int. J. Heat Mass Transfer 18 (1975) 1049; Ra_D < 10¹²)."""

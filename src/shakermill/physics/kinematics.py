@@ -34,20 +34,25 @@ def right_face(vial_centre: float, vial_length: float) -> float:
 
 # A rigid vial moving in three dimensions (MODEL.md section 12.2): each of its six coordinates, the
 # translations x, y, z of its centre (m) and the angles roll, pitch, yaw about the lab's x, y and z axes
-# (rad), is a Fourier series in the drive's phase ωt + φ. The coefficients are an array
-# ``harmonics[coordinate, k] = (cos, sin)``, so every kinematic model is data, not a code path.
+# (rad), is a Fourier series in the drive's phase θ = ωt + φ, plus a steady turn for the angles of a mill
+# that rotates (a planetary mill's sun wheel and jar): q = a₀ + s·θ + Σ_k≥1 (a_k cos kθ + b_k sin kθ).
+# The coefficients are an array ``harmonics[coordinate, k] = (cos, sin)`` whose k = 0 sine slot, which a
+# Fourier series leaves empty (sin 0θ = 0), holds the steady rate s (rad per radian of θ); so every
+# kinematic model, rotating or not, is data, not a code path.
 
 
 @njit(cache=True)
 def fourier_coordinates(
     t: float, omega: float, phase: float, harmonics: np.ndarray, values: np.ndarray, rates: np.ndarray
 ) -> None:
-    """Write each coordinate q = Σ a_k cos kθ + b_k sin kθ, θ = ωt + φ, into ``values`` and dq/dt into ``rates``."""
+    """Write each coordinate q = a₀ + s·θ + Σ_k≥1 (a_k cos kθ + b_k sin kθ), θ = ωt + φ, s = ``harmonics[., 0, 1]``
+    (the steady rate), into ``values`` and dq/dt into ``rates``."""
     angle = omega * t + phase
     for coordinate in range(harmonics.shape[0]):
-        value = 0.0
-        rate = 0.0
-        for k in range(harmonics.shape[1]):
+        steady = harmonics[coordinate, 0, 1]
+        value = harmonics[coordinate, 0, 0] + steady * angle
+        rate = steady * omega
+        for k in range(1, harmonics.shape[1]):
             a, b = harmonics[coordinate, k, 0], harmonics[coordinate, k, 1]
             if a == 0.0 and b == 0.0:
                 continue  # most coefficients of a mill's motion are zero; their sines cost the most here

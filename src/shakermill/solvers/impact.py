@@ -55,7 +55,7 @@ _UNREAD_GROUPS = (
     (("engine",), "a lone impact always runs the 'dem' engine's contact law"),
     (
         ("gravity", "kinematics", "motion", "amplitude", "omega", "phase", "lateral_amplitude", "yaw_amplitude",
-         "swing_radius"),
+         "swing_radius", "revolution_radius", "speed_ratio", "jar_tilt"),
         "a lone impact happens in a vial at rest without gravity; the vial's motion applies to runs",
     ),
     (

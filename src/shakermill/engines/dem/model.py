@@ -1,7 +1,7 @@
 """Constants and state of the 'dem' engine, derived once from :class:`Parameters` (MODEL.md section 12).
 
-Frames: the lab frame has z up (gravity −z) and x along the vial's axis at rest; the vial frame moves
-with the vial (its axis is its x). Contacts live in slots: ball pair (i, j), i < j, in slot ``i·N + j``;
+Frames: the lab frame has z up (gravity −z) and, for every motion but a planetary jar's (whose axis stands
+along z), x along the vial's axis at rest; the vial frame moves with the vial (its axis is its x). Contacts live in slots: ball pair (i, j), i < j, in slot ``i·N + j``;
 ball i against the left end, the right end or the cylindrical side in slot ``N² + 3i + wall``.
 """
 
@@ -15,9 +15,9 @@ import numpy as np
 from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.network import ThermalNetwork, air_constants, build_network
 from shakermill.parameters.keys import Parameters
-from shakermill.parameters.kinematic_models import MOTION_COORDINATES, motion_terms
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS, MOTION_COORDINATES, motion_terms
 from shakermill.physics import contact
-from shakermill.physics.kinematics import fourier_coordinates, rotation_matrix
+from shakermill.physics.kinematics import angular_velocity, fourier_coordinates, rotation_matrix
 
 LEFT_END, RIGHT_END, SIDE = 0, 1, 2
 WALL_NAMES = ("left", "right", "side")
@@ -167,15 +167,17 @@ def _motion_bounds(harmonics: np.ndarray, omega: float, reach: float) -> tuple[f
     """Upper bounds of the vial's angular speed and of the acceleration of any vial point within ``reach``
     of its centre.
 
-    Each coordinate's Fourier series bounds its rate by Σ kω(|a|+|b|) and its second rate by Σ (kω)²(|a|+|b|);
-    a rotating point adds (|Ω̇| + |Ω|²)·r.
+    Each coordinate's Fourier series bounds its rate by |s|ω + Σ kω(|a|+|b|) (s its steady rate) and its second
+    rate by Σ (kω)²(|a|+|b|); a rotating point adds (|Ω̇| + |Ω|²)·r. Ω̇ of the composed turns holds each angle's
+    second rate and a product of the rates of every two of them (a jar spinning about an axis that itself turns).
     """
     k = np.arange(harmonics.shape[1])
     size = np.abs(harmonics).sum(axis=2)
-    rate = size @ (k * omega)
+    rate = size @ (k * omega) + np.abs(harmonics[:, 0, 1]) * omega
     second = size @ (k * omega) ** 2
     angular_rate, angular_second = rate[3:].sum(), second[3:].sum()
-    acceleration = float(np.linalg.norm(second[:3]) + (angular_second + angular_rate**2) * reach)
+    turns_of_turns = 0.5 * (angular_rate**2 - float(np.sum(rate[3:] ** 2)))
+    acceleration = float(np.linalg.norm(second[:3]) + (angular_second + turns_of_turns + angular_rate**2) * reach)
     return float(angular_rate), acceleration
 
 
@@ -303,9 +305,9 @@ def kick_for_replica(state: State, replica: int) -> None:
 
 
 def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> State:
-    """Balls at rest where :meth:`Parameters.initial_positions` puts them (one ball: ``ball_position`` and
-    ``ball_momentum`` along the axis, as the 1-D engine), every node of ``network`` at the initial temperature
-    (held ones at the ambient)."""
+    """Balls where :meth:`Parameters.initial_positions` puts them, at rest (one ball: ``ball_position`` and
+    ``ball_momentum`` along the axis, as the 1-D engine) or, in a vial that rotates steadily (a planetary jar),
+    carried with it; every node of ``network`` at the initial temperature (held ones at the ambient)."""
     n = params.n_balls
     slots = slot_count(n)
     centre = np.zeros(6)
@@ -315,14 +317,22 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
     rotation_matrix(centre[3], centre[4], centre[5], orientation)
     position = centre[:3] + params.initial_positions() @ orientation.T
     velocity = np.zeros((n, 3))
-    if n == 1:
+    spin = np.zeros((n, 3))
+    if KINEMATIC_MODELS[params.kinematics].balls_start_with_the_vial:
+        # A jar at full speed hitting balls at rest would begin with an impact at metres per second that no mill
+        # makes (the mill spins up over seconds): the balls start as if stuck to the jar.
+        turning = np.empty(3)
+        angular_velocity(centre[4], centre[5], rates[3], rates[4], rates[5], turning)
+        velocity[:] = rates[:3] + np.cross(turning, position - centre[:3])
+        spin[:] = turning
+    elif n == 1:
         velocity[0, 0] = params.ball_momentum / k.mass[0]
     drives = kernel.drive_count(n)
     return State(
         clock=np.zeros(2),
         position=position,
         velocity=velocity,
-        spin=np.zeros((n, 3)),
+        spin=spin,
         force=np.zeros((n, 3)),
         torque=np.zeros((n, 3)),
         temperature=network.initial_temperatures(params.initial_temperature),

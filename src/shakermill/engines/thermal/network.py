@@ -21,7 +21,7 @@ from shakermill.engines.thermal.paths import (
     radiation,
 )
 from shakermill.parameters.keys import Parameters
-from shakermill.parameters.kinematic_models import MOTION_COORDINATES, motion_terms
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS, MOTION_COORDINATES, motion_terms
 from shakermill.physics import heat_paths, thermal
 
 PAPER_PATHS = "Son 2025 (Mathematics 13, 446)"
@@ -235,8 +235,9 @@ NATURAL_CONVECTION_RISE_K = 20.0
 
 def vial_outer_convection(params: Parameters) -> OuterConvection:
     """Convection from the vial's outside (a cylinder of ``outer_diameter`` × ``outer_length``) at the rms speed of
-    its motion: the side as a plate along the flow, each end as a disk facing it, each combined with natural
-    convection (Churchill's rule); air properties at the ambient temperature."""
+    its motion, each face combined with natural convection (Churchill's rule); air properties at the ambient
+    temperature. A shaken vial meets the air along its axis (:func:`_along_the_axis`), a planetary jar across it
+    (:func:`_across_the_axis`)."""
     constants = air_constants(params)
     viscosity, prandtl = constants["viscosity_ambient"], constants["prandtl"]
     speed = vial_rms_speed(params)
@@ -247,26 +248,56 @@ def vial_outer_convection(params: Parameters) -> OuterConvection:
         params.air_density, k_air, params.air_cp,
     )
     natural = heat_paths.churchill_chu_cylinder_nusselt(rayleigh, prandtl) * k_air / diameter
-    side = heat_paths.flat_plate_nusselt(thermal.reynolds_number(length / 2, params.air_density, speed, viscosity), prandtl)
-    end = heat_paths.disk_nusselt(thermal.reynolds_number(diameter / 2, params.air_density, speed, viscosity), prandtl)
-    h_side = heat_paths.mixed_convection_coefficient(side * k_air / length, natural)
-    h_end = heat_paths.mixed_convection_coefficient(end * k_air / diameter, natural)
+    faces = _across_the_axis if KINEMATIC_MODELS[params.kinematics].flow_across_the_axis else _along_the_axis
+    h_side, h_end, correlations, validity = faces(params, speed, viscosity, prandtl)
     area = side_area + end_area
     return OuterConvection(
-        coefficient=(h_side * side_area + h_end * end_area) / area,
+        coefficient=(heat_paths.mixed_convection_coefficient(h_side, natural) * side_area
+                     + heat_paths.mixed_convection_coefficient(h_end, natural) * end_area) / area,
         area=area,
         speed=speed,
         source=(
-            f"side: laminar flat plate, Nu = 0.664 Re_L^1/2 Pr^1/3 (Incropera & DeWitt Eq. 7.30); ends: disk facing the "
-            f"flow, Nu = 1.05 Re_D^1/2 Pr^0.36 (Sparrow & Geiger 1985, recalled, not re-read); each with natural "
-            f"convection (Churchill & Chu 1975, horizontal cylinder, at a {NATURAL_CONVECTION_RISE_K:g} K rise) by "
-            f"Churchill's rule; at the vial's rms speed {speed:.3g} m/s"
+            f"{correlations}; each with natural convection (Churchill & Chu 1975, horizontal cylinder, at a "
+            f"{NATURAL_CONVECTION_RISE_K:g} K rise) by Churchill's rule; at the vial's rms speed {speed:.3g} m/s"
         ),
-        validity=(
-            "quasi-steady flow: the vial's stroke is ~3 diameters (Keulegan-Carpenter number ~3), so steady "
-            "correlations at the rms speed are a ±30 % estimate; Re_L < 5e5 (laminar), the disk measured for "
-            "5e3 < Re_D < 5e4"
-        ),
+        validity=validity,
+    )
+
+
+def _reynolds(length: float, params: Parameters, speed: float, viscosity: float) -> float:
+    return thermal.reynolds_number(length, params.air_density, speed, viscosity)
+
+
+def _along_the_axis(params: Parameters, speed: float, viscosity: float, prandtl: float) -> tuple[float, float, str, str]:
+    """The forced coefficients (W/(m²·K)) of a vial shaken along its axis: the side a plate along the flow, each end
+    a disk facing it; what they rest on and where they hold."""
+    diameter, length, k_air = params.outer_diameter, params.outer_length, params.air_conductivity
+    side = heat_paths.flat_plate_nusselt(_reynolds(length / 2, params, speed, viscosity), prandtl) * k_air / length
+    end = heat_paths.disk_nusselt(_reynolds(diameter / 2, params, speed, viscosity), prandtl) * k_air / diameter
+    return side, end, (
+        "side: laminar flat plate, Nu = 0.664 Re_L^1/2 Pr^1/3 (Incropera & DeWitt Eq. 7.30); ends: disk facing the "
+        "flow, Nu = 1.05 Re_D^1/2 Pr^0.36 (Sparrow & Geiger 1985, recalled, not re-read)"
+    ), (
+        "quasi-steady flow: the vial's stroke is ~3 diameters (Keulegan-Carpenter number ~3), so steady "
+        "correlations at the rms speed are a ±30 % estimate; Re_L < 5e5 (laminar), the disk measured for "
+        "5e3 < Re_D < 5e4"
+    )
+
+
+def _across_the_axis(params: Parameters, speed: float, viscosity: float, prandtl: float) -> tuple[float, float, str, str]:
+    """The forced coefficients (W/(m²·K)) of a jar carried across its axis: the side a cylinder in cross flow, each
+    end a plate along the flow, as long as the jar is wide; what they rest on and where they hold."""
+    diameter, k_air = params.outer_diameter, params.air_conductivity
+    reynolds = _reynolds(diameter, params, speed, viscosity)
+    side = heat_paths.churchill_bernstein_nusselt(reynolds, prandtl) * k_air / diameter
+    end = heat_paths.flat_plate_nusselt(reynolds, prandtl) * k_air / diameter
+    return side, end, (
+        "side: cylinder in cross flow, Churchill & Bernstein 1977 (Incropera & DeWitt Eq. 7.54); ends: laminar flat "
+        "plate along the flow, Nu = 0.664 Re_D^1/2 Pr^1/3 (Eq. 7.30)"
+    ), (
+        "the jar's speed round the sun wheel taken as the air's speed past it: the air inside a mill's housing turns "
+        "with the wheel and the jar's own spin adds (1 + k)·ω·D_o/2 at its surface, so this is a ±50 % estimate; "
+        "Re_D·Pr > 0.2"
     )
 
 
