@@ -525,7 +525,7 @@ def test_plot_of_a_sweep_over_the_solver_draws_every_figure(tmp_path):
 DEM = ["--set", "engine=dem", "--set", "n_balls=3", "--set", "vial_diameter=38 mm", "--set", "duration=2",
        "--set", "record_windows=0:0.5,1.5:0.1"]
 DEM_FIGURES = ("ball_heating_zoom", "heat_by_channel", "temperatures", "trajectories")
-DEM_IMPACT_FIGURES = ("impact_energy_histogram", "impact_speed_histogram", "impacts_per_second")
+DEM_IMPACT_FIGURES = ("impact_energy_histogram", "impact_speed_histogram", "impacts_per_second", "stress_energy_spectrum")
 
 
 @pytest.fixture(scope="module")

@@ -40,7 +40,9 @@ from shakermill.views.figures.sweeps import (
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 ALL_FIGURES = ("ball_heating_zoom", "ball_motion", "temperatures")
-IMPACT_FIGURE_NAMES = ("impact_energy_histogram", "impact_phase_histogram", "impact_speed_histogram", "impacts_per_second")
+IMPACT_FIGURE_NAMES = (
+    "impact_energy_histogram", "impact_phase_histogram", "impact_speed_histogram", "impacts_per_second", "stress_energy_spectrum"
+)
 # "quantity (unit)": every axis label ends with its unit in parentheses.
 LABEL_WITH_UNIT = re.compile(r"^\S.* \([^()]+\)$")
 
@@ -224,6 +226,23 @@ def test_impacts_per_second_integrate_to_the_impacts_at_each_wall(result):
     for wall, step in zip(("left", "right"), steps):
         rates, edges, _ = step.get_data()
         assert np.sum(rates * np.diff(edges)) == pytest.approx((result.impacts["wall"] == wall).sum())
+
+
+@pytest.mark.slow
+def test_the_stress_spectrum_counts_every_impact_and_its_power_at_the_lowest_energy(result):
+    events, power = impact_figures(result)["stress_energy_spectrum"].axes[:2]
+    window = result.summary["stress_window_s"]
+    # One ball on the axis: the total and its normal part, which is all of it; no tangential part, no ball hit.
+    assert [line.get_label() for line in events.get_lines() if not line.get_label().startswith("_")] == [
+        "all impacts, normal + tangential", "normal part"]
+    total_events, total_power = events.get_lines()[0], power.get_lines()[0]
+    assert total_events.get_ydata()[0] == pytest.approx(len(result.impacts) / window)
+    assert total_power.get_ydata()[0] == pytest.approx(result.impacts["dissipated_energy"].sum() / window)
+    assert np.all(np.diff(total_events.get_ydata()) <= 0) and np.all(np.diff(total_power.get_ydata()) <= 0)
+    assert events.get_xscale() == "log" and events.get_xlabel() == "stress energy E, dissipated per impact (J)"
+    # The thresholds of the run, dash-dot.
+    assert sorted(line.get_xdata()[0] for line in power.get_lines() if line.get_linestyle() == "-.") == sorted(
+        result.params.stress_energy_thresholds)
 
 
 def test_rate_bins_span_the_impacts_in_bins_of_at_least_a_second_and_at_most_120():

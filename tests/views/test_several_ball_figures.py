@@ -139,7 +139,7 @@ def test_heat_by_channel_adds_up_to_the_runs_heat(stored):
 
 def test_figures_of_one_ball_on_the_axis_are_left_out(stored):
     names = set(run_figures(stored, impacts=True))
-    assert names == set(SEVERAL_BALL_FIGURES) | {"impact_speed_histogram", "impact_energy_histogram", "impacts_per_second"}
+    assert names == set(SEVERAL_BALL_FIGURES) | {"impact_speed_histogram", "impact_energy_histogram", "impacts_per_second", "stress_energy_spectrum"}
     assert "ball_motion" not in names and "impact_phase_histogram" not in names
 
 

@@ -65,3 +65,9 @@ Window = tuple[
     Annotated[float, annotated_types.Ge(0), annotated_types.Le(LONGEST_RUN_S)],
     Annotated[float, annotated_types.Gt(0), annotated_types.Le(MAX_RECORDED_SECONDS)],
 ]
+
+
+# Stress energies (J) a run reports the power of the impacts above: a ball of a gram at a centimetre a second stores
+# ~0.05 µJ, a 40 mm steel ball at 10 m/s ~13 J; 1 nJ to 1 kJ spans every mill, and eight thresholds any spectrum.
+MAX_STRESS_THRESHOLDS = 8
+StressThreshold = Annotated[float, annotated_types.Ge(1e-9), annotated_types.Le(1e3)]

@@ -133,9 +133,15 @@ def _window(pair: Any) -> tuple[float, float]:
 
 def per_ball(key: str, value: Any, unit: str) -> tuple[float, ...]:
     """Per-ball values in SI ``unit`` from "6 mm, 5 mm" (the command line; "" means none) or a list (TOML, Python)."""
+    return quantity_list(key, value, unit, "a list of values, one per ball")
+
+
+def quantity_list(key: str, value: Any, unit: str, expected: str) -> tuple[float, ...]:
+    """Values in SI ``unit`` from "1 mJ, 10 mJ" (the command line; "" means none) or a list (TOML, Python);
+    ``expected`` says what the error names when ``value`` is neither."""
     items = [item for item in value.split(",") if item.strip()] if isinstance(value, str) else value
     if not isinstance(items, (list, tuple)):
-        raise UnitError(f"{key}: expected a list of values, one per ball, got {quoted(value)}")
+        raise UnitError(f"{key}: expected {expected}, got {quoted(value)}")
     return tuple(to_si(item, unit, key=key) for item in items)
 
 

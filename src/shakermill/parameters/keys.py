@@ -24,6 +24,8 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.fields import (
     LONGEST_RUN_S,
     MAX_HARMONICS,
+    MAX_STRESS_THRESHOLDS,
+    StressThreshold,
     Harmonic,
     Window,
     choice,
@@ -307,6 +309,13 @@ class Parameters(BaseModel):
     )
     # A free-flight step never lets a contact begin inside it; this caps it further (1 s: no cap in practice).
     max_flight_step: float = quantity("s", "longest step of the 'dem' engine in free flight", ge=1e-7, le=1.0)
+    stress_energy_thresholds: tuple[StressThreshold, ...] = Field(
+        max_length=MAX_STRESS_THRESHOLDS,
+        json_schema_extra={
+            "unit": "J",
+            "description": "stress energies above which each run reports the impacts' power (analysis/stress_energy.py)",
+        },
+    )
     record_windows: tuple[Window, ...] = Field(
         max_length=MAX_RECORD_WINDOWS,
         json_schema_extra={"unit": "s", "description": "(start, length) windows stored at full resolution"},
@@ -329,7 +338,7 @@ class Parameters(BaseModel):
         consistency.fill_sets_the_balls(self, PER_BALL_KEYS)
         consistency.engine_takes_the_keys(self)
         for key in PER_BALL_KEYS:
-            _checkper_ball(key, getattr(self, key), self.n_balls)
+            _check_per_ball(key, getattr(self, key), self.n_balls)
         consistency.motion_is_well_formed(self)
         consistency.balls_fit_side_by_side(self)
         consistency.stored_data_fit_in_memory(self)
@@ -438,7 +447,7 @@ SCALAR_KEY_OF = {per_ball: scalar for scalar, per_ball in PER_BALL_KEY_OF.items(
 MATERIAL_KEYS = ("ball_material", "vial_material", "ball_materials")
 
 
-def _checkper_ball(key: str, values: tuple[float, ...], n_balls: int) -> None:
+def _check_per_ball(key: str, values: tuple[float, ...], n_balls: int) -> None:
     if values and len(values) != n_balls:
         raise ValueError(
             f"{key}: {len(values)} values for n_balls = {n_balls}; allowed an empty list or exactly {n_balls} values"
@@ -484,6 +493,8 @@ def allowed_range(key: str, refused: Any = None) -> str:
         return "one of " + ", ".join(repr(choice) for choice in choices)
     if field.annotation is bool:
         return "true or false"
+    if key == "stress_energy_thresholds":
+        return f"at most {MAX_STRESS_THRESHOLDS} energies in J, each in [1e-09, 1000]"
     if key == "record_windows":
         return (
             f"at most {MAX_RECORD_WINDOWS} (start, length) pairs in s, start in [0, {LONGEST_RUN_S:g}], length > 0, "
@@ -599,6 +610,8 @@ def _coerce(key: str, value: Any) -> Any:
             return guards.switch(key, value)
         if key == "record_windows":
             return guards.windows(value)
+        if key == "stress_energy_thresholds":
+            return guards.quantity_list(key, value, "J", "a list of energies")
         if key in PER_BALL_KEYS:
             scalar = SCALAR_KEY_OF[key]
             return tuple(map(bounds(scalar).snapped, guards.per_ball(key, value, field_unit(scalar))))

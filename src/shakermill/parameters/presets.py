@@ -223,6 +223,11 @@ SPEX_8000M = Preset(
             "statistics within their statistical errors of finer steps (benchmarks/README.md, enduring contacts)",
         ),
         "max_flight_step": Cited(1e-4, "numerical choice: ~1/60 of a drive period, so the wall's motion is resolved"),
+        "stress_energy_thresholds": Cited(
+            (1e-3, 1e-2),
+            "numerical choice: 1 mJ and 10 mJ, about the median and the upper tail of the energy a steel ball dissipates "
+            "per impact in the SPEX 8000M and the planetary presets (benchmarks/README.md, stress energies)",
+        ),
         "record_windows": Cited(
             ((0.0, 1.0), (600.0, 0.1)),
             f"the windows of {PAPER} Fig. 4 (first second) and Fig. 5b (100 ms at 10 min)",

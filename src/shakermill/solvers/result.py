@@ -14,6 +14,7 @@ import numpy as np
 from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
 from shakermill.analysis.steady import SteadyState, run_length_note, steady_state
+from shakermill.analysis.stress_energy import stress_spectrum
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
     CELSIUS_VARIABLES,
@@ -314,6 +315,7 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         ),
     }
     summary.update(understood_inputs(params))
+    summary.update(stress_spectrum(impacts, impact_window, params.stress_energy_thresholds).as_summary())
     summary.update(several_ball_summary(result))
     if "theta_clamp" in series.variables:
         summary["clamp_C"] = kelvin_to_celsius(float(series["theta_clamp"][-1]))

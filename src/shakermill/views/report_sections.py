@@ -29,6 +29,10 @@ FIGURE_CAPTIONS = {
     ),
     "impact_speed_histogram": "Impact speed of the ball relative to the end face it hits, by end face.",
     "impact_energy_histogram": "Energy dissipated in each impact (mJ), by end face.",
+    "stress_energy_spectrum": (
+        "Stress-energy spectrum: impacts per second (left) and their power (right) at or above each stress energy, the "
+        "energy an impact dissipates (Kwade; Burmeister & Kwade 2013). One ball on the axis hits head on: all normal."
+    ),
     "impacts_per_second": "Impacts per second at each end face over the time the impacts were resolved.",
     "impact_phase_histogram": (
         "Drive phase ωt + φ (mod 2π) at the impacts of the settled motion, by end face: sharp lines for a "
@@ -58,6 +62,11 @@ SEVERAL_BALL_CAPTIONS = {
     ),
     "impact_speed_histogram": "Normal impact speed relative to what is hit: an end face, the side wall or another ball.",
     "impact_energy_histogram": "Energy dissipated in each impact (mJ), by what was hit.",
+    "stress_energy_spectrum": (
+        "Stress-energy spectrum: impacts per second (left) and their power (right) at or above each stress energy, the "
+        "energy an impact dissipates, in its normal part and its tangential part (damping, sliding, rolling), on the "
+        "vial and between balls (Kwade; Burmeister & Kwade 2013); dash-dot lines: stress_energy_thresholds."
+    ),
     "impacts_per_second": "Impacts per second on each wall and between balls over the time the impacts were resolved.",
 }
 
@@ -225,7 +234,30 @@ def impacts_section(run: RunData, numbers: Iterator[int]) -> str:
             )
         )
     parts.append(figures_html(impact_figures(run), numbers, captions_of(run)))
+    if run.summary.get("stress_window_s") and not run.impacts.empty:
+        parts.append(stress_energy_table(run))
     return section("Impacts", *parts)
+
+
+def stress_energy_table(run: RunData) -> str:
+    """The stress-energy spectrum in numbers: events per second, median and 90th percentile of the total, of each
+    part and on each target, then the power above each of the run's thresholds (analysis/stress_energy.py)."""
+    from shakermill.analysis.stress_energy import stress_spectrum
+
+    spectrum = stress_spectrum(run.impacts, run.summary["stress_window_s"], run.params.stress_energy_thresholds)
+    rows = [
+        (f"{component}, {target if target != 'all' else 'all targets'}", number(spectrum.events_per_second(0.0, component, target), ".4g"),
+         number(spectrum.percentile(50, component, target), ".3g"), number(spectrum.percentile(90, component, target), ".3g"),
+         number(spectrum.power(0.0, component, target), ".4g"))
+        for component, target in (("total", "all"), ("normal", "all"), ("tangential", "all"), ("total", "wall"), ("total", "ball"))
+    ]
+    rows += [
+        (f"total at or above {threshold:g} J", number(spectrum.events_per_second(threshold), ".4g"), "", "",
+         number(spectrum.power(threshold), ".4g"))
+        for threshold in spectrum.thresholds
+    ]
+    header = ("stress energy (J dissipated per impact)", "events per second (1/s)", "median (J)", "90th percentile (J)", "power (W)")
+    return table(header, rows, numeric=(1, 2, 3, 4))
 
 
 def numerics_section(run: RunData) -> str:

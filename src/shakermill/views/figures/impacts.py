@@ -1,4 +1,5 @@
-"""The impact statistics of a run: histograms of impact speed and dissipated energy per impact, impacts per
+"""The impact statistics of a run: histograms of impact speed and dissipated energy per impact, the stress-energy
+spectrum (analysis/stress_energy.py), impacts per
 second on each kind of target against time, and the drive phase of the impacts; each split by what was hit (the
 end faces, and for an engine of several balls the side wall and the other balls)."""
 
@@ -10,6 +11,7 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 import pandas as pd
 
+from shakermill.analysis.stress_energy import StressSpectrum, stress_spectrum
 from shakermill.views.figures.common import (
     RunLike,
     add_context,
@@ -23,7 +25,9 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
-IMPACT_FIGURES = ("impact_speed_histogram", "impact_energy_histogram", "impacts_per_second", "impact_phase_histogram")
+IMPACT_FIGURES = (
+    "impact_speed_histogram", "impact_energy_histogram", "stress_energy_spectrum", "impacts_per_second", "impact_phase_histogram"
+)
 
 
 WALLS = (("left", "left end face", "tab:blue"), ("right", "right end face", "tab:orange"))
@@ -65,11 +69,54 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
         ),
         "impacts_per_second": impact_rate_figure(impacts),
     }
+    window = run.summary.get("stress_window_s")
+    if window:  # a run folder written before the spectrum was reported has none
+        figures["stress_energy_spectrum"] = stress_energy_figure(
+            stress_spectrum(impacts, window, run.params.stress_energy_thresholds)
+        )
     if not balls:
         # Regimes are sequences of end faces hit at fixed drive phases: a notion of one ball on the axis.
         figures["impact_phase_histogram"] = impact_phase_figure(run)
     context, window = run_context(run), averaging_window_note(run)
     return {name: add_context(figure, context, window) for name, figure in figures.items()}
+
+
+# The spectrum's curves: (component, target, label, style); the split by target only where balls hit balls.
+SPECTRUM_CURVES = (
+    ("total", "all", "all impacts, normal + tangential", {"color": "black", "lw": 2.0}),
+    ("normal", "all", "normal part", {"color": "tab:blue", "lw": 1.5}),
+    ("tangential", "all", "tangential part (damping, sliding, rolling)", {"color": "tab:orange", "lw": 1.5, "ls": "--"}),
+    ("total", "wall", "impacts on the vial", {"color": "tab:green", "lw": 1.2, "ls": ":"}),
+    ("total", "ball", "impacts between balls", {"color": "tab:purple", "lw": 1.2, "ls": ":"}),
+)
+
+
+def stress_energy_figure(spectrum: StressSpectrum) -> Figure:
+    """The stress-energy spectrum: stress events per second (left) and their power (right) at or above each
+    energy, for the total, its normal and tangential parts and each target, with the run's thresholds marked."""
+    figure, (events, power) = new_figure(columns=2, height=4.5, width=11.0)
+    shown = [curve for curve in SPECTRUM_CURVES if curve[1] == "all" or spectrum.hit_ball.any()]
+    for component, target, label, style in shown:
+        energies = np.sort(spectrum.of(component, target))
+        energies = energies[energies > 0.0]
+        if not energies.size:
+            continue
+        # Ascending energies E_i: at E in (E_{i-1}, E_i] the events at or above E are the i-th and all after it.
+        events.step(energies, np.arange(energies.size, 0, -1) / spectrum.window, where="pre", label=label, **style)
+        power.step(energies, np.cumsum(energies[::-1])[::-1] / spectrum.window, where="pre", label=label, **style)
+    for axis in (events, power):
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        axis.set_xlabel("stress energy E, dissipated per impact (J)")
+        for threshold in spectrum.thresholds:
+            axis.axvline(threshold, color="0.5", lw=0.8, ls="-.")
+        axis.grid(alpha=0.3, which="both")
+    events.set_ylabel("stress events at or above E per second (1/s)")
+    power.set_ylabel("power of the stress events at or above E (W)")
+    events.set_title(f"Stress frequency ({spectrum.of().size} impacts in {spectrum.window:.3g} s)")
+    power.set_title("Stress power" + (" (dash-dot: the run's thresholds)" if spectrum.thresholds else ""))
+    events.legend(loc="lower left", fontsize="small")
+    return figure
 
 
 def impact_kinds(impacts: pd.DataFrame) -> tuple[np.ndarray, tuple[tuple[str, str, str], ...]]:

@@ -26,6 +26,9 @@ SWEEP_QUANTITIES = (
     ("heat_power_W", "heat generated", "W"),
     ("mean_impact_speed_m_s", "mean impact speed", "m/s"),
     ("ball_steady_C", "ball steady state", "°C"),
+    # The stress-energy spectrum (analysis/stress_energy.py): its middle and its upper tail.
+    ("stress_energy_median_J", "median stress energy (dissipated per impact)", "J"),
+    ("stress_energy_p90_J", "90th percentile of the stress energy", "J"),
 )
 
 
@@ -54,6 +57,8 @@ SHORT_NAMES = {
     "heat_power_W": "heat power",
     "mean_impact_speed_m_s": "mean impact speed",
     "ball_steady_C": "ball steady state",
+    "stress_energy_median_J": "median stress energy",
+    "stress_energy_p90_J": "stress energy p90",
 }
 
 

@@ -1,0 +1,91 @@
+"""The stress-energy spectrum of a run: how the energy of its impacts is distributed, which is what process engineers
+compare between mills rather than one mean speed (Kwade's stress energy and stress number; Burmeister & Kwade,
+Chem. Soc. Rev. 42 (2013) 7660).
+
+A stress event is one impact of a ball on a wall or on another ball: one row of an engine's impact records. Its
+stress energy is the energy the contact dissipated over that impact (J), the DEM practice the review describes for
+the energy available to stress the powder caught between the surfaces. It has a normal part, from the damping of
+the normal force, and a tangential part, from tangential damping, sliding and rolling resistance (MODEL.md §12.4);
+the 1-D engine's impacts are head-on, all normal. A ball's kinetic energy before an impact bounds the normal part
+from above; it is not what is reported.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping, Sequence
+
+import numpy as np
+
+COMPONENTS = ("total", "normal", "tangential")
+# What was hit: the vial (its end faces or, in three dimensions, its side) or another ball.
+TARGETS = ("all", "wall", "ball")
+PERCENTILES = (("median", 50.0), ("p90", 90.0))
+# The 'dem' engine's channels that make up the tangential part (engines/dem/model.py, TOTAL_NAMES).
+TANGENTIAL_CHANNELS = ("dissipated_tangential", "dissipated_sliding", "dissipated_rolling")
+
+
+def threshold_name(threshold: float) -> str:
+    """How a threshold (J) appears in the summary's names: 0.001 -> '0.001J'."""
+    return f"{threshold:g}J"
+
+
+@dataclass(frozen=True)
+class StressSpectrum:
+    """The stress energies of the impacts resolved over ``window`` seconds: each impact's normal, tangential and
+    total energy (J) and whether it hit the vial or another ball."""
+
+    energies: Mapping[str, np.ndarray]
+    hit_ball: np.ndarray
+    window: float
+    thresholds: tuple[float, ...] = ()
+
+    def of(self, component: str = "total", target: str = "all") -> np.ndarray:
+        """The stress energies (J) of ``component`` of the impacts on ``target`` (:data:`COMPONENTS`, :data:`TARGETS`)."""
+        energies = self.energies[component]
+        if target == "all":
+            return energies
+        return energies[self.hit_ball] if target == "ball" else energies[~self.hit_ball]
+
+    def percentile(self, q: float, component: str = "total", target: str = "all") -> float:
+        """The ``q``-th percentile (J) of :meth:`of`; NaN without impacts."""
+        energies = self.of(component, target)
+        return float(np.percentile(energies, q)) if energies.size else math.nan
+
+    def events_per_second(self, above: float = 0.0, component: str = "total", target: str = "all") -> float:
+        """Stress events per second (1/s) of at least ``above`` J: Kwade's stress frequency above an energy."""
+        return float(np.count_nonzero(self.of(component, target) >= above)) / self.window if self.window > 0 else math.nan
+
+    def power(self, above: float = 0.0, component: str = "total", target: str = "all") -> float:
+        """The energy per second (W) of the stress events of at least ``above`` J."""
+        energies = self.of(component, target)
+        return float(energies[energies >= above].sum()) / self.window if self.window > 0 else math.nan
+
+    def as_summary(self) -> dict[str, float]:
+        """The summary's keys: the median and 90th percentile of the total, of each part and for each target, and
+        per threshold the events per second and their power."""
+        summary: dict[str, float] = {"stress_window_s": self.window}
+        for name, q in PERCENTILES:
+            summary[f"stress_energy_{name}_J"] = self.percentile(q)
+            for part in COMPONENTS[1:]:
+                summary[f"stress_energy_{part}_{name}_J"] = self.percentile(q, part)
+            for target in TARGETS[1:]:
+                summary[f"stress_energy_{target}_{name}_J"] = self.percentile(q, target=target)
+        for threshold in self.thresholds:
+            summary[f"stress_events_above_{threshold_name(threshold)}_hz"] = self.events_per_second(threshold)
+            summary[f"stress_power_above_{threshold_name(threshold)}_W"] = self.power(threshold)
+        return summary
+
+
+def stress_spectrum(impacts: Mapping[str, Sequence], window: float, thresholds: Sequence[float] = ()) -> StressSpectrum:
+    """The spectrum of the impact records ``impacts`` (an engine's impact columns) resolved over ``window`` s."""
+    total = np.asarray(impacts["dissipated_energy"], dtype=float)
+    if "dissipated_normal" in impacts:
+        normal = np.asarray(impacts["dissipated_normal"], dtype=float)
+        tangential = sum((np.asarray(impacts[channel], dtype=float) for channel in TANGENTIAL_CHANNELS), np.zeros_like(total))
+    else:
+        normal, tangential = total, np.zeros_like(total)
+    hit_ball = np.asarray(impacts["target"]) == "ball" if "target" in impacts else np.zeros(total.size, dtype=bool)
+    return StressSpectrum({"total": total, "normal": normal, "tangential": tangential}, hit_ball, float(window),
+                          tuple(sorted(thresholds)))

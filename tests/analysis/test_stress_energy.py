@@ -1,0 +1,69 @@
+"""The stress-energy spectrum (analysis/stress_energy.py) against values counted by hand, and against the energy a
+run dissipates."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import shakermill as sm
+from shakermill.analysis.stress_energy import stress_spectrum
+
+# Five impacts of the 'dem' engine over 2 s: on the side, between balls, on an end face.
+DEM_IMPACTS = {
+    "target": np.array(["side", "ball", "left", "ball", "right"]),
+    "dissipated_normal": np.array([1e-3, 4e-3, 0.0, 2e-2, 5e-3]),
+    "dissipated_tangential": np.array([0.0, 1e-3, 1e-4, 0.0, 0.0]),
+    "dissipated_sliding": np.array([0.0, 2e-3, 0.0, 0.0, 5e-3]),
+    "dissipated_rolling": np.array([0.0, 0.0, 0.0, 0.0, 0.0]),
+    "dissipated_energy": np.array([1e-3, 7e-3, 1e-4, 2e-2, 1e-2]),
+}
+
+
+def test_the_spectrum_of_five_impacts_counted_by_hand():
+    spectrum = stress_spectrum(DEM_IMPACTS, 2.0, (0.01, 0.005))
+    # Totals sorted: 0.1, 1, 7, 10, 20 mJ; the median is the third, the 90th percentile 10 + 0.6·(20 − 10) mJ.
+    assert spectrum.percentile(50) == pytest.approx(7e-3)
+    assert spectrum.percentile(90) == pytest.approx(1.6e-2)
+    # Tangential parts 0, 3, 0.1, 0, 5 mJ: median 0.1 mJ; normal parts 1, 4, 0, 20, 5 mJ: median 4 mJ.
+    assert spectrum.percentile(50, "tangential") == pytest.approx(1e-4)
+    assert spectrum.percentile(50, "normal") == pytest.approx(4e-3)
+    # Between balls: 7 and 20 mJ; on the vial: 0.1, 1 and 10 mJ.
+    assert spectrum.percentile(50, target="ball") == pytest.approx(1.35e-2)
+    assert spectrum.percentile(50, target="wall") == pytest.approx(1e-3)
+    # At or above 10 mJ: 10 and 20 mJ, two events in 2 s carrying 30 mJ; at or above 5 mJ three, 37 mJ.
+    assert spectrum.events_per_second(0.01) == pytest.approx(1.0)
+    assert spectrum.power(0.01) == pytest.approx(0.015)
+    summary = spectrum.as_summary()
+    assert summary["stress_power_above_0.005J_W"] == pytest.approx(0.0185)
+    assert summary["stress_events_above_0.005J_hz"] == pytest.approx(1.5)
+    assert summary["stress_energy_ball_p90_J"] == pytest.approx(7e-3 + 0.9 * 13e-3)
+    assert summary["stress_window_s"] == 2.0
+
+
+def test_one_ball_on_the_axis_stresses_head_on_and_hits_no_ball():
+    impacts = {"wall": np.array(["left", "right"]), "dissipated_energy": np.array([2e-3, 4e-3])}
+    summary = stress_spectrum(impacts, 1.0).as_summary()
+    assert summary["stress_energy_normal_median_J"] == summary["stress_energy_median_J"] == pytest.approx(3e-3)
+    assert summary["stress_energy_tangential_p90_J"] == 0.0
+    assert math.isnan(summary["stress_energy_ball_median_J"])
+    assert summary["stress_energy_wall_median_J"] == pytest.approx(3e-3)
+
+
+def test_no_impacts_give_no_energies_and_no_power():
+    empty = {name: values[:0] for name, values in DEM_IMPACTS.items()}
+    spectrum = stress_spectrum(empty, 5.0, (1e-3,))
+    assert math.isnan(spectrum.percentile(50))
+    assert spectrum.power(1e-3) == 0.0
+
+
+@pytest.mark.slow
+def test_the_stress_power_of_a_run_is_the_power_its_impacts_dissipate():
+    """All of a full 1-D run's dissipation happens in its recorded impacts: the spectrum's power above zero is the
+    summary's dissipated power (but for the impact still running at the end)."""
+    result = sm.simulate(sm.default_parameters(duration=30.0))
+    spectrum = stress_spectrum(result.impact_columns, result.t_end)
+    assert spectrum.power() == pytest.approx(result.summary["dissipated_power_W"], rel=1e-3)
+    assert spectrum.events_per_second() == pytest.approx(result.summary["impact_rate_hz"], rel=1e-12)
