@@ -19,6 +19,7 @@ DEM_IMPACTS = {
     "dissipated_sliding": np.array([0.0, 2e-3, 0.0, 0.0, 5e-3]),
     "dissipated_rolling": np.array([0.0, 0.0, 0.0, 0.0, 0.0]),
     "dissipated_energy": np.array([1e-3, 7e-3, 1e-4, 2e-2, 1e-2]),
+    "duration": np.array([5e-5, 6e-5, 4e-5, 8e-5, 7e-5]),
 }
 
 
@@ -44,12 +45,27 @@ def test_the_spectrum_of_five_impacts_counted_by_hand():
 
 
 def test_one_ball_on_the_axis_stresses_head_on_and_hits_no_ball():
-    impacts = {"wall": np.array(["left", "right"]), "dissipated_energy": np.array([2e-3, 4e-3])}
+    impacts = {"wall": np.array(["left", "right"]), "dissipated_energy": np.array([2e-3, 4e-3]), "duration": np.full(2, 5e-5)}
     summary = stress_spectrum(impacts, 1.0).as_summary()
     assert summary["stress_energy_normal_median_J"] == summary["stress_energy_median_J"] == pytest.approx(3e-3)
     assert summary["stress_energy_tangential_p90_J"] == 0.0
     assert math.isnan(summary["stress_energy_ball_median_J"])
     assert summary["stress_energy_wall_median_J"] == pytest.approx(3e-3)
+
+
+def test_a_lasting_contact_is_no_stress_event_but_the_power_of_steady_grinding():
+    """A ball that slid on the wall for 0.4 s dissipated 0.5 J: counted apart, not in the spectrum's tail."""
+    impacts = {**DEM_IMPACTS, "dissipated_energy": np.append(DEM_IMPACTS["dissipated_energy"], 0.5),
+               "duration": np.append(DEM_IMPACTS["duration"], 0.4), "target": np.append(DEM_IMPACTS["target"], "side"),
+               **{name: np.append(DEM_IMPACTS[name], value) for name, value in (
+                   ("dissipated_normal", 0.0), ("dissipated_tangential", 0.0), ("dissipated_sliding", 0.5),
+                   ("dissipated_rolling", 0.0))}}
+    with_lasting, without = stress_spectrum(impacts, 2.0), stress_spectrum(DEM_IMPACTS, 2.0)
+    assert with_lasting.percentile(90) == without.percentile(90)
+    assert with_lasting.power() == without.power()
+    summary = with_lasting.as_summary()
+    assert summary["stress_lasting_power_W"] == pytest.approx(0.25)
+    assert summary["stress_lasting_contacts_hz"] == pytest.approx(0.5)
 
 
 def test_no_impacts_give_no_energies_and_no_power():
@@ -61,9 +77,11 @@ def test_no_impacts_give_no_energies_and_no_power():
 
 @pytest.mark.slow
 def test_the_stress_power_of_a_run_is_the_power_its_impacts_dissipate():
-    """All of a full 1-D run's dissipation happens in its recorded impacts: the spectrum's power above zero is the
-    summary's dissipated power (but for the impact still running at the end)."""
+    """All of a full 1-D run's dissipation happens in its recorded impacts: the spectrum's power above zero and that
+    of the lasting contacts (none here: the ball flies from end to end) is the summary's dissipated power (but for the
+    impact still running at the end)."""
     result = sm.simulate(sm.default_parameters(duration=30.0))
     spectrum = stress_spectrum(result.impact_columns, result.t_end)
+    assert spectrum.lasting_power() == 0.0
     assert spectrum.power() == pytest.approx(result.summary["dissipated_power_W"], rel=1e-3)
     assert spectrum.events_per_second() == pytest.approx(result.summary["impact_rate_hz"], rel=1e-12)

@@ -8,6 +8,11 @@ the energy available to stress the powder caught between the surfaces. It has a 
 the normal force, and a tangential part, from tangential damping, sliding and rolling resistance (MODEL.md §12.4);
 the 1-D engine's impacts are head-on, all normal. A ball's kinetic energy before an impact bounds the normal part
 from above; it is not what is reported.
+
+A contact that lasts (a ball rolling or sliding on the wall under a planetary jar's centrifugal load for a good part
+of a second) is recorded as one row too, with all it dissipated while it lasted: it is no stress event but a steady
+grinding, and it would put joules into the spectrum's tail. A record longer than :data:`LASTING_CONTACT_S` is
+counted apart, as the power of the lasting contacts.
 """
 
 from __future__ import annotations
@@ -22,6 +27,9 @@ COMPONENTS = ("total", "normal", "tangential")
 # What was hit: the vial (its end faces or, in three dimensions, its side) or another ball.
 TARGETS = ("all", "wall", "ball")
 PERCENTILES = (("median", 50.0), ("p90", 90.0))
+# A Hertz impact of steel balls of 5-40 mm lasts 20-600 µs from 10 m/s down to 1 mm/s (its duration grows as R·v^-1/5):
+# a contact of more than a millisecond rolls, slides or rests.
+LASTING_CONTACT_S = 1e-3
 # The 'dem' engine's channels that make up the tangential part (engines/dem/model.py, TOTAL_NAMES).
 TANGENTIAL_CHANNELS = ("dissipated_tangential", "dissipated_sliding", "dissipated_rolling")
 
@@ -33,20 +41,29 @@ def threshold_name(threshold: float) -> str:
 
 @dataclass(frozen=True)
 class StressSpectrum:
-    """The stress energies of the impacts resolved over ``window`` seconds: each impact's normal, tangential and
-    total energy (J) and whether it hit the vial or another ball."""
+    """The stress energies of the contacts recorded over ``window`` seconds: each one's normal, tangential and total
+    energy (J), whether it hit the vial or another ball, and whether it lasted (:data:`LASTING_CONTACT_S`)."""
 
     energies: Mapping[str, np.ndarray]
     hit_ball: np.ndarray
+    lasting: np.ndarray
     window: float
     thresholds: tuple[float, ...] = ()
 
     def of(self, component: str = "total", target: str = "all") -> np.ndarray:
-        """The stress energies (J) of ``component`` of the impacts on ``target`` (:data:`COMPONENTS`, :data:`TARGETS`)."""
-        energies = self.energies[component]
-        if target == "all":
-            return energies
-        return energies[self.hit_ball] if target == "ball" else energies[~self.hit_ball]
+        """The stress energies (J) of ``component`` of the impacts (the contacts that did not last) on ``target``
+        (:data:`COMPONENTS`, :data:`TARGETS`)."""
+        chosen = ~self.lasting
+        if target != "all":
+            chosen &= self.hit_ball if target == "ball" else ~self.hit_ball
+        return self.energies[component][chosen]
+
+    def lasting_power(self) -> float:
+        """The energy per second (W) the lasting contacts dissipated: rolling, sliding and resting under load."""
+        return self._per_second(float(self.energies["total"][self.lasting].sum()))
+
+    def _per_second(self, amount: float) -> float:
+        return amount / self.window if self.window > 0 else math.nan
 
     def percentile(self, q: float, component: str = "total", target: str = "all") -> float:
         """The ``q``-th percentile (J) of :meth:`of`; NaN without impacts."""
@@ -55,17 +72,18 @@ class StressSpectrum:
 
     def events_per_second(self, above: float = 0.0, component: str = "total", target: str = "all") -> float:
         """Stress events per second (1/s) of at least ``above`` J: Kwade's stress frequency above an energy."""
-        return float(np.count_nonzero(self.of(component, target) >= above)) / self.window if self.window > 0 else math.nan
+        return self._per_second(float(np.count_nonzero(self.of(component, target) >= above)))
 
     def power(self, above: float = 0.0, component: str = "total", target: str = "all") -> float:
         """The energy per second (W) of the stress events of at least ``above`` J."""
         energies = self.of(component, target)
-        return float(energies[energies >= above].sum()) / self.window if self.window > 0 else math.nan
+        return self._per_second(float(energies[energies >= above].sum()))
 
     def as_summary(self) -> dict[str, float]:
         """The summary's keys: the median and 90th percentile of the total, of each part and for each target, and
         per threshold the events per second and their power."""
-        summary: dict[str, float] = {"stress_window_s": self.window}
+        summary: dict[str, float] = {"stress_window_s": self.window, "stress_lasting_power_W": self.lasting_power(),
+                                     "stress_lasting_contacts_hz": self._per_second(float(np.count_nonzero(self.lasting)))}
         for name, q in PERCENTILES:
             summary[f"stress_energy_{name}_J"] = self.percentile(q)
             for part in COMPONENTS[1:]:
@@ -87,5 +105,6 @@ def stress_spectrum(impacts: Mapping[str, Sequence], window: float, thresholds: 
     else:
         normal, tangential = total, np.zeros_like(total)
     hit_ball = np.asarray(impacts["target"]) == "ball" if "target" in impacts else np.zeros(total.size, dtype=bool)
-    return StressSpectrum({"total": total, "normal": normal, "tangential": tangential}, hit_ball, float(window),
+    lasting = np.asarray(impacts["duration"], dtype=float) > LASTING_CONTACT_S
+    return StressSpectrum({"total": total, "normal": normal, "tangential": tangential}, hit_ball, lasting, float(window),
                           tuple(sorted(thresholds)))

@@ -65,7 +65,8 @@ SEVERAL_BALL_CAPTIONS = {
     "stress_energy_spectrum": (
         "Stress-energy spectrum: impacts per second (left) and their power (right) at or above each stress energy, the "
         "energy an impact dissipates, in its normal part and its tangential part (damping, sliding, rolling), on the "
-        "vial and between balls (Kwade; Burmeister & Kwade 2013); dash-dot lines: stress_energy_thresholds."
+        "vial and between balls (Kwade; Burmeister & Kwade 2013); dash-dot lines: stress_energy_thresholds. Contacts "
+        "that last over a millisecond roll or slide: their power is given apart."
     ),
     "impacts_per_second": "Impacts per second on each wall and between balls over the time the impacts were resolved.",
 }
@@ -245,17 +246,20 @@ def stress_energy_table(run: RunData) -> str:
     from shakermill.analysis.stress_energy import stress_spectrum
 
     spectrum = stress_spectrum(run.impacts, run.summary["stress_window_s"], run.params.stress_energy_thresholds)
+    parts = (("total", "all"), ("normal", "all"), ("tangential", "all"), ("total", "wall"), ("total", "ball"))
     rows = [
-        (f"{component}, {target if target != 'all' else 'all targets'}", number(spectrum.events_per_second(0.0, component, target), ".4g"),
-         number(spectrum.percentile(50, component, target), ".3g"), number(spectrum.percentile(90, component, target), ".3g"),
-         number(spectrum.power(0.0, component, target), ".4g"))
-        for component, target in (("total", "all"), ("normal", "all"), ("tangential", "all"), ("total", "wall"), ("total", "ball"))
+        (f"{component}, {target if target != 'all' else 'all targets'}",
+         number(spectrum.events_per_second(0.0, component, target), ".4g"), number(spectrum.percentile(50, component, target), ".3g"),
+         number(spectrum.percentile(90, component, target), ".3g"), number(spectrum.power(0.0, component, target), ".4g"))
+        for component, target in parts
     ]
     rows += [
         (f"total at or above {threshold:g} J", number(spectrum.events_per_second(threshold), ".4g"), "", "",
          number(spectrum.power(threshold), ".4g"))
         for threshold in spectrum.thresholds
     ]
+    lasting = number(run.summary.get("stress_lasting_contacts_hz"), ".4g")
+    rows.append(("lasting contacts (rolling, sliding: no stress events)", lasting, "", "", number(spectrum.lasting_power(), ".4g")))
     header = ("stress energy (J dissipated per impact)", "events per second (1/s)", "median (J)", "90th percentile (J)", "power (W)")
     return table(header, rows, numeric=(1, 2, 3, 4))
 

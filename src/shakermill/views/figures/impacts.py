@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 import pandas as pd
 
-from shakermill.analysis.stress_energy import StressSpectrum, stress_spectrum
+from shakermill.analysis.stress_energy import LASTING_CONTACT_S, StressSpectrum, stress_spectrum
 from shakermill.views.figures.common import (
     RunLike,
     add_context,
@@ -81,6 +81,10 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
     return {name: add_context(figure, context, window) for name, figure in figures.items()}
 
 
+# The spectrum's energy axis spans six decades below its largest energy.
+SPECTRUM_DECADES = 1e-6
+
+
 # The spectrum's curves: (component, target, label, style); the split by target only where balls hit balls.
 SPECTRUM_CURVES = (
     ("total", "all", "all impacts, normal + tangential", {"color": "black", "lw": 2.0}),
@@ -92,11 +96,23 @@ SPECTRUM_CURVES = (
 
 
 def stress_energy_figure(spectrum: StressSpectrum) -> Figure:
-    """The stress-energy spectrum: stress events per second (left) and their power (right) at or above each
-    energy, for the total, its normal and tangential parts and each target, with the run's thresholds marked."""
+    """The stress-energy spectrum of one run: its total, the total's normal and tangential parts and (where balls
+    hit balls) its impacts on each target, with the run's thresholds marked (:func:`spectra_figure`)."""
+    curves = [(label, spectrum, component, target, style) for component, target, label, style in SPECTRUM_CURVES
+              if target == "all" or spectrum.hit_ball.any()]
+    figure = spectra_figure(curves, spectrum.thresholds)
+    events, power = figure.axes
+    events.set_title(f"Stress frequency ({spectrum.of().size} impacts in {spectrum.window:.3g} s)")
+    if spectrum.lasting.any():
+        power.set_title(f"Stress power; contacts over {LASTING_CONTACT_S * 1e3:g} ms apart: {spectrum.lasting_power():.3g} W")
+    return figure
+
+
+def spectra_figure(curves: Sequence[tuple[str, StressSpectrum, str, str, dict]], thresholds: Sequence[float] = ()) -> Figure:
+    """Stress events per second (left) and their power (right) at or above each stress energy E, one line per
+    ``(label, spectrum, component, target, style)``; ``thresholds`` (J) dash-dot."""
     figure, (events, power) = new_figure(columns=2, height=4.5, width=11.0)
-    shown = [curve for curve in SPECTRUM_CURVES if curve[1] == "all" or spectrum.hit_ball.any()]
-    for component, target, label, style in shown:
+    for label, spectrum, component, target, style in curves:
         energies = np.sort(spectrum.of(component, target))
         energies = energies[energies > 0.0]
         if not energies.size:
@@ -108,14 +124,20 @@ def stress_energy_figure(spectrum: StressSpectrum) -> Figure:
         axis.set_xscale("log")
         axis.set_yscale("log")
         axis.set_xlabel("stress energy E, dissipated per impact (J)")
-        for threshold in spectrum.thresholds:
+        for threshold in thresholds:
             axis.axvline(threshold, color="0.5", lw=0.8, ls="-.")
         axis.grid(alpha=0.3, which="both")
     events.set_ylabel("stress events at or above E per second (1/s)")
     power.set_ylabel("power of the stress events at or above E (W)")
-    events.set_title(f"Stress frequency ({spectrum.of().size} impacts in {spectrum.window:.3g} s)")
-    power.set_title("Stress power" + (" (dash-dot: the run's thresholds)" if spectrum.thresholds else ""))
+    events.set_title("Stress frequency")
+    power.set_title("Stress power" + (" (dash-dot: the run's thresholds)" if thresholds else ""))
     events.legend(loc="lower left", fontsize="small")
+    # Energies below a millionth of the largest carry nothing a reader can see: the axes start there.
+    largest = max((float(np.max(spectrum.of(component, target), initial=0.0)) for _, spectrum, component, target, _ in curves),
+                  default=0.0)
+    if largest > 0.0:
+        for axis in (events, power):
+            axis.set_xlim(left=largest * SPECTRUM_DECADES)
     return figure
 
 
