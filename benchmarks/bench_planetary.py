@@ -2,17 +2,19 @@
 spectra side by side (issue 27).
 
 Part ``second``: one simulated second at full resolution of each planetary preset (``pulverisette7``, ``pm100``:
-ten Ø10-mm steel balls) and five seconds of five 12.7-mm balls in the SPEX 8000M (``spex8000m-3d``), each in a
-fresh process's CPU time with Numba's cache warm: steps, impacts per second, heat power and the stress-energy
-spectrum's median, 90th percentile and power above the thresholds. It draws the spectra of the three runs into
-``docs/figures/stress-energy-spex-vs-planetary.png``.
+ten Ø10-mm steel balls, started carried by the jar) and five seconds of five 12.7-mm balls in the SPEX 8000M
+(``spex8000m-3d``), in CPU time with Numba's cache warm: steps, impacts per second, heat power and the
+stress-energy spectrum of that start.
 
-Part ``hour``: one averaged hour of each planetary preset as shipped (``--batch-periods`` changes the batches of
-the averaged solver's mechanics): wall and CPU time, seconds of mechanics, the balls', jar's and air's temperatures
-and the heat paths that carry the most. The planetary presets are not calibrated: their temperatures are estimates.
+Part ``hour``: one averaged hour of each planetary preset as shipped (``--batch-periods`` changes the batches of the
+averaged solver's mechanics) and of the five SPEX balls: wall and CPU time, seconds of mechanics, the balls', jar's
+and air's temperatures, the heat paths that carry the most and the spectrum of the settled motion (the averaged
+solver's impact records, after its transient). It draws those three spectra into
+``docs/figures/stress-energy-spex-vs-planetary.png``. The planetary presets are not calibrated: their temperatures
+are estimates.
 
-    .venv/bin/python benchmarks/bench_planetary.py                 # both parts
-    .venv/bin/python benchmarks/bench_planetary.py --only second   # the second and the figure (~1.5 min)
+    .venv/bin/python benchmarks/bench_planetary.py                 # both parts (~20 min on 2 cores)
+    .venv/bin/python benchmarks/bench_planetary.py --only second   # the first seconds (~1 min)
     .venv/bin/python benchmarks/bench_planetary.py --only hour --presets pm100 --batch-periods 4
 """
 
@@ -29,13 +31,15 @@ from shakermill.analysis.stress_energy import stress_spectrum
 ROOT = Path(__file__).resolve().parents[1]
 FIGURE = ROOT / "docs" / "figures" / "stress-energy-spex-vs-planetary.png"
 PLANETARY = ("pulverisette7", "pm100")
-# (label, preset, overrides, simulated seconds): five SPEX balls for five seconds hold about as many impacts as a
-# planetary jar's second.
-SECOND_RUNS = (
-    ("SPEX 8000M, 5 balls Ø12.7 mm (spex8000m-3d)", "spex8000m-3d", {"n_balls": 5}, 5.0),
-    ("Pulverisette 7 type, 10 balls Ø10 mm, 800 rpm (pulverisette7)", "pulverisette7", {}, 1.0),
-    ("PM 100 type, 10 balls Ø10 mm, 500 rpm (pm100)", "pm100", {}, 1.0),
-)
+LABELS = {
+    "spex8000m-3d": "SPEX 8000M, 5 balls Ø12.7 mm (spex8000m-3d)",
+    "pulverisette7": "Pulverisette 7 type, 10 balls Ø10 mm, 800 rpm (pulverisette7)",
+    "pm100": "PM 100 type, 10 balls Ø10 mm, 500 rpm (pm100)",
+}
+SPEX = ("spex8000m-3d", {"n_balls": 5})
+# (preset, overrides, simulated seconds): five SPEX balls for five seconds hold about as many impacts as a planetary
+# jar's second.
+SECOND_RUNS = ((*SPEX, 5.0), ("pulverisette7", {}, 1.0), ("pm100", {}, 1.0))
 STYLES = ({"color": "tab:blue", "lw": 2.0}, {"color": "tab:red", "lw": 2.0}, {"color": "tab:green", "lw": 2.0, "ls": "--"})
 HOUR_S = 3600.0
 
@@ -63,40 +67,41 @@ def spectrum_line(summary: dict) -> str:
 
 
 def second_part() -> None:
-    from shakermill.views.figures.impacts import spectra_figure
-
-    curves = []
-    for (label, preset, overrides, seconds), style in zip(SECOND_RUNS, STYLES, strict=True):
+    for preset, overrides, seconds in SECOND_RUNS:
         params = sm.default_parameters(preset, solver="full", duration=seconds, record_windows=(), **overrides)
         result, wall, cpu = timed(params)
         summary = result.summary
-        print(f"{label}: {seconds:g} simulated s in {cpu:.1f} CPU-s ({wall:.1f} wall-s), {cpu / seconds:.3g} CPU-s per "
-              f"simulated s; {result.counters['steps']} steps, {summary['impact_rate_hz']:.4g} impacts/s, heat "
+        print(f"{LABELS[preset]}: {seconds:g} simulated s in {cpu:.1f} CPU-s ({wall:.1f} wall-s), {cpu / seconds:.3g} CPU-s "
+              f"per simulated s; {result.counters['steps']} steps, {summary['impact_rate_hz']:.4g} impacts/s, heat "
               f"{summary['heat_power_W']:.3g} W, audit residual {summary['energy_audit_residual']:.1e}")
         print(f"  {spectrum_line(summary)}")
-        spectrum = stress_spectrum(result.impact_columns, result.t_end, params.stress_energy_thresholds)
-        curves.append((label, spectrum, "total", "all", style))
-    figure = spectra_figure(curves, params.stress_energy_thresholds)
-    figure.suptitle("Stress-energy spectra, full resolution: a SPEX 8000M and two planetary mills (not calibrated)")
-    figure.savefig(FIGURE, dpi=110)
-    print(f"figure: {FIGURE.relative_to(ROOT)}")
 
 
 def hour_part(presets: list[str], batch_periods: int | None) -> None:
-    for preset in presets:
-        settings = {"averaging_batch_periods": batch_periods} if batch_periods else {}
-        params = sm.default_parameters(preset, duration=HOUR_S, **settings)
+    from shakermill.views.figures.impacts import spectra_figure
+
+    curves = []
+    for (preset, overrides), style in zip((SPEX, *((name, {}) for name in presets)), STYLES, strict=False):
+        settings = {"averaging_batch_periods": batch_periods} if batch_periods and preset != SPEX[0] else {}
+        params = sm.default_parameters(preset, duration=HOUR_S, **overrides, **settings)
         result, wall, cpu = timed(params)
         summary = result.summary
         paths = sorted(summary["heat_paths_W"].items(), key=lambda item: -abs(item[1]))[:4]
-        print(f"{preset}, averaged hour (batches of {params.averaging_batch_periods} periods): {wall:.0f} wall-s, "
-              f"{cpu:.0f} CPU-s; {summary.get('averaging_window_s', float('nan')):.3g} s of mechanics; status "
-              f"{result.status}: {result.message}")
+        print(f"{LABELS[preset]}, averaged hour (batches of {params.averaging_batch_periods} periods): {wall:.0f} "
+              f"wall-s, {cpu:.0f} CPU-s; {summary.get('averaging_window_s', float('nan')):.3g} s of mechanics kept; "
+              f"status {result.status}: {result.message}")
         print(f"  balls {summary['ball_C']:.1f} °C (mean; hottest {summary['hottest_ball_C']:.1f} °C), jar "
               f"{summary['vial_C']:.1f} °C, air {summary['air_C']:.1f} °C, holder {summary.get('clamp_C', float('nan')):.1f} °C; "
               f"heat {summary['heat_power_W']:.3g} W at {summary['impact_rate_hz']:.4g} impacts/s")
         print(f"  {spectrum_line(summary)}")
         print("  largest heat paths: " + "; ".join(f"{name} {flow:.3g} W" for name, flow in paths))
+        spectrum = stress_spectrum(result.impact_columns, summary["stress_window_s"], params.stress_energy_thresholds,
+                                   summary["dissipated_power_W"])
+        curves.append((LABELS[preset], spectrum, "total", "all", style))
+    figure = spectra_figure(curves, params.stress_energy_thresholds)
+    figure.suptitle("Stress-energy spectra of the settled motion: a SPEX 8000M and two planetary mills (not calibrated)")
+    figure.savefig(FIGURE, dpi=110)
+    print(f"figure: {FIGURE.relative_to(ROOT)}")
 
 
 def main() -> None:

@@ -66,6 +66,9 @@ def test_a_lasting_contact_is_no_stress_event_but_the_power_of_steady_grinding()
     summary = with_lasting.as_summary()
     assert summary["stress_lasting_power_W"] == pytest.approx(0.25)
     assert summary["stress_lasting_contacts_hz"] == pytest.approx(0.5)
+    # Given all the contacts dissipated (a contact still running is in no record), the lasting contacts have the rest:
+    # 0.4 W less the impacts' 38.1 mJ over 2 s.
+    assert stress_spectrum(impacts, 2.0, dissipated_power=0.4).lasting_power() == pytest.approx(0.4 - 0.01905)
 
 
 def test_no_impacts_give_no_energies_and_no_power():
@@ -83,5 +86,6 @@ def test_the_stress_power_of_a_run_is_the_power_its_impacts_dissipate():
     result = sm.simulate(sm.default_parameters(duration=30.0))
     spectrum = stress_spectrum(result.impact_columns, result.t_end)
     assert spectrum.lasting_power() == 0.0
+    assert result.summary["stress_lasting_power_W"] == pytest.approx(0.0, abs=1e-3 * result.summary["dissipated_power_W"])
     assert spectrum.power() == pytest.approx(result.summary["dissipated_power_W"], rel=1e-3)
     assert spectrum.events_per_second() == pytest.approx(result.summary["impact_rate_hz"], rel=1e-12)

@@ -10,9 +10,10 @@ the 1-D engine's impacts are head-on, all normal. A ball's kinetic energy before
 from above; it is not what is reported.
 
 A contact that lasts (a ball rolling or sliding on the wall under a planetary jar's centrifugal load for a good part
-of a second) is recorded as one row too, with all it dissipated while it lasted: it is no stress event but a steady
-grinding, and it would put joules into the spectrum's tail. A record longer than :data:`LASTING_CONTACT_S` is
-counted apart, as the power of the lasting contacts.
+of a second) is recorded as one row too, with all it dissipated while it lasted, and only once it ends: it is no
+stress event but a steady grinding, and it would put joules into the spectrum's tail. A record longer than
+:data:`LASTING_CONTACT_S` is left out of the spectrum, and the power of the lasting contacts is the run's dissipated
+power less that of its impacts, so that a contact still running when the records end counts too.
 """
 
 from __future__ import annotations
@@ -49,6 +50,7 @@ class StressSpectrum:
     lasting: np.ndarray
     window: float
     thresholds: tuple[float, ...] = ()
+    dissipated_power: float = math.nan  # W: all the contacts dissipated over the window, recorded or not
 
     def of(self, component: str = "total", target: str = "all") -> np.ndarray:
         """The stress energies (J) of ``component`` of the impacts (the contacts that did not last) on ``target``
@@ -59,7 +61,10 @@ class StressSpectrum:
         return self.energies[component][chosen]
 
     def lasting_power(self) -> float:
-        """The energy per second (W) the lasting contacts dissipated: rolling, sliding and resting under load."""
+        """The energy per second (W) the lasting contacts dissipated, rolling, sliding and resting under load: the
+        dissipated power less the impacts' (those recorded, without a dissipated power)."""
+        if math.isfinite(self.dissipated_power):
+            return self.dissipated_power - self.power()
         return self._per_second(float(self.energies["total"][self.lasting].sum()))
 
     def _per_second(self, amount: float) -> float:
@@ -96,8 +101,10 @@ class StressSpectrum:
         return summary
 
 
-def stress_spectrum(impacts: Mapping[str, Sequence], window: float, thresholds: Sequence[float] = ()) -> StressSpectrum:
-    """The spectrum of the impact records ``impacts`` (an engine's impact columns) resolved over ``window`` s."""
+def stress_spectrum(impacts: Mapping[str, Sequence], window: float, thresholds: Sequence[float] = (),
+                    dissipated_power: float = math.nan) -> StressSpectrum:
+    """The spectrum of the impact records ``impacts`` (an engine's impact columns) resolved over ``window`` s, in
+    which the contacts dissipated ``dissipated_power`` (W) in all."""
     total = np.asarray(impacts["dissipated_energy"], dtype=float)
     if "dissipated_normal" in impacts:
         normal = np.asarray(impacts["dissipated_normal"], dtype=float)
@@ -107,4 +114,4 @@ def stress_spectrum(impacts: Mapping[str, Sequence], window: float, thresholds: 
     hit_ball = np.asarray(impacts["target"]) == "ball" if "target" in impacts else np.zeros(total.size, dtype=bool)
     lasting = np.asarray(impacts["duration"], dtype=float) > LASTING_CONTACT_S
     return StressSpectrum({"total": total, "normal": normal, "tangential": tangential}, hit_ball, lasting, float(window),
-                          tuple(sorted(thresholds)))
+                          tuple(sorted(thresholds)), float(dissipated_power))

@@ -245,7 +245,8 @@ def stress_energy_table(run: RunData) -> str:
     part and on each target, then the power above each of the run's thresholds (analysis/stress_energy.py)."""
     from shakermill.analysis.stress_energy import stress_spectrum
 
-    spectrum = stress_spectrum(run.impacts, run.summary["stress_window_s"], run.params.stress_energy_thresholds)
+    spectrum = stress_spectrum(run.impacts, run.summary["stress_window_s"], run.params.stress_energy_thresholds,
+                               run.summary.get("dissipated_power_W", math.nan))
     parts = (("total", "all"), ("normal", "all"), ("tangential", "all"), ("total", "wall"), ("total", "ball"))
     rows = [
         (f"{component}, {target if target != 'all' else 'all targets'}",

@@ -72,7 +72,7 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
     window = run.summary.get("stress_window_s")
     if window:  # a run folder written before the spectrum was reported has none
         figures["stress_energy_spectrum"] = stress_energy_figure(
-            stress_spectrum(impacts, window, run.params.stress_energy_thresholds)
+            stress_spectrum(impacts, window, run.params.stress_energy_thresholds, run.summary.get("dissipated_power_W", math.nan))
         )
     if not balls:
         # Regimes are sequences of end faces hit at fixed drive phases: a notion of one ball on the axis.
