@@ -475,8 +475,9 @@ def test_plot_of_a_sweep_folder_draws_maps_with_the_contour(sweep_folder, tmp_pa
     assert outcome.exit_code == 0, outcome.stderr
     stems = {path.stem for path in (tmp_path / "maps").iterdir()}
     assert stems == {"sweep_theta_inf_C", "sweep_tau_min", "sweep_impact_rate_hz", "sweep_heat_power_W",
-                     "sweep_mean_impact_speed_m_s", "sweep_ball_steady_C", "sweep_regime"}
-    assert "14 files written" in outcome.stdout
+                     "sweep_mean_impact_speed_m_s", "sweep_ball_steady_C", "sweep_stress_energy_median_J",
+                     "sweep_stress_energy_p90_J", "sweep_regime"}
+    assert "18 files written" in outcome.stdout
     assert "not crossed" not in outcome.stderr
 
 
@@ -488,7 +489,7 @@ def test_plot_says_when_a_contour_level_is_never_reached(sweep_folder, tmp_path)
     assert outcome.exit_code == 0, outcome.stderr
     (line,) = outcome.stderr.strip().splitlines()
     assert line.startswith(f"note: theta_inf_C = {level:g} not crossed") and "below it at every point" in line
-    assert "14 files written" in outcome.stdout
+    assert "18 files written" in outcome.stdout
 
 
 @pytest.mark.slow
@@ -518,7 +519,7 @@ def test_plot_of_a_sweep_over_the_solver_draws_every_figure(tmp_path):
     assert swept.exit_code == 0, swept.stderr
     outcome = invoke("plot", str(folder), "--out", str(tmp_path / "lines"))
     assert outcome.exit_code == 0, outcome.stderr
-    assert "14 files written" in outcome.stdout
+    assert "18 files written" in outcome.stdout
 
 
 # Three balls in a vial wide enough for them side by side, for 2 s: a few seconds with the figures.

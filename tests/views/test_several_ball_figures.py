@@ -181,7 +181,7 @@ def test_the_report_has_a_table_per_ball_and_leaves_out_what_is_one_dimensional(
         assert f"<td>{ball}</td><td class=\"num\">6.35</td><td class=\"num\">{value:.2f}</td>" in document
     assert "regime of the settled motion" not in document
     assert "n_balls = 3 (experiment: one ball)" in document
-    assert document.count("<figure>") == 4 + 3  # temperatures, paths, heat, heating zoom; three impact figures
+    assert document.count("<figure>") == 4 + 4  # temperatures, paths, heat, heating zoom; four impact figures
     assert "After 0.0333 min the 3 balls are at" in document
 
 
