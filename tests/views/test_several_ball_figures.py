@@ -190,3 +190,12 @@ def test_result_plot_and_html_of_a_dem_result(result):
     assert list(figures) == ["temperatures", "trajectories", "heat_by_channel", "ball_heating_zoom"]
     assert figures._repr_html_().count("data:image/png;base64,") == 4
     assert "the 3 balls are at" in result._repr_html_()
+
+
+def test_a_planetary_jar_is_seen_from_the_side_along_its_upright_axis_and_from_the_top_across_it():
+    from shakermill.views.trajectories import axis_label, view_name
+
+    planetary = sm.default_parameters("pulverisette7")
+    shaker = sm.default_parameters("spex8000m-3d")
+    assert (view_name(planetary, "end view"), axis_label(planetary, "x")) == ("top view", "x, along the jar's axis, up (mm)")
+    assert (view_name(shaker, "end view"), axis_label(shaker, "z")) == ("end view", "z, up at rest (mm)")

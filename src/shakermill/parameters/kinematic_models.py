@@ -49,6 +49,8 @@ class KinematicModel:
     # The air meets the vial's outside across its axis (a planetary jar carried round the sun wheel), not along it
     # (a shaken vial): which correlations its outside's convection takes (engines/thermal/network.py).
     flow_across_the_axis: bool = False
+    # The vial's axis stands up (its frame's x along the lab's z), not horizontal: what the figures call its views.
+    axis_upright: bool = False
 
 
 def axial_terms(amplitude: float) -> tuple[Term, ...]:
@@ -143,6 +145,7 @@ KINEMATIC_MODELS: dict[str, KinematicModel] = {
         planetary_terms,
         balls_start_with_the_vial=True,
         flow_across_the_axis=True,
+        axis_upright=True,
     ),
 }
 

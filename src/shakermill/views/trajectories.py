@@ -17,6 +17,7 @@ import numpy as np
 
 from shakermill.parameters.defaults import ANIMATION_FRAMES, MOST_ANIMATION_FRAMES
 from shakermill.parameters.keys import Parameters
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.physics import kinematics
 
 if TYPE_CHECKING:
@@ -30,6 +31,18 @@ BALL_COLOURS = ("tab:red", "tab:orange", "tab:purple", "tab:brown", "tab:pink", 
 VIEWS = (("x", "y", "top view"), ("x", "z", "side view"), ("y", "z", "end view"))
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 AXIS_MEANING = {"x": "along the vial's axis", "y": "across", "z": "up at rest"}
+# A jar whose axis stands up (a planetary mill's): the same projections seen from the side, and from the top.
+UPRIGHT_VIEW_NAMES = {"top view": "side view", "side view": "side view, a quarter turn round", "end view": "top view"}
+UPRIGHT_AXIS_MEANING = {"x": "along the jar's axis, up", "y": "across", "z": "across"}
+
+
+def axis_label(params: Parameters, axis: str) -> str:
+    upright = KINEMATIC_MODELS[params.kinematics].axis_upright
+    return f"{axis}, {(UPRIGHT_AXIS_MEANING if upright else AXIS_MEANING)[axis]} (mm)"
+
+
+def view_name(params: Parameters, name: str) -> str:
+    return UPRIGHT_VIEW_NAMES[name] if KINEMATIC_MODELS[params.kinematics].axis_upright else name
 # A window of minutes at 10 kHz would be millions of points per ball: longer windows are drawn thinned to this.
 MOST_PATH_POINTS = 20_000
 ANIMATION_FPS = 24
@@ -99,8 +112,8 @@ def draw_vial(axis: Axes, across: str, up: str, params: Parameters) -> None:
     axis.set_xlim(-reach[0], reach[0])
     axis.set_ylim(-reach[1], reach[1])
     axis.set_aspect("equal")
-    axis.set_xlabel(f"{across}, {AXIS_MEANING[across]} (mm)")
-    axis.set_ylabel(f"{up}, {AXIS_MEANING[up]} (mm)")
+    axis.set_xlabel(axis_label(params, across))
+    axis.set_ylabel(axis_label(params, up))
 
 
 def trajectory_figure(params: Parameters, window: xr.Dataset, record_window: tuple[float, float] | None = None) -> Figure:
@@ -127,7 +140,7 @@ def trajectory_figure(params: Parameters, window: xr.Dataset, record_window: tup
             axis.plot(local[drawn, ball, i], local[drawn, ball, j], color=colour, lw=0.6, label=f"ball {ball}")
             where = (local[-1, ball, i], local[-1, ball, j])
             axis.add_patch(Circle(where, radii[ball], facecolor=colour, edgecolor="black", lw=0.5, alpha=0.4))
-        axis.set_title(name)
+        axis.set_title(view_name(params, name))
         axis.grid(alpha=0.3)
     thinned = "" if drawn.size == time.size else f" ({drawn.size} of {time.size} stored points)"
     figure.suptitle(
@@ -160,7 +173,7 @@ def animation_gif(
     figure.set_dpi(dpi)
     axis = figure.subplots()
     draw_vial(axis, "x", "z", params)
-    axis.set_title("Balls in the vial frame, side view", loc="left")
+    axis.set_title(f"Balls in the vial frame, {view_name(params, 'side view')}", loc="left")
     # Animated artists are left out of the full draw: it makes the still background they are drawn onto.
     discs = [
         axis.add_patch(Circle((0.0, 0.0), radius, facecolor=colour, edgecolor="black", lw=0.5, animated=True))
