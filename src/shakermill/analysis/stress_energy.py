@@ -67,6 +67,10 @@ class StressSpectrum:
             return self.dissipated_power - self.power()
         return self._per_second(float(self.energies["total"][self.lasting].sum()))
 
+    def lasting_per_second(self) -> float:
+        """Contacts per second (1/s) that lasted, among those recorded."""
+        return self._per_second(float(np.count_nonzero(self.lasting)))
+
     def _per_second(self, amount: float) -> float:
         return amount / self.window if self.window > 0 else math.nan
 
@@ -88,7 +92,7 @@ class StressSpectrum:
         """The summary's keys: the median and 90th percentile of the total, of each part and for each target, and
         per threshold the events per second and their power."""
         summary: dict[str, float] = {"stress_window_s": self.window, "stress_lasting_power_W": self.lasting_power(),
-                                     "stress_lasting_contacts_hz": self._per_second(float(np.count_nonzero(self.lasting)))}
+                                     "stress_lasting_contacts_hz": self.lasting_per_second()}
         for name, q in PERCENTILES:
             summary[f"stress_energy_{name}_J"] = self.percentile(q)
             for part in COMPONENTS[1:]:

@@ -54,11 +54,7 @@ Harmonic = tuple[
 ]
 
 
-# Every key has hard bounds: a value outside them is refused with one line naming the key and its range.
-# They are wide enough for any real mill (PLAUSIBLE_RANGES warns about the merely unusual inside them)
-# and tight enough that the model and its integrator stay meaningful and finish; the comment above each
-# field says why its bounds are where they are. Lower bounds of 0 that stay open are physical (no
-# negative length), except where a small value makes the run misbehave.
+# The longest run (s): longer than any milling run (~100 h).
 LONGEST_RUN_S = 1e6
 Window = tuple[
     # A window may start anywhere in the longest run; its length is capped with the others' (MAX_RECORDED_SECONDS).

@@ -25,8 +25,8 @@ from shakermill.parameters.fields import (
     LONGEST_RUN_S,
     MAX_HARMONICS,
     MAX_STRESS_THRESHOLDS,
-    StressThreshold,
     Harmonic,
+    StressThreshold,
     Window,
     choice,
     count,
@@ -44,6 +44,11 @@ if TYPE_CHECKING:
     import numpy
 
 
+# Every key has hard bounds: a value outside them is refused with one line naming the key and its range.
+# They are wide enough for any real mill (PLAUSIBLE_RANGES warns about the merely unusual inside them)
+# and tight enough that the model and its integrator stay meaningful and finish; the comment above each
+# field says why its bounds are where they are. Lower bounds of 0 that stay open are physical (no
+# negative length), except where a small value makes the run misbehave.
 class Parameters(BaseModel):
     """One run of the one-ball shaker-mill model (MODEL.md sections 1–9)."""
 

@@ -44,12 +44,9 @@ class KinematicModel:
     keys: tuple[str, ...]
     terms: Callable[..., tuple[Term, ...]]
     assumed: tuple[str, ...] = ()
-    # A jar that turns steadily starts with its balls carried along, not at rest (engines/dem/model.py).
-    balls_start_with_the_vial: bool = False
-    # The air meets the vial's outside across its axis (a planetary jar carried round the sun wheel), not along it
-    # (a shaken vial): which correlations its outside's convection takes (engines/thermal/network.py).
-    flow_across_the_axis: bool = False
-    # The vial's axis stands up (its frame's x along the lab's z), not horizontal: what the figures call its views.
+    # The vial's axis stands up (its frame's x along the lab's z) and the vial is carried across it, as a planetary
+    # jar round its sun wheel: the air meets its outside across the axis, not along it as a shaken vial's
+    # (engines/thermal/network.py), and the figures name its views as seen with the axis up (views/trajectories.py).
     axis_upright: bool = False
 
 
@@ -143,8 +140,6 @@ KINEMATIC_MODELS: dict[str, KinematicModel] = {
         "speed_ratio relative to it",
         ("revolution_radius", "speed_ratio", "jar_tilt"),
         planetary_terms,
-        balls_start_with_the_vial=True,
-        flow_across_the_axis=True,
         axis_upright=True,
     ),
 }

@@ -7,9 +7,10 @@ import math
 from typing import Any, Iterator, Mapping
 
 from shakermill.analysis.regime import classify_impacts, settled_run_impacts
+from shakermill.analysis.stress_energy import StressSpectrum
 from shakermill.io.runs import RunData
 from shakermill.views.figures.common import several_balls
-from shakermill.views.figures.impacts import TARGETS, impact_figures
+from shakermill.views.figures.impacts import TARGETS, impact_figures, run_stress_spectrum
 from shakermill.views.figures.run import impact_span
 from shakermill.views.html import figures_html, paragraph, section, table
 from shakermill.views.notebook import number
@@ -235,18 +236,15 @@ def impacts_section(run: RunData, numbers: Iterator[int]) -> str:
             )
         )
     parts.append(figures_html(impact_figures(run), numbers, captions_of(run)))
-    if run.summary.get("stress_window_s") and not run.impacts.empty:
-        parts.append(stress_energy_table(run))
+    spectrum = run_stress_spectrum(run)
+    if spectrum is not None and not run.impacts.empty:
+        parts.append(stress_energy_table(spectrum))
     return section("Impacts", *parts)
 
 
-def stress_energy_table(run: RunData) -> str:
+def stress_energy_table(spectrum: StressSpectrum) -> str:
     """The stress-energy spectrum in numbers: events per second, median and 90th percentile of the total, of each
     part and on each target, then the power above each of the run's thresholds (analysis/stress_energy.py)."""
-    from shakermill.analysis.stress_energy import stress_spectrum
-
-    spectrum = stress_spectrum(run.impacts, run.summary["stress_window_s"], run.params.stress_energy_thresholds,
-                               run.summary.get("dissipated_power_W", math.nan))
     parts = (("total", "all"), ("normal", "all"), ("tangential", "all"), ("total", "wall"), ("total", "ball"))
     rows = [
         (f"{component}, {target if target != 'all' else 'all targets'}",
@@ -259,7 +257,7 @@ def stress_energy_table(run: RunData) -> str:
          number(spectrum.power(threshold), ".4g"))
         for threshold in spectrum.thresholds
     ]
-    lasting = number(run.summary.get("stress_lasting_contacts_hz"), ".4g")
+    lasting = number(spectrum.lasting_per_second(), ".4g")
     rows.append(("lasting contacts (rolling, sliding: no stress events)", lasting, "", "", number(spectrum.lasting_power(), ".4g")))
     header = ("stress energy (J dissipated per impact)", "events per second (1/s)", "median (J)", "90th percentile (J)", "power (W)")
     return table(header, rows, numeric=(1, 2, 3, 4))

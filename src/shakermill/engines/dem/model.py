@@ -1,8 +1,9 @@
 """Constants and state of the 'dem' engine, derived once from :class:`Parameters` (MODEL.md section 12).
 
 Frames: the lab frame has z up (gravity −z) and, for every motion but a planetary jar's (whose axis stands
-along z), x along the vial's axis at rest; the vial frame moves with the vial (its axis is its x). Contacts live in slots: ball pair (i, j), i < j, in slot ``i·N + j``;
-ball i against the left end, the right end or the cylindrical side in slot ``N² + 3i + wall``.
+along z), x along the vial's axis at rest; the vial frame moves with the vial (its axis is its x). Contacts
+live in slots: ball pair (i, j), i < j, in slot ``i·N + j``; ball i against the left end, the right end or the
+cylindrical side in slot ``N² + 3i + wall``.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import numpy as np
 from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.network import ThermalNetwork, air_constants, build_network
 from shakermill.parameters.keys import Parameters
-from shakermill.parameters.kinematic_models import KINEMATIC_MODELS, MOTION_COORDINATES, motion_terms
+from shakermill.parameters.kinematic_models import MOTION_COORDINATES, motion_terms
 from shakermill.physics import contact
 from shakermill.physics.kinematics import angular_velocity, fourier_coordinates, rotation_matrix
 
@@ -318,9 +319,9 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
     position = centre[:3] + params.initial_positions() @ orientation.T
     velocity = np.zeros((n, 3))
     spin = np.zeros((n, 3))
-    if KINEMATIC_MODELS[params.kinematics].balls_start_with_the_vial:
-        # A jar at full speed hitting balls at rest would begin with an impact at metres per second that no mill
-        # makes (the mill spins up over seconds): the balls start as if stuck to the jar.
+    if np.any(k.harmonics[3:, 0, 1] != 0.0):
+        # A jar turning steadily at full speed and hitting balls at rest would begin with an impact at metres per
+        # second that no mill makes (the mill spins up over seconds): the balls start as if stuck to the jar.
         turning = np.empty(3)
         angular_velocity(centre[4], centre[5], rates[3], rates[4], rates[5], turning)
         velocity[:] = rates[:3] + np.cross(turning, position - centre[:3])

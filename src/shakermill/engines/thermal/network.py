@@ -248,7 +248,7 @@ def vial_outer_convection(params: Parameters) -> OuterConvection:
         params.air_density, k_air, params.air_cp,
     )
     natural = heat_paths.churchill_chu_cylinder_nusselt(rayleigh, prandtl) * k_air / diameter
-    faces = _across_the_axis if KINEMATIC_MODELS[params.kinematics].flow_across_the_axis else _along_the_axis
+    faces = _across_the_axis if KINEMATIC_MODELS[params.kinematics].axis_upright else _along_the_axis
     h_side, h_end, correlations, validity = faces(params, speed, viscosity, prandtl)
     area = side_area + end_area
     return OuterConvection(

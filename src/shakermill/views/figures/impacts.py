@@ -69,11 +69,9 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
         ),
         "impacts_per_second": impact_rate_figure(impacts),
     }
-    window = run.summary.get("stress_window_s")
-    if window:  # a run folder written before the spectrum was reported has none
-        figures["stress_energy_spectrum"] = stress_energy_figure(
-            stress_spectrum(impacts, window, run.params.stress_energy_thresholds, run.summary.get("dissipated_power_W", math.nan))
-        )
+    spectrum = run_stress_spectrum(run)
+    if spectrum is not None:
+        figures["stress_energy_spectrum"] = stress_energy_figure(spectrum)
     if not balls:
         # Regimes are sequences of end faces hit at fixed drive phases: a notion of one ball on the axis.
         figures["impact_phase_histogram"] = impact_phase_figure(run)
@@ -93,6 +91,16 @@ SPECTRUM_CURVES = (
     ("total", "wall", "impacts on the vial", {"color": "tab:green", "lw": 1.2, "ls": ":"}),
     ("total", "ball", "impacts between balls", {"color": "tab:purple", "lw": 1.2, "ls": ":"}),
 )
+
+
+def run_stress_spectrum(run: RunLike) -> StressSpectrum | None:
+    """The stress-energy spectrum of ``run``'s impacts as its summary measured it; None for a run folder written
+    before the spectrum was reported."""
+    window = run.summary.get("stress_window_s")
+    if not window:
+        return None
+    return stress_spectrum(run.impacts, window, run.params.stress_energy_thresholds,
+                           run.summary.get("dissipated_power_W", math.nan))
 
 
 def stress_energy_figure(spectrum: StressSpectrum) -> Figure:
