@@ -89,3 +89,19 @@ def test_the_stress_power_of_a_run_is_the_power_its_impacts_dissipate():
     assert result.summary["stress_lasting_power_W"] == pytest.approx(0.0, abs=1e-3 * result.summary["dissipated_power_W"])
     assert spectrum.power() == pytest.approx(result.summary["dissipated_power_W"], rel=1e-3)
     assert spectrum.events_per_second() == pytest.approx(result.summary["impact_rate_hz"], rel=1e-12)
+
+
+def test_distinct_thresholds_get_distinct_summary_keys():
+    """Issue 35: two thresholds that agreed to six digits shared one summary key, and one result was overwritten."""
+    from shakermill.analysis.stress_energy import threshold_name
+
+    assert threshold_name(1e-3) == "0.001J" and threshold_name(1e-2) == "0.01J" and threshold_name(1000.0) == "1000J"
+    assert threshold_name(0.0010000001) == "0.0010000001J" != threshold_name(0.001)
+    spectrum = stress_spectrum({"dissipated_energy": np.array([2e-3]), "duration": np.array([1e-5])}, 1.0, (0.001, 0.0010000001))
+    keys = [key for key in spectrum.as_summary() if key.startswith("stress_events_above_")]
+    assert len(keys) == 2
+
+
+def test_a_threshold_given_twice_is_refused():
+    with pytest.raises(sm.ParameterError, match=r"^stress_energy_thresholds: 0\.001 J is given 2 times; allowed distinct"):
+        sm.default_parameters("spex8000m-3d", stress_energy_thresholds=(0.001, 1e-3))

@@ -422,6 +422,10 @@ def test_validate_prints_table5_with_fitted_and_predicted_roles():
     study = {tuple(entry["free"]): entry for entry in payload["free_set_study"]}
     assert study[DEFAULT_FREE]["follows_curve"] and not study[("beta", "vial_mass")]["follows_curve"]
     assert "still rising at the hour" in study[("beta", "vial_mass")]["verdict"]
+    # Issue 35: a quick validation without the 3-D studies said "full": true; it says what it ran.
+    assert payload["full"] is False
+    assert payload["ran"] == {"table5": True, "free_set_study": True, "validation_matrix": False, "experiments": [],
+                              "structure_study": False, "held_out": False}
 
 
 @pytest.mark.slow
@@ -672,8 +676,10 @@ def interrupt_after(command: list[str], after_s: float, exits_within_s: float = 
     process.send_signal(signal.SIGINT)
     _, stderr = process.communicate(timeout=exits_within_s)
     assert process.returncode == 130, stderr
-    assert len(stderr.strip().splitlines()) == 1 and "Traceback" not in stderr, stderr
-    return stderr
+    # A fit says which keys it moves once it starts; the Ctrl-C is the one line after.
+    lines = [line for line in stderr.strip().splitlines() if not line.startswith("calibrate: fitting ")]
+    assert len(lines) == 1 and "Traceback" not in stderr, stderr
+    return lines[0]
 
 
 @pytest.mark.slow
@@ -777,7 +783,9 @@ def test_real_ctrl_c_in_validate_says_so_in_one_line(start_up_s):
     # Heard between bytecodes: on a fresh clone a compilation still running (Numba's, tens of seconds) comes first.
     stdout, stderr = process.communicate(timeout=120)
     assert process.returncode == 130 and stdout == ""
-    said, interrupted = stderr.strip().splitlines()  # what it is about to do, then the Ctrl-C
+    # What it is about to do, its steps as they end (piped: a line each), then the Ctrl-C.
+    said, *steps, interrupted = stderr.strip().splitlines()
+    assert all(step.startswith("validation: ") for step in steps), stderr
     assert said.startswith("validate: quick")
     assert interrupted.startswith("error: interrupted; nothing was written") and "Traceback" not in stderr
 
@@ -974,3 +982,19 @@ def test_a_run_of_an_uncalibrated_preset_reports_no_intervals(tmp_path):
     result = invoke("run", *SHORT, "--out", str(out), "--no-plots", "--json")
     assert result.exit_code == 0, result.stderr
     assert not any(key.endswith("_low") for key in json.loads(result.stdout))
+
+
+def test_long_work_piped_into_a_log_says_how_far_it_is_at_most_every_interval(monkeypatch, capsys):
+    """Issue 35: a calibration piped into a log ran 91 s and 1,379 evaluations without a line."""
+    clock = [0.0]
+    monkeypatch.setattr(cli_common.time, "monotonic", lambda: clock[0])
+    update = cli_common.piped_lines("fitting", "{task.completed} model evaluations", interval_s=30.0)
+    for evaluation, now in enumerate((1.0, 29.0, 31.0, 40.0, 62.0, 95.0), start=1):
+        clock[0] = now
+        update(evaluation)
+    assert capsys.readouterr().err.splitlines() == [
+        "fitting: 3 model evaluations, 0 min 31 s", "fitting: 5 model evaluations, 1 min 02 s", "fitting: 6 model evaluations, 1 min 35 s",
+    ]
+    sweep = cli_common.piped_lines("sweep", "{task.completed}/{task.total} points · {task.fields[failed]} failed", 0.0, 4, failed=0)
+    sweep(1, failed=1)
+    assert capsys.readouterr().err == "sweep: 1/4 points · 1 failed, 0 min 00 s\n"

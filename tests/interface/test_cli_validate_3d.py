@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 
 from shakermill import cli
 from shakermill.studies import held_out, validation_report
+from shakermill.studies.validation import VALIDATION_PRESETS
 from shakermill.studies.validation_matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
 from shakermill.views.validation_page import QUICK_NOTE
 
@@ -96,10 +97,10 @@ def test_validate_is_quick_by_default_and_says_each_run_when_piped(quick_runs, t
     assert "five_balls" not in payload and "structure_study" not in payload
     held_out_rows = [row for row in payload["validation_matrix"]["rows"] if row["role"] == "held out"]
     assert {row["experiment"] for row in held_out_rows} == {"takacs-mchenry-five-balls"}
-    # Not a terminal: a plain line for each run, so a log shows the study moving.
-    runs = len(quick) * len(THERMAL_MODEL_PRESETS)
-    lines = [line for line in outcome.stderr.splitlines() if line.startswith("3-D validation: ")]
-    assert [line.split(",")[0] for line in lines] == [f"3-D validation: {done}/{runs} runs" for done in range(1, runs + 1)]
+    # Not a terminal: a plain line for each step (Table 5's runs, then each 3-D run), so a log shows the study moving.
+    steps = len(VALIDATION_PRESETS) + len(quick) * len(THERMAL_MODEL_PRESETS)
+    lines = [line for line in outcome.stderr.splitlines() if line.startswith("validation: ")]
+    assert [line.split(",")[0] for line in lines] == [f"validation: {done}/{steps} steps" for done in range(1, steps + 1)]
     assert outcome.stderr.startswith("validate: quick, ~2 min; --full for everything")
     # Its page says it is the quick one, and what --full adds.
     assert html.escape(QUICK_NOTE) in page.read_text(encoding="utf-8")

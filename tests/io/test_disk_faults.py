@@ -168,7 +168,10 @@ def test_calibrate_onto_a_full_disk_says_why_in_one_line(tmp_path, disk_with):
     disk_with(0)
     outcome = invoke("calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", str(preset))
     assert outcome.exit_code == 2
-    assert_one_error_line(outcome.stderr, str(preset), "cannot write the preset", NO_SPACE)
+    # The fit said which key it moves when it started; the failed write is the one error line after it.
+    announced, error = outcome.stderr.splitlines()
+    assert announced == "calibrate: fitting beta"
+    assert_one_error_line(error, str(preset), "cannot write the preset", NO_SPACE)
     assert list(tmp_path.iterdir()) == []
 
 
@@ -371,3 +374,15 @@ def test_a_file_created_exclusively_is_created_once(tmp_path, monkeypatch, hard_
         create_exclusively(manifest, "the second")
     assert manifest.read_text() == "the first"
     assert [entry.name for entry in tmp_path.iterdir()] == ["sweep.json"]
+
+
+@pytest.mark.skipif(not Path("/proc/sys").is_dir(), reason="needs /proc/sys (Linux), a folder no file can be made in")
+def test_a_place_that_refuses_files_is_found_before_the_work_even_as_root(tmp_path):
+    """Issue 35: `validate --report` into such a path was refused only after the study had run; permissions say
+    nothing to root, so a file is made (and removed) where the output would go."""
+    from shakermill.support.atomic import StorageError, check_writable_place
+
+    with pytest.raises(StorageError, match=r"^/proc/sys/report\.html: cannot write in /proc/sys \(.+\); choose another --report$"):
+        check_writable_place(Path("/proc/sys/report.html"), "--report")
+    check_writable_place(tmp_path / "new" / "report.html", "--report")
+    assert list(tmp_path.iterdir()) == []

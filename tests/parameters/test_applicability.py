@@ -11,7 +11,7 @@ import shakermill as sm
 from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import WINDOW_INTERVAL, DemEngine
 from shakermill.parameters.config import load_config, write_config_toml
-from shakermill.parameters.engine_keys import AVERAGED_ONLY, ENGINE_KEYS, MILL_HEAD_ONLY, MOTION_KEYS, Reader
+from shakermill.parameters.engine_keys import AVERAGED_ONLY, ENGINE_KEYS, MILL_HEAD_ONLY, MOTION_KEYS, NETWORK_ONLY, Reader
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.parameters.errors import ParameterError
 from shakermill.solvers import simulate as simulate_module
@@ -58,6 +58,28 @@ def test_a_file_written_by_hand_is_explicit_a_runs_own_configuration_is_not(tmp_
     written = tmp_path / "config.toml"
     write_config_toml(sm.default_parameters(), written, preset="spex8000m")
     assert load_config(written).params == sm.default_parameters()
+
+
+@pytest.mark.parametrize("network, other", [("paper", "mill-head"), ("mill-head", "paper")])
+def test_a_key_of_one_network_is_refused_on_a_run_of_the_other_both_ways(network, other):
+    """Issue 35: with thermal_model = 'mill-head', h_outer and outer_area changed nothing and were accepted."""
+    reader = Reader("dem", "averaged", other, "spex8000m")
+    for key in NETWORK_ONLY[network]:
+        assert reader.not_read(key) == f"the {other!r} network does not read it; it applies to thermal_model = {network!r}"
+        assert Reader("dem", "averaged", network, "spex8000m").not_read(key) is None
+    key = sorted(NETWORK_ONLY[network])[0]
+    preset = "spex8000m-3d-calibrated" if other == "mill-head" else "spex8000m-3d"
+    with pytest.raises(ParameterError) as raised:
+        load_config(preset=preset, overrides=[f"{key}=1"])
+    assert str(raised.value).startswith(f"{key}: set explicitly, but the {other!r} network does not read it")
+
+
+def test_a_key_the_preset_inherits_but_its_own_run_does_not_read_is_no_note():
+    """spex8000m-3d-calibrated (mill-head) inherits spex8000m-3d's outer_area, which neither of them reads with its
+    network: it was never part of the preset's answer, so a run of it is not told it was ignored."""
+    assert load_config(preset="spex8000m-3d-calibrated").params.outer_area != sm.default_parameters().outer_area
+    assert load_config(preset="spex8000m-3d-calibrated").notes == ()
+    assert load_config(preset="pulverisette7").notes == ()
 
 
 def test_the_keys_a_preset_sets_and_the_run_does_not_read_are_said_in_a_note():

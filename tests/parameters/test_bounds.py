@@ -44,8 +44,20 @@ def test_a_bound_is_printed_in_as_many_digits_as_tell_it_from_the_value():
     assert Bounds(0.0, math.pi / 2, low_open=False, high_open=False).shown(1.5708) == "[0, 1.570796]"
     with pytest.raises(ParameterError, match=r"^yaw_amplitude: 1\.5708 is out of range; allowed \[0, 1\.570796\] rad$"):
         build_parameters(preset_values("spex8000m"), {"yaw_amplitude": 1.5708})
-    # Six digits suffice where they already put the value outside (6.28319 < 6.2832); 2π against 6.28319 needs seven.
-    with pytest.raises(ParameterError, match=r"allowed \[-6\.28319, 6\.28319\] rad$"):
+    # A closed bound is printed in as many digits as are accepted as written: 6.28319 lies beyond 2π, 6.283185 inside.
+    with pytest.raises(ParameterError, match=r"allowed \[-6\.283185, 6\.283185\] rad$"):
         build_parameters(preset_values("spex8000m"), {"phase": 6.2832})
-    with pytest.raises(ParameterError, match=r"^phase: 6\.28319 is out of range; allowed \[-6\.28319, 6\.283185\] rad$"):
+    with pytest.raises(ParameterError, match=r"^phase: 6\.28319 is out of range; allowed \[-6\.283185, 6\.283185\] rad$"):
         build_parameters(preset_values("spex8000m"), {"phase": 6.28319})
+
+
+@pytest.mark.parametrize("key", ["jar_tilt", "phase", "yaw_amplitude", "contact_step_fraction", "vial_length", "omega"])
+def test_every_printed_closed_bound_is_accepted_as_written(key):
+    """Issue 35: `keys` printed jar_tilt <= 1.0472, and 1.0472 was refused (the bound is π/3 = 1.047198...)."""
+    from shakermill.parameters.keys import bounds
+
+    limits = bounds(key)
+    shown = limits.shown()[1:-1].split(", ")
+    for text, bound, is_open in zip(shown, (limits.low, limits.high), (limits.low_open, limits.high_open)):
+        if not is_open and math.isfinite(bound):
+            assert limits.contains(limits.snapped(float(text))), (key, text)

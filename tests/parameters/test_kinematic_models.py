@@ -108,7 +108,7 @@ def test_every_value_a_preset_sets_names_its_source(name):
     "overrides, fragments",
     [
         ({"kinematics": "spex8000m", "lateral_amplitude": "-1 mm"}, ("lateral_amplitude:", "allowed [0, 0.5] m")),
-        ({"kinematics": "spex8000m", "yaw_amplitude": "100 deg"}, ("yaw_amplitude:", "allowed [0, 1.5708] rad")),
+        ({"kinematics": "spex8000m", "yaw_amplitude": "100 deg"}, ("yaw_amplitude:", "allowed [0, 1.570796] rad")),
         ({"kinematics": "mixer-mill-arc", "swing_radius": 0}, ("swing_radius:", "allowed [0.001, 1] m")),
         ({"kinematics": "mixer-mill-arc", "swing_radius": "10 mm"}, ("amplitude:", "swing_radius·π/2 = 0.01571 m")),
         ({"kinematics": "figure8"}, ("kinematics:", "'spex8000m', 'mixer-mill-arc'")),

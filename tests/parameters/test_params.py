@@ -356,7 +356,7 @@ def test_non_finite_values_are_refused_naming_the_key_and_its_range(key: str, va
         ("ball_density", 1e308, "ball_density: 1e+308 is out of range; allowed [500, 25000] kg/m^3"),
         ("ball_density", 1e-6, "ball_density: 1e-06 is out of range; allowed [500, 25000] kg/m^3"),
         ("duration", 1e308, "duration: 1e+308 is out of range; allowed [1e-06, 1e+06] s"),
-        ("phase", 7.0, "phase: 7 is out of range; allowed [-6.28319, 6.28319] rad"),
+        ("phase", 7.0, "phase: 7 is out of range; allowed [-6.283185, 6.283185] rad"),
         ("ball_poisson_ratio", 0.5, "ball_poisson_ratio: 0.5 is out of range; allowed [-0.5, 0.5)"),
         ("attractor_starts", 101, "attractor_starts: 101 is out of range; allowed a whole number in [1, 100]"),
         ("ball_position", 0.50000001, "ball_position: 0.50000001 is out of range; allowed [-0.5, 0.5] m"),
@@ -497,5 +497,5 @@ def test_direct_construction_refuses_non_finite_values(defaults: Parameters) -> 
 
 
 def test_replace_refuses_what_default_parameters_refuses(defaults: Parameters) -> None:
-    with pytest.raises(ParameterError, match=r"^phase: 'nan' is not a finite number; allowed \[-6.28319, 6.28319\] rad$"):
+    with pytest.raises(ParameterError, match=r"^phase: 'nan' is not a finite number; allowed \[-6.283185, 6.283185\] rad$"):
         defaults.replace(phase="nan")

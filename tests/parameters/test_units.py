@@ -98,10 +98,10 @@ def test_unit_error_is_a_value_error() -> None:
     ],
 )
 def test_arithmetic_in_a_quantity_is_refused_before_pint_sees_it(value: str) -> None:
-    started = time.perf_counter()
+    started = time.process_time()
     with pytest.raises(UnitError, match="cannot read .* as a number with a unit"):
         to_si(value, "m", key="k")
-    assert time.perf_counter() - started < 0.1
+    assert time.process_time() - started < 0.1
 
 
 @pytest.mark.parametrize(
@@ -113,10 +113,10 @@ def test_single_digit_powers_and_reciprocals_of_units_are_read(value: str, unit:
 
 
 def test_a_value_longer_than_any_number_is_refused_before_it_is_parsed() -> None:
-    started = time.perf_counter()
+    started = time.process_time()
     with pytest.raises(UnitError, match="k: a value of 100000 characters is too long; allowed at most 100"):
         to_si("1" * 100_000, "m", key="k")
-    assert time.perf_counter() - started < 0.1
+    assert time.process_time() - started < 0.1
     assert to_si("1" * 100, "m", key="k") == pytest.approx(1.111111111111111e99, rel=1e-12)
 
 

@@ -13,7 +13,9 @@ from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import DemEngine
 from shakermill.solvers.averaged import full_resolution_instead, least_mechanics, settle_mechanics
 from shakermill.solvers.driver import least_rounds
-from shakermill.solvers.replicas import THREADS_VARIABLE, ReplicaSet, replica_threads
+from shakermill.parameters.environment import THREADS_VARIABLE
+from shakermill.parameters.errors import ParameterError
+from shakermill.solvers.replicas import ReplicaSet, replica_threads
 from shakermill.solvers.result import INTERRUPTED
 
 # Five balls knock each other about a wide bore (the cheapest chaotic case); batches of 4 periods and a loose target
@@ -71,8 +73,16 @@ def test_a_replica_starts_where_the_run_does_with_each_ball_kicked_by_its_own_se
 def test_the_threads_are_capped_by_the_variable_and_the_replicas(monkeypatch):
     monkeypatch.setenv(THREADS_VARIABLE, "3")
     assert [replica_threads(count) for count in (1, 2, 8)] == [1, 2, 3]
-    monkeypatch.setenv(THREADS_VARIABLE, "not a number")
+    monkeypatch.delenv(THREADS_VARIABLE)
     assert 1 <= replica_threads(64) <= 64
+
+
+@pytest.mark.parametrize("setting", ["not a number", "0", "-1", "2.5", "1e3", "99999"])
+def test_a_threads_variable_that_is_not_a_number_of_threads_is_refused_in_one_line(monkeypatch, setting):
+    monkeypatch.setenv(THREADS_VARIABLE, setting)
+    with pytest.raises(ParameterError) as caught:
+        replica_threads(2)
+    assert str(caught.value).startswith(f"{THREADS_VARIABLE}: {setting!r} is not a number of threads; allowed")
 
 
 class _Stepping:

@@ -19,8 +19,11 @@ from shakermill.studies.calibrate import (
     log_bounds,
     parse_free,
     parse_targets,
+    unstarted_defaults,
     write_preset,
 )
+from shakermill.parameters.engine_keys import reader_of
+from shakermill.studies.identifiability import check_determinable, informative_points, undetermined_keys
 from shakermill.studies.validation import CURVE_TOLERANCE_K, TABLE5, Curve, curve_from_option, experiment_curve
 
 TABLE5_TARGETS = {entry.key: entry.experiment for entry in TABLE5 if entry.key != "vial_ball_ratio"}
@@ -172,7 +175,7 @@ def test_calibrate_checks_its_targets_before_any_run() -> None:
 @pytest.mark.parametrize(
     ("times", "temperatures", "fragment"),
     [
-        ([0, 600, 1200], [20, float("nan"), 40], "point 2 has ball_C = nan; allowed a finite temperature above -273.15 °C"),
+        ([0, 600, 1200], [20, float("nan"), 40], "point 2 has ball_C = nan °C; allowed a finite temperature above -273.15 °C"),
         ([0, 600, float("inf")], [20, 30, 40], "point 3 is at inf s; allowed times in [0, 1e+06] s"),
         ([0, 600, 1e308], [20, 30, 40], "point 3 is at 1e+308 s"),
         ([-60, 600], [20, 30], "point 1 is at -60 s"),
@@ -202,7 +205,8 @@ def test_a_curve_file_with_a_byte_order_mark_is_read(tmp_path) -> None:
         ("time_s,ball_C\n0,20\n".encode("utf-16"), "not UTF-8 text"),
         (b"time_s,ball_C\n0," + b"2" * 150 + b"\n", "line 2: a cell of 150 characters; allowed at most 100"),
         (b'time_s,ball_C\n0,"' + b"2" * 140_000 + b'"\n', "malformed CSV at line 2"),
-        (b"time_s,ball_C\n0,20\n600\n", "line 3: needs a number in time_s and in ball_C"),
+        (b"time_s,ball_C\n0,20\n600\n", "line 3: 1 cell for the 2 columns of its header (time_s, ball_C)"),
+        (b"time_s,ball_C\n0,20\n600,x\n", "line 3: needs a number in time_s and in ball_C"),
         (b"time_s,ball_C\n", "has no data rows"),
     ],
 )
@@ -235,6 +239,100 @@ def test_the_default_free_set_is_what_moves_the_engines_network_alone():
     assert default_free(sm.default_parameters(engine="dem")) == DEM_DEFAULT_FREE == ("beta", "vial_mass", "h_outer")
 
 
+@pytest.mark.parametrize("preset", ["spex8000m-3d-mill-head", "spex8000m-3d-calibrated", "pm100", "pulverisette7"])
+def test_the_default_free_set_of_a_mill_head_network_is_keys_it_reads(preset):
+    """Issue 35: every 3-D preset's default free set held h_outer, which the mill-head network does not read."""
+    params = sm.default_parameters(preset)
+    free = default_free(params)
+    assert "h_outer" not in free and set(free) | set(unstarted_defaults(params)) == {"drive_heat", "clamp_heat_capacity", "clamp_loss"}
+    assert all(reader_of(params).not_read(key) is None and getattr(params, key) > 0 for key in free)
+    # The planetary presets start the drive's heat at 0: fitted in log space it needs a positive start.
+    assert unstarted_defaults(params) == (("drive_heat",) if preset in ("pm100", "pulverisette7") else ())
+
+
+def test_the_default_free_set_of_an_empty_mill_leaves_the_balls_keys_out():
+    assert default_free(sm.default_parameters("spex8000m-3d", n_balls=0)) == ("vial_mass", "h_outer")
+
+
+def test_a_fit_of_more_keys_than_informative_values_is_refused_before_it_runs():
+    """Issue 35: four free keys fitted to a curve of one or two rows said "success": true, RMS 5e-7 K."""
+    two_rows = Curve(np.array([0.0, 1800.0]), np.array([20.0, 40.0]), "lab")
+    assert informative_points(two_rows) == 1
+    with pytest.raises(ParameterError) as raised:
+        calibrate(sm.default_parameters(), DEFAULT_FREE, curve=two_rows)
+    assert str(raised.value) == (
+        "free: 4 keys (beta, vial_mass, h_outer, lam) cannot be determined by 1 informative value (1 of lab after "
+        "t = 0); allowed at most 1 free key (--free), or more measured points"
+    )
+    with pytest.raises(ParameterError, match="by 2 informative values \\(2 targets after t = 0\\)"):
+        check_determinable(("beta", "vial_mass", "h_outer"), {"theta_inf_C": 48.0, "tau_min": 16.7}, ())
+    check_determinable(("beta", "vial_mass"), {"theta_inf_C": 48.0}, (two_rows,))
+
+
+def test_a_jacobian_that_leaves_keys_free_is_named_undetermined():
+    rng = np.random.default_rng(1)
+    good = rng.standard_normal((12, 3))
+    assert undetermined_keys(good, ("a", "b", "c")) == ""
+    dead = good.copy()
+    dead[:, 1] = 0.0
+    assert undetermined_keys(dead, ("a", "b", "c")) == "undetermined: the fitted values do not depend on b (sensitivity 0)"
+    # h_outer and outer_area enter as their product: their columns are equal, one combination is all the data fix.
+    collinear = good.copy()
+    collinear[:, 2] = collinear[:, 0] * (1 + 1e-9)
+    message = undetermined_keys(collinear, ("h_outer", "b", "outer_area"))
+    assert message.startswith("undetermined: the data fix no more than a combination of h_outer, outer_area")
+    assert undetermined_keys(np.zeros((3, 2)), ("a", "b")) == "undetermined: the fitted values do not depend on a, b (sensitivity 0)"
+
+
+@pytest.mark.slow
+def test_a_fit_whose_run_does_not_depend_on_its_keys_is_undetermined_not_a_success():
+    # An empty mill on the paper's network makes no heat: its vial stays at the room's temperature whatever β is.
+    curve = Curve(np.array([0.0, 600.0, 1800.0, 3600.0]), np.array([20.0, 25.0, 30.0, 33.0]), "lab", node="vial")
+    fitted = calibrate(sm.default_parameters("spex8000m-3d", n_balls=0), ("beta", "vial_mass"), curve=curve,
+                       sample_posterior=False)
+    assert fitted.status == "undetermined" and not fitted.success
+    assert fitted.message.startswith("undetermined: the fitted values do not depend on beta, vial_mass")
+    assert fitted.as_dict()["status"] == "undetermined"
+
+
+@pytest.mark.parametrize(
+    ("text", "expected_C", "note"),
+    [
+        ("time_min;vial_C\n0;20\n5;25,1\n", [20.0, 25.1], "read as ';'-separated columns, with decimal commas as points"),
+        ("time_min,vial_K\n0,293.15\n5,298.25\n", [0.0 + 20.0, 25.1], ""),
+        ("time_min,vial_C,remark\n0,20,start\n5,25.1,\n", [20.0, 25.1], ""),
+    ],
+)
+def test_a_curve_file_is_read_in_its_own_unit_and_separator(tmp_path, text, expected_C, note):
+    path = tmp_path / "curve.csv"
+    path.write_text(text)
+    curve = Curve.from_csv(path)
+    np.testing.assert_allclose(curve.temperature_C, expected_C, rtol=1e-12)
+    np.testing.assert_allclose(curve.times, [0.0, 300.0])
+    assert curve.node == "vial" and curve.note.endswith(note) and bool(curve.note) == bool(note)
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("time_min,vial_C\n0,20\n5,25,1\n", "line 3: 3 cells for the 2 columns of its header (time_min, vial_C); a decimal comma"),
+        ("time_s,time_min,vial_C\n0,0,20\n", "has both time_s and time_min"),
+        ("time_min,vial_C,vial_C\n0,20,20\n", "the column vial_C appears 2 times"),
+        ("time_min,vial_C\n0,293.15\n60,320\n", "vial_C holds 293.15 to 320, which look like kelvin"),
+        ("time_min,ball_K\n0,20\n60,48\n", "ball_K holds 20 to 48, which look like °C"),
+        ("time_min,vial_C\n0,20\n30,-300\n", "point 2 has vial_C = -300 °C"),
+    ],
+)
+def test_a_curve_file_that_says_one_thing_and_means_another_is_refused(tmp_path, text, fragment):
+    """Issue 35: decimal commas dropped a cell without a word (25.1 °C read as 25), kelvin was fitted as °C, a bad
+    vial_C value was reported as ball_C."""
+    path = tmp_path / "curve.csv"
+    path.write_text(text)
+    with pytest.raises(ParameterError) as raised:
+        Curve.from_csv(path)
+    assert fragment in str(raised.value) and str(raised.value).startswith(f"curve {path}")
+
+
 # --- several curves, each of its own node and conditions (issue 23) ------------------------------------------
 
 
@@ -247,7 +345,7 @@ def test_a_curve_option_names_its_file_its_node_and_its_conditions(tmp_path) -> 
     np.testing.assert_allclose(curve.temperature_C, [20.0, 31.0])
     assert curve_from_option(str(path)).conditions == ()
     (tmp_path / "both.csv").write_text("time_s,ball_C,vial_C\n0,20,20\n")
-    with pytest.raises(ParameterError, match="one of ball_C or vial_C"):
+    with pytest.raises(ParameterError, match="one of ball_C, vial_C, ball_K, vial_K"):
         Curve.from_csv(tmp_path / "both.csv")
 
 
@@ -274,3 +372,19 @@ def test_curves_of_two_nodes_under_two_conditions_recover_the_parameters_that_ma
     assert fit.curve_rms_K < 0.01
     assert "vial_C at 30 min (omega=100)" in fit.sensitivities
     assert "vial at 100 rad/s (vial, omega=100)" in fit.curve_source
+
+
+def test_a_ctrl_c_while_the_posterior_is_sampled_is_raised_without_emcee_printing_a_traceback(capsys):
+    from shakermill.studies.calibrate import posterior_samples
+
+    calls = []
+
+    def residuals_of(x):
+        calls.append(x)
+        if len(calls) == 5:
+            raise KeyboardInterrupt
+        return x - 1.0
+
+    with pytest.raises(KeyboardInterrupt):
+        posterior_samples(residuals_of, np.zeros(2), np.full(2, -5.0), np.full(2, 5.0), 1.0)
+    assert capsys.readouterr().err == "" and len(calls) == 5

@@ -244,11 +244,11 @@ def test_a_points_file_beyond_the_limits_is_one_line_naming_it(tmp_path, content
     ],
 )
 def test_grids_are_capped_before_their_points_are_made(grids, message):
-    started = time.perf_counter()
+    started = time.process_time()
     with pytest.raises(ParameterError) as caught:
         plan_sweep(grids)
     assert message in str(caught.value)
-    assert time.perf_counter() - started < 1.0
+    assert time.process_time() - started < 1.0
 
 
 def test_a_grid_times_a_points_file_is_capped_as_a_product(tmp_path):

@@ -36,8 +36,10 @@ TANGENTIAL_CHANNELS = ("dissipated_tangential", "dissipated_sliding", "dissipate
 
 
 def threshold_name(threshold: float) -> str:
-    """How a threshold (J) appears in the summary's names: 0.001 -> '0.001J'."""
-    return f"{threshold:g}J"
+    """How a threshold (J) appears in the summary's names: 0.001 -> '0.001J', with as many digits as tell it apart
+    from every other number (0.0010000001 -> '0.0010000001J'), so that distinct thresholds never share a key."""
+    digits = next(digits for digits in range(6, 18) if float(f"{threshold:.{digits}g}") == threshold)
+    return f"{threshold:.{digits}g}J"
 
 
 @dataclass(frozen=True)

@@ -120,6 +120,10 @@ def _root(
     ] = False,
 ) -> None:
     """Simulate a high-energy shaker mill (SPEX 8000M type): ball motion, impacts and temperatures."""
+    from shakermill.parameters.environment import check_environment
+
+    with user_errors():
+        check_environment()
 
 
 def stdout_console() -> Console:
@@ -254,22 +258,27 @@ def simulate_with_progress(params: Parameters) -> Result:
 
     counter = "{task.completed:.5g}/{task.total:.5g} s simulated"
     with progress_bar("simulating", counter, params.duration, delay_s=PROGRESS_DELAY_S) as update:
-        return simulate(params, progress=None if update is None else lambda done, total: update(done, total=total))
+        return simulate(params, progress=lambda done, total: update(done, total=total))
+
+
+# Long work piped into a log says how far it is in a plain line at most this often (s), the first after as long: a
+# bar redrawn many times a second would fill the log, and none would leave it silent for half an hour.
+PIPED_INTERVAL_S = 30.0
 
 
 @contextmanager
 def progress_bar(
     verb: str, counter: str, total: float | None, delay_s: float = 0.0, lines_when_piped: bool = False, **fields: Any
-) -> Iterator[Callable[..., None] | None]:
-    """``update(completed, **fields)`` of a transient progress bar with an ETA on stderr; None when stderr is not a terminal.
+) -> Iterator[Callable[..., None]]:
+    """``update(completed, **fields)`` of a transient progress bar with an ETA on stderr.
 
-    The bar shows from the first update ``delay_s`` seconds after the start, or at once without a delay.
-    Pipes and logs stay clean: a bar redrawn many times a second would fill them. A study whose steps take minutes
-    (``lines_when_piped``) says each step there in a plain line instead, or a log would show nothing for half an hour.
+    On a terminal the bar shows from the first update ``delay_s`` seconds after the start, or at once without a
+    delay. Piped, stderr gets plain lines (:func:`piped_lines`) instead: one every :data:`PIPED_INTERVAL_S`, or each
+    step of a study whose steps take minutes (``lines_when_piped``).
     """
     console = Console(stderr=True)
     if not console.is_terminal:
-        yield piped_lines(verb, counter) if lines_when_piped else None
+        yield piped_lines(verb, counter, 0.0 if lines_when_piped else PIPED_INTERVAL_S, total, **fields)
         return
     columns = (TextColumn(verb), BarColumn(), TextColumn(counter), TimeRemainingColumn())
     bar = Progress(*columns, console=console, transient=True)
@@ -292,18 +301,24 @@ def progress_bar(
             bar.stop()
 
 
-def piped_lines(verb: str, counter: str) -> Callable[..., None]:
-    """``update(completed, total=...)`` printing one plain line on stderr each time ``completed`` changes: the
-    ``counter`` of a progress bar (``{task.completed}``, ``{task.total}``) and the time elapsed."""
+def piped_lines(verb: str, counter: str, interval_s: float = 0.0, total: float | None = None, **fields: Any) -> Callable[..., None]:
+    """``update(completed, total=..., **fields)`` printing one plain line on stderr when ``completed`` has changed and
+    ``interval_s`` has passed since the last line (or the start): the ``counter`` of a progress bar
+    (``{task.completed}``, ``{task.total}``, ``{task.fields[NAME]}``) and the time elapsed."""
     started = time.monotonic()
     said: list[float] = []
+    last = [started]
+    known: dict[str, Any] = {"total": total, **fields}
 
-    def update(completed: float, total: float | None = None, **_: Any) -> None:
-        if said and said[-1] == completed:
+    def update(completed: float, **updates: Any) -> None:
+        known.update(updates)
+        now = time.monotonic()
+        if (said and said[-1] == completed) or now - last[0] < interval_s:
             return
         said.append(completed)
-        task = SimpleNamespace(completed=completed, total=total)
-        minutes, seconds = divmod(round(time.monotonic() - started), 60)
+        last[0] = now
+        task = SimpleNamespace(completed=completed, total=known["total"], fields={k: v for k, v in known.items() if k != "total"})
+        minutes, seconds = divmod(round(now - started), 60)
         typer.echo(f"{verb}: {counter.format(task=task)}, {minutes} min {seconds:02d} s", err=True)
 
     return update

@@ -32,7 +32,7 @@ from shakermill.cli.common import (
     user_errors,
     writing,
 )
-from shakermill.parameters.defaults import DEFAULT_FREE, DEM_DEFAULT_FREE, TARGET_KEYS
+from shakermill.parameters.defaults import DEFAULT_FREE, DEFAULT_FREE_BY_NETWORK, DEM_DEFAULT_FREE, TARGET_KEYS
 from shakermill.parameters.errors import ParameterError
 from shakermill.support.atomic import check_writable_place
 
@@ -90,9 +90,8 @@ def validate(
                f"Table 5 with the {solver} solver" + (", then the 3-D validation matrix" if three_d else ""), err=True)
     with (nothing_written_when_interrupted("validate prints and writes once every run has ended"),
           nothing_written_when_a_run_is_stopped("validate"),
-          progress_bar("3-D validation", "{task.completed}/{task.total} runs", None, lines_when_piped=True) as update):
-        show = None if update is None else lambda done, total: update(done, total=total)
-        report = validation_report(solver, study, three_d, progress=show, everything=full)
+          progress_bar("validation", "{task.completed}/{task.total} steps", None, lines_when_piped=True) as update):
+        report = validation_report(solver, study, three_d, progress=lambda done, total: update(done, total=total), everything=full)
     # Printed before the page is written: a page that cannot be written loses nothing the study found.
     if json_output:
         typer.echo(json.dumps(to_jsonable(report.as_dict()), sort_keys=True, allow_nan=False))
@@ -263,7 +262,8 @@ def calibrate(
     ] = None,
     free: Annotated[
         list[str] | None,
-        typer.Option("--free", "-f", metavar="KEY[,KEY]", help=f"Keys to fit (default: {','.join(DEFAULT_FREE)}; engine = 'dem': {','.join(DEM_DEFAULT_FREE)})."),
+        typer.Option("--free", "-f", metavar="KEY[,KEY]", help=f"Keys to fit (default: those of the run's network that it reads: 'paper' {','.join(DEFAULT_FREE)}, with "
+                     f"engine = 'dem' {','.join(DEM_DEFAULT_FREE)}; 'mill-head' {','.join(DEFAULT_FREE_BY_NETWORK['mill-head'])})."),
     ] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
     full_resolution: FullResolutionOption = False,
@@ -291,18 +291,41 @@ def calibrate(
             "the fit"
         ), progress_bar("fitting", "{task.completed} model evaluations", None, delay_s=PROGRESS_DELAY_S) as update:
             calibration = fit_parameters(
-                run_config.params, free_keys, targets, measured, full_resolution=full_resolution, progress=update
+                run_config.params, free_keys, targets, measured, full_resolution=full_resolution, progress=update,
+                on_start=lambda: announce(run_config.params, free_keys, bool(free), [item.note for item in measured if item.note]),
             )
-    if out is not None:
+    # A fit that leaves its keys undetermined has values that any others would match as well: no preset of them.
+    written = out if out is not None and calibration.status != "undetermined" else None
+    if written is not None:
         settings = values_beyond_preset(run_config.params, run_config.preset)
-        write_fitted_preset(calibration, out, run_config.preset, free_keys, targets, settings)
+        write_fitted_preset(calibration, written, run_config.preset, free_keys, targets, settings)
     if json_output:
-        typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False))
+        typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(written) if written else None}), sort_keys=True, allow_nan=False))
     else:
-        print_calibration(calibration, free_keys, targets, out)
+        print_calibration(calibration, free_keys, targets, written)
     if not calibration.success:
-        typer.echo(f"error: calibration did not meet its targets: {calibration.message}", err=True)
+        verdict = "did not meet its targets"
+        if calibration.status == "undetermined":
+            verdict = "could not determine its keys" + (f" (nothing written to {out})" if out is not None else "")
+        typer.echo(f"error: calibration {verdict}: {calibration.message}", err=True)
         raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def announce(params: Any, free_keys: Sequence[str], chosen: bool, notes: Sequence[str]) -> None:
+    """What a fit says once its inputs are all accepted: the keys it moves and, where they are the default set, which
+    keys of that set it left out; then how its curves were read."""
+    from shakermill.studies.calibrate import unstarted_defaults
+
+    line = f"calibrate: fitting {', '.join(free_keys)}"
+    if not chosen:
+        line += f", the default free set of the {params.thermal_model!r} network for this run (--free to choose)"
+        unstarted = unstarted_defaults(params)
+        if unstarted:
+            one = len(unstarted) == 1
+            line += (f"; {', '.join(unstarted)} start{'s' if one else ''} at 0 and {'is' if one else 'are'} left out: "
+                     f"set a positive start (--set KEY=VALUE) to fit {'it' if one else 'them'}")
+    for said in (line, *(f"note: {note}" for note in notes)):
+        typer.echo(said, err=True)
 
 
 def check_preset_target(out: Path, overwrite: bool) -> None:

@@ -99,7 +99,7 @@ def sweep(
     try:
         counter = "{task.completed}/{task.total} points · {task.fields[running]} running · {task.fields[failed]} failed"
         with user_errors(), warnings_as_lines(), progress_bar("sweep", counter, len(plan.points), running=0, failed=0) as update:
-            progress = None if update is None else lambda state: update(state.done, running=state.running, failed=state.failed)
+            progress = lambda state: update(state.done, running=state.running, failed=state.failed)
             table = run_sweep(
                 run_config.params, plan, target, workers=workers, scheduler=scheduler,
                 keep_runs=keep_runs, progress=progress, preset=run_config.preset, scheduler_timeout=scheduler_timeout,
@@ -242,7 +242,7 @@ def bifurcation(
     with nothing_written_when_interrupted("a scan is quick to repeat"), nothing_written_when_a_run_is_stopped(
         "the scan"
     ), progress_bar("scanning", "{task.completed}/{task.total} runs", len(values)) as update:
-        scan = regime_scan(run_config.params, values, key, progress=None if update is None else lambda done, _total: update(done))
+        scan = regime_scan(run_config.params, values, key, progress=lambda done, _total: update(done))
 
     def fill(folder: Path) -> None:
         write_bifurcation(scan, folder)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 # Far above the rounding of a unit conversion (~1e-16), far below any difference a user means.
 RELATIVE_TOLERANCE = 1e-9
@@ -17,12 +18,13 @@ SHORT_DIGITS = 6
 EXACT_DIGITS = 17
 
 
-def number(value: float, beside: float | None = None) -> str:
-    """``value`` in as few significant digits (at least six) as tell it from ``beside``: 1.5708 against
-    π/2 reads 1.570796, so that a value shown inside a range is inside it."""
+def number(value: float, beside: float | None = None, accepted: Callable[[float], bool] = lambda shown: True) -> str:
+    """``value`` in as few significant digits (at least six) as tell it from ``beside`` and make the number shown
+    ``accepted``: 1.5708 against π/2 reads 1.570796, so that a value shown inside a range is inside it."""
     for digits in range(SHORT_DIGITS, EXACT_DIGITS + 1):
         shown = f"{value:.{digits}g}"
-        if beside is None or beside == value or not math.isfinite(value) or _same_side(float(shown), value, beside):
+        tells = beside is None or beside == value or not math.isfinite(value) or _same_side(float(shown), value, beside)
+        if tells and accepted(float(shown)):
             return shown
     return repr(value)
 
@@ -44,9 +46,15 @@ class Bounds:
         return self.shown()
 
     def shown(self, value: float | None = None) -> str:
-        """The interval, each bound in enough digits to tell it from ``value`` (the one refused)."""
-        low, high = number(self.low, value), number(self.high, value)
+        """The interval, each bound in enough digits to tell it from ``value`` (the one refused) and, where it is
+        closed, to be accepted as written: π/3 reads 1.047198, since 1.0472 lies beyond it."""
+        low, high = self._bound_text(self.low, self.low_open, value), self._bound_text(self.high, self.high_open, value)
         return f"{'(' if self.low_open else '['}{low}, {high}{')' if self.high_open else ']'}"
+
+    def _bound_text(self, bound: float, is_open: bool, value: float | None) -> str:
+        if is_open or not math.isfinite(bound):
+            return number(bound, value)
+        return number(bound, value, accepted=lambda shown: self.contains(self.snapped(shown)))
 
     def contains(self, value: float) -> bool:
         above = value > self.low if self.low_open else value >= self.low

@@ -21,7 +21,7 @@ from typing import Any, Mapping, Sequence
 import tomli_w
 
 from shakermill.parameters.defaults import DEFAULT_PRESET
-from shakermill.parameters.engine_keys import reader_of
+from shakermill.parameters.engine_keys import READER_FIELDS, Reader, reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import (
     Parameters,
@@ -91,7 +91,9 @@ def load_config(
     if problem is not None:
         raise ParameterError(problem)
     inherited = {key: value for key, value in preset_layer.items() if key not in explicit}
-    notes = [run.ignored_note(inherited, preset_values(DEFAULT_PRESET))]
+    defaults = preset_values(DEFAULT_PRESET)
+    preset_reader = Reader(*(preset_layer.get(field, defaults[field]) for field in READER_FIELDS))
+    notes = [run.ignored_note(inherited, defaults, preset_reader)]
     if file_preset is not None and chosen_preset != file_preset:
         notes.append(f"The preset is {chosen_preset!r} (--preset), not the {file_preset!r} that {source} names.")
     return RunConfig(params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note))

@@ -243,3 +243,15 @@ def thermal_time_constants_at_rest(params: Any) -> dict[str, tuple[float, tuple[
             ("clamp_heat_capacity", "clamp_conductance", "clamp_loss"),
         )
     return constants
+
+
+def thresholds_are_distinct(params: Any) -> None:
+    """Each stress-energy threshold once: a threshold given twice ("1 mJ" and "0.001 J") would report one result
+    under one summary key twice over."""
+    thresholds = list(params.stress_energy_thresholds)
+    repeated = sorted({value for value in thresholds if thresholds.count(value) > 1})
+    if repeated:
+        raise ValueError(
+            f"stress_energy_thresholds: {repeated[0]!r} J is given {thresholds.count(repeated[0])} times; allowed "
+            "distinct energies"
+        )

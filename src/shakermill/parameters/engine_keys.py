@@ -91,10 +91,17 @@ AVERAGED_ONLY = frozenset(
     {"averaging_rel_error", "dem_averaging_rel_error", "dem_replicas", "averaging_batch_periods", "averaging_min_batches",
      "averaging_max_time", "averaging_fallback"}
 )
-# Keys only the 'mill-head' network reads (engines/thermal/network.py): the vial's outside and the clamp.
-MILL_HEAD_ONLY = frozenset(
-    {"outer_diameter", "outer_length", "emissivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss", "drive_heat"}
-)
+# Keys only one thermal network reads (engines/thermal/network.py), stated once for both directions: 'paper' loses
+# the vial's heat to the room through a constant h_outer·outer_area; 'mill-head' computes that loss from the vial's
+# outside and its speed instead, and adds the clamp. A key of one network set on a run of the other changes nothing.
+NETWORK_ONLY: dict[str, frozenset[str]] = {
+    "paper": frozenset({"h_outer", "outer_area"}),
+    "mill-head": frozenset(
+        {"outer_diameter", "outer_length", "emissivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss",
+         "drive_heat"}
+    ),
+}
+MILL_HEAD_ONLY = NETWORK_ONLY["mill-head"]
 
 
 # Keys of the vial's motion each kinematic model reads (its ``keys``): the others are read by none of its runs.
@@ -119,8 +126,9 @@ class Reader:
             return f"{ENGINE_KEYS[self.engine].title} (engine = {self.engine!r}) does not read it; it applies to {where}"
         if self.solver != "averaged" and key in AVERAGED_ONLY:
             return f"the {self.solver!r} solver does not read it; it applies to solver = 'averaged'"
-        if self.thermal_model != "mill-head" and key in MILL_HEAD_ONLY:
-            return f"the {self.thermal_model!r} network does not read it; it applies to thermal_model = 'mill-head'"
+        for network, keys in NETWORK_ONLY.items():
+            if key in keys and self.thermal_model != network:
+                return f"the {self.thermal_model!r} network does not read it; it applies to thermal_model = {network!r}"
         if key in MOTION_KEYS and key not in KINEMATIC_MODELS[self.kinematics].keys:
             readers = " or ".join(repr(name) for name, model in KINEMATIC_MODELS.items() if key in model.keys)
             return f"kinematics = {self.kinematics!r} does not read it; it applies to kinematics = {readers}"
@@ -135,11 +143,14 @@ class Reader:
                 return f"{key}: {how}, but {why}"
         return None
 
-    def ignored_note(self, values: Mapping[str, Any], defaults: Mapping[str, Any]) -> str | None:
-        """A sentence naming the keys of a preset (``values``) that differ from ``defaults`` and that the run does
-        not read, or None: inherited, not asked for, so ignored, but said."""
+    def ignored_note(self, values: Mapping[str, Any], defaults: Mapping[str, Any], preset: Reader | None = None) -> str | None:
+        """A sentence naming the keys of a preset (``values``) that differ from ``defaults``, that a run of the preset
+        itself reads (``preset``, its own reader) and that this run does not, or None: inherited, not asked for, so
+        ignored, but said. (A key the preset's own run does not read either, inherited from a preset it builds on,
+        was never part of its answer.)"""
         ignored = [key for key, value in values.items()
-                   if key in defaults and value != defaults[key] and self.not_read(key) is not None]
+                   if key in defaults and value != defaults[key] and self.not_read(key) is not None
+                   and (preset is None or preset.not_read(key) is None)]
         if not ignored:
             return None
         return f"Ignored, as this run does not read them: the preset's {', '.join(ignored)}."

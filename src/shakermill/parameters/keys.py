@@ -348,6 +348,7 @@ class Parameters(BaseModel):
         consistency.balls_fit_side_by_side(self)
         consistency.stored_data_fit_in_memory(self)
         consistency.thermal_network_is_not_stiff(self)
+        consistency.thresholds_are_distinct(self)
         return self
 
     @property

@@ -18,22 +18,14 @@ from typing import Callable, Sequence
 
 from shakermill.engines.calls import CALL_SECONDS
 from shakermill.engines.interface import Engine
-
-# The environment variable that caps the threads of one run's replicas (default: the cores this process may use).
-# A sweep's workers set it to 1: the pool already gives every core a point.
-THREADS_VARIABLE = "SHAKERMILL_THREADS"
-
+from shakermill.parameters.environment import threads_cap
 
 def replica_threads(replicas: int) -> int:
     """The threads ``replicas`` replicas share: one per replica, at most the cores this process may use or
-    THREADS_VARIABLE, if set."""
-    setting = os.environ.get(THREADS_VARIABLE, "").strip()
+    THREADS_VARIABLE, if set (refused in one line where it is not a number of threads)."""
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-    try:
-        cap = int(setting) if setting else cores
-    except ValueError:
-        cap = cores
-    return max(1, min(replicas, cap))
+    cap = threads_cap()
+    return max(1, min(replicas, cap if cap is not None else cores))
 
 
 class _Stopped(Exception):

@@ -32,12 +32,14 @@ from scipy.optimize import least_squares
 
 from shakermill.engines.registry import describe
 from shakermill.parameters.config import parse_overrides
-from shakermill.parameters.defaults import DEFAULT_FREE
+from shakermill.parameters.defaults import DEFAULT_FREE, DEFAULT_FREE_BY_NETWORK
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters, bounds, check_known_keys
 from shakermill.solvers.result import Result
 from shakermill.solvers.simulate import preflight, thermal_variants
+from shakermill.studies.defensible import DEFENSIBLE_RANGES
+from shakermill.studies.identifiability import check_determinable, undetermined_keys
 from shakermill.studies.validation import (
     CURVE_TOLERANCE_K,
     TARGET_KEYS,
@@ -90,6 +92,9 @@ class Calibration:
     at_bounds: list[str]
     success: bool
     message: str
+    # 'undetermined' (the data leave a direction of the keys free: a singular Jacobian, whatever the residuals),
+    # 'fitted' (the targets met) or 'not met'; only 'fitted' is a success.
+    status: str
     evaluations: int
     solver: str
     curve_source: str = ""
@@ -139,6 +144,7 @@ class Calibration:
             "defensible": self.defensible,
             "at_bounds": self.at_bounds,
             "success": self.success,
+            "status": self.status,
             "message": self.message,
             "evaluations": self.evaluations,
             "solver": self.solver,
@@ -173,12 +179,32 @@ def _plain_number(text: str) -> float | None:
         return None
 
 
+# Keys that reach the network through the balls alone: an empty mill (n_balls = 0) reads none of them.
+BALL_HEAT_KEYS = frozenset({"beta", "lam", "eta"})
+
+
 def default_free(params: Parameters) -> tuple[str, ...]:
-    """The free set a calibration of ``params`` fits when none is given: DEFAULT_FREE, or for an engine whose fits
-    measure the mechanics once (it declares thermal-only keys: the 'dem' engine, DEM_DEFAULT_FREE) those of
-    DEFAULT_FREE that move its network alone."""
+    """The free set a calibration of ``params`` fits when none is given, derived from what its run reads: its
+    network's keys (DEFAULT_FREE_BY_NETWORK) less those the run does not read (another network's, the balls' of an
+    empty mill), those that would move the mechanics of an engine whose fits measure them once (it declares
+    thermal-only keys: the 'dem' engine), and those that start at 0 (:func:`unstarted_defaults`)."""
+    return tuple(key for key in _default_candidates(params) if getattr(params, key) > 0)
+
+
+def unstarted_defaults(params: Parameters) -> tuple[str, ...]:
+    """The keys of the network's default free set that ``params`` start at 0 (a planetary preset's drive_heat): fitted
+    in log space, they need a positive start, so the default leaves them out and the command line says so."""
+    return tuple(key for key in _default_candidates(params) if getattr(params, key) <= 0)
+
+
+def _default_candidates(params: Parameters) -> tuple[str, ...]:
+    reader = reader_of(params)
     thermal_only = describe(params.engine).thermal_only_keys
-    return tuple(key for key in DEFAULT_FREE if key in thermal_only) if thermal_only else DEFAULT_FREE
+    return tuple(
+        key for key in DEFAULT_FREE_BY_NETWORK[params.thermal_model]
+        if reader.not_read(key) is None and (not thermal_only or key in thermal_only)
+        and not (params.n_balls == 0 and key in BALL_HEAT_KEYS)
+    )
 
 
 def parse_free(items: Sequence[str], default: tuple[str, ...] = DEFAULT_FREE) -> tuple[str, ...]:
@@ -191,72 +217,6 @@ def parse_free(items: Sequence[str], default: tuple[str, ...] = DEFAULT_FREE) ->
     if len(set(keys)) != len(keys):
         raise ParameterError(f"free: a key is listed twice in {', '.join(keys)}")
     return keys
-
-
-@dataclass(frozen=True)
-class DefensibleRange:
-    """Where a fitted value can still be argued for physically, and the argument (SI units)."""
-
-    low: float
-    high: float
-    reason: str
-
-    def contains(self, value: float) -> bool:
-        return self.low <= value <= self.high
-
-
-CENGEL = "Çengel, Heat and Mass Transfer: free convection of gases 2-25, forced 25-250 W/(m²·K)"
-DEFENSIBLE_RANGES: dict[str, DefensibleRange] = {
-    "beta": DefensibleRange(
-        0.1, 3.0,
-        "Whitaker's correlation (β = 1) holds to about ±30 % in steady flow; a factor 3 either way covers the "
-        "unsteady, wall-bounded flow round a ball that reverses every few ms (the paper's 0.3 included)",
-    ),
-    "vial_mass": DefensibleRange(
-        0.02, 1.0,
-        "from the steel of the two 19-mm end faces a few mm thick (~0.02 kg) to a whole hardened-steel vial "
-        "with its cap (order 1 kg)",
-    ),
-    "h_outer": DefensibleRange(5.0, 250.0, f"{CENGEL}; the vial moves at up to ωX_v ≈ 2.8 m/s"),
-    "h_inner": DefensibleRange(5.0, 250.0, f"{CENGEL}; the trapped air is stirred by the ball"),
-    "outer_area": DefensibleRange(
-        5.67e-4, 0.03,
-        "from the paper's two 19-mm end faces to the whole outer surface of a SPEX steel vial "
-        "(~0.02 m² if it is about 57 mm × 76 mm: no published dimensions were found)",
-    ),
-    "inner_area": DefensibleRange(
-        5.67e-4, 0.01, "from the paper's two end faces to the whole inner surface of a SPEX vial (~0.009 m², estimated)"
-    ),
-    "lam": DefensibleRange(
-        0.25, 0.75,
-        "two steel bodies share the heat of a contact about evenly (equal thermal effusivities give 0.5); "
-        "the paper's 0.368 lies inside",
-    ),
-    "drive_heat": DefensibleRange(
-        0.01, 30.0,
-        "no published value: from nearly none to ~10 % of a motor of a few hundred watts reaching the clamp as heat "
-        "(motor, bearings, the clamp's springs; an assumed bound, not a measurement)",
-    ),
-    "clamp_heat_capacity": DefensibleRange(
-        200.0, 10_000.0,
-        "no published value: 0.4-20 kg of steel (c ≈ 460-500 J/(kg·K)) in the clamp, its arm and the parts of the mill "
-        "head in good thermal contact with them",
-    ),
-    "clamp_loss": DefensibleRange(
-        0.5, 10.0,
-        "no published value: 0.02-0.4 m² of clamp and head at ~25 W/(m²·K) of forced convection, plus conduction into "
-        "the frame",
-    ),
-    "clamp_conductance": DefensibleRange(
-        1.0, 100.0,
-        "steel-on-steel contact conductance 10³-10⁴ W/(m²·K) (Madhusudana 1996) over 10⁻³-10⁻² m² of clamped faces",
-    ),
-    "eta": DefensibleRange(
-        0.7, 1.0,
-        "most plastic work in metals becomes heat (Taylor-Quinney coefficient ~0.9); with no powder in the "
-        "vial little else can store it",
-    ),
-}
 
 
 # An open hard bound is approached to this relative distance: exp(log(bound)) may round onto it.
@@ -287,26 +247,25 @@ def calibrate(
     full_resolution: bool = False,
     progress: Callable[[int], None] | None = None,
     sample_posterior: bool = True,
+    on_start: Callable[[], None] | None = None,
 ) -> Calibration:
     """Fit ``free`` keys of ``base`` to ``targets`` and/or one or several curves (``curve``), each of a node under
     its own conditions (:class:`~shakermill.studies.validation.Curve`); see the module docstring.
 
-    ``progress(evaluations)`` is called after every model evaluation. With ``sample_posterior``, a fit whose
+    ``on_start()`` is called once every input has been checked, before the first evaluation;
+    ``progress(evaluations)`` after every model evaluation. With ``sample_posterior``, a fit whose
     evaluations integrate the network alone (the engine has thermal-only keys) also samples the posterior of its keys
     (:func:`posterior_samples`, a few minutes). A run that uses up its budget stops the fit
     (:class:`~shakermill.budget.BudgetExceeded`): its partial result is no evaluation.
     """
     targets, curves, free = _checked(base, free, targets, curve)
-    solver = "full" if full_resolution else "averaged"
     start = {key: float(getattr(base, key)) for key in free}
     x0 = np.log([start[key] for key in free])
     lower, upper = (np.array(side) for side in zip(*(log_bounds(key, start[key]) for key in free)))
-    # The fit needs the configured motion only: probing other attractors would cost every evaluation.
-    longest = max((float(measured.times.max()) for measured in curves), default=0.0)
-    if full_resolution:
-        check_full_resolution_work(base, max(base.duration, longest))
-    fitting = base.replace(solver=solver, attractor_starts=1, duration=max(base.duration, longest))
-    preflight(fitting)  # once, before the first evaluation: every evaluation has the same needs
+    fitting = _fitting_parameters(base, curves, full_resolution)
+    solver = fitting.solver
+    if on_start is not None:
+        on_start()
     evaluate, cache = _evaluator(fitting, free, targets, curves, progress)
     solution = least_squares(
         lambda x: evaluate(x)[0], x0, bounds=(lower, upper), diff_step=JACOBIAN_STEP, x_scale=1.0, method="trf"
@@ -327,8 +286,7 @@ def calibrate(
     if sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution:
         variance = _residual_variance(residuals, len(free), curves)
         posterior = posterior_samples(lambda x: evaluate(x)[0], solution.x, lower, upper, variance).tolist()
-    off_curve = curve_rms is not None and curve_rms > CURVE_TOLERANCE_K
-    stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
+    status, message = _verdict(solution, result.success, free, missed, at_bounds, curve_rms)
     return Calibration(
         params=result.params.replace(solver=base.solver, attractor_starts=base.attractor_starts),
         free=free,
@@ -343,13 +301,39 @@ def calibrate(
         sensitivities=_sensitivities(solution.jac, free, targets, curves),
         predictions={key: float(result.summary[key]) for key in PREDICTED_KEYS if key not in targets},
         at_bounds=at_bounds,
-        success=bool(solution.success) and not stuck and not missed and not off_curve and result.success,
-        message=_outcome(str(solution.message), free, missed, at_bounds, curve_rms if off_curve else None),
+        success=status == "fitted",
+        message=message,
+        status=status,
         evaluations=len(cache),
         solver=solver,
         curve_source="; ".join(_described(measured) for measured in curves),
         result=result,
     )
+
+
+def _fitting_parameters(base: Parameters, curves: Sequence[Curve], full_resolution: bool) -> Parameters:
+    """The parameters every evaluation of a fit runs, checked once (the preflight) before the first: its solver, the
+    configured motion only (probing other attractors would cost every evaluation), long enough for every curve."""
+    longest = max((float(measured.times.max()) for measured in curves), default=0.0)
+    if full_resolution:
+        check_full_resolution_work(base, max(base.duration, longest))
+    fitting = base.replace(solver="full" if full_resolution else "averaged", attractor_starts=1,
+                           duration=max(base.duration, longest))
+    preflight(fitting)
+    return fitting
+
+
+def _verdict(solution: Any, run_success: bool, free: Sequence[str], missed: Mapping[str, float], at_bounds: Sequence[str],
+             curve_rms: float | None) -> tuple[str, str]:
+    """The fit's status ('fitted', 'undetermined' or 'not met') and its message."""
+    off_curve = curve_rms is not None and curve_rms > CURVE_TOLERANCE_K
+    stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
+    met = bool(solution.success) and not stuck and not missed and not off_curve and run_success
+    undetermined = undetermined_keys(solution.jac, free)
+    message = _outcome(str(solution.message), free, missed, at_bounds, curve_rms if off_curve else None)
+    if undetermined:
+        return "undetermined", f"{undetermined}; {message}"
+    return ("fitted" if met else "not met"), message
 
 
 Evaluation = tuple[np.ndarray, dict[tuple[str, ...], Result]]
@@ -419,6 +403,7 @@ def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float]
             raise ParameterError(f"curve: {measured.source or 'the curve'} is of the balls, and its run has none "
                                  "(n_balls = 0); allowed a vial_C curve for an empty mill")
     _check_free_for_engine(base, free)
+    check_determinable(free, targets, curves)
     for key in free:
         if getattr(base, key) <= 0:
             raise ParameterError(f"free: {key} must start positive to be fitted in log space, got {getattr(base, key)}")
@@ -537,10 +522,18 @@ def posterior_samples(residuals_of: Callable[[np.ndarray], np.ndarray], best: np
     covariance cannot."""
     import emcee
 
+    # emcee prints a traceback of whatever the likelihood raises (a Ctrl-C, a spent budget) before raising it again:
+    # the first is kept, every later call refused at once, and it is raised after the sampler, with nothing printed.
+    raised: list[BaseException] = []
+
     def log_probability(x: np.ndarray) -> float:
-        if np.any(x < lower) or np.any(x > upper):
+        if raised or np.any(x < lower) or np.any(x > upper):
             return -np.inf
-        return -0.5 * float(np.sum(residuals_of(x) ** 2)) / variance
+        try:
+            return -0.5 * float(np.sum(residuals_of(x) ** 2)) / variance
+        except BaseException as exc:  # noqa: BLE001 - raised again below, after the sampler
+            raised.append(exc)
+            return -np.inf
 
     keys = best.size
     walkers = WALKERS_PER_KEY * keys
@@ -549,6 +542,8 @@ def posterior_samples(residuals_of: Callable[[np.ndarray], np.ndarray], best: np
     sampler = emcee.EnsembleSampler(walkers, keys, log_probability)
     sampler.random_state = np.random.RandomState(POSTERIOR_SEED).get_state()
     sampler.run_mcmc(start, POSTERIOR_STEPS)
+    if raised:
+        raise raised[0]
     chain = sampler.get_chain(discard=POSTERIOR_STEPS // 2, flat=True)
     return chain[np.linspace(0, len(chain) - 1, POSTERIOR_KEPT).astype(int)]
 
@@ -667,8 +662,14 @@ class FreeSetOutcome:
 
 
 def free_set_study(
-    base: Parameters, free_sets: Sequence[tuple[str, ...]] = FREE_SET_STUDY, curve: Curve | None = None
+    base: Parameters, free_sets: Sequence[tuple[str, ...]] = FREE_SET_STUDY, curve: Curve | None = None,
+    progress: Callable[[int], None] | None = None,
 ) -> list[FreeSetOutcome]:
-    """Fit each free set to ``curve`` (the experiment's by default) from ``base``."""
+    """Fit each free set to ``curve`` (the experiment's by default) from ``base``; ``progress(fits done)`` after each."""
     curve = curve or experiment_curve()
-    return [FreeSetOutcome(tuple(free), calibrate(base, free, curve=curve)) for free in free_sets]
+    outcomes = []
+    for free in free_sets:
+        outcomes.append(FreeSetOutcome(tuple(free), calibrate(base, free, curve=curve)))
+        if progress is not None:
+            progress(len(outcomes))
+    return outcomes

@@ -230,7 +230,7 @@ def _start_worker(sweep_pid: int) -> None:
 
     import psutil
 
-    from shakermill.solvers.replicas import THREADS_VARIABLE
+    from shakermill.parameters.environment import THREADS_VARIABLE
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     # The pool gives every core a point already: a point's replicas take turns on its worker's core.

@@ -148,9 +148,17 @@ def _first_difference(stored: Mapping[str, Any], wanted: Mapping[str, Any]) -> t
 
 def read_manifest(folder: Path) -> dict[str, Any]:
     """``sweep.json`` of ``folder``, checked: paths are built from its point ids, so each must be one."""
+    damaged = f"run the sweep into a new folder, or put back the {MANIFEST_FILE} it wrote"
     try:
         manifest = json.loads((folder / MANIFEST_FILE).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+    except UnicodeDecodeError:
+        raise ParameterError(f"{folder}: {MANIFEST_FILE} is not UTF-8 text, so not the manifest a sweep writes; {damaged}") from None
+    except json.JSONDecodeError as exc:
+        raise ParameterError(
+            f"{folder}: {MANIFEST_FILE} is not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg}), so not the "
+            f"manifest a sweep writes; {damaged}"
+        ) from None
+    except OSError as exc:
         raise ParameterError(f"{folder}: cannot read {MANIFEST_FILE} ({in_one_line(exc)})") from None
     if not isinstance(manifest, dict) or manifest.get("format") != MANIFEST_FORMAT:
         raise ParameterError(f"{folder}: {MANIFEST_FILE} is not a shakermill sweep manifest")

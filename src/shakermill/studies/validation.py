@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
-from shakermill.parameters.csvinput import read_csv_rows
+from shakermill.parameters.csvinput import check_rectangular, read_csv_rows
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.fields import LONGEST_RUN_S
 from shakermill.parameters.keys import Bounds, field_unit
@@ -94,9 +94,14 @@ def target_range(name: str) -> str:
     return f"{TARGET_BOUNDS[name]} {quantity(name).unit}".rstrip()
 
 
-# The columns a curve file may measure, and the node of the network each is of (the balls' mean, the vial).
-NODE_COLUMNS = {"ball_C": "ball", "vial_C": "vial"}
+# The columns a curve file may measure, the node of the network each is of (the balls' mean, the vial) and the
+# offset that turns its unit into °C.
+NODE_COLUMNS = {"ball_C": ("ball", 0.0), "vial_C": ("vial", 0.0), "ball_K": ("ball", -273.15), "vial_K": ("vial", -273.15)}
+TIME_COLUMNS = {"time_s": 1.0, "time_min": 60.0}
 NODE_VARIABLES = {"ball": "theta_ball", "vial": "theta_vial"}
+# A mill starts at room temperature: °C values that never fall below this are kelvin (293 K is 20 °C), and kelvin
+# values that never rise above it are °C.
+KELVIN_FLOOR = 200.0
 
 
 @dataclass(frozen=True)
@@ -106,7 +111,8 @@ class Curve:
     with units, e.g. "n_balls=5").
 
     Checked on creation: finite times in [0, the longest run] that increase, finite temperatures above
-    absolute zero, at most :data:`MAX_CURVE_POINTS` points; :class:`ParameterError` names the first point that is not.
+    absolute zero, at most :data:`MAX_CURVE_POINTS` points; :class:`ParameterError` names the first point that is not,
+    and the column it read (``column``).
     """
 
     times: np.ndarray
@@ -116,6 +122,9 @@ class Curve:
     sigma_K: float | None = None
     node: str = "ball"
     conditions: tuple[str, ...] = ()
+    column: str = ""
+    # What reading the file took on itself (a ';'-separated file's decimal commas), said where the curve is used.
+    note: str = ""
 
     def __post_init__(self) -> None:
         what = f"curve {self.source}".rstrip()
@@ -123,37 +132,35 @@ class Curve:
             raise ParameterError(
                 f"{what}: {self.times.size} times and {self.temperature_C.size} temperatures; allowed 1 to {MAX_CURVE_POINTS:,} of each"
             )
+        column = self.column or f"{self.node}_C"
         for index, (time, temperature) in enumerate(zip(self.times.tolist(), self.temperature_C.tolist())):
-            _check_point(what, index, time, temperature, self.times[index - 1] if index else None)
+            _check_point(what, column, index, time, temperature, self.times[index - 1] if index else None)
 
     @classmethod
     def from_csv(cls, path: Path | str, conditions: tuple[str, ...] = ()) -> Curve:
-        """Read ``time_s`` or ``time_min`` and one of ``ball_C`` or ``vial_C`` (header required; other columns
-        ignored); ``conditions`` as the class says."""
+        """Read ``time_s`` or ``time_min`` and one of ``ball_C``, ``vial_C``, ``ball_K`` or ``vial_K`` (header
+        required; other columns ignored, every row as long as the header); ``conditions`` as the class says. A file
+        whose header is separated by ';' is read so, its decimal commas as points, and says so in ``note``."""
         path = Path(path)
         what = f"curve {path}"
-        rows = [row for row in read_csv_rows(path, what, MAX_CURVE_POINTS) if any(cell.strip() for cell in row)]
-        if len(rows) < 2:
-            raise ParameterError(f"{what}: has no data rows")
+        rows, note = _curve_rows(path, what)
         header = [cell.strip() for cell in rows[0]]
-        measured = [name for name in NODE_COLUMNS if name in header]
-        if len(measured) != 1 or not {"time_s", "time_min"} & set(header):
-            raise ParameterError(
-                f"{what}: needs columns time_s (or time_min) and one of ball_C or vial_C, found {quoted(header)}"
-            )
-        scale, column = (1.0, "time_s") if "time_s" in header else (60.0, "time_min")
+        time_column, measured = _curve_columns(header, what)
+        check_rectangular(rows[1:], header, what)
         times, temperatures = [], []
         for number, row in enumerate(rows[1:], start=2):
             cells = dict(zip(header, row))
             try:
-                times.append(float(cells[column]) * scale)
-                temperatures.append(float(cells[measured[0]]))
-            except (KeyError, ValueError):
-                raise ParameterError(f"{what} line {number}: needs a number in {column} and in {measured[0]}") from None
+                times.append(float(cells[time_column]) * TIME_COLUMNS[time_column])
+                temperatures.append(float(cells[measured]))
+            except ValueError:
+                raise ParameterError(f"{what} line {number}: needs a number in {time_column} and in {measured}") from None
+        node, offset = NODE_COLUMNS[measured]
+        _check_unit(what, measured, temperatures)
         import numpy as np
 
-        return cls(np.array(times), np.array(temperatures), str(path), node=NODE_COLUMNS[measured[0]],
-                   conditions=tuple(conditions))
+        return cls(np.array(times), np.array(temperatures) + offset, str(path), node=node, conditions=tuple(conditions),
+                   column=measured, note=note)
 
     @property
     def variable(self) -> str:
@@ -179,7 +186,52 @@ def curve_from_option(item: str) -> Curve:
     return Curve.from_csv(path, tuple(setting.strip() for setting in settings.split(",") if setting.strip()))
 
 
-def _check_point(what: str, index: int, time: float, temperature: float, previous: float | None) -> None:
+def _curve_rows(path: Path, what: str) -> tuple[list[list[str]], str]:
+    """The non-empty rows of a curve file, and a note where it was read as ';'-separated with decimal commas."""
+    rows = [row for row in read_csv_rows(path, what, MAX_CURVE_POINTS) if any(cell.strip() for cell in row)]
+    note = ""
+    if rows and len(rows[0]) == 1 and ";" in rows[0][0]:
+        rows = [row for row in read_csv_rows(path, what, MAX_CURVE_POINTS, delimiter=";") if any(cell.strip() for cell in row)]
+        rows = [[cell.replace(",", ".") for cell in row] for row in rows]
+        note = f"{what}: read as ';'-separated columns, with decimal commas as points"
+    if len(rows) < 2:
+        raise ParameterError(f"{what}: has no data rows")
+    return rows, note
+
+
+def _curve_columns(header: list[str], what: str) -> tuple[str, str]:
+    """The time column and the measured column of a curve file's header: one of each, each once."""
+    repeated = sorted({name for name in header if name and header.count(name) > 1})
+    if repeated:
+        raise ParameterError(f"{what}: the column {repeated[0]} appears {header.count(repeated[0])} times; allowed once")
+    times = [name for name in TIME_COLUMNS if name in header]
+    measured = [name for name in NODE_COLUMNS if name in header]
+    if len(times) > 1:
+        raise ParameterError(f"{what}: has both time_s and time_min, which need not agree; allowed one of them")
+    if len(measured) != 1 or not times:
+        raise ParameterError(
+            f"{what}: needs columns time_s (or time_min) and one of {', '.join(NODE_COLUMNS)}, found {quoted(header)}"
+        )
+    return times[0], measured[0]
+
+
+def _check_unit(what: str, column: str, temperatures: list[float]) -> None:
+    """Refuse a curve whose values are plainly in the other unit than its column says (a mill starts near 20 °C)."""
+    low, high = min(temperatures), max(temperatures)
+    kelvin = column.endswith("_K")
+    if not kelvin and low >= KELVIN_FLOOR:
+        raise ParameterError(
+            f"{what}: {column} holds {low:g} to {high:g}, which look like kelvin (a mill starts near 20 °C = 293 K); "
+            f"allowed °C in {column}, or name the column {column[:-2]}_K to give kelvin"
+        )
+    if kelvin and high < KELVIN_FLOOR:
+        raise ParameterError(
+            f"{what}: {column} holds {low:g} to {high:g}, which look like °C (kelvin never falls below 0 and a mill "
+            f"starts near 293 K); allowed kelvin in {column}, or name the column {column[:-2]}_C to give °C"
+        )
+
+
+def _check_point(what: str, column: str, index: int, time: float, temperature: float, previous: float | None) -> None:
     point = f"point {index + 1}"
     if not (math.isfinite(time) and 0.0 <= time <= LONGEST_RUN_S):
         raise ParameterError(f"{what}: {point} is at {time:g} s; allowed times in [0, {LONGEST_RUN_S:g}] s")
@@ -187,7 +239,7 @@ def _check_point(what: str, index: int, time: float, temperature: float, previou
         raise ParameterError(f"{what}: {point} at {time:g} s does not come after the one before ({previous:g} s); times must increase")
     if not (math.isfinite(temperature) and temperature > ABSOLUTE_ZERO_C):
         raise ParameterError(
-            f"{what}: {point} has ball_C = {temperature:g}; allowed a finite temperature above {ABSOLUTE_ZERO_C:g} °C"
+            f"{what}: {point} has {column} = {temperature:g} °C; allowed a finite temperature above {ABSOLUTE_ZERO_C:g} °C"
         )
 
 
@@ -271,9 +323,10 @@ class ValidationRun:
         return f"{self.preset}: {', '.join(self.fitted)} fitted to {through}; {deviation}; {', '.join(predicted)} predicted."
 
 
-def validate(solver: str = "full") -> list[ValidationRun]:
-    """Run the published and the calibrated preset and compare both with Table 5 and the experiment's curve. Ctrl-C
-    raises ``KeyboardInterrupt`` and a spent budget ``BudgetExceeded``: a run cut short is no row of Table 5."""
+def validate(solver: str = "full", progress: Callable[[int], None] | None = None) -> list[ValidationRun]:
+    """Run the published and the calibrated preset and compare both with Table 5 and the experiment's curve
+    (``progress(runs done)`` after each). Ctrl-C raises ``KeyboardInterrupt`` and a spent budget ``BudgetExceeded``: a
+    run cut short is no row of Table 5."""
     from shakermill.parameters.presets import PRESETS, default_parameters
     from shakermill.solvers.simulate import simulate_whole
 
@@ -293,6 +346,8 @@ def validate(solver: str = "full") -> list[ValidationRun]:
                 fitted_to_curve="curve" in preset.provenance,
             )
         )
+        if progress is not None:
+            progress(len(runs))
     return runs
 
 

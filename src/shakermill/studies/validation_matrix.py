@@ -20,6 +20,7 @@ import numpy as np
 
 from shakermill.engines.registry import engine_named
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
+from shakermill.parameters.defaults import DEFAULT_FREE_BY_NETWORK
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import PRESETS, default_parameters, preset_values
 from shakermill.solvers.averaged import integrate_network
@@ -208,7 +209,7 @@ class Structure:
         return values["thermal_model"] == "mill-head" and values["beta"] == 1.0 and "beta" not in self.free
 
 
-MILL_HEAD_FREE = ("drive_heat", "clamp_heat_capacity", "clamp_loss")
+MILL_HEAD_FREE = DEFAULT_FREE_BY_NETWORK["mill-head"]
 STRUCTURES: tuple[Structure, ...] = (
     Structure("paper: β, vial mass", "spex8000m-3d", ("beta", "vial_mass")),
     Structure("paper: β, vial mass, h_outer", "spex8000m-3d", ("beta", "vial_mass", "h_outer")),

@@ -11,9 +11,9 @@ from typing import Any, Callable, Sequence
 from shakermill.parameters.config import load_config
 from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.keys import Parameters
-from shakermill.studies.calibrate import FreeSetOutcome, free_set_study
+from shakermill.studies.calibrate import FREE_SET_STUDY, FreeSetOutcome, free_set_study
 from shakermill.studies.held_out import HeldOutStudies, held_out_studies
-from shakermill.studies.validation import EXPERIMENT, TABLE5, ValidationRun, validate
+from shakermill.studies.validation import EXPERIMENT, TABLE5, VALIDATION_PRESETS, ValidationRun, validate
 from shakermill.studies.validation_matrix import (
     STRUCTURES,
     Experiment,
@@ -48,6 +48,14 @@ class ValidationReport:
             "experiment_source": EXPERIMENT,
             "solver": self.solver,
             "full": self.everything,
+            "ran": {
+                "table5": True,
+                "free_set_study": bool(self.outcomes),
+                "validation_matrix": self.matrix is not None,
+                "experiments": [] if self.matrix is None else [experiment.name for experiment in self.matrix.experiments],
+                "structure_study": bool(self.structures),
+                "held_out": self.held_out is not None,
+            },
             "quantities": {
                 entry.key: {"label": entry.label, "unit": entry.unit, "experiment": entry.experiment, "paper_model": entry.paper_model}
                 for entry in TABLE5
@@ -96,18 +104,25 @@ def validation_report(solver: str, study: bool = True, three_d: bool = True,
     ``three_d`` the validation matrix of the thermal models (``progress(done, total)`` counts its runs) and, with
     ``everything``, its experiments of one ball, the structure study and the held-out studies; without, only the
     experiments that run in minutes (:func:`quick_experiments`)."""
-    runs = tuple(validate(solver))
-    outcomes = tuple(free_set_study(preset_parameters(DEFAULT_PRESET))) if study else ()
-    if not three_d:
-        return ValidationReport(solver, runs, outcomes, None)
     show = progress if progress is not None else (lambda done, total: None)
     experiments = load_experiments() if everything else quick_experiments(load_experiments())
-    pairs = len(experiments) * len(THERMAL_MODEL_PRESETS)
-    matrix = validation_matrix(experiments=experiments, progress=show)
+    # Every step counted, Table 5's runs and the free-set fits first: minutes pass before the 3-D studies begin.
+    first = len(VALIDATION_PRESETS) + (len(FREE_SET_STUDY) if study else 0)
+    pairs = len(experiments) * len(THERMAL_MODEL_PRESETS) if three_d else 0
+    runs = tuple(validate(solver, lambda done: show(done, first + pairs)))
+
+    def fitted(done: int) -> None:
+        show(len(VALIDATION_PRESETS) + done, first + pairs)
+
+    outcomes = tuple(free_set_study(preset_parameters(DEFAULT_PRESET), progress=fitted)) if study else ()
+    if not three_d:
+        return ValidationReport(solver, runs, outcomes, None, everything=False)
+    matrix = validation_matrix(experiments=experiments, progress=lambda done, total: show(first + done, first + total))
     if not everything:
         return ValidationReport(solver, runs, outcomes, None, matrix, everything=False)
-    structures = structure_study(progress=lambda done, total: show(pairs + done, pairs + total))
-    before = pairs + len(STRUCTURES)
+    before = first + pairs
+    structures = structure_study(progress=lambda done, total: show(before + done, before + total))
+    before += len(STRUCTURES)
     held_out = held_out_studies(lambda done, total: show(before + done, before + total))
     return ValidationReport(solver, runs, outcomes, held_out, matrix, structures)
 

@@ -15,6 +15,7 @@ import re
 import secrets
 import shutil
 import socket
+import tempfile
 from pathlib import Path
 from typing import Mapping
 
@@ -152,6 +153,12 @@ def check_writable_place(path: Path, option: str = "--out") -> None:
     if not os.access(ancestor, os.W_OK | os.X_OK):
         reason = os.strerror(errno.EROFS if _read_only(ancestor) else errno.EACCES)
         raise StorageError(f"{path}: cannot write in {ancestor} ({reason}); choose another {option}")
+    # Permissions say nothing to root, nor of a filesystem such as /proc that refuses files: a file is made there.
+    try:
+        with tempfile.NamedTemporaryFile(dir=ancestor, prefix=".shakermill-probe-"):
+            pass
+    except OSError as exc:
+        raise StorageError(f"{path}: cannot write in {ancestor} ({exc.strerror or exc}); choose another {option}") from None
 
 
 def _read_only(folder: Path) -> bool:
