@@ -105,3 +105,34 @@ def test_distinct_thresholds_get_distinct_summary_keys():
 def test_a_threshold_given_twice_is_refused():
     with pytest.raises(sm.ParameterError, match=r"^stress_energy_thresholds: 0\.001 J is given 2 times; allowed distinct"):
         sm.default_parameters("spex8000m-3d", stress_energy_thresholds=(0.001, 1e-3))
+
+
+def test_kwades_stress_energy_is_the_pairs_relative_kinetic_energy_at_first_touch_counted_by_hand():
+    """½·m*·v_n²: balls of 1 and 3 kg closing at 2 m/s bring 0.5·0.75·4 = 1.5 J; the 1-kg ball on the vial at 2 m/s
+    brings 2 J; the 3-kg ball on the vial at 1 m/s 1.5 J."""
+    from shakermill.analysis.stress_energy import collision_energy
+
+    impacts = {"impact_speed": np.array([2.0, 2.0, 1.0]), "ball": np.array([0, 0, 1]), "other_ball": np.array([1, -1, -1]),
+               "dissipated_energy": np.array([0.5, 1.0, 0.2]), "duration": np.full(3, 1e-4)}
+    np.testing.assert_allclose(collision_energy(impacts, (1.0, 3.0)), [1.5, 2.0, 1.5], rtol=1e-15)
+    summary = stress_spectrum(impacts, 1.0, masses=(1.0, 3.0), dissipated_power=2.0).as_summary()
+    assert summary["stress_energy_kinetic_median_J"] == pytest.approx(1.5)
+    # One ball on the axis (the 1-D engine's columns have no ball index): its own mass.
+    np.testing.assert_allclose(collision_energy({"impact_speed": np.array([3.0])}, (0.5,)), [2.25])
+    # Of the 2 W dissipated, the impacts' 1.7 J in 1 s leave 0.3 W, 15 %, to lasting contacts.
+    assert summary["stress_lasting_share"] == pytest.approx(0.15)
+
+
+@pytest.mark.slow
+def test_a_head_on_impact_dissipates_one_minus_e_squared_of_kwades_stress_energy():
+    """One ball dropped head-on on the end face of a resting vial: the energy it brought, ½·m·v_n², and what the
+    contact dissipated, (1 − e²) of it, for the engine's own restitution."""
+    from shakermill.solvers.impact import single_impact
+
+    params = sm.default_parameters("spex8000m-3d")
+    outcome = single_impact(params, 2.0)
+    impacts = {"impact_speed": np.array([outcome.normal_speed_in]), "dissipated_energy": np.array([outcome.dissipated_J]),
+               "duration": np.array([outcome.contact_time_s])}
+    kinetic = stress_spectrum(impacts, 1.0, masses=params.ball_masses()).percentile(50, "kinetic")
+    assert kinetic == pytest.approx(0.5 * params.ball_mass * 2.0**2, rel=1e-12)
+    assert outcome.dissipated_J == pytest.approx((1 - outcome.normal_restitution**2) * kinetic, rel=1e-3)

@@ -176,3 +176,90 @@ def test_a_steady_translation_and_too_fast_a_turn_are_refused_in_one_line():
         sm.default_parameters(engine="dem", kinematics="fourier", motion="x:0:0:1")
     with pytest.raises(sm.ParameterError, match=r"motion: a steady rate 6 of yaw .*at most 5"):
         sm.default_parameters(engine="dem", kinematics="fourier", motion="yaw:0:0:6")
+
+
+# --- MODEL.md §14.3: a ball in a planetary jar, closed forms in the frame of the sun wheel (issue 36, point 5) ------
+
+
+def wheel_frame_angle(params: sm.Parameters, engine: DemEngine) -> float:
+    """φ of the ball: its angle about the jar's centre from the point of the wall farthest from the sun axis (rad),
+    positive in the wheel's sense of turning."""
+    centre, _, _, _ = jar_motion(params, engine.t)
+    radial = centre / np.linalg.norm(centre)
+    offset = engine.state.position[0] - centre
+    return math.atan2(float(np.cross(radial, offset)[2]), float(offset @ radial))
+
+
+def rolling_ball(params: sm.Parameters, start: float) -> DemEngine:
+    """One ball on the bore of an upright planetary jar at ``start`` rad from its outermost point, at rest in the
+    wheel's frame and spinning so that it rolls on the wall without slipping (the wall moves under it at k·ω)."""
+    engine = DemEngine(params)
+    centre, velocity, orientation, _ = jar_motion(params, 0.0)
+    rho, radius, omega, k = params.vial_diameter / 2 - params.ball_radius, params.ball_radius, params.omega, params.speed_ratio
+    radial = centre / np.linalg.norm(centre)
+    normal = math.cos(start) * radial + math.sin(start) * np.cross([0.0, 0.0, 1.0], radial)
+    engine.state.position[0] = centre + rho * normal
+    engine.state.velocity[0] = np.cross([0.0, 0.0, omega], engine.state.position[0])
+    # No slip: the contact point, R beyond the centre along the normal, moves as the wall there, whose velocity less
+    # the centre's is ((1 + k)·R_c − ρ)·ω across the normal.
+    engine.state.spin[0] = [0.0, 0.0, ((1 + k) * omega * (rho + radius) - omega * rho) / radius]
+    assert velocity @ radial == pytest.approx(0.0, abs=1e-9)  # the jar's centre moves across its radius
+    return engine
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ratio", [-2.0, -1.0, 0.0, 1.0])
+def test_a_ball_rolling_on_the_wall_of_a_planetary_jar_swings_as_a_pendulum_whatever_the_jars_spin(ratio):
+    """(7/5)·ρ·φ̈ = −ω²·R_p·sin φ: small swings of period 2π·√(7ρ / (5ω²R_p)), the same for every speed ratio k
+    (MODEL.md §14.3), gravity off, friction enough to roll without slipping."""
+    params = sm.default_parameters("pulverisette7", **PLANETARY, n_balls=1, speed_ratio=ratio, gravity=False,
+                                   friction=1.0, rolling_friction=0.0, restitution=0.3, jar_tilt=0.0)
+    rho = params.vial_diameter / 2 - params.ball_radius
+    period = 2 * math.pi * math.sqrt(7 * rho / (5 * params.omega**2 * params.revolution_radius))
+    engine = rolling_ball(params, 0.1)
+    step = period / 200
+    times, angles = [], []
+    while engine.t < 4.5 * period:
+        engine.advance(engine.t + step)
+        times.append(engine.t)
+        angles.append(wheel_frame_angle(params, engine))
+    times, angles = np.array(times), np.array(angles)
+    # Upward zero crossings of φ, interpolated: their spacing is the period.
+    rising = np.flatnonzero((angles[:-1] < 0) & (angles[1:] >= 0))
+    crossings = times[rising] - angles[rising] * (times[rising + 1] - times[rising]) / (angles[rising + 1] - angles[rising])
+    assert len(crossings) >= 3
+    measured = float(np.mean(np.diff(crossings)))
+    # A swing of 0.1 rad lengthens the period by φ₀²/16 (0.0625 %): measured, 0.064 % for every k.
+    assert measured == pytest.approx(period * (1 + 0.1**2 / 16), rel=2e-4)
+    assert measured != pytest.approx(period, rel=2e-4)
+    # It swings about the outermost point and keeps its amplitude: a contact that rolls dissipates nothing.
+    assert np.max(angles) == pytest.approx(0.1, rel=1e-3) and np.min(angles) == pytest.approx(-0.1, rel=1e-3)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ratio", [-2.0, -1.0, 0.5, 1.0])
+def test_a_ball_carried_with_the_wall_of_a_planetary_jar_is_pressed_as_the_closed_form_says(ratio):
+    """N = m·ω²·(R_p·cos φ + (1 + k)²·ρ) on a ball carried by the wall without slipping or rolling (MODEL.md §14.3),
+    gravity off, from 6° to 35° of its way round (past the settling of its start) from the outermost point: friction and rolling resistance of 1 hold
+    it there. (Farther round, what holds it carried, F_t/N = R_p·sin φ / (R_p·cos φ + (1 + k)²·ρ), outgrows any
+    friction before N reaches 0: it slips before cos φ = −(1 + k)²·ρ/R_p, the no-slip limit where it would leave.)"""
+    params = sm.default_parameters("pulverisette7", **PLANETARY, n_balls=1, speed_ratio=ratio, gravity=False,
+                                   friction=1.0, rolling_friction=1.0, restitution=0.3, jar_tilt=0.0)
+    rho, omega, arm = params.vial_diameter / 2 - params.ball_radius, params.omega, params.revolution_radius
+    centre, _, orientation, _ = jar_motion(params, 0.0)
+    engine = carried_ball(params, orientation.T @ (rho * centre / np.linalg.norm(centre)))
+    turn = 2 * math.pi / abs(ratio * omega)
+    compared = []
+    while engine.t < 0.12 * turn:
+        engine.advance(engine.t + turn / 2000)
+        centre, _, _, _ = jar_motion(params, engine.t)
+        offset = engine.state.position[0] - centre
+        phi = wheel_frame_angle(params, engine)
+        if math.radians(6) <= abs(phi) <= math.radians(35):
+            pressed = -float(engine.state.force[0] @ offset) / float(np.linalg.norm(offset))
+            compared.append((pressed, engine.constants.mass[0] * omega**2 * (arm * math.cos(phi) + (1 + ratio) ** 2 * rho)))
+    pressed, expected = np.array(compared).T
+    assert len(compared) >= 50
+    # Within 0.5 %: the overlap puts the centre ~1e-4 beyond ρ, and the rolling torque's direction flips about a spin
+    # that is the wall's. Dropping the jar's own turn, (1 + k)² → 1, would miss by 20-40 % at k = −1, 0.5 and 1.
+    np.testing.assert_allclose(pressed, expected, rtol=5e-3)

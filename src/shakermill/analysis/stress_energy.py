@@ -9,6 +9,11 @@ the normal force, and a tangential part, from tangential damping, sliding and ro
 the 1-D engine's impacts are head-on, all normal. A ball's kinetic energy before an impact bounds the normal part
 from above; it is not what is reported.
 
+Beside it, the stress energy as Kwade's group defines it: the relative normal kinetic energy of the colliding pair at
+first touch, ½·m*·v_n², with m* = m_i·m_j/(m_i + m_j) for two balls and the ball's own mass on the vial (Burmeister &
+Kwade 2013; read as the review summarises it, not re-derived from its sources). It is the ``kinetic`` component: what
+an impact brings, of which the dissipated energy is the part the contact turned into heat (1 − e² of it, head-on).
+
 A contact that lasts (a ball rolling or sliding on the wall under a planetary jar's centrifugal load for a good part
 of a second) is recorded as one row too, with all it dissipated while it lasted, and only once it ends: it is no
 stress event but a steady grinding, and it would put joules into the spectrum's tail. A record longer than
@@ -24,7 +29,8 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-COMPONENTS = ("total", "normal", "tangential")
+# The energy dissipated per impact (total, its normal and tangential parts) and Kwade's stress energy ½·m*·v_n².
+COMPONENTS = ("total", "normal", "tangential", "kinetic")
 # What was hit: the vial (its end faces or, in three dimensions, its side) or another ball.
 TARGETS = ("all", "wall", "ball")
 PERCENTILES = (("median", 50.0), ("p90", 90.0))
@@ -69,6 +75,13 @@ class StressSpectrum:
             return self.dissipated_power - self.power()
         return self._per_second(float(self.energies["total"][self.lasting].sum()))
 
+    def lasting_share(self) -> float:
+        """The share of the dissipated power that the lasting contacts took, left out of the spectrum (NaN without a
+        dissipated power): a median over impacts describes only the rest."""
+        if not (math.isfinite(self.dissipated_power) and self.dissipated_power > 0):
+            return math.nan
+        return self.lasting_power() / self.dissipated_power
+
     def lasting_per_second(self) -> float:
         """Contacts per second (1/s) that lasted, among those recorded."""
         return self._per_second(float(np.count_nonzero(self.lasting)))
@@ -94,6 +107,7 @@ class StressSpectrum:
         """The summary's keys: the median and 90th percentile of the total, of each part and for each target, and
         per threshold the events per second and their power."""
         summary: dict[str, float] = {"stress_window_s": self.window, "stress_lasting_power_W": self.lasting_power(),
+                                     "stress_lasting_share": self.lasting_share(),
                                      "stress_lasting_contacts_hz": self.lasting_per_second()}
         for name, q in PERCENTILES:
             summary[f"stress_energy_{name}_J"] = self.percentile(q)
@@ -107,10 +121,25 @@ class StressSpectrum:
         return summary
 
 
+def collision_energy(impacts: Mapping[str, Sequence], masses: Sequence[float]) -> np.ndarray:
+    """Kwade's stress energy of each impact (J): ½·m*·v_n² of the pair at first touch, m* the reduced mass of two balls
+    (``other_ball`` ≥ 0) or the ball's mass on the vial; ``masses`` (kg) by ball index (a one-ball engine has no
+    ``ball`` column: ball 0)."""
+    speed = np.asarray(impacts["impact_speed"], dtype=float)
+    mass = np.asarray(masses, dtype=float)
+    ball = np.asarray(impacts["ball"], dtype=np.int64) if "ball" in impacts else np.zeros(speed.size, dtype=np.int64)
+    other = np.asarray(impacts["other_ball"], dtype=np.int64) if "other_ball" in impacts else np.full(speed.size, -1)
+    on_ball = other >= 0
+    m_i, m_j = mass[ball], mass[np.where(on_ball, other, ball)]
+    reduced = np.where(on_ball, m_i * m_j / (m_i + m_j), m_i)
+    return 0.5 * reduced * speed**2
+
+
 def stress_spectrum(impacts: Mapping[str, Sequence], window: float, thresholds: Sequence[float] = (),
-                    dissipated_power: float = math.nan) -> StressSpectrum:
+                    dissipated_power: float = math.nan, masses: Sequence[float] | None = None) -> StressSpectrum:
     """The spectrum of the impact records ``impacts`` (an engine's impact columns) resolved over ``window`` s, in
-    which the contacts dissipated ``dissipated_power`` (W) in all."""
+    which the contacts dissipated ``dissipated_power`` (W) in all; with the balls' ``masses`` (kg) also Kwade's stress
+    energy of each impact (:func:`collision_energy`; NaN without them)."""
     total = np.asarray(impacts["dissipated_energy"], dtype=float)
     if "dissipated_normal" in impacts:
         normal = np.asarray(impacts["dissipated_normal"], dtype=float)
@@ -119,5 +148,7 @@ def stress_spectrum(impacts: Mapping[str, Sequence], window: float, thresholds: 
         normal, tangential = total, np.zeros_like(total)
     hit_ball = np.asarray(impacts["target"]) == "ball" if "target" in impacts else np.zeros(total.size, dtype=bool)
     lasting = np.asarray(impacts["duration"], dtype=float) > LASTING_CONTACT_S
-    return StressSpectrum({"total": total, "normal": normal, "tangential": tangential}, hit_ball, lasting, float(window),
+    kinetic = collision_energy(impacts, masses) if masses is not None else np.full(total.size, math.nan)
+    energies = {"total": total, "normal": normal, "tangential": tangential, "kinetic": kinetic}
+    return StressSpectrum(energies, hit_ball, lasting, float(window),
                           tuple(sorted(thresholds)), float(dissipated_power))

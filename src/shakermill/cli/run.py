@@ -284,6 +284,14 @@ def several_ball_rows(s: Mapping[str, Any], channels: Sequence[str]) -> list[tup
         else:
             rows.append((f"balls {what}: coolest; hottest", f"{number(min(values), '.2f')}; {number(max(values), '.2f')}", "°C"))
     rows.append(("impacts on the walls; between balls", f"{s['wall_impacts']}; {s['ball_ball_impacts']}", ""))
+    if s.get("stress_energy_median_J") is not None:
+        # Kwade's ½·m*·v_n² beside the energy dissipated, and how much of the dissipation neither describes.
+        rows.append(("stress energy dissipated per impact: median; p90",
+                     f"{number(s.get('stress_energy_median_J'), '.3g')}; {number(s.get('stress_energy_p90_J'), '.3g')}", "J"))
+        rows.append(("½·m*·v_n² at contact (Kwade): median; p90",
+                     f"{number(s.get('stress_energy_kinetic_median_J'), '.3g')}; {number(s.get('stress_energy_kinetic_p90_J'), '.3g')}", "J"))
+        share = s.get("stress_lasting_share")
+        rows.append(("dissipation in lasting contacts (not in the medians)", number(None if share is None else 100 * share, ".3g"), "%"))
     heat = [s.get(f"heat_{channel}_W") for channel in channels]
     if any(value is not None for value in heat):
         # The averaged solver has no split by channel: its heat comes from the thermal network's means.

@@ -391,6 +391,11 @@ class Parameters(BaseModel):
         """m_b = ρ_b·4/3·π R³ (kg)."""
         return self.ball_density * 4.0 / 3.0 * math.pi * self.ball_radius**3
 
+    def ball_masses(self) -> tuple[float, ...]:
+        """Each ball's mass ρ·4/3·π R³ (kg), from its per-ball values or the scalar ones."""
+        radii, densities = self.ball_values("ball_radius"), self.ball_values("ball_density")
+        return tuple(density * 4.0 / 3.0 * math.pi * radius**3 for radius, density in zip(radii, densities))
+
     @property
     def end_face_area(self) -> float:
         """2·π·d_v²/4: both circular end faces (m²), MODEL.md section 1; the paper's A_i = A_o."""

@@ -316,7 +316,7 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
     }
     summary.update(understood_inputs(params))
     summary.update(stress_spectrum(impacts, impact_window, params.stress_energy_thresholds,
-                                   summary["dissipated_power_W"]).as_summary())
+                                   summary["dissipated_power_W"], params.ball_masses()).as_summary())
     summary.update(several_ball_summary(result))
     if "theta_clamp" in series.variables:
         summary["clamp_C"] = kelvin_to_celsius(float(series["theta_clamp"][-1]))

@@ -258,7 +258,12 @@ def stress_energy_table(spectrum: StressSpectrum) -> str:
         for threshold in spectrum.thresholds
     ]
     lasting = number(spectrum.lasting_per_second(), ".4g")
-    rows.append(("lasting contacts (rolling, sliding: no stress events)", lasting, "", "", number(spectrum.lasting_power(), ".4g")))
+    share = spectrum.lasting_share()
+    rows.append((f"lasting contacts (rolling, sliding: no stress events; {number(100 * share, '.3g')} % of the dissipation, "
+                 "left out of every row above)", lasting, "", "", number(spectrum.lasting_power(), ".4g")))
+    rows.append(("Kwade's stress energy ½·m*·v_n² at first touch (brought, not dissipated)",
+                 number(spectrum.events_per_second(0.0, "kinetic"), ".4g"), number(spectrum.percentile(50, "kinetic"), ".3g"),
+                 number(spectrum.percentile(90, "kinetic"), ".3g"), ""))
     header = ("stress energy (J dissipated per impact)", "events per second (1/s)", "median (J)", "90th percentile (J)", "power (W)")
     return table(header, rows, numeric=(1, 2, 3, 4))
 

@@ -184,7 +184,7 @@ def _motion_bounds(harmonics: np.ndarray, omega: float, reach: float) -> tuple[f
 
 def _masses(params: Parameters) -> np.ndarray:
     """Each ball's mass ρ·4/3·π R³ (kg)."""
-    return np.array(params.ball_values("ball_density")) * 4.0 / 3.0 * math.pi * np.array(params.ball_values("ball_radius")) ** 3
+    return np.array(params.ball_masses(), dtype=float)
 
 
 def network_of(params: Parameters) -> ThermalNetwork:

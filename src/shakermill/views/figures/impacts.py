@@ -100,7 +100,7 @@ def run_stress_spectrum(run: RunLike) -> StressSpectrum | None:
     if not window:
         return None
     return stress_spectrum(run.impacts, window, run.params.stress_energy_thresholds,
-                           run.summary.get("dissipated_power_W", math.nan))
+                           run.summary.get("dissipated_power_W", math.nan), run.params.ball_masses())
 
 
 def stress_energy_figure(spectrum: StressSpectrum) -> Figure:
