@@ -24,7 +24,7 @@ import time
 from reference_tree import measured_in, reference_tree
 
 import shakermill as sm
-from shakermill.solvers.replicas import THREADS_VARIABLE
+from shakermill.parameters.environment import THREADS_VARIABLE
 
 PRESET = "spex8000m-3d-calibrated"
 
