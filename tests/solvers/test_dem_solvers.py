@@ -15,10 +15,13 @@ BALLS = {"engine": "dem", "n_balls": 5, "vial_diameter": "38 mm", "record_window
 
 @pytest.fixture(name="pair", scope="module")
 def pair_fixture():
-    """The same 20 s of five balls, at full resolution and averaged (mechanics until ±2 % per ball)."""
+    """The same 20 s of five balls, at full resolution and averaged (mechanics until ±2 % per ball, in batches of
+    8 periods so that the least mechanics, 40 batches, fit in the run)."""
     full = sm.simulate(sm.default_parameters(**BALLS, duration=20.0))
     averaged = sm.simulate(
-        sm.default_parameters(**BALLS, duration=20.0, solver="averaged", dem_averaging_rel_error=0.02)
+        sm.default_parameters(
+            **BALLS, duration=20.0, solver="averaged", dem_averaging_rel_error=0.02, averaging_batch_periods=8
+        )
     )
     return full, averaged
 

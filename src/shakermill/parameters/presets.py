@@ -161,7 +161,9 @@ SPEX_8000M = Preset(
             1, "numerical choice: one replica, as before replicas existed; set it to the cores a run may use"
         ),
         "averaging_batch_periods": Cited(16, "numerical choice: batches of 16 drive periods (~0.9 s)"),
-        "averaging_min_batches": Cited(10, "numerical choice: the usual minimum for batch means"),
+        "averaging_min_batches": Cited(
+            20, "MODEL.md §14.2: at least 20 uncorrelated batches, so that their lag-1 autocorrelation can be tested"
+        ),
         "averaging_max_time": Cited(120.0, "numerical choice: 2 simulated minutes of mechanics at most"),
         "averaging_fallback": Cited("full", "numerical choice: fall back to full resolution and say so"),
         "attractor_starts": Cited(

@@ -10,7 +10,18 @@ from typing import Sequence
 
 import numpy as np
 
-from shakermill.analysis.batch_means import batch_rates, mser_truncation, normalised, relative_error, standard_error
+from shakermill.analysis.batch_means import (
+    DRIFT_SIGMAS,
+    Grouping,
+    batch_rates,
+    drifts,
+    grouped,
+    mser_truncation,
+    normalised,
+    relative_error,
+    standard_error,
+    uncorrelated_grouping,
+)
 from shakermill.engines.interface import Engine, Measured, ProgressCallback
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad
@@ -100,7 +111,7 @@ def measure_means(params: Parameters, engines: Sequence[Engine], progress: Progr
     cumulative = [[_flat(engine.measured())] for engine in engines]
     limit, limit_name = mechanics_limit(params)
     heartbeat = None if progress is None else lambda t: progress(t, limit)
-    status, converged, cuts, message = REACHED_STOP, False, [0] * len(engines), ""
+    status, converged, message = REACHED_STOP, False, ""
     with ReplicaSet(engines, threads) as replicas:
         while True:
             t = engines[0].t + batch
@@ -113,21 +124,73 @@ def measure_means(params: Parameters, engines: Sequence[Engine], progress: Progr
             for series, engine in zip(cumulative, engines):
                 series.append(_flat(engine.measured()))
             if len(cumulative[0]) > least_rounds(params, len(engines)):
-                kept, cuts = _pooled(cumulative, batch, sources, balls)
-                totals = _totals(kept, sources, balls)
-                columns = np.column_stack([totals, kept[:, : sources + balls]])
-                if len(kept) >= params.averaging_min_batches and all(relative_error(c) <= target for c in columns.T):
+                settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target)
+                if settled.ready and all(relative_error(c) <= target for c in settled.checked.T):
                     converged = True
-                    message = f"converged after {t:.3g} s of mechanics{_in_each(engines)} ({len(kept)} batches of {batch:.3g} s)"
+                    message = (f"converged after {t:.3g} s of mechanics{_in_each(engines)} ({settled.grouping.groups} "
+                               f"uncorrelated batches of {settled.batch:.3g} s)")
                     break
             if t + batch > limit:
                 message = (
-                    f"the averages did not converge to a relative standard error of {target:g} ({key}) within "
-                    f"{limit_name} = {limit:g} s{_in_each(engines)} (irregular or slowly settling motion)"
+                    f"the averages did not converge to a relative standard error of {target:g} ({key}) in uncorrelated, "
+                    f"stationary batches within {limit_name} = {limit:g} s{_in_each(engines)} (irregular or slowly "
+                    "settling motion)"
                 )
                 break
-    rates = np.concatenate([batch_rates(np.array(series), batch)[cut:] for series, cut in zip(cumulative, cuts)])
-    return _means(engines, rates, sources, balls, cuts, len(cumulative[0]) - 1, batch, converged, message), status
+    settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target)
+    return _means(engines, settled, sources, balls, len(cumulative[0]) - 1, converged, message), status
+
+
+@dataclass(frozen=True)
+class Settled:
+    """The batches of every replica after its start-up transient (``cuts``, in batches of ``base`` s), grouped to
+    uncorrelated means of ``batch`` s (``grouping``) and pooled in ``rates``; ``checked`` holds the columns held to
+    the target error (total heat, mean velocity term, each source and ball). ``ready``: enough uncorrelated
+    groups, and no drift between the halves of the settled window."""
+
+    rates: np.ndarray
+    checked: np.ndarray
+    cuts: list[int]
+    base: float
+    grouping: Grouping
+    drifting: bool
+    transient_heat_power: float
+
+    @property
+    def batch(self) -> float:
+        return self.base * self.grouping.size
+
+    @property
+    def ready(self) -> bool:
+        return self.grouping.uncorrelated and not self.drifting
+
+
+def _settled(cumulative: list[list[np.ndarray]], base: float, sources: int, balls: int, least: int,
+             target: float) -> Settled:
+    """Cut each replica's transient (MSER on its total heat power and its balls' mean velocity term, White 1997),
+    group its batches until their means are uncorrelated, and test the totals for drift (MODEL.md §14.2); a
+    spread or drift within the ``target`` relative error is no concern."""
+    kept, cuts = [], []
+    for series in cumulative:
+        rates = batch_rates(np.array(series), base)
+        cut = max(mser_truncation(normalised(column)) for column in _totals(rates, sources, balls).T)
+        kept.append(rates[cut:])
+        cuts.append(cut)
+    grouping = uncorrelated_grouping([_totals(rates, sources, balls) for rates in kept], least, target)
+    rates = np.concatenate([grouped(part, grouping.size) for part in kept])
+    # The batches that fill no group are left out of the averages, so they count as transient.
+    cuts = [cut + len(part) % grouping.size for cut, part in zip(cuts, kept)]
+    totals = _totals(rates, sources, balls)
+    first = batch_rates(np.array(cumulative[0]), base)[: cuts[0], :sources].sum(axis=1)
+    return Settled(
+        rates=rates,
+        checked=np.column_stack([totals, rates[:, : sources + balls]]),
+        cuts=cuts,
+        base=base,
+        grouping=grouping,
+        drifting=grouping.uncorrelated and any(drifts(column, target) for column in totals.T),
+        transient_heat_power=_mean(first),
+    )
 
 
 def _in_each(engines: Sequence[Engine]) -> str:
@@ -137,17 +200,6 @@ def _in_each(engines: Sequence[Engine]) -> str:
 def _totals(rates: np.ndarray, sources: int, balls: int) -> np.ndarray:
     """Each batch's total heat power and its balls' mean velocity term, from rates with the columns of ``_flat``."""
     return np.column_stack([rates[:, :sources].sum(axis=1), rates[:, sources : sources + balls].mean(axis=1)])
-
-
-def _pooled(cumulative: list[list[np.ndarray]], batch: float, sources: int, balls: int) -> tuple[np.ndarray, list[int]]:
-    """The batch rates of every replica after its own start-up transient, stacked, and each replica's cut (batches)."""
-    kept, cuts = [], []
-    for series in cumulative:
-        rates = batch_rates(np.array(series), batch)
-        cut = max(mser_truncation(normalised(column)) for column in _totals(rates, sources, balls).T)
-        kept.append(rates[cut:])
-        cuts.append(cut)
-    return np.concatenate(kept), cuts
 
 
 def least_batches(params: Parameters) -> int:
@@ -174,32 +226,54 @@ def mechanics_limit(params: Parameters) -> tuple[float, str]:
     return params.averaging_max_time, "averaging_max_time"
 
 
-def _means(engines: Sequence[Engine], rates: np.ndarray, sources: int, balls: int, cuts: list[int], rounds: int,
-           batch: float, converged: bool, message: str) -> Means:
-    """The means of the kept batch ``rates`` of every replica (columns: each source's heat, each ball's term, each
-    contact conductance, the dissipation). The conductances are averaged but not held to the target error: a pair
-    of balls that rarely touch has a noisy one, and a small one. ``cuts``: the batches each replica cut of the
-    ``rounds`` it ran. The transient and window are the first replica's, whose motion and impacts a result shows."""
+def _means(engines: Sequence[Engine], settled: Settled, sources: int, balls: int, rounds: int, converged: bool,
+           message: str) -> Means:
+    """The means of the settled, grouped batch rates of every replica (columns: each source's heat, each ball's
+    term, each contact conductance, the dissipation). The conductances are averaged but not held to the target
+    error: a pair of balls that rarely touch has a noisy one, and a small one. ``rounds``: the batches each replica
+    ran. The transient and window are the first replica's, whose motion and impacts a result shows."""
+    rates = settled.rates
     heat, terms, conductances = rates[:, :sources], rates[:, sources : sources + balls], rates[:, sources + balls : -1]
     total_heat, mean_terms = heat.sum(axis=1), terms.mean(axis=1)
-    impacts = sum(len(engine.impact_columns(since=cut * batch)["time"]) for engine, cut in zip(engines, cuts))
-    pooled_window = len(rates) * batch
+    impacts = sum(len(engine.impact_columns(since=cut * settled.base)["time"])
+                  for engine, cut in zip(engines, settled.cuts))
+    pooled_window = sum(rounds - cut for cut in settled.cuts) * settled.base
     averages = MechanicsAverages(
         heat_power=_mean(total_heat),
         heat_power_stderr=standard_error(total_heat),
         dissipated_power=_mean(rates[:, -1]),
         velocity_term=_mean(mean_terms),
         velocity_term_stderr=standard_error(mean_terms),
-        transient=cuts[0] * batch,
-        window=(rounds - cuts[0]) * batch,
+        transient=settled.cuts[0] * settled.base,
+        window=(rounds - settled.cuts[0]) * settled.base,
         batches=len(rates),
         impact_interval=pooled_window / impacts if impacts else math.inf,
         converged=converged,
-        message=message,
+        message=message + _change(settled, _mean(total_heat), standard_error(total_heat)),
         replicas=len(engines),
+        batch_length=settled.batch,
+        batch_autocorrelation=settled.grouping.autocorrelation,
+        transient_heat_power=settled.transient_heat_power,
     )
     load = engines[0].load(*(np.array([_mean(column) for column in part.T]) for part in (heat, terms, conductances)))
     return Means(load, averages)
+
+
+def _change(settled: Settled, heat_power: float, error: float) -> str:
+    """What the run says of a change of regime: a transient whose mean heat power differs from the settled one by
+    more than CHANGE_SHARE and by more than DRIFT_SIGMAS standard errors lasted past the start-up
+    (LEAST_BATCHES_PER_REPLICA batches) is a motion of its own, not the start from rest (MODEL.md §14.2)."""
+    before, cut = settled.transient_heat_power, settled.cuts[0]
+    if cut < LEAST_BATCHES_PER_REPLICA or not math.isfinite(before):
+        return ""
+    if abs(before - heat_power) <= max(CHANGE_SHARE * abs(heat_power), DRIFT_SIGMAS * error):
+        return ""
+    return (f"; the motion changed at t = {cut * settled.base:.3g} s (heat power {before:.3g} W before, "
+            f"{heat_power:.3g} W after): the averages are of the motion after the change")
+
+
+# A transient whose heat power differs from the settled motion's by more than this share is reported as a change.
+CHANGE_SHARE = 0.1
 
 
 def _nothing_moves(engine: Engine, first: Measured) -> Means:

@@ -64,6 +64,11 @@ class MechanicsAverages:
     message: str
     # Independent replicas of the mechanics pooled (solvers/replicas.py); transient and window are the first's.
     replicas: int = 1
+    # The batches after grouping to uncorrelated means (MODEL.md §14.2): their length (s) and the largest |lag-1
+    # autocorrelation| of the total heat and mean velocity term, and the mean heat power of the transient cut (W).
+    batch_length: float = math.nan
+    batch_autocorrelation: float = math.nan
+    transient_heat_power: float = math.nan
 
     def as_summary(self) -> dict[str, float | int | bool | str]:
         return {
@@ -76,6 +81,9 @@ class MechanicsAverages:
             "averaging_window_s": self.window,
             "averaging_batches": self.batches,
             "averaging_replicas": self.replicas,
+            "averaging_batch_s": self.batch_length,
+            "averaging_batch_autocorrelation": self.batch_autocorrelation,
+            "averaging_transient_heat_power_W": self.transient_heat_power,
             "averaging_converged": self.converged,
             "averaging_message": self.message,
         }
