@@ -82,6 +82,13 @@ def judge(name: str, overrides: dict, span: float) -> None:
           f"|r1| {grouping.autocorrelation:.2f}, {verdict}")
     print(f"  error after / before: {after_error / before_error:.2f}; the halves drift: "
           f"{any(drifts(column) for column in after.T)}")
+    # The solver's own rule: a column whose batch means spread less than the target error is known well enough
+    # whatever their correlation (the variance of a mean never exceeds its values').
+    target = getattr(params, "dem_averaging_rel_error")
+    spread = kept.std(axis=0) / np.abs(kept.mean(axis=0))
+    solver = uncorrelated_grouping([kept], params.averaging_min_batches, target)
+    print(f"  the solver's verdict (target {target:g}): batch spread {spread[0]:.2%} (heat), {spread[1]:.2%} (term); "
+          f"{'accepted' if solver.uncorrelated else 'not yet'}: {solver.groups} groups of {solver.size}")
 
 
 def main() -> None:

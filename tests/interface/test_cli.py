@@ -275,6 +275,16 @@ def test_presets_lists_and_shows_values_with_units_and_sources():
     missing = invoke("presets", "nope")
     assert missing.exit_code == 2
     assert_one_error_line(missing.stderr, "unknown preset 'nope'")
+    # The paper's preset has no assumed inputs stated; a 3-D preset shows its own with ranges and reasons.
+    assert "assumed inputs" not in shown.stdout
+    planetary = invoke("presets", "pulverisette7")
+    assert planetary.exit_code == 0
+    for text in ("assumed inputs, no source fixes them", "[0.1, 0.6]", "[1000, 4000] J/K", "log-uniform", "[0.368, 0.5]"):
+        assert text in planetary.stdout, text
+    assert "lateral_amplitude" not in planetary.stdout.split("assumed inputs")[1]
+    listed = invoke("keys", "pair_friction")
+    assert listed.exit_code == 0
+    assert "Assumed, no source fixes it: [0.1, 0.6]" in " ".join(listed.stdout.split())
 
 
 def test_keys_lists_every_key_with_its_allowed_range():

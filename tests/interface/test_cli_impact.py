@@ -63,8 +63,11 @@ def test_settings_reach_the_impact():
 def test_spin_angle_and_ball_target_are_passed_on():
     spinning = invoke("--speed", "1", "--angle", "60", "--spin", "300", "--set", "rolling_friction=0.05", "--json")
     assert json.loads(spinning.stdout)["dissipated_rolling_J"] > 0.0
-    ball = invoke("--speed", "1", "--target", "ball", "--set", "restitution=0.9", "--json", *FINE)
+    ball = invoke("--speed", "1", "--target", "ball", "--set", "pair_restitution=0.9", "--json", *FINE)
     assert json.loads(ball.stdout)["normal_restitution"] == pytest.approx(0.9, abs=1e-3)
+    # The end face's restitution is not the balls': set for a ball target, it is refused, not ignored.
+    refused = invoke("--speed", "1", "--target", "ball", "--set", "restitution=0.9", "--json")
+    assert refused.exit_code == 2 and "restitution: an impact on a ball does not read it" in refused.stderr
 
 
 def test_a_ball_too_large_for_the_default_vial_is_accepted():
@@ -178,7 +181,8 @@ def hertz(mass: float, radius: float, modulus: float, speed: float) -> tuple[flo
 )
 def test_chung_ooi_elastic_normal_impacts_follow_hertz(target, settings):
     speed = 20.0 if target == "ball" else 0.2
-    outcome = impact_json("--speed", str(speed), "--target", target, "--set", "restitution=1", *settings, *FINE)
+    elastic = "pair_restitution=1" if target == "ball" else "restitution=1"
+    outcome = impact_json("--speed", str(speed), "--target", target, "--set", elastic, *settings, *FINE)
     # The command makes the vial large enough for any ball; so does this, for the ball's mass and moduli.
     params = sm.default_parameters(vial_length=1.0, vial_diameter=0.9, **dict(item.split("=", 1) for item in settings[1::2]))
     own = (params.ball_youngs_modulus, params.ball_poisson_ratio)

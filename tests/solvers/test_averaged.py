@@ -151,4 +151,4 @@ def test_a_planetary_charge_that_collapses_into_a_pack_is_averaged_after_the_cha
     assert f"the motion changed at t = {averages.transient:.3g} s" in result.message
     assert result.summary["averaging_transient_heat_power_W"] == averages.transient_heat_power
     # The pack: its dissipation in contacts that last, as measured over the window after the change alone.
-    assert result.summary["stress_lasting_share"] > 0.8
+    assert result.summary["stress_lasting_share"] > 0.8 and result.summary["charge_regime"] == "pack"

@@ -65,7 +65,7 @@ def assert_like_hertz(outcome, mass: float, radius: float, modulus: float, speed
 
 
 def test_chung_ooi_1_two_glass_balls_collide_as_hertz_says():
-    params = parameters(GLASS, LARGE_VIAL, FINE, restitution=1.0, friction=0.35)
+    params = parameters(GLASS, LARGE_VIAL, FINE, pair_restitution=1.0, pair_friction=0.35)
     speed = 20.0  # relative: the benchmark's ±10 m/s
     outcome = single_impact(params, speed, target="ball")
     material = (params.ball_youngs_modulus, params.ball_poisson_ratio)
@@ -93,6 +93,27 @@ def test_steel_restitution_holds_from_slow_to_fast_impacts(speed):
     params = parameters(FINE)
     assert single_impact(params, speed).normal_restitution == pytest.approx(params.restitution, abs=1e-3)
     assert single_impact(params, speed, target="ball").normal_restitution == pytest.approx(params.restitution, abs=1e-3)
+
+
+@pytest.mark.parametrize(("wall", "pair"), [(0.9, 0.5), (0.5, 0.9)])
+def test_two_balls_and_a_ball_on_the_vial_each_restitute_with_their_own_e(wall, pair):
+    """MODEL.md §14.1: ball-ball and ball-wall contacts have their own restitution (pair_restitution, restitution),
+    and neither key moves the other contact."""
+    params = parameters(FINE, restitution=wall, pair_restitution=pair)
+    assert single_impact(params, 1.0).normal_restitution == pytest.approx(wall, abs=1e-3)
+    assert single_impact(params, 1.0, target="ball").normal_restitution == pytest.approx(pair, abs=1e-3)
+
+
+def test_two_balls_and_a_ball_on_the_vial_each_slide_with_their_own_friction():
+    # A steep impact slides throughout: the centre's tangential velocity changes by μ(1+e)v_n (the wall), and by
+    # half of μ(1+e)v_n for a ball on a ball at rest of equal mass (m* = m/2), each with its own μ.
+    angle, speed = 70.0, 1.0
+    params = parameters(FINE, friction=0.1, pair_friction=0.2, restitution=0.7, pair_restitution=0.7)
+    normal = speed * math.cos(math.radians(angle))
+    for target, mu, share in (("wall", 0.1, 1.0), ("ball", 0.2, 0.5)):
+        outcome = single_impact(params, speed, angle_deg=angle, target=target)
+        change = outcome.tangential_speed_in - outcome.tangential_velocity_out_m_s
+        assert change == pytest.approx(share * mu * 1.7 * normal, rel=0.02), target
 
 
 def sliding_predictions(params: sm.Parameters, outcome) -> tuple[float, float, float]:
@@ -228,7 +249,8 @@ def test_a_wall_impact_ends_with_the_motion_it_reports():
 @pytest.mark.parametrize("target", ["wall", "ball"])
 @pytest.mark.parametrize("angle", [0.0, 30.0])
 def test_an_elastic_frictionless_impact_dissipates_nothing(target, angle):
-    outcome = single_impact(parameters(FINER, restitution=1.0, friction=0.0), 2.0, angle, target)
+    elastic = {"restitution": 1.0, "friction": 0.0, "pair_restitution": 1.0, "pair_friction": 0.0}
+    outcome = single_impact(parameters(FINER, **elastic), 2.0, angle, target)
     assert abs(outcome.dissipated_J) < 1e-6 * outcome.kinetic_energy_in_J
 
 
@@ -313,8 +335,14 @@ def test_the_keys_a_lone_impact_does_not_read_are_keys_and_refused_with_why():
     # What the contact law reads stays readable.
     assert not {"ball_radius", "ball_material", "restitution", "friction", "contact_step_fraction"} & set(UNREAD_KEYS)
     with pytest.raises(ParameterError, match="^ball_materials: a lone impact takes the scalar ball keys"):
-        check_keys_read(["restitution", "ball_materials", "fill"])
-    check_keys_read(["restitution", "ball_material"])
+        check_keys_read(["restitution", "ball_materials", "fill"], "wall")
+    check_keys_read(["restitution", "ball_material"], "wall")
+    check_keys_read(["pair_restitution", "pair_friction", "ball_material"], "ball")
+    # Each target reads its own pair's restitution and friction, and refuses the other's.
+    with pytest.raises(ParameterError, match="^pair_friction: an impact on a wall does not read it"):
+        check_keys_read(["pair_friction"], "wall")
+    with pytest.raises(ParameterError, match="^restitution: an impact on a ball does not read it.*pair_restitution"):
+        check_keys_read(["restitution"], "ball")
 
 
 def test_a_coarse_contact_step_is_warned_of_and_the_default_one_is_not():

@@ -7,7 +7,7 @@ import pytest
 
 import shakermill as sm
 from shakermill.engines.dem.engine import DemEngine
-from shakermill.parameters.defaults import HIT_SPEED
+from shakermill.parameters.defaults import FAST_IMPACT_SPEED, HIT_SPEED
 from shakermill.parameters.errors import ParameterError
 from shakermill.solvers.averaged import settle_mechanics, simulate_averaged
 from shakermill.solvers.simulate import thermal_variants
@@ -63,3 +63,6 @@ def test_hits_leave_out_contacts_slower_than_the_hit_speed(base):
     assert 0 < hits.size < speeds.size  # resting balls chatter; flying ones hit
     assert result.summary["hit_rate_hz"] == pytest.approx(hits.size / 2.0)
     assert result.summary["mean_hit_speed_m_s"] == pytest.approx(hits.mean())
+    fast = speeds[speeds >= FAST_IMPACT_SPEED]
+    assert 0 < fast.size < hits.size
+    assert result.summary["fast_impact_rate_hz"] == pytest.approx(fast.size / 2.0)

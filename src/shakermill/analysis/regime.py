@@ -113,3 +113,19 @@ def classify_impacts(settled: ImpactColumns, omega: float, phase: float) -> tupl
         if all(signatures_match(signatures[k], signatures[k + period]) for k in range(len(signatures) - period)):
             return f"period-{period}", period
     return IRREGULAR, None
+
+
+# A charge moves as a pack on the wall when its lasting contacts (over 1 ms: rolling, sliding, resting) take most of
+# the dissipation and its balls hit at over 1 m/s less than once a turn each; otherwise it is active (MODEL.md §14.2:
+# the regime named from the lasting contacts' share and the rate of impacts above 1 m/s).
+PACK = "pack"
+ACTIVE = "active"
+PACK_SHARE = 0.5
+PACK_FAST_IMPACTS_PER_BALL_AND_TURN = 1.0
+
+
+def charge_regime(lasting_share: float, fast_impact_rate: float, n_balls: int, frequency: float) -> str:
+    """:data:`PACK` or :data:`ACTIVE` from the lasting contacts' share of the dissipation, the impacts above 1 m/s a
+    second, the balls and the drive's turns a second (Hz)."""
+    rare = fast_impact_rate < PACK_FAST_IMPACTS_PER_BALL_AND_TURN * n_balls * frequency
+    return PACK if lasting_share >= PACK_SHARE and rare else ACTIVE

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import fnmatch
 import json
-from typing import Annotated, Any, Sequence
+from typing import Annotated, Any, Mapping, Sequence
 
 import typer
 from rich.table import Table
@@ -34,6 +34,13 @@ def presets(
     for key, cited in preset.values.items():
         add_plain_row(table, key, format_value(key, cited.value), cited.source)
     console.print(table)
+    if preset.assumed:
+        assumed = Table("key", "value", "range", "distribution", "reason",
+                        title=f"{preset.name}: assumed inputs, no source fixes them (MODEL.md §14.1)")
+        for key, stated in preset.assumed.items():
+            add_plain_row(assumed, key, format_value(key, preset.values[key].value), stated.shown_range(),
+                          stated.distribution, stated.reason)
+        console.print(assumed)
     if preset.caveat:
         console.print(Text(f"Caveat ({preset.name}): {preset.caveat}"))
 
@@ -108,7 +115,7 @@ def keys(
     """List the canonical parameter keys with unit, allowed values, default and description."""
     from shakermill.parameters.engine_keys import ENGINE_KEYS, reads
     from shakermill.parameters.keys import FIELD_NAMES, allowed_range, field_description
-    from shakermill.parameters.presets import preset_values
+    from shakermill.parameters.presets import PRESETS, preset_values
 
     if engine is not None and engine not in ENGINE_KEYS:
         fail(f"--engine: {engine!r} is no engine; allowed {', '.join(map(repr, ENGINE_KEYS))}")
@@ -128,8 +135,21 @@ def keys(
     table = Table("key", "allowed (SI)", f"default ({DEFAULT_PRESET})", "description", title=title)
     for key in chosen:
         default = format_value(key, defaults[key]) if key in defaults else ""
-        add_plain_row(table, key, allowed_range(key), default, field_description(key))
+        add_plain_row(table, key, allowed_range(key), default, field_description(key) + _assumed_note(key, PRESETS))
     stdout_console().print(table)
+
+
+def _assumed_note(key: str, presets: Mapping[str, Any]) -> str:
+    """Where presets state ``key`` as an assumed input: its ranges and how many presets state each."""
+    ranges: dict[str, int] = {}
+    for preset in presets.values():
+        if key in preset.assumed:
+            shown = preset.assumed[key].shown_range()
+            ranges[shown] = ranges.get(shown, 0) + 1
+    if not ranges:
+        return ""
+    stated = "; ".join(f"{shown} in {count} preset{'s' if count > 1 else ''}" for shown, count in ranges.items())
+    return f". Assumed, no source fixes it: {stated} (`presets NAME`)"
 
 
 def _matches(pattern: str, *texts: str) -> bool:

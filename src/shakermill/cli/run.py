@@ -292,6 +292,9 @@ def several_ball_rows(s: Mapping[str, Any], channels: Sequence[str]) -> list[tup
                      f"{number(s.get('stress_energy_kinetic_median_J'), '.3g')}; {number(s.get('stress_energy_kinetic_p90_J'), '.3g')}", "J"))
         share = s.get("stress_lasting_share")
         rows.append(("dissipation in lasting contacts (not in the medians)", number(None if share is None else 100 * share, ".3g"), "%"))
+    if s.get("charge_regime") is not None:
+        rows.append(("motion (pack: lasting contacts, under one impact > 1 m/s a ball and turn; else active)",
+                     f"{s['charge_regime']}, {number(s.get('fast_impact_rate_hz'), '.4g')} impacts > 1 m/s a second", ""))
     heat = [s.get(f"heat_{channel}_W") for channel in channels]
     if any(value is not None for value in heat):
         # The averaged solver has no split by channel: its heat comes from the thermal network's means.
@@ -379,7 +382,7 @@ def impact(
 
     with user_errors(), nothing_written_when_interrupted("impact writes no files"):
         # Before the parameters are built: a fill would make balls for the impact's own large vial.
-        check_keys_read(parse_overrides(settings or []))
+        check_keys_read(parse_overrides(settings or []), target)
         # A lone impact reads the keys its own way (solvers/impact.py), whatever engine the preset names.
         params = load_config(config, preset=preset, overrides=[*IMPACT_VIAL, *(settings or [])], reader=None).params
         echo_warnings(unit_slip_warnings(params))

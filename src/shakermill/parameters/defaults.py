@@ -31,3 +31,5 @@ MOST_ANIMATION_FRAMES = 300
 # times as often as it is hit (0.1 m/s is a free fall of 0.5 mm). The 'dem' engine's impact counts include
 # that chatter, so the hit rate and speed are what compare with the 1-D model's impacts.
 HIT_SPEED = 0.1
+# Impacts faster than this (m/s) tell an active charge from a pack rolling on the wall (MODEL.md §14.2).
+FAST_IMPACT_SPEED = 1.0

@@ -141,7 +141,11 @@ class Parameters(BaseModel):
     # Collision and heat generation (Table 4)
     # A perfectly plastic contact (0) has no damping ratio. Towards 0 the ball chatters on the face and a
     # run takes more steps (20 times at 0.05, 40 at 1e-6), but it stays correct and finishes.
-    restitution: float = quantity("", "coefficient of restitution e", gt=0, le=1)
+    restitution: float = quantity(
+        "", "coefficient of restitution e of a ball on the vial (every contact of the 1-D engine)", gt=0, le=1
+    )
+    # Ball-ball and ball-wall contacts are different pairs of bodies, each with its own e and μ (MODEL.md §14.1).
+    pair_restitution: float = quantity("", "coefficient of restitution e of two balls (engine = 'dem')", gt=0, le=1)
     eta: float = quantity("", "fraction η of dissipated power turned into heat", ge=0, le=1)
     lam: float = quantity("", "fraction λ of the heat that goes to the ball", ge=0, le=1)
     # β scales Whitaker's correlation, defensible within 0.1-3 (calibrate.DEFENSIBLE_RANGES); 100 leaves
@@ -264,7 +268,8 @@ class Parameters(BaseModel):
         strict=True, json_schema_extra={"description": "gravity 9.81 m/s² downward, the vial axis horizontal (engine = 'dem')"}
     )
     # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
-    friction: float = quantity("", "Coulomb friction coefficient μ of every contact (engine = 'dem')", ge=0, le=5.0)
+    friction: float = quantity("", "Coulomb friction coefficient μ of a ball on the vial (engine = 'dem')", ge=0, le=5.0)
+    pair_friction: float = quantity("", "Coulomb friction coefficient μ of two balls (engine = 'dem')", ge=0, le=5.0)
     rolling_friction: float = quantity("", "rolling resistance coefficient μ_r (engine = 'dem')", ge=0, le=1.0)
     kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc", "planetary"] = choice(
         "vial motion of the 'dem' engine (parameters/kinematic_models.py): 'axial' (amplitude, "

@@ -13,7 +13,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
+from shakermill.parameters.assumed import AssumedInput, inherited_assumed
 from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.engine_keys import READER_FIELDS, Reader
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.geometry import end_faces_area
 from shakermill.parameters.keys import PER_BALL_KEYS, Parameters, build_parameters, material_sources
@@ -39,6 +41,8 @@ class Preset:
     values: Mapping[str, Cited]
     fitted: tuple[str, ...] = ()
     provenance: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+    # The inputs no source fixes, with their ranges (MODEL.md §14.1, parameters/assumed.py).
+    assumed: Mapping[str, AssumedInput] = dataclasses.field(default_factory=dict)
 
     @property
     def covariance(self) -> list[list[float]] | None:
@@ -205,6 +209,10 @@ SPEX_8000M = Preset(
             "assumption: a common choice for dry steel-on-steel contacts in DEM mill studies; not measured for SPEX "
             "media (docs/notes/dem-references.md, section 3), so results should be checked against it",
         ),
+        "pair_friction": Cited(
+            0.3, "assumption: the ball-on-vial friction's common choice for steel on steel, no source of its own"
+        ),
+        "pair_restitution": Cited(0.7, f"{PAPER}, Table 4 (e): the paper's one e, for two balls too (no source of its own)"),
         "rolling_friction": Cited(0.0, "MODEL.md section 12.3: no rolling resistance by default"),
         "kinematics": Cited("axial", f"{PAPER}: the vial moves along its axis (MODEL.md section 12.2)"),
         "motion": Cited((), "used only with kinematics = 'fourier'"),
@@ -249,6 +257,7 @@ def load_preset_file(path: Path, known: Mapping[str, Preset]) -> Preset:
     with path.open("rb") as handle:
         data = tomllib.load(handle)
     provenance = dict(data.pop("provenance", {}))
+    assumed_tables = data.pop("assumed", {})
     base = known[data.pop("preset")]
     fitted = tuple(provenance.get("fitted", ()))
     sources = provenance.get("sources", {})
@@ -257,12 +266,15 @@ def load_preset_file(path: Path, known: Mapping[str, Preset]) -> Preset:
     for key, value in data.items():
         source = note if key in fitted else sources.get(key, f"set in {path.name}")
         values[key] = Cited(tuple(map(tuple, value)) if key == "record_windows" else value, source)
+    plain = {key: cited.value for key, cited in values.items()}
+    reader = Reader(*(plain[field] for field in READER_FIELDS))
     return Preset(
         name=path.stem,
         description=str(provenance.get("description", f"{base.name} with values from {path.name}")),
         values=values,
         fitted=fitted,
         provenance=provenance,
+        assumed=inherited_assumed(base.assumed, assumed_tables, plain, fitted, reader, path.name),
     )
 
 

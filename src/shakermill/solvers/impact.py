@@ -86,11 +86,23 @@ _UNREAD_GROUPS = (
 UNREAD_KEYS: dict[str, str] = {key: why for keys, why in _UNREAD_GROUPS for key in keys}
 
 
-def check_keys_read(keys: Iterable[str]) -> None:
-    """Raise :class:`ParameterError` naming the first of ``keys`` (set explicitly) that a lone impact does not read."""
+# A ball on the end face touches the vial alone, a ball on a ball the other ball alone: each reads its own pair's
+# restitution and friction (MODEL.md §14.1).
+OTHER_PAIR_KEYS = {
+    "wall": (("pair_restitution", "pair_friction"), "two balls' contacts; --target ball reads it"),
+    "ball": (("restitution", "friction"), "a ball on the vial; --target ball reads pair_restitution and pair_friction"),
+}
+
+
+def check_keys_read(keys: Iterable[str], target: str) -> None:
+    """Raise :class:`ParameterError` naming the first of ``keys`` (set explicitly) that a lone impact on ``target``
+    does not read (a target that is none of them is refused by :func:`check_inputs`)."""
+    other, applies = OTHER_PAIR_KEYS.get(target, ((), ""))
     for key in keys:
         if key in UNREAD_KEYS:
             raise ParameterError(f"{key}: {UNREAD_KEYS[key]}")
+        if key in other:
+            raise ParameterError(f"{key}: an impact on a {target} does not read it; it applies to {applies}")
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ import numpy as np
 
 from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
+from shakermill.analysis.regime import charge_regime
 from shakermill.analysis.steady import SteadyState, run_length_note, steady_state
 from shakermill.analysis.stress_energy import stress_spectrum
 from shakermill.engines.records import (
@@ -25,7 +26,7 @@ from shakermill.engines.records import (
 from shakermill.engines.registry import describe
 from shakermill.engines.status import REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
-from shakermill.parameters.defaults import HIT_SPEED
+from shakermill.parameters.defaults import FAST_IMPACT_SPEED, HIT_SPEED
 from shakermill.parameters.keys import Parameters, unit_slip_warnings
 from shakermill.support.presenters import present
 
@@ -326,6 +327,9 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
     summary.update(stress_spectrum(impacts, impact_window, params.stress_energy_thresholds,
                                    summary["dissipated_power_W"], params.ball_masses()).as_summary())
     summary.update(several_ball_summary(result))
+    if describe(params.engine).several_balls and math.isfinite(summary["stress_lasting_share"]):
+        summary["charge_regime"] = charge_regime(summary["stress_lasting_share"], summary["fast_impact_rate_hz"],
+                                                 params.n_balls, params.omega / (2.0 * math.pi))
     if "theta_clamp" in series.variables:
         summary["clamp_C"] = kelvin_to_celsius(float(series["theta_clamp"][-1]))
     if result.steady is not None:
@@ -344,9 +348,11 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
 def _hits(speeds: np.ndarray, window: float) -> dict[str, float]:
     speeds = np.asarray(speeds)
     hits = speeds[speeds >= HIT_SPEED]
+    fast = np.count_nonzero(speeds >= FAST_IMPACT_SPEED)
     return {
         "hit_rate_hz": hits.size / window if window > 0 else math.nan,
         "mean_hit_speed_m_s": float(hits.mean()) if hits.size else math.nan,
+        "fast_impact_rate_hz": fast / window if window > 0 else math.nan,
     }
 
 

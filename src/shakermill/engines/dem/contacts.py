@@ -56,8 +56,10 @@ def wall_gap(position: np.ndarray, radius: float, wall: int, k: Constants, w: Sc
 
 @njit(cache=True, inline="always")
 def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: float, shear_modulus: float,
-              radius: float, mass: float, dt: float, k: Constants, s: State, w: Scratch) -> None:
-    """Normal, tangential and rolling response of a contact (MODEL.md §12.3) into ``w``'s arrays of ``slot``.
+              radius: float, mass: float, beta_e: float, friction: float, dt: float, k: Constants, s: State,
+              w: Scratch) -> None:
+    """Normal, tangential and rolling response of a contact (MODEL.md §12.3) into ``w``'s arrays of ``slot``, with
+    the damping ratio ``beta_e`` and Coulomb coefficient ``friction`` of its pair of bodies.
 
     ``w.normal`` points into ball i; ``w.point_velocity`` is i's contact point's velocity relative to the
     other body's. Updates the tangential spring and the running contact's record in place.
@@ -69,7 +71,7 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     # step's earlier part, which in free flight can be far longer than a contact step.
     stretching = dt if c.active[slot] else 0.0
     elastic = contact.hertz_force(overlap, modulus, radius)
-    damping = contact.damping_coefficient(overlap, mass, radius, modulus, k.beta_e)
+    damping = contact.damping_coefficient(overlap, mass, radius, modulus, beta_e)
     magnitude = contact.contact_force(elastic, damping, -approach, k.no_tension)
     w.elastic_energy[slot] = contact.elastic_energy(overlap, modulus, radius)
     spring = c.spring[slot]
@@ -81,9 +83,9 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     if turned > 0.0:
         scaled_into(spring, length / turned, spring)
     stiffness = contact.tangential_stiffness(shear_modulus, radius, overlap)
-    damping_t = contact.tangential_damping(k.beta_e, stiffness, mass)
+    damping_t = contact.tangential_damping(beta_e, stiffness, mass)
     pressing = max(magnitude, 0.0)
-    limit = k.friction * pressing
+    limit = friction * pressing
     c.slip_loss[slot] = 0.0
     for axis in range(3):
         sliding = relative[axis] - approach * normal[axis]
@@ -162,10 +164,13 @@ def _contact_point_velocity(ball: int, lever_sign: float, s: State, w: Scratch, 
 def _engage(slot: int, t: float, overlap: float, modulus: float, shear_modulus: float, radius: float, mass: float,
             ball_radius: float, dt: float, k: Constants, s: State, w: Scratch, live: int) -> int:
     """A touching slot (ball pair or wall): start its record if it is new, its response with these effective
-    values, the tangential force's torque on ball i (of radius ``ball_radius``); returns the live-slot count."""
+    values and its pair's restitution and friction, the tangential force's torque on ball i (of radius
+    ``ball_radius``); returns the live-slot count."""
     if not s.contacts.active[slot]:
         _touch(slot, t, s, w)
-    _response(slot, overlap, w.relative_spin, modulus, shear_modulus, radius, mass, dt, k, s, w)
+    pair = slot < k.n_balls * k.n_balls
+    beta_e, friction = (k.pair_beta_e, k.pair_friction) if pair else (k.beta_e, k.friction)
+    _response(slot, overlap, w.relative_spin, modulus, shear_modulus, radius, mass, beta_e, friction, dt, k, s, w)
     scaled_into(w.normal, -ball_radius, w.lever)
     cross_into(w.lever, w.tangential_force[slot], w.lever_torque_i[slot])
     w.touching[slot] = True

@@ -74,9 +74,12 @@ class Constants(NamedTuple):
     conductivity: np.ndarray  # (N,) W/(m·K)
     vial_effusivity: float
     vial_conductivity: float
+    # Damping ratio and Coulomb coefficient of a ball on the vial (beta_e, friction) and of two balls (pair_*).
     beta_e: float
+    pair_beta_e: float
     no_tension: bool
     friction: float
+    pair_friction: float
     rolling_friction: float
     eta: float
     lam: float
@@ -249,8 +252,10 @@ def constants_from(params: Parameters) -> Constants:
         vial_effusivity=vial_effusivity,
         vial_conductivity=params.vial_conductivity,
         beta_e=contact.damping_ratio(params.restitution),
+        pair_beta_e=contact.damping_ratio(params.pair_restitution),
         no_tension=params.no_tension,
         friction=params.friction,
+        pair_friction=params.pair_friction,
         rolling_friction=params.rolling_friction,
         eta=params.eta,
         lam=params.lam,

@@ -1,0 +1,369 @@
+"""An answer over its assumed inputs (MODEL.md §14.1, issue 36): a quasi-random ensemble, its 5/50/95 % points,
+the variance-based sensitivity of each headline, and the motion regimes its members fell into.
+
+The members are a scrambled Sobol' design (``scipy.stats.qmc``) over the assumed inputs' ranges, each mapped
+through its distribution, run as the points of a sweep (``studies/sweep.py``: in parallel, on the local pool or a
+Dask cluster, stored one file a member, resumable, the same numbers whatever the number of workers). The
+headlines' 5, 50 and 95 % points are those of the members: the design samples the inputs' distribution evenly.
+Sobol' indices need far more runs than an ensemble can afford (N·(d + 2) for d inputs), so they are computed
+(SALib, Saltelli's design and Jansen's estimators) on a Gaussian-process surrogate fitted to the members
+(scikit-learn), whose own error is measured on members it did not see (k-fold cross-validation): an index
+of a headline the surrogate does not predict is not reported.
+
+A calibrated preset's fitted keys are not assumed inputs but they are uncertain: their posterior joins the design
+(MODEL.md §14.1: the interval of a calibrated prediction carries the posterior of the fitted keys, the assumed inputs
+not fitted, and the averaging error of the mechanics, the members' own noise). It enters as a Gaussian in the
+keys' logarithms with the mean and covariance of the calibration's posterior samples, drawn through independent
+normals ξ (log v = mean + L·ξ, L its Cholesky factor), so that each ξ is an input of its own: "KEY (fitted)", the
+part of that key's spread the keys before it do not explain.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from shakermill.analysis.regime import ACTIVE, PACK, charge_regime
+from shakermill.parameters.assumed import AssumedInput, parse_assumption
+from shakermill.parameters.engine_keys import reader_of
+from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import Parameters
+from shakermill.parameters.presets import Preset
+from shakermill.studies.sweep import ProgressCallback, sweep
+
+# The headlines an ensemble reports: summary key -> (what it is, unit). Rises are computed from the end and
+# steady temperatures and the run's starting temperature.
+HEADLINES: dict[str, tuple[str, str]] = {
+    "ball_rise_K": ("balls' mean rise at the end", "K"),
+    "vial_rise_K": ("vial's rise at the end", "K"),
+    "air_rise_K": ("air's rise at the end", "K"),
+    "ball_steady_rise_K": ("balls' mean rise at steady state", "K"),
+    "vial_steady_rise_K": ("vial's rise at steady state", "K"),
+    "heat_power_W": ("heat power", "W"),
+    "impact_rate_hz": ("impact rate", "1/s"),
+    "fast_impact_rate_hz": ("impacts above 1 m/s", "1/s"),
+    "stress_energy_median_J": ("stress energy, median", "J"),
+    "stress_energy_p90_J": ("stress energy, 90th percentile", "J"),
+    "stress_lasting_share": ("share of the dissipation in lasting contacts", ""),
+}
+RISES = {"ball_rise_K": "ball_C", "vial_rise_K": "vial_C", "air_rise_K": "air_C",
+         "ball_steady_rise_K": "ball_steady_C", "vial_steady_rise_K": "vial_steady_C"}
+POWER_ABOVE = "stress_power_above_"
+QUANTILES = (0.05, 0.5, 0.95)
+# The surrogate's cross-validated Q² below which its Sobol' indices are not reported, and its folds.
+LEAST_Q2 = 0.5
+FOLDS = 5
+# A headline whose members spread less than this share of its size does not depend on the inputs: a part in a
+# million is the integrators' tolerance, not a sensitivity.
+STEADY_SPREAD = 1e-6
+# Base samples of Saltelli's design on the surrogate: N·(d + 2) predictions.
+SALTELLI_BASE = 1024
+# The fewest members (a power of two) and the most.
+LEAST_MEMBERS, MOST_MEMBERS = 8, 4096
+
+
+@dataclass(frozen=True)
+class FittedPosterior:
+    """A calibration's fitted keys as a Gaussian in their logarithms (:func:`fitted_posterior`)."""
+
+    keys: tuple[str, ...]
+    mean: np.ndarray
+    factor: np.ndarray  # lower Cholesky factor of the covariance of the logarithms
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(f"{key} (fitted)" for key in self.keys)
+
+    def values(self, unit: np.ndarray) -> np.ndarray:
+        """The keys' values (last axis) at points of the unit cube, one independent normal per key."""
+        from scipy.stats import norm
+
+        return np.exp(self.mean + norm.ppf(unit) @ self.factor.T)
+
+    def unit(self, values: np.ndarray) -> np.ndarray:
+        """The inverse of :meth:`values`."""
+        from scipy.linalg import solve_triangular
+        from scipy.stats import norm
+
+        normals = solve_triangular(self.factor, (np.log(values) - self.mean).T, lower=True).T
+        return norm.cdf(normals)
+
+    def as_dict(self) -> dict[str, Any]:
+        spread = np.sqrt(np.diag(self.factor @ self.factor.T))
+        return {key: {"median": float(np.exp(centre)), "log_sd": float(sd)}
+                for key, centre, sd in zip(self.keys, self.mean, spread)}
+
+
+def fitted_posterior(keys: Sequence[str], samples: Sequence[Sequence[float]] | None) -> FittedPosterior | None:
+    """The posterior of ``keys`` from a calibration's samples of their logarithms; None without enough samples to
+    estimate a covariance."""
+    if not keys or samples is None or len(samples) <= len(keys):
+        return None
+    logs = np.asarray(samples, dtype=float)
+    return FittedPosterior(tuple(keys), logs.mean(axis=0), np.linalg.cholesky(np.cov(logs, rowvar=False)))
+
+
+@dataclass(frozen=True)
+class HeadlineSpread:
+    """One headline over the ensemble: its quantiles, and its Sobol' indices per input where the surrogate
+    predicts it (``surrogate_q2`` ≥ LEAST_Q2)."""
+
+    key: str
+    label: str
+    unit: str
+    quantiles: tuple[float, float, float]
+    surrogate_q2: float
+    first: Mapping[str, float] = field(default_factory=dict)
+    total: Mapping[str, float] = field(default_factory=dict)
+    # False where every member gave the same value (to round-off): no input decides it.
+    varies: bool = True
+
+    @property
+    def deciding(self) -> list[str]:
+        """The inputs by total Sobol' index, largest first (none without a surrogate that predicts)."""
+        return sorted(self.total, key=lambda key: -self.total[key])
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"label": self.label, "unit": self.unit, **dict(zip(("p5", "p50", "p95"), self.quantiles)),
+                "surrogate_q2": self.surrogate_q2, "sobol_first": dict(self.first), "sobol_total": dict(self.total),
+                "deciding": self.deciding[:3], "varies": self.varies}
+
+
+@dataclass(frozen=True)
+class Ensemble:
+    """What an ensemble found: its inputs, members, headlines, regimes and the folder that holds its members."""
+
+    inputs: tuple[AssumedInput, ...]
+    posterior: FittedPosterior | None
+    members: int
+    failed: int
+    headlines: tuple[HeadlineSpread, ...]
+    regimes: Mapping[str, Mapping[str, Any]]
+    folder: Path
+    table: pd.DataFrame = field(repr=False)
+
+    def headline(self, key: str) -> HeadlineSpread:
+        return next(spread for spread in self.headlines if spread.key == key)
+
+    def as_dict(self) -> dict[str, Any]:
+        """Everything as plain JSON: a number that is not finite (a quantile of no member, an unmeasured Q²) is null."""
+        return _finite({
+            "members": self.members,
+            "failed": self.failed,
+            "inputs": [{"key": item.key, "low": item.low, "high": item.high, "distribution": item.distribution,
+                        "reason": item.reason} for item in self.inputs],
+            "fitted": None if self.posterior is None else self.posterior.as_dict(),
+            "headlines": {spread.key: spread.as_dict() for spread in self.headlines},
+            "regimes": {name: dict(regime) for name, regime in self.regimes.items()},
+            "folder": str(self.folder),
+        })
+
+
+def _finite(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {key: _finite(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(item) for item in value]
+    return None if isinstance(value, float) and not math.isfinite(value) else value
+
+
+def ensemble_inputs(preset: Preset, params: Parameters, assume: Sequence[str], vary: Sequence[str]
+                    ) -> tuple[list[AssumedInput], FittedPosterior | None]:
+    """What an ensemble of ``params`` varies: the assumed inputs ``preset`` states that the run reads, replaced or
+    joined by the user's ranges (``assume``: ``KEY=LOW:HIGH[:DIST]``), only those named in ``vary`` where it names
+    some; and, varying all, the posterior of the keys the preset's calibration fitted, where the run keeps their
+    fitted values (a run that sets one asks about its own value, not the calibration's)."""
+    reader = reader_of(params)
+    stated = {key: item for key, item in preset.assumed.items() if reader.not_read(key) is None}
+    inputs = {**stated, **{item.key: item for item in (parse_assumption(text, reader) for text in assume)}}
+    missing = [key for key in vary if key not in inputs]
+    if missing:
+        raise ParameterError(f"--vary {missing[0]}: no range is stated for it; give one with --assume "
+                             f"{missing[0]}=LOW:HIGH (stated: {', '.join(inputs) or 'none'})")
+    if vary:
+        return [inputs[key] for key in dict.fromkeys(vary)], None
+    keeps_fit = all(getattr(params, key) == preset.values[key].value for key in preset.fitted)
+    return list(inputs.values()), fitted_posterior(preset.fitted, preset.posterior) if keeps_fit else None
+
+
+def design(inputs: Sequence[AssumedInput], members: int, seed: int,
+           posterior: FittedPosterior | None = None) -> list[dict[str, float]]:
+    """``members`` points (a power of two) of a scrambled Sobol' design over ``inputs`` and the ``posterior``'s
+    normals, each value drawn through its input's distribution."""
+    from scipy.stats import qmc
+
+    fitted = () if posterior is None else posterior.keys
+    unit = qmc.Sobol(len(inputs) + len(fitted), scramble=True, seed=seed).random_base2(int(math.log2(members)))
+    values = from_unit(inputs, unit[:, : len(inputs)])
+    if posterior is not None:
+        values = np.column_stack([values, posterior.values(unit[:, len(inputs) :])])
+    keys = [item.key for item in inputs] + list(fitted)
+    return [{key: float(value) for key, value in zip(keys, row)} for row in values]
+
+
+def from_unit(inputs: Sequence[AssumedInput], unit: np.ndarray) -> np.ndarray:
+    """Points of the unit cube (last axis: the inputs) mapped onto the inputs' ranges by their distributions."""
+    values = np.empty_like(unit, dtype=float)
+    for column, item in enumerate(inputs):
+        share = unit[..., column]
+        if item.distribution == "log-uniform":
+            values[..., column] = np.exp(np.log(item.low) + share * (np.log(item.high) - np.log(item.low)))
+        else:
+            values[..., column] = item.low + share * (item.high - item.low)
+    return values
+
+
+def to_unit(inputs: Sequence[AssumedInput], values: np.ndarray) -> np.ndarray:
+    """The inverse of :func:`from_unit`."""
+    unit = np.empty_like(values, dtype=float)
+    for column, item in enumerate(inputs):
+        if item.distribution == "log-uniform":
+            unit[..., column] = np.log(values[..., column] / item.low) / np.log(item.high / item.low)
+        else:
+            unit[..., column] = (values[..., column] - item.low) / (item.high - item.low)
+    return unit
+
+
+def check_members(members: int) -> None:
+    if members < LEAST_MEMBERS or members > MOST_MEMBERS or members & (members - 1):
+        raise ParameterError(f"members: {members} is not allowed; a power of two in [{LEAST_MEMBERS}, {MOST_MEMBERS}]"
+                             " (a Sobol' design is balanced at powers of two)")
+
+
+def design_seed(base: Parameters, inputs: Sequence[AssumedInput]) -> int:
+    """The design's seed: a hash of the configuration and the inputs' ranges, so that the same ensemble asked for
+    twice has the same members (and resumes)."""
+    text = json.dumps([base.model_dump(mode="json"), [vars(item) for item in inputs]], sort_keys=True, default=str)
+    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:4], "big")
+
+
+def run_ensemble(base: Parameters, inputs: Sequence[AssumedInput], out_dir: Path | str, members: int,
+                 workers: int | None = None, scheduler: str | None = None,
+                 progress: ProgressCallback | None = None, *, preset: str,
+                 posterior: FittedPosterior | None = None) -> Ensemble:
+    """Run ``base`` at ``members`` points of a Sobol' design over ``inputs`` and the fitted keys' ``posterior`` (a
+    sweep stored in ``out_dir``, resumed where an earlier run of the same ensemble stopped) and analyse the members
+    (:func:`analyse`)."""
+    check_members(members)
+    if not inputs and posterior is None:
+        raise ParameterError("assumed inputs: none to vary; the preset states none that this run reads, give some "
+                             "with --assume KEY=LOW:HIGH")
+    seed = design_seed(base, inputs) + (0 if posterior is None else 1)
+    points = design(inputs, members, seed, posterior)
+    table = sweep(base, points, out_dir, workers=workers, scheduler=scheduler, progress=progress, preset=preset)
+    return analyse(table, inputs, Path(out_dir), posterior)
+
+
+def analyse(table: pd.DataFrame, inputs: Sequence[AssumedInput], folder: Path,
+            posterior: FittedPosterior | None = None) -> Ensemble:
+    """The quantiles, Sobol' indices and regimes of an ensemble's members (the sweep ``table``)."""
+    finished = table[table["error"].isna()].copy() if "error" in table else table.copy()
+    for rise, end in RISES.items():
+        if end in finished:
+            finished[rise] = finished[end] - finished["initial_temperature_C"]
+    keys = [key for key in (*HEADLINES, *sorted(c for c in finished if c.startswith(POWER_ABOVE))) if key in finished]
+    unit = to_unit(inputs, finished[[item.key for item in inputs]].to_numpy(dtype=float))
+    names = [item.key for item in inputs]
+    if posterior is not None:
+        unit = np.column_stack([unit, posterior.unit(finished[list(posterior.keys)].to_numpy(dtype=float))])
+        names += posterior.names
+    headlines = tuple(_spread(key, finished[key].to_numpy(dtype=float), unit, names) for key in keys)
+    return Ensemble(tuple(inputs), posterior, len(table), len(table) - len(finished), headlines,
+                    _regimes(finished, keys), folder, finished)
+
+
+def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]) -> HeadlineSpread:
+    label, symbol = HEADLINES.get(key, (_power_label(key), "W"))
+    good = np.isfinite(values)
+    quantiles = tuple(float(q) for q in np.quantile(values[good], QUANTILES)) if good.any() else (math.nan,) * 3
+    varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * np.max(np.abs(values[good]))
+    if not varies:
+        return HeadlineSpread(key, label, symbol, quantiles, math.nan, varies=False)
+    q2, first, total = _sensitivity(unit[good], values[good], names)
+    return HeadlineSpread(key, label, symbol, quantiles, q2, first, total)
+
+
+def _power_label(key: str) -> str:
+    return f"power in impacts above {key.removeprefix(POWER_ABOVE).removesuffix('_W')}"
+
+
+def _sensitivity(unit: np.ndarray, values: np.ndarray, names: Sequence[str]
+                 ) -> tuple[float, dict[str, float], dict[str, float]]:
+    """The surrogate's cross-validated Q² and, where it reaches LEAST_Q2, the first and total Sobol' indices of
+    each input computed on it."""
+    if len(values) < FOLDS:
+        return math.nan, {}, {}
+    q2 = _cross_validated_q2(unit, values)
+    if not q2 >= LEAST_Q2:
+        return q2, {}, {}
+    from SALib.analyze import sobol as sobol_analyse
+    from SALib.sample import sobol as sobol_sample
+
+    problem = {"num_vars": len(names), "names": list(names), "bounds": [[0.0, 1.0]] * len(names)}
+    samples = sobol_sample.sample(problem, SALTELLI_BASE, calc_second_order=False, seed=1)
+    predicted = _surrogate(unit, values).predict(samples)
+    indices = sobol_analyse.analyze(problem, predicted, calc_second_order=False, seed=1)
+    return q2, dict(zip(names, map(float, indices["S1"]))), dict(zip(names, map(float, indices["ST"])))
+
+
+def _surrogate(unit: np.ndarray, values: np.ndarray) -> Any:
+    """A Gaussian process with one length scale per input (Matérn 5/2) and a noise term for the averaging error."""
+    from sklearn.exceptions import ConvergenceWarning
+    from sklearn.gaussian_process import GaussianProcessRegressor
+    from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
+
+    kernel = ConstantKernel(1.0) * Matern(length_scale=np.ones(unit.shape[1]), length_scale_bounds=(1e-2, 1e3),
+                                          nu=2.5) + WhiteKernel(1e-3, noise_level_bounds=(1e-8, 1.0))
+    regressor = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=2, random_state=0)
+    # A length scale at its upper bound is an input the headline does not depend on: an answer, not a problem.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        return regressor.fit(unit, values)
+
+
+def _cross_validated_q2(unit: np.ndarray, values: np.ndarray) -> float:
+    """1 − (sum of squared errors on held-out members)/(their sum of squares about the mean), over FOLDS folds."""
+    from sklearn.model_selection import KFold
+
+    predicted = np.empty_like(values)
+    for train, test in KFold(FOLDS, shuffle=True, random_state=0).split(unit):
+        predicted[test] = _surrogate(unit[train], values[train]).predict(unit[test])
+    return float(1.0 - np.sum((values - predicted) ** 2) / np.sum((values - values.mean()) ** 2))
+
+
+REGIME_FEATURES = ("stress_lasting_share", "fast_impact_rate_hz", "n_balls", "omega_hz")
+
+
+def _named_regimes(rows: pd.DataFrame) -> np.ndarray | None:
+    """Each member's regime as its summary names it, or from its features where a several-ball engine's member was
+    stored before summaries named it; None for an engine that names none."""
+    if rows.empty:
+        return None
+    if "charge_regime" in rows and rows["charge_regime"].notna().all():
+        return rows["charge_regime"].to_numpy()
+    if "ball_ball_impacts" in rows and all(key in rows for key in REGIME_FEATURES):
+        return np.array([charge_regime(*values) for values in rows[list(REGIME_FEATURES)].itertuples(index=False)])
+    return None
+
+
+def _regimes(finished: pd.DataFrame, keys: Sequence[str]) -> dict[str, dict[str, Any]]:
+    """Each regime's share of the members and its headlines' medians (MODEL.md §14.2)."""
+    named = _named_regimes(finished)
+    if named is None:
+        return {}
+    regimes = {}
+    for name in (ACTIVE, PACK):
+        members = named == name
+        if members.any():
+            chosen = finished[members]
+            regimes[name] = {"share": float(members.mean()), "members": int(members.sum()),
+                             "medians": {key: float(chosen[key].median()) for key in keys}}
+    return regimes
