@@ -135,3 +135,19 @@ def test_a_calibrations_posterior_joins_the_design_as_independent_normals(tmp_pa
     assert ensemble.headline("heat_power_W").deciding[0] == "drive_heat (fitted)"
     assert set(ensemble.as_dict()["fitted"]) == {"drive_heat", "clamp_heat_capacity"}
     assert fitted_posterior(("drive_heat",), [[1.0]]) is None
+
+
+def test_the_interval_is_split_into_its_named_parts(tmp_path: Path):
+    # heat = 4·u + 2·ξ-part + noise: the assumed input, the posterior and the members' own noise each take a share.
+    rng = np.random.default_rng(12)
+    samples = rng.normal([np.log(20.0)], [0.2], size=(300, 1))
+    posterior = fitted_posterior(("drive_heat",), samples.tolist())
+    points = design([LINEAR], 64, seed=13, posterior=posterior)
+    friction = np.array([point["friction"] for point in points])
+    drive = np.log([point["drive_heat"] for point in points])
+    heat = 4.0 * friction + 2.0 * (drive - np.log(20.0)) / 0.2 * 0.3 + rng.normal(0.0, 0.2, size=64)
+    parts = analyse(members_table(points, heat), [LINEAR], tmp_path, posterior).headline("heat_power_W").parts
+    # Variances: 16/12 = 1.33 (assumed), 0.6² = 0.36 (posterior), 0.04 (noise): shares 0.77, 0.21, 0.02.
+    assert parts["assumed inputs"] == pytest.approx(0.77, abs=0.08)
+    assert parts["fitted keys' posterior"] == pytest.approx(0.21, abs=0.06)
+    assert 0.0 < parts["averaging noise"] < 0.08

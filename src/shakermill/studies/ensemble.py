@@ -66,6 +66,8 @@ FOLDS = 5
 STEADY_SPREAD = 1e-6
 # Base samples of Saltelli's design on the surrogate: N·(d + 2) predictions.
 SALTELLI_BASE = 1024
+# How the design names a fitted key's normal.
+FITTED_SUFFIX = " (fitted)"
 # The fewest members (a power of two) and the most.
 LEAST_MEMBERS, MOST_MEMBERS = 8, 4096
 
@@ -80,7 +82,7 @@ class FittedPosterior:
 
     @property
     def names(self) -> tuple[str, ...]:
-        return tuple(f"{key} (fitted)" for key in self.keys)
+        return tuple(f"{key}{FITTED_SUFFIX}" for key in self.keys)
 
     def values(self, unit: np.ndarray) -> np.ndarray:
         """The keys' values (last axis) at points of the unit cube, one independent normal per key."""
@@ -108,7 +110,7 @@ def fitted_posterior(keys: Sequence[str], samples: Sequence[Sequence[float]] | N
     if not keys or samples is None or len(samples) <= len(keys):
         return None
     logs = np.asarray(samples, dtype=float)
-    return FittedPosterior(tuple(keys), logs.mean(axis=0), np.linalg.cholesky(np.cov(logs, rowvar=False)))
+    return FittedPosterior(tuple(keys), logs.mean(axis=0), np.linalg.cholesky(np.atleast_2d(np.cov(logs, rowvar=False))))
 
 
 @dataclass(frozen=True)
@@ -125,6 +127,10 @@ class HeadlineSpread:
     total: Mapping[str, float] = field(default_factory=dict)
     # False where every member gave the same value (to round-off): no input decides it.
     varies: bool = True
+    # The interval's parts (MODEL.md §14.1): the total Sobol' index of the assumed inputs together and of the
+    # fitted keys' posterior together, as shares of the members' variance, and the share of the members' own noise
+    # (the averaging error of the mechanics, the surrogate's white noise).
+    parts: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def deciding(self) -> list[str]:
@@ -134,7 +140,7 @@ class HeadlineSpread:
     def as_dict(self) -> dict[str, Any]:
         return {"label": self.label, "unit": self.unit, **dict(zip(("p5", "p50", "p95"), self.quantiles)),
                 "surrogate_q2": self.surrogate_q2, "sobol_first": dict(self.first), "sobol_total": dict(self.total),
-                "deciding": self.deciding[:3], "varies": self.varies}
+                "deciding": self.deciding[:3], "varies": self.varies, "parts": dict(self.parts)}
 
 
 @dataclass(frozen=True)
@@ -287,31 +293,49 @@ def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]
     varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * np.max(np.abs(values[good]))
     if not varies:
         return HeadlineSpread(key, label, symbol, quantiles, math.nan, varies=False)
-    q2, first, total = _sensitivity(unit[good], values[good], names)
-    return HeadlineSpread(key, label, symbol, quantiles, q2, first, total)
+    q2, first, total, parts = _sensitivity(unit[good], values[good], names)
+    return HeadlineSpread(key, label, symbol, quantiles, q2, first, total, parts=parts)
 
 
 def _power_label(key: str) -> str:
     return f"power in impacts above {key.removeprefix(POWER_ABOVE).removesuffix('_W')}"
 
 
+ASSUMED_PART, POSTERIOR_PART, NOISE_PART = "assumed inputs", "fitted keys' posterior", "averaging noise"
+
+
 def _sensitivity(unit: np.ndarray, values: np.ndarray, names: Sequence[str]
-                 ) -> tuple[float, dict[str, float], dict[str, float]]:
+                 ) -> tuple[float, dict[str, float], dict[str, float], dict[str, float]]:
     """The surrogate's cross-validated Q² and, where it reaches LEAST_Q2, the first and total Sobol' indices of
-    each input computed on it."""
+    each input computed on it, and the interval's parts (:attr:`HeadlineSpread.parts`)."""
     if len(values) < FOLDS:
-        return math.nan, {}, {}
+        return math.nan, {}, {}, {}
     q2 = _cross_validated_q2(unit, values)
     if not q2 >= LEAST_Q2:
-        return q2, {}, {}
+        return q2, {}, {}, {}
+    surrogate = _surrogate(unit, values)
+    first, total = _sobol(surrogate, list(names))
+    groups = [POSTERIOR_PART if name.endswith(FITTED_SUFFIX) else ASSUMED_PART for name in names]
+    # The surrogate's targets are scaled to unit variance: its white noise is the members' own share.
+    noise = min(float(surrogate.kernel_.k2.noise_level), 1.0)
+    by_group = _sobol(surrogate, list(names), groups)[1] if len(set(groups)) > 1 else {groups[0]: 1.0}
+    parts = {group: (1.0 - noise) * share for group, share in by_group.items()} | {NOISE_PART: noise}
+    return q2, first, total, parts
+
+
+def _sobol(surrogate: Any, names: list[str], groups: list[str] | None = None) -> tuple[dict[str, float], dict[str, float]]:
+    """First and total Sobol' indices (SALib: Saltelli's design, Jansen's estimators) of the ``surrogate``'s mean over
+    the unit cube of ``names``, of each input or, with ``groups``, of each group of them."""
     from SALib.analyze import sobol as sobol_analyse
     from SALib.sample import sobol as sobol_sample
 
-    problem = {"num_vars": len(names), "names": list(names), "bounds": [[0.0, 1.0]] * len(names)}
+    problem: dict[str, Any] = {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
+    if groups is not None:
+        problem["groups"] = groups
     samples = sobol_sample.sample(problem, SALTELLI_BASE, calc_second_order=False, seed=1)
-    predicted = _surrogate(unit, values).predict(samples)
-    indices = sobol_analyse.analyze(problem, predicted, calc_second_order=False, seed=1)
-    return q2, dict(zip(names, map(float, indices["S1"]))), dict(zip(names, map(float, indices["ST"])))
+    indices = sobol_analyse.analyze(problem, surrogate.predict(samples), calc_second_order=False, seed=1)
+    labels = list(dict.fromkeys(groups)) if groups is not None else names
+    return dict(zip(labels, map(float, indices["S1"]))), dict(zip(labels, map(float, indices["ST"])))
 
 
 def _surrogate(unit: np.ndarray, values: np.ndarray) -> Any:

@@ -6,7 +6,14 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from shakermill.studies.ensemble import LEAST_Q2, Ensemble, HeadlineSpread
+from shakermill.studies.ensemble import (
+    ASSUMED_PART,
+    LEAST_Q2,
+    NOISE_PART,
+    POSTERIOR_PART,
+    Ensemble,
+    HeadlineSpread,
+)
 from shakermill.support.version import __version__
 from shakermill.views.html import (
     check_page_target,
@@ -17,7 +24,8 @@ from shakermill.views.html import (
 )
 from shakermill.views.notebook import esc
 
-HEADLINE_HEADERS = ("headline", "unit", "5 %", "50 %", "95 %", "surrogate Q²", "deciding inputs (total Sobol' index)")
+HEADLINE_HEADERS = ("headline", "unit", "5 %", "50 %", "95 %", "surrogate Q²", "deciding inputs (total Sobol' index)",
+                    "variance: assumed; posterior; noise")
 INPUT_HEADERS = ("input", "range", "distribution", "reason")
 REGIME_NOTE = ("pack: lasting contacts (over 1 ms) take most of the dissipation and the balls hit at over 1 m/s less "
                "than once a turn each; active: otherwise (MODEL.md §14.2).")
@@ -37,9 +45,18 @@ def deciding_text(spread: HeadlineSpread, most: int = 3) -> str:
     return ", ".join(f"{key} {spread.total[key]:.2f}" for key in spread.deciding[:most])
 
 
+def parts_text(spread: HeadlineSpread) -> str:
+    """The interval's parts (MODEL.md §14.1): the assumed inputs', the fitted keys' posterior's and the members' own
+    noise's shares of the variance."""
+    if not spread.parts:
+        return "n/a"
+    return "; ".join(f"{spread.parts[part]:.2f}" if part in spread.parts else "—"
+                     for part in (ASSUMED_PART, POSTERIOR_PART, NOISE_PART))
+
+
 def headline_rows(ensemble: Ensemble) -> list[tuple[str, ...]]:
     return [(spread.label, spread.unit, *map(_value, spread.quantiles), _value(spread.surrogate_q2),
-             deciding_text(spread)) for spread in ensemble.headlines]
+             deciding_text(spread), parts_text(spread)) for spread in ensemble.headlines]
 
 
 def input_rows(ensemble: Ensemble) -> list[tuple[str, ...]]:
@@ -70,8 +87,10 @@ def render_ensemble_page(ensemble: Ensemble, title: str) -> str:
                   f"{'' if ensemble.posterior is None else ' and the posterior of the fitted keys'} (MODEL.md §14.1)."
                   f"{failed} The 5, 50 and 95 % points are the members'; the Sobol' indices are "
                   "computed on a Gaussian-process surrogate of the members, and reported only where it predicts "
-                  f"members it did not see with Q² ≥ {LEAST_Q2:g}.", "note"),
-        section("Headlines", table(HEADLINE_HEADERS, headline_rows(ensemble), numeric=(2, 3, 4, 5))),
+                  f"members it did not see with Q² ≥ {LEAST_Q2:g}. The variance of a headline is split into the "
+                  "total index of the assumed inputs together, of the fitted keys' posterior together, and the "
+                  "members' own noise (the averaging error of the mechanics).", "note"),
+        section("Headlines", table(HEADLINE_HEADERS, headline_rows(ensemble), numeric=(2, 3, 4, 5, 7))),
         section("Regimes", paragraph(REGIME_NOTE), table(REGIME_HEADERS, regime_rows(ensemble), numeric=(1, 2, 3, 4, 5))
                 if ensemble.regimes else paragraph(NO_REGIMES)),
         section("Assumed inputs", table(INPUT_HEADERS, input_rows(ensemble))),
