@@ -150,4 +150,4 @@ def test_the_interval_is_split_into_its_named_parts(tmp_path: Path):
     # Variances: 16/12 = 1.33 (assumed), 0.6² = 0.36 (posterior), 0.04 (noise): shares 0.77, 0.21, 0.02.
     assert parts["assumed inputs"] == pytest.approx(0.77, abs=0.08)
     assert parts["fitted keys' posterior"] == pytest.approx(0.21, abs=0.06)
-    assert 0.0 < parts["averaging noise"] < 0.08
+    assert 0.0 < parts["unexplained"] < 0.08

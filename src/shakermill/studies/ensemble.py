@@ -128,8 +128,8 @@ class HeadlineSpread:
     # False where every member gave the same value (to round-off): no input decides it.
     varies: bool = True
     # The interval's parts (MODEL.md §14.1): the total Sobol' index of the assumed inputs together and of the
-    # fitted keys' posterior together, as shares of the members' variance, and the share of the members' own noise
-    # (the averaging error of the mechanics, the surrogate's white noise).
+    # fitted keys' posterior together, as shares of the variance the surrogate explains (Q²), and the share it does
+    # not: the members' own averaging noise and the surrogate's error, which held-out members cannot tell apart.
     parts: Mapping[str, float] = field(default_factory=dict)
 
     @property
@@ -301,7 +301,7 @@ def _power_label(key: str) -> str:
     return f"power in impacts above {key.removeprefix(POWER_ABOVE).removesuffix('_W')}"
 
 
-ASSUMED_PART, POSTERIOR_PART, NOISE_PART = "assumed inputs", "fitted keys' posterior", "averaging noise"
+ASSUMED_PART, POSTERIOR_PART, NOISE_PART = "assumed inputs", "fitted keys' posterior", "unexplained"
 
 
 def _sensitivity(unit: np.ndarray, values: np.ndarray, names: Sequence[str]
@@ -316,10 +316,8 @@ def _sensitivity(unit: np.ndarray, values: np.ndarray, names: Sequence[str]
     surrogate = _surrogate(unit, values)
     first, total = _sobol(surrogate, list(names))
     groups = [POSTERIOR_PART if name.endswith(FITTED_SUFFIX) else ASSUMED_PART for name in names]
-    # The surrogate's targets are scaled to unit variance: its white noise is the members' own share.
-    noise = min(float(surrogate.kernel_.k2.noise_level), 1.0)
     by_group = _sobol(surrogate, list(names), groups)[1] if len(set(groups)) > 1 else {groups[0]: 1.0}
-    parts = {group: (1.0 - noise) * share for group, share in by_group.items()} | {NOISE_PART: noise}
+    parts = {group: q2 * share for group, share in by_group.items()} | {NOISE_PART: 1.0 - q2}
     return q2, first, total, parts
 
 

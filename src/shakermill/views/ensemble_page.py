@@ -25,7 +25,7 @@ from shakermill.views.html import (
 from shakermill.views.notebook import esc
 
 HEADLINE_HEADERS = ("headline", "unit", "5 %", "50 %", "95 %", "surrogate Q²", "deciding inputs (total Sobol' index)",
-                    "variance: assumed; posterior; noise")
+                    "variance: assumed; posterior; unexplained")
 INPUT_HEADERS = ("input", "range", "distribution", "reason")
 REGIME_NOTE = ("pack: lasting contacts (over 1 ms) take most of the dissipation and the balls hit at over 1 m/s less "
                "than once a turn each; active: otherwise (MODEL.md §14.2).")
@@ -46,8 +46,8 @@ def deciding_text(spread: HeadlineSpread, most: int = 3) -> str:
 
 
 def parts_text(spread: HeadlineSpread) -> str:
-    """The interval's parts (MODEL.md §14.1): the assumed inputs', the fitted keys' posterior's and the members' own
-    noise's shares of the variance."""
+    """The interval's parts (MODEL.md §14.1): the assumed inputs', the fitted keys' posterior's and the unexplained
+    (averaging noise, surrogate error) shares of the variance."""
     if not spread.parts:
         return "n/a"
     return "; ".join(f"{spread.parts[part]:.2f}" if part in spread.parts else "—"
@@ -88,8 +88,9 @@ def render_ensemble_page(ensemble: Ensemble, title: str) -> str:
                   f"{failed} The 5, 50 and 95 % points are the members'; the Sobol' indices are "
                   "computed on a Gaussian-process surrogate of the members, and reported only where it predicts "
                   f"members it did not see with Q² ≥ {LEAST_Q2:g}. The variance of a headline is split into the "
-                  "total index of the assumed inputs together, of the fitted keys' posterior together, and the "
-                  "members' own noise (the averaging error of the mechanics).", "note"),
+                  "total index of the assumed inputs together and of the fitted keys' posterior together, scaled by "
+                  "Q², and the 1 − Q² the surrogate does not explain: the members' own averaging noise and its own "
+                  "error, which held-out members cannot tell apart.", "note"),
         section("Headlines", table(HEADLINE_HEADERS, headline_rows(ensemble), numeric=(2, 3, 4, 5, 7))),
         section("Regimes", paragraph(REGIME_NOTE), table(REGIME_HEADERS, regime_rows(ensemble), numeric=(1, 2, 3, 4, 5))
                 if ensemble.regimes else paragraph(NO_REGIMES)),
