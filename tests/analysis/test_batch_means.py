@@ -103,3 +103,7 @@ def test_drift_between_the_halves():
 
 def test_mser_of_no_batches_cuts_nothing():
     assert mser_truncation(np.array([])) == 0
+
+
+def test_too_few_means_have_no_autocorrelation():
+    assert lag1_autocorrelation([np.array([])]) == 0.0 and lag1_autocorrelation([np.array([3.0])]) == 0.0

@@ -65,9 +65,11 @@ def lag1_autocorrelation(series: Sequence[np.ndarray]) -> float:
     products of neighbours within each series about the pooled mean, over the pooled sum of squares; 0 for
     equal means."""
     values = np.concatenate(series)
+    if values.size < 2:
+        return 0.0
     deviations = [part - values.mean() for part in series]
     squares = float(np.sum((values - values.mean()) ** 2))
-    if values.size < 2 or squares == 0.0:
+    if squares == 0.0:
         return 0.0
     return sum(float(np.sum(part[:-1] * part[1:])) for part in deviations) / squares
 
