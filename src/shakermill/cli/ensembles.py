@@ -73,10 +73,13 @@ def uncertainty(
     target = out if out is not None else timestamped_folder("uncertainty")
     try:
         counter = "{task.completed}/{task.total} members · {task.fields[running]} running · {task.fields[failed]} failed"
-        with user_errors(), warnings_as_lines(), progress_bar("uncertainty", counter, members, running=0, failed=0) as update:
+        # A member takes seconds to minutes: piped, each one finished is a line.
+        with user_errors(), warnings_as_lines(), progress_bar(
+            "uncertainty", counter, members, lines_when_piped=True, running=0, failed=0
+        ) as update:
             ensemble = run_ensemble(
                 run_config.params, inputs, target, members, workers=workers, scheduler=scheduler, preset=run_config.preset,
-                posterior=posterior,
+                posterior=posterior, announce=lambda line: typer.echo(f"uncertainty: {line}", err=True),
                 progress=lambda state: update(state.done, running=state.running, failed=state.failed),
             )
     except SweepFailed as exc:

@@ -26,7 +26,7 @@ import math
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -254,17 +254,22 @@ def design_seed(base: Parameters, inputs: Sequence[AssumedInput]) -> int:
 def run_ensemble(base: Parameters, inputs: Sequence[AssumedInput], out_dir: Path | str, members: int,
                  workers: int | None = None, scheduler: str | None = None,
                  progress: ProgressCallback | None = None, *, preset: str,
-                 posterior: FittedPosterior | None = None) -> Ensemble:
+                 posterior: FittedPosterior | None = None, announce: Callable[[str], None] | None = None) -> Ensemble:
     """Run ``base`` at ``members`` points of a Sobol' design over ``inputs`` and the fitted keys' ``posterior`` (a
     sweep stored in ``out_dir``, resumed where an earlier run of the same ensemble stopped) and analyse the members
-    (:func:`analyse`)."""
+    (:func:`analyse`). ``announce`` is told what runs and when the members are being analysed, which takes a while
+    (a surrogate cross-validated for each headline)."""
     check_members(members)
     if not inputs and posterior is None:
         raise ParameterError("assumed inputs: none to vary; the preset states none that this run reads, give some "
                              "with --assume KEY=LOW:HIGH")
     seed = design_seed(base, inputs) + (0 if posterior is None else 1)
     points = design(inputs, members, seed, posterior)
+    say = announce or (lambda _: None)
+    fitted = "" if posterior is None else f" and the posterior of {', '.join(posterior.keys)}"
+    say(f"{members} members over {', '.join(item.key for item in inputs) or 'no assumed input'}{fitted}")
     table = sweep(base, points, out_dir, workers=workers, scheduler=scheduler, progress=progress, preset=preset)
+    say("analysing the members: a surrogate and Sobol' indices for each headline")
     return analyse(table, inputs, Path(out_dir), posterior)
 
 
