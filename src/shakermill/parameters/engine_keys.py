@@ -53,8 +53,8 @@ ONE_DIMENSIONAL = EngineKeys(
         {
             "n_balls", "fill", "ball_radii", "ball_densities", "ball_youngs_moduli", "ball_poisson_ratios",
             "ball_heat_capacities", "ball_conductivities", "ball_materials", "ball_conductivity", "gravity", "friction",
-            "pair_friction", "pair_restitution", "rolling_friction", "kinematics", "lateral_amplitude", "yaw_amplitude", "swing_radius", "motion",
-            "revolution_radius", "speed_ratio", "jar_tilt",
+            "pair_friction", "pair_restitution", "rolling_friction", "kinematics", "lateral_amplitude", "yaw_amplitude",
+            "swing_radius", "motion", "revolution_radius", "speed_ratio", "jar_tilt",
             "contact_step_fraction", "enduring_step_fraction", "max_flight_step", "dem_averaging_rel_error",
             "dem_replicas", "thermal_model", "outer_diameter", "outer_length", "emissivity", "vial_conductivity", "clamp_heat_capacity",
             "clamp_conductance", "clamp_loss", "drive_heat",

@@ -111,7 +111,7 @@ def measure_means(params: Parameters, engines: Sequence[Engine], progress: Progr
     cumulative = [[_flat(engine.measured())] for engine in engines]
     limit, limit_name = mechanics_limit(params)
     heartbeat = None if progress is None else lambda t: progress(t, limit)
-    status, converged, message = REACHED_STOP, False, ""
+    status, converged, message, settled = REACHED_STOP, False, "", None
     with ReplicaSet(engines, threads) as replicas:
         while True:
             t = engines[0].t + batch
@@ -137,7 +137,9 @@ def measure_means(params: Parameters, engines: Sequence[Engine], progress: Progr
                     "settling motion)"
                 )
                 break
-    settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target)
+    if settled is None:
+        # Stopped before convergence was first tested; once tested, the batches have not changed since.
+        settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target)
     return _means(engines, settled, sources, balls, len(cumulative[0]) - 1, converged, message), status
 
 
@@ -170,18 +172,15 @@ def _settled(cumulative: list[list[np.ndarray]], base: float, sources: int, ball
     """Cut each replica's transient (MSER on its total heat power and its balls' mean velocity term, White 1997),
     group its batches until their means are uncorrelated, and test the totals for drift (MODEL.md §14.2); a
     spread or drift within the ``target`` relative error is no concern."""
-    kept, cuts = [], []
-    for series in cumulative:
-        rates = batch_rates(np.array(series), base)
-        cut = max(mser_truncation(normalised(column)) for column in _totals(rates, sources, balls).T)
-        kept.append(rates[cut:])
-        cuts.append(cut)
+    every = [batch_rates(np.array(series), base) for series in cumulative]
+    cuts = [max(mser_truncation(normalised(column)) for column in _totals(rates, sources, balls).T) for rates in every]
+    kept = [rates[cut:] for rates, cut in zip(every, cuts)]
     grouping = uncorrelated_grouping([_totals(rates, sources, balls) for rates in kept], least, target)
     rates = np.concatenate([grouped(part, grouping.size) for part in kept])
     # The batches that fill no group are left out of the averages, so they count as transient.
     cuts = [cut + len(part) % grouping.size for cut, part in zip(cuts, kept)]
     totals = _totals(rates, sources, balls)
-    first = batch_rates(np.array(cumulative[0]), base)[: cuts[0], :sources].sum(axis=1)
+    first = every[0][: cuts[0], :sources].sum(axis=1)
     return Settled(
         rates=rates,
         checked=np.column_stack([totals, rates[:, : sources + balls]]),

@@ -31,7 +31,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from shakermill.analysis.regime import ACTIVE, PACK, charge_regime
+from shakermill.analysis.regime import ACTIVE, PACK
 from shakermill.parameters.assumed import AssumedInput, parse_assumption
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
@@ -366,26 +366,12 @@ def _cross_validated_q2(unit: np.ndarray, values: np.ndarray) -> float:
     return float(1.0 - np.sum((values - predicted) ** 2) / np.sum((values - values.mean()) ** 2))
 
 
-REGIME_FEATURES = ("stress_lasting_share", "fast_impact_rate_hz", "n_balls", "omega_hz")
-
-
-def _named_regimes(rows: pd.DataFrame) -> np.ndarray | None:
-    """Each member's regime as its summary names it, or from its features where a several-ball engine's member was
-    stored before summaries named it; None for an engine that names none."""
-    if rows.empty:
-        return None
-    if "charge_regime" in rows and rows["charge_regime"].notna().all():
-        return rows["charge_regime"].to_numpy()
-    if "ball_ball_impacts" in rows and all(key in rows for key in REGIME_FEATURES):
-        return np.array([charge_regime(*values) for values in rows[list(REGIME_FEATURES)].itertuples(index=False)])
-    return None
-
-
 def _regimes(finished: pd.DataFrame, keys: Sequence[str]) -> dict[str, dict[str, Any]]:
-    """Each regime's share of the members and its headlines' medians (MODEL.md §14.2)."""
-    named = _named_regimes(finished)
-    if named is None:
+    """Each regime's share of the members, as their summaries name it (``charge_regime``: an engine of several
+    balls), and its headlines' medians (MODEL.md §14.2)."""
+    if finished.empty or "charge_regime" not in finished:
         return {}
+    named = finished["charge_regime"].to_numpy()
     regimes = {}
     for name in (ACTIVE, PACK):
         members = named == name
