@@ -435,7 +435,7 @@ def test_validate_prints_table5_with_fitted_and_predicted_roles():
     # Issue 35: a quick validation without the 3-D studies said "full": true; it says what it ran.
     assert payload["full"] is False
     assert payload["ran"] == {"table5": True, "free_set_study": True, "validation_matrix": False, "experiments": [],
-                              "structure_study": False, "held_out": False}
+                              "structure_study": False, "held_out": False, "cross_prediction": False}
 
 
 @pytest.mark.slow

@@ -10,11 +10,14 @@ import json
 import pytest
 from typer.testing import CliRunner
 
+import numpy as np
+
 from shakermill import cli
-from shakermill.studies import held_out, validation_report
+from shakermill.parameters.assumed import AssumedInput
+from shakermill.studies import cross_prediction, held_out, joint_calibration, validation_report
 from shakermill.studies.validation import VALIDATION_PRESETS
 from shakermill.studies.validation_matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
-from shakermill.views.validation_page import QUICK_NOTE
+from shakermill.views.validation_page import CROSS_TITLE, QUICK_NOTE
 
 runner = CliRunner()
 # A few drive periods at full resolution for every run: the command's shape, not its numbers.
@@ -29,6 +32,28 @@ def quick_runs_fixture(monkeypatch):
     monkeypatch.setattr(validation_report, "validation_matrix", functools.partial(validation_matrix, overrides=QUICK))
     # Each structure's fit runs the one-ball hour: its study has tests of its own.
     monkeypatch.setattr(validation_report, "structure_study", lambda progress: ())
+    # Both directions run 64 averaged hours: emulators of made-up rises stand in (tests/studies/test_joint_calibration.py
+    # tests the method, its CLI test the runs).
+    monkeypatch.setattr(joint_calibration, "STEPS", 400)
+    monkeypatch.setattr(validation_report, "cross_prediction", made_up_cross_prediction)
+
+
+def made_up_cross_prediction(progress):
+    """Both directions on emulators of rises linear in one input: each experiment's points at 1-2x the measured."""
+    experiments = {experiment.name: experiment for experiment in load_experiments()}
+    emulators = {}
+    unit = np.random.default_rng(1).random((16, 1))
+    for name in (cross_prediction.ONE_BALL, cross_prediction.FIVE_BALLS):
+        points = experiments[name].points
+        rises = np.column_stack([point.rise_K * (1.0 + unit[:, 0]) for point in points])
+        training = joint_calibration.Training(
+            (AssumedInput("friction", 0.1, 0.6, "uniform", "a test's"),),
+            tuple(joint_calibration.Observable(point.node, point.time_s) for point in points), unit, rises, np.arange(16))
+        emulators[name] = joint_calibration.emulate(training)
+    pair = (experiments[cross_prediction.ONE_BALL], experiments[cross_prediction.FIVE_BALLS])
+    directions = tuple(cross_prediction._direction(fitted_on, predicted, emulators)
+                       for fitted_on, predicted in (pair, pair[::-1]))
+    return cross_prediction.CrossPrediction("spex8000m-3d-mill-head", ("drive_heat",), emulators, directions)
 
 
 @pytest.mark.slow
@@ -57,6 +82,15 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
     for row in payload["validation_matrix"]["rows"]:
         assert f"{row['predicted_K']:.3g}" in html
     assert "Held out: five balls" in html and html.count("<img") == 1
+    # Both directions of issue 36 point 4, each measured point plainly inside its interval or not.
+    cross = payload["cross_prediction"]
+    assert [(direction["fitted_on"], direction["predicted"]) for direction in cross["directions"]] == [
+        (cross_prediction.ONE_BALL, cross_prediction.FIVE_BALLS), (cross_prediction.FIVE_BALLS, cross_prediction.ONE_BALL)]
+    for direction in cross["directions"]:
+        for point in direction["predictions"]:
+            assert point["inside_90"] == (point["p5"] <= point["measured_K"] <= point["p95"])
+        assert direction["verdict"][1:] in html
+    assert payload["ran"]["cross_prediction"] is True and CROSS_TITLE in html
     five = payload["five_balls"]
     assert five["preset"] == "spex8000m-3d-calibrated" and five["fitted_parameters"]
     rows = five["rows"]

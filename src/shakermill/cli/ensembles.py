@@ -59,7 +59,7 @@ def uncertainty(
 ) -> None:
     """Run a quasi-random ensemble over the assumed inputs; print each headline's 5/50/95 % points, the inputs that
     decide it (Sobol' indices) and the motion regimes found."""
-    from shakermill.parameters.presets import PRESETS
+    from shakermill.parameters.config import config_preset
     from shakermill.studies.ensemble import check_members, ensemble_inputs, run_ensemble
     from shakermill.studies.sweep import SweepFailed, SweepInterrupted
     from shakermill.studies.sweep_plan import sweep_parameters
@@ -69,7 +69,7 @@ def uncertainty(
     with user_errors():
         check_members(members)
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
-        inputs, posterior = ensemble_inputs(PRESETS[run_config.preset], run_config.params, assume or [], vary or [])
+        inputs, posterior = ensemble_inputs(config_preset(run_config), run_config.params, assume or [], vary or [])
     target = out if out is not None else timestamped_folder("uncertainty")
     try:
         counter = "{task.completed}/{task.total} members · {task.fields[running]} running · {task.fields[failed]} failed"

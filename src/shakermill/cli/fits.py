@@ -126,6 +126,19 @@ def print_report(report: Any) -> None:
         print_structures(console, report.structures)
     if report.held_out is not None:
         print_held_out(console, report.held_out)
+    if report.cross is not None:
+        print_cross(console, report.cross)
+
+
+def print_cross(console: Console, cross: Any) -> None:
+    """Both directions of the SPEX experiments, each fitted over every uncertain input, plainly inside or not."""
+    from shakermill.views.validation_page import CROSS_HEADERS, CROSS_TITLE, cross_rows, cross_statement
+
+    table = Table(*CROSS_HEADERS, title=CROSS_TITLE)
+    for row in cross_rows(cross):
+        add_plain_row(table, *row)
+    console.print(table)
+    console.print(Text(cross_statement(cross)))
 
 
 def print_matrix(console: Console, matrix: Any) -> None:
@@ -269,8 +282,19 @@ def calibrate(
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
+    with_assumed: Annotated[
+        bool,
+        typer.Option("--with-assumed", help="Also free the preset's assumed inputs that move the mechanics (friction, "
+                     "restitution, λ, the clamp's motion, ...), their stated ranges as priors: a Bayesian fit on "
+                     "emulators of the runs, with posterior-predictive intervals (MODEL.md §14.1; minutes)."),
+    ] = False,
+    members: Annotated[
+        int, typer.Option("--members", "-n", help="With --with-assumed: mechanical runs per set of conditions, a power "
+                          "of two.")
+    ] = 32,
 ) -> None:
-    """Fit free parameters to measured curves (the experiment's by default) and/or Table 5 targets by bounded least squares."""
+    """Fit free parameters to measured curves (the experiment's by default) and/or Table 5 targets by bounded least
+    squares; with --with-assumed, over every uncertain input by Bayesian inference."""
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import load_config, values_beyond_preset
     from shakermill.studies.calibrate import calibrate as fit_parameters
@@ -287,6 +311,9 @@ def calibrate(
         if out is not None:
             # Checked before the fit, which takes a while.
             check_preset_target(out, overwrite)
+        if with_assumed:
+            calibrate_over_assumed(run_config, free_keys, targets, measured, members, full_resolution, out, json_output)
+            return
         with nothing_written_when_interrupted("the fit starts again from the beginning"), nothing_written_when_a_run_is_stopped(
             "the fit"
         ), progress_bar("fitting", "{task.completed} model evaluations", None, delay_s=PROGRESS_DELAY_S) as update:
@@ -309,6 +336,75 @@ def calibrate(
             verdict = "could not determine its keys" + (f" (nothing written to {out})" if out is not None else "")
         typer.echo(f"error: calibration {verdict}: {calibration.message}", err=True)
         raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def calibrate_over_assumed(run_config: Any, free_keys: Sequence[str], targets: Mapping[str, float],
+                           curves: Sequence[Any], members: int, full_resolution: bool, out: Path | None,
+                           json_output: bool) -> None:
+    """``calibrate --with-assumed``: the posterior of the network's free keys and the preset's assumed inputs given the
+    curves, printed, and the preset of its medians written."""
+    from shakermill.engines.registry import describe
+    from shakermill.io.runs import to_jsonable
+    from shakermill.parameters.config import config_preset, values_beyond_preset
+    from shakermill.studies.ensemble import check_members
+    from shakermill.studies.joint_calibration import calibrate_jointly, write_joint_preset
+    from shakermill.studies.validation import experiment_curve
+
+    if targets:
+        raise ParameterError("target: a calibration --with-assumed fits measured rises; allowed --curve (a Table 5 "
+                             "target is a summary of a curve, not a measurement)")
+    if full_resolution:
+        raise ParameterError("full-resolution: a calibration --with-assumed runs the averaged solver on a design of "
+                             "runs; allowed without --full-resolution")
+    check_members(members)
+    thermal_only = describe(run_config.params.engine).thermal_only_keys
+    moving = [key for key in free_keys if thermal_only and key not in thermal_only]
+    if moving:
+        raise ParameterError(f"free: {', '.join(moving)} move the mechanics; --with-assumed frees the preset's assumed "
+                             f"inputs over their stated ranges; allowed --free keys of the network: {', '.join(thermal_only)}")
+    params = run_config.params.replace(solver="averaged", attractor_starts=1)
+    curves = list(curves) or [experiment_curve()]
+    sets = len({tuple(item.conditions) for item in curves} | {()})
+    typer.echo(f"calibrate: fitting {', '.join(free_keys)} and the assumed inputs of {run_config.preset} over "
+               f"{members} mechanical runs per set of conditions ({sets}), then emcee on their emulators", err=True)
+    with nothing_written_when_interrupted("the fit starts again from the beginning"), \
+            nothing_written_when_a_run_is_stopped("the fit"), \
+            progress_bar("fitting", "{task.completed}/{task.total} runs", members * sets, lines_when_piped=True) as update:
+        joint = calibrate_jointly(config_preset(run_config), params, free_keys, curves, members,
+                                  progress=lambda done, total: update(done, total=total))
+    if out is not None:
+        command = "shakermill calibrate " + " ".join(sys.argv[2:])
+        with writing(out, "the preset"):
+            write_joint_preset(joint, out, base_preset=run_config.preset, command=command,
+                               settings=values_beyond_preset(run_config.params, run_config.preset))
+    if json_output:
+        typer.echo(json.dumps(to_jsonable({**joint.as_dict(), "output": str(out) if out else None}), sort_keys=True,
+                              allow_nan=False))
+    else:
+        print_joint(joint, out)
+
+
+def print_joint(joint: Any, out: Path | None) -> None:
+    """Each freed input's prior and posterior, each measured point against its posterior-predictive interval, and the
+    run's end with its interval."""
+    console = stdout_console()
+    table = Table("input", "prior", "posterior 5 %", "median", "95 %", title="calibration over every uncertain input")
+    for item in joint.posterior.inputs:
+        low, middle, high = joint.posterior.quantiles()[item.key]
+        add_plain_row(table, item.key, f"{item.shown_range()} {item.distribution}", f"{low:.3g}", f"{middle:.3g}",
+                      f"{high:.3g}")
+    console.print(table)
+    points = Table("measured", "rise [K]", "posterior-predictive 90 % [K]", "inside?", title="the fitted points")
+    for item in joint.fitted:
+        add_plain_row(points, item.observable.label, f"{item.measured_K:.3g}",
+                      f"{item.quantiles[0]:.3g} to {item.quantiles[2]:.3g}", "yes" if item.inside else "no")
+    console.print(points)
+    for item in joint.predictions:
+        console.print(Text(f"predicted: {item.observable.label} {item.quantiles[1]:.3g} K "
+                           f"(90 %: {item.quantiles[0]:.3g} to {item.quantiles[2]:.3g} K)"))
+    console.print(Text(f"{joint.status}: {joint.message}"))
+    if out is not None:
+        console.print(Text(f"preset written to {out}; `shakermill uncertainty {out}` carries its posterior into any run"))
 
 
 def announce(params: Any, free_keys: Sequence[str], chosen: bool, notes: Sequence[str]) -> None:

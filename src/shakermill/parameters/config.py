@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import platform
 import tomllib
-from dataclasses import dataclass
+import dataclasses
+from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -31,13 +32,16 @@ from shakermill.parameters.keys import (
     layered,
     with_materials,
 )
-from shakermill.parameters.presets import default_parameters, preset_values
+from shakermill.parameters.assumed import inherited_assumed
+from shakermill.parameters.presets import PRESETS, Cited, Preset, default_parameters, preset_values
 from shakermill.support.atomic import write_text_atomically
 from shakermill.support.limits import MAX_CONFIG_BYTES, quoted
 from shakermill.support.version import __version__
 
 PRESET_KEY = "preset"
 PROVENANCE_TABLE = "provenance"
+# A configuration's own ranges of assumed inputs (MODEL.md §14.1): [assumed.KEY] tables, as a preset file's.
+ASSUMED_TABLE = "assumed"
 SI_NOTE = "all values are SI (m, kg, s, K, rad, Pa, J, W); strings with units are accepted on input"
 
 
@@ -50,6 +54,9 @@ class RunConfig:
     source: Path | None
     # Sentences for the user that are no problem: the preset's keys that this run does not read.
     notes: tuple[str, ...] = ()
+    # The file's [assumed.KEY] tables and [provenance] (a calibration's), unchecked: parameters/assumed.py reads them.
+    assumed_tables: Mapping[str, Any] = field(default_factory=dict)
+    provenance: Mapping[str, Any] = field(default_factory=dict)
 
 
 def load_config(
@@ -71,10 +78,12 @@ def load_config(
     file_preset: str | None = None
     source = Path(path) if path is not None else None
     written_by_hand = False
+    tables: dict[str, Any] = {"assumed_tables": {}, "provenance": {}}
     if source is not None:
         document = _config_document(source)
         written_by_hand = PROVENANCE_TABLE not in document
-        file_values = {key: value for key, value in document.items() if key != PROVENANCE_TABLE}
+        tables = {"assumed_tables": document.pop(ASSUMED_TABLE, {}), "provenance": document.pop(PROVENANCE_TABLE, {})}
+        file_values = document
         file_preset = _file_preset(file_values, source)
     # An empty --preset names no preset: refused as unknown, not read as "the default".
     chosen_preset = preset if preset is not None else file_preset or DEFAULT_PRESET
@@ -84,7 +93,7 @@ def load_config(
     asked = parse_overrides(overrides)
     params = build_parameters(base, asked)
     if reader is None:
-        return RunConfig(params=params, preset=chosen_preset, source=source)
+        return RunConfig(params=params, preset=chosen_preset, source=source, **tables)
     run = reader_of(params, None if reader == "run" else reader)
     explicit = [*(key for key in file_values if written_by_hand and key != PRESET_KEY), *asked]
     problem = run.unread_problem(explicit)
@@ -96,13 +105,38 @@ def load_config(
     notes = [run.ignored_note(inherited, defaults, preset_reader)]
     if file_preset is not None and chosen_preset != file_preset:
         notes.append(f"The preset is {chosen_preset!r} (--preset), not the {file_preset!r} that {source} names.")
-    return RunConfig(params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note))
+    config = RunConfig(params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note),
+                       **tables)
+    if config.assumed_tables:
+        config_preset(config)  # its [assumed.KEY] tables checked now, with one line for the first that is wrong
+    return config
+
+
+def config_preset(config: RunConfig) -> Preset:
+    """The preset a run of ``config`` stands on: its named preset, with the file's own [assumed.KEY] tables (which
+    replace the preset's ranges) and, for a file a calibration wrote, the keys it fitted and their posterior."""
+    base = PRESETS[config.preset]
+    if config.source is None:
+        return base
+    if "fitted" in config.provenance:
+        fitted = tuple(config.provenance["fitted"])
+        note = f"fitted by calibration ({config.source.name}, [provenance])"
+        values = {**base.values, **{key: Cited(getattr(config.params, key), note) for key in fitted}}
+        base = dataclasses.replace(base, name=config.source.stem, values=values, fitted=fitted,
+                                   provenance=config.provenance)
+    tables = config.assumed_tables
+    if not isinstance(tables, Mapping):
+        raise ParameterError(f"{config.source}: [assumed] must hold tables [assumed.KEY]")
+    assumed = inherited_assumed(base.assumed, tables, config.params.model_dump(), base.fitted, reader_of(config.params),
+                                config.source.name)
+    return dataclasses.replace(base, assumed=assumed)
 
 
 def read_config_file(path: Path) -> dict[str, Any]:
     """The parameter entries of a TOML configuration (``preset`` included, ``[provenance]`` dropped)."""
     document = _config_document(path)
     document.pop(PROVENANCE_TABLE, None)
+    document.pop(ASSUMED_TABLE, None)
     return document
 
 

@@ -318,7 +318,7 @@ def _sensitivity(unit: np.ndarray, values: np.ndarray, names: Sequence[str]
     q2 = _cross_validated_q2(unit, values)
     if not q2 >= LEAST_Q2:
         return q2, {}, {}, {}
-    surrogate = _surrogate(unit, values)
+    surrogate = gaussian_process(unit, values)
     first, total = _sobol(surrogate, list(names))
     groups = [POSTERIOR_PART if name.endswith(FITTED_SUFFIX) else ASSUMED_PART for name in names]
     by_group = _sobol(surrogate, list(names), groups)[1] if len(set(groups)) > 1 else {groups[0]: 1.0}
@@ -341,8 +341,8 @@ def _sobol(surrogate: Any, names: list[str], groups: list[str] | None = None) ->
     return dict(zip(labels, map(float, indices["S1"]))), dict(zip(labels, map(float, indices["ST"])))
 
 
-def _surrogate(unit: np.ndarray, values: np.ndarray) -> Any:
-    """A Gaussian process with one length scale per input (Matérn 5/2) and a noise term for the averaging error."""
+def gaussian_process(unit: np.ndarray, values: np.ndarray) -> Any:
+    """A Gaussian process fitted to ``values`` at ``unit`` with one length scale per input (Matérn 5/2) and a noise term for the averaging error."""
     from sklearn.exceptions import ConvergenceWarning
     from sklearn.gaussian_process import GaussianProcessRegressor
     from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
@@ -362,7 +362,7 @@ def _cross_validated_q2(unit: np.ndarray, values: np.ndarray) -> float:
 
     predicted = np.empty_like(values)
     for train, test in KFold(FOLDS, shuffle=True, random_state=0).split(unit):
-        predicted[test] = _surrogate(unit[train], values[train]).predict(unit[test])
+        predicted[test] = gaussian_process(unit[train], values[train]).predict(unit[test])
     return float(1.0 - np.sum((values - predicted) ** 2) / np.sum((values - values.mean()) ** 2))
 
 

@@ -22,7 +22,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from shakermill.analysis.steady import steady_state
-from shakermill.engines.registry import engine_named
+from shakermill.engines.registry import describe, engine_named
 from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
@@ -70,16 +70,23 @@ class Uncertainty:
     fitted: tuple[str, ...]
     covariance: np.ndarray | None = None
     posterior: np.ndarray | None = None
+    # Fitted keys that move the mechanics (a calibration over every uncertain input): a run's mean load cannot carry
+    # them, `shakermill uncertainty` does.
+    left_out: tuple[str, ...] = ()
 
 
 def uncertainty_of(preset: Preset) -> Uncertainty | None:
-    """What the calibration of ``preset`` recorded of its uncertainty; None for a preset that no calibration made or
+    """What the calibration of ``preset`` recorded of its uncertainty, of the keys its network alone reads (an
+    engine without thermal-only keys reruns everything: all of them); None for a preset that no calibration made or
     that predates the record."""
     if preset.covariance is None and preset.posterior is None:
         return None
-    covariance = None if preset.covariance is None else np.asarray(preset.covariance, dtype=float)
-    posterior = None if preset.posterior is None else np.asarray(preset.posterior, dtype=float)
-    return Uncertainty(preset.fitted, covariance, posterior)
+    thermal_only = describe(preset.values["engine"].value).thermal_only_keys
+    kept = [index for index, key in enumerate(preset.fitted) if not thermal_only or key in thermal_only]
+    covariance = None if preset.covariance is None else np.asarray(preset.covariance, dtype=float)[np.ix_(kept, kept)]
+    posterior = None if preset.posterior is None else np.asarray(preset.posterior, dtype=float)[:, kept]
+    left_out = tuple(key for index, key in enumerate(preset.fitted) if index not in kept)
+    return Uncertainty(tuple(preset.fitted[index] for index in kept), covariance, posterior, left_out)
 
 
 def headline_temperatures(params: Parameters, load: NetworkLoad) -> dict[str, float]:
@@ -140,6 +147,9 @@ def _from_samples(params: Parameters, load: NetworkLoad, uncertainty: Uncertaint
     table = np.array([[value[name] for name in centre] for value in values])
     low, high = np.percentile(table, [50 * (1 - LEVEL), 50 * (1 + LEVEL)], axis=0)
     sources = ("the calibration's posterior (emcee)",) + (("the averaging error of the heat",) if heat_error > 0 else ())
+    if uncertainty.left_out:
+        sources += (f"not the posterior of {', '.join(uncertainty.left_out)}, which moves the mechanics "
+                    "(shakermill uncertainty carries it)",)
     return Intervals(centre, dict(zip(centre, map(float, low))), dict(zip(centre, map(float, high))), sources)
 
 

@@ -12,6 +12,7 @@ from shakermill.parameters.config import load_config
 from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.keys import Parameters
 from shakermill.studies.calibrate import FREE_SET_STUDY, FreeSetOutcome, free_set_study
+from shakermill.studies.cross_prediction import CrossPrediction, cross_prediction
 from shakermill.studies.held_out import HeldOutStudies, held_out_studies
 from shakermill.studies.validation import EXPERIMENT, TABLE5, VALIDATION_PRESETS, ValidationRun, validate
 from shakermill.studies.validation_matrix import (
@@ -41,6 +42,8 @@ class ValidationReport:
     structures: tuple[StructureOutcome, ...] = ()
     # False for the quick validation: the matrix holds only the experiments of quick_experiments.
     everything: bool = True
+    # Fitted over every uncertain input on one SPEX experiment, the other predicted (--full only).
+    cross: CrossPrediction | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON object of ``validate --json``."""
@@ -55,6 +58,7 @@ class ValidationReport:
                 "experiments": [] if self.matrix is None else [experiment.name for experiment in self.matrix.experiments],
                 "structure_study": bool(self.structures),
                 "held_out": self.held_out is not None,
+                "cross_prediction": self.cross is not None,
             },
             "quantities": {
                 entry.key: {"label": entry.label, "unit": entry.unit, "experiment": entry.experiment, "paper_model": entry.paper_model}
@@ -65,6 +69,7 @@ class ValidationReport:
             **(self.held_out.as_dict() if self.held_out is not None else {}),
             **({"validation_matrix": self.matrix.as_dict()} if self.matrix is not None else {}),
             **({"structure_study": [outcome.as_dict() for outcome in self.structures]} if self.structures else {}),
+            **({"cross_prediction": self.cross.as_dict()} if self.cross is not None else {}),
         }
 
 
@@ -102,7 +107,8 @@ def validation_report(solver: str, study: bool = True, three_d: bool = True,
                       progress: Callable[[int, int], None] | None = None, everything: bool = True) -> ValidationReport:
     """Validate with ``solver`` ('full' or 'averaged'); with ``study`` the free-set study of the default preset, with
     ``three_d`` the validation matrix of the thermal models (``progress(done, total)`` counts its runs) and, with
-    ``everything``, its experiments of one ball, the structure study and the held-out studies; without, only the
+    ``everything``, its experiments of one ball, the structure study, the held-out studies and both directions of
+    the SPEX experiments fitted over every uncertain input (:func:`cross_prediction`); without, only the
     experiments that run in minutes (:func:`quick_experiments`)."""
     show = progress if progress is not None else (lambda done, total: None)
     experiments = load_experiments() if everything else quick_experiments(load_experiments())
@@ -123,8 +129,16 @@ def validation_report(solver: str, study: bool = True, three_d: bool = True,
     before = first + pairs
     structures = structure_study(progress=lambda done, total: show(before + done, before + total))
     before += len(STRUCTURES)
-    held_out = held_out_studies(lambda done, total: show(before + done, before + total))
-    return ValidationReport(solver, runs, outcomes, held_out, matrix, structures)
+    held_out_steps = [0]
+
+    def held(done: int, total: int) -> None:
+        held_out_steps[0] = total
+        show(before + done, before + total)
+
+    held_out = held_out_studies(held)
+    before += held_out_steps[0]
+    cross = cross_prediction(progress=lambda done, total: show(before + done, before + total))
+    return ValidationReport(solver, runs, outcomes, held_out, matrix, structures, cross=cross)
 
 
 def quick_experiments(experiments: Sequence[Experiment]) -> tuple[Experiment, ...]:

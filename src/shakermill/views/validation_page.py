@@ -15,6 +15,7 @@ from shakermill.views.notebook import esc
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+    from shakermill.studies.cross_prediction import CrossPrediction
     from shakermill.studies.held_out import HeldOutPrediction
     from shakermill.studies.validation_matrix import StructureOutcome, ValidationMatrix
     from shakermill.studies.validation_report import ValidationReport
@@ -119,6 +120,38 @@ def matrix_figure(matrix: ValidationMatrix) -> Figure:
     return figure
 
 
+CROSS_HEADERS = ("fitted on", "predicted", "measured [K]", "predicted median [K]", "90 % interval [K]", "inside?",
+                 "prior alone: 90 % [K]")
+CROSS_TITLE = "Both directions: fitted over every uncertain input on one SPEX experiment, the other predicted"
+
+
+def cross_rows(cross: CrossPrediction) -> list[tuple[str, ...]]:
+    """Each direction's predictions of the other experiment's measured points, beside what the prior alone says."""
+    rows = []
+    for direction in cross.directions:
+        for prediction, prior in zip(direction.predictions, direction.prior_predictions, strict=True):
+            low, median, high = prediction.quantiles
+            rows.append((
+                direction.fitted_on.name, f"{direction.predicted.name}: {prediction.observable.label}",
+                f"{prediction.measured_K:.3g}", f"{median:.3g}", f"{low:.3g} to {high:.3g}",
+                "yes" if prediction.inside else "no", f"{prior.quantiles[0]:.3g} to {prior.quantiles[2]:.3g}",
+            ))
+    return rows
+
+
+def cross_statement(cross: CrossPrediction) -> str:
+    """The verdicts, what was freed and how, and how well the emulators predict runs they did not see."""
+    from shakermill.studies.joint_calibration import ASSUMED_MEASUREMENT_SD_K
+
+    verdicts = "; ".join(direction.verdict for direction in cross.directions)
+    q2 = ", ".join(f"{name} {value:.2f}" for emulator in cross.emulators.values() for name, value in emulator.q2.items())
+    freed = sorted({item.key for emulator in cross.emulators.values() for item in emulator.inputs})
+    return (f"{verdicts[0].upper()}{verdicts[1:]}. Each fit starts from {cross.preset} and frees {', '.join(freed)} over their "
+            f"stated ranges (the priors; pair keys only where two balls meet), the measurements with a standard "
+            f"deviation of {ASSUMED_MEASUREMENT_SD_K:g} K (assumed: no source states one); the posterior by "
+            f"emcee on Gaussian-process emulators of the runs, whose Q² on runs they did not see is {q2}.")
+
+
 QUICK_NOTE = ("A quick validation: the matrix holds the experiments of five balls and of none. `shakermill validate "
               "--full` adds those of one ball, the structure study, the engines' one-ball comparison and the "
               "sensitivity to the assumed SPEX kinematics (~17 min on two cores).")
@@ -158,6 +191,9 @@ def render_validation_page(report: ValidationReport) -> str:
         prediction = report.held_out.prediction
         sections.append(section("Held out: five balls", table(HELD_OUT_HEADERS, held_out_rows(prediction), numeric=(2, 3, 4)),
                                 paragraph(prediction.statement, "statement")))
+    if report.cross is not None:
+        sections.append(section(CROSS_TITLE, table(CROSS_HEADERS, cross_rows(report.cross), numeric=(2, 3, 4, 6)),
+                                paragraph(cross_statement(report.cross), "statement")))
     return (
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
         f"<title>shakermill validation</title>\n<style>{STYLE}</style>\n</head>\n<body>\n"

@@ -1,0 +1,111 @@
+"""Both directions of the SPEX measurements (issue 36 point 4, for ``validate --full``): fitted over every uncertain
+input on the one-ball curve, is the five-ball measurement inside the 90 % posterior-predictive interval; fitted on
+the five-ball point, is the one-ball curve inside. Each fit frees the assumed inputs its run can feel, with their
+stated ranges as priors, and the network's own free keys over their defensible ranges
+(:mod:`studies.joint_calibration`); nothing else is tuned.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+from shakermill.parameters.defaults import DEFAULT_FREE_BY_NETWORK
+from shakermill.parameters.presets import PRESETS, default_parameters
+from shakermill.studies.joint_calibration import (
+    ASSUMED_MEASUREMENT_SD_K,
+    Emulator,
+    Measured,
+    Observable,
+    Posterior,
+    Prediction,
+    emulate,
+    emulator_as_dict,
+    fit_inputs,
+    measured_of,
+    posterior_as_dict,
+    predict,
+    prior_sample,
+    sample_posterior,
+    train,
+)
+from shakermill.studies.validation_matrix import Experiment, load_experiments
+
+# The uncalibrated preset both fits start from: the calibrated one was fitted to the one-ball curve already.
+BASE_PRESET = "spex8000m-3d-mill-head"
+ONE_BALL, FIVE_BALLS = "takacs-mchenry-one-ball", "takacs-mchenry-five-balls"
+# Mechanical runs of each configuration and network points per run: 32 x 8 = 256 training points a configuration.
+MEMBERS, THERMAL_DRAWS = 32, 8
+# The averaged mechanics' target error: 5 % of the heat power is ~1 K of a rise, half the measurements' 2 K, and the
+# emulator's white noise takes it up; at 1 % a lone ball on some of the design's clamp motions takes minutes.
+AVERAGING_ERROR = 0.05
+
+
+@dataclass(frozen=True)
+class Direction:
+    """A fit on one experiment and what it then predicts of the other, beside what the prior alone predicts."""
+
+    fitted_on: Experiment
+    predicted: Experiment
+    posterior: Posterior
+    fitted: tuple[Prediction, ...]  # the fitted experiment's own points at the posterior
+    predictions: tuple[Prediction, ...]
+    prior_predictions: tuple[Prediction, ...]
+
+    @property
+    def verdict(self) -> str:
+        inside = [prediction.inside for prediction in self.predictions]
+        held = "every" if all(inside) else "no" if not any(inside) else f"{sum(inside)} of {len(inside)}"
+        return f"fitted on {self.fitted_on.name}: {held} measured point of {self.predicted.name} inside its 90 % interval"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"fitted_on": self.fitted_on.name, "predicted": self.predicted.name, "verdict": self.verdict,
+                "posterior": posterior_as_dict(self.posterior),
+                "fitted_points": [prediction.as_dict() for prediction in self.fitted],
+                "predictions": [prediction.as_dict() for prediction in self.predictions],
+                "prior_predictions": [prediction.as_dict() for prediction in self.prior_predictions]}
+
+
+@dataclass(frozen=True)
+class CrossPrediction:
+    preset: str
+    free: tuple[str, ...]
+    emulators: Mapping[str, Emulator]
+    directions: tuple[Direction, ...]
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"preset": self.preset, "network_free": list(self.free),
+                "measurement_sd_K": ASSUMED_MEASUREMENT_SD_K, "averaging_error": AVERAGING_ERROR,
+                "emulators": {name: emulator_as_dict(emulator) for name, emulator in self.emulators.items()},
+                "directions": [direction.as_dict() for direction in self.directions]}
+
+
+def cross_prediction(preset: str = BASE_PRESET, members: int = MEMBERS, thermal_draws: int = THERMAL_DRAWS,
+                     overrides: Mapping[str, Any] | None = None,
+                     progress: Callable[[int, int], None] | None = None) -> CrossPrediction:
+    """Emulate both experiments over their uncertain inputs, fit each and predict the other (module docstring);
+    ``progress(done, total)`` counts the mechanical members of both."""
+    experiments = {experiment.name: experiment for experiment in load_experiments()}
+    pair = (experiments[ONE_BALL], experiments[FIVE_BALLS])
+    settings = {"solver": "averaged", "record_windows": (), "attractor_starts": 1,
+                "dem_averaging_rel_error": AVERAGING_ERROR, **(overrides or {})}
+    free = DEFAULT_FREE_BY_NETWORK[PRESETS[preset].values["thermal_model"].value]
+    emulators = {}
+    for index, experiment in enumerate(pair):
+        params = default_parameters(preset, **{**settings, **experiment.conditions})
+        observables = [Observable(point.node, point.time_s) for point in experiment.points]
+        shown = None if progress is None else (lambda done, total, before=index * members: progress(before + done, 2 * members))
+        training = train(params, fit_inputs(PRESETS[preset], params, free), observables, members, thermal_draws, shown)
+        emulators[experiment.name] = emulate(training)
+    directions = tuple(_direction(fitted_on, predicted, emulators)
+                       for fitted_on, predicted in (pair, pair[::-1]))
+    return CrossPrediction(preset, tuple(free), emulators, directions)
+
+
+def _direction(fitted_on: Experiment, predicted: Experiment, emulators: Mapping[str, Emulator]) -> Direction:
+    measured: list[Measured] = measured_of(fitted_on)
+    source, target = emulators[fitted_on.name], emulators[predicted.name]
+    posterior = sample_posterior([(source, measured)])
+    return Direction(fitted_on, predicted, posterior, tuple(predict(source, posterior, measured)),
+                     tuple(predict(target, posterior, measured_of(predicted))),
+                     tuple(predict(target, prior_sample(target.inputs), measured_of(predicted))))
