@@ -44,9 +44,10 @@ if TYPE_CHECKING:
 def validate(
     full: Annotated[
         bool,
-        typer.Option("--full", help="Everything (~17 min on two cores): Table 5 at full resolution, the matrix's "
+        typer.Option("--full", help="Everything (~30 min on two cores): Table 5 at full resolution, the matrix's "
                      "experiments of one ball, the structure study, the engines' one-ball comparison and the "
-                     "sensitivity to the assumed SPEX kinematics. Without it, a quick validation (~2 min)."),
+                     "sensitivity to the assumed SPEX kinematics, and both SPEX experiments fitted over every uncertain input, "
+                     "each predicting the other. Without it, a quick validation (~2 min)."),
     ] = False,
     solver: Annotated[
         str | None,
@@ -75,7 +76,8 @@ def validate(
     """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
     calibrated parameters, which free sets of a calibration can follow the curve, and (3-D) the validation matrix of
     the thermal models against the five-ball experiment no fit has seen and the empty mill; with --full also the
-    one-ball experiments, the structures that follow the one-ball curve and the held-out studies."""
+    one-ball experiments, the structures that follow the one-ball curve, the held-out studies, and each SPEX
+    experiment fitted over every uncertain input predicting the other."""
     from shakermill.io.runs import to_jsonable
     from shakermill.studies.validation_report import SOLVERS, validation_report
 
@@ -86,7 +88,7 @@ def validate(
         if not three_d:
             fail("report: the page holds the three-dimensional studies; allowed --report with --three-d (the default)")
         check_report_target(html, overwrite)
-    typer.echo(f"validate: {'everything (--full), ~17 min' if full else 'quick, ~2 min; --full for everything (~17 min)'}; "
+    typer.echo(f"validate: {'everything (--full), ~30 min' if full else 'quick, ~2 min; --full for everything (~30 min)'}; "
                f"Table 5 with the {solver} solver" + (", then the 3-D validation matrix" if three_d else ""), err=True)
     with (nothing_written_when_interrupted("validate prints and writes once every run has ended"),
           nothing_written_when_a_run_is_stopped("validate"),
@@ -255,6 +257,17 @@ def free_set_table(outcomes: Sequence[Any]) -> Table:
     return table
 
 
+WithAssumedOption = Annotated[
+    bool,
+    typer.Option("--with-assumed", help="Also free the preset's assumed inputs that move the mechanics (friction, "
+                 "restitution, λ, the clamp's motion, ...), their stated ranges as priors: a Bayesian fit on emulators "
+                 "of the runs, with posterior-predictive intervals (MODEL.md §14.1; minutes)."),
+]
+MembersOption = Annotated[
+    int, typer.Option("--members", "-n", help="With --with-assumed: mechanical runs per set of conditions, a power of two.")
+]
+
+
 def calibrate(
     config: ConfigArgument = None,
     preset: PresetOption = None,
@@ -282,16 +295,8 @@ def calibrate(
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
-    with_assumed: Annotated[
-        bool,
-        typer.Option("--with-assumed", help="Also free the preset's assumed inputs that move the mechanics (friction, "
-                     "restitution, λ, the clamp's motion, ...), their stated ranges as priors: a Bayesian fit on "
-                     "emulators of the runs, with posterior-predictive intervals (MODEL.md §14.1; minutes)."),
-    ] = False,
-    members: Annotated[
-        int, typer.Option("--members", "-n", help="With --with-assumed: mechanical runs per set of conditions, a power "
-                          "of two.")
-    ] = 32,
+    with_assumed: WithAssumedOption = False,
+    members: MembersOption = 32,
 ) -> None:
     """Fit free parameters to measured curves (the experiment's by default) and/or Table 5 targets by bounded least
     squares; with --with-assumed, over every uncertain input by Bayesian inference."""

@@ -39,7 +39,8 @@ def presets(
                         title=f"{preset.name}: assumed inputs, no source fixes them (MODEL.md §14.1)")
         for key, stated in preset.assumed.items():
             add_plain_row(assumed, key, format_value(key, preset.values[key].value), stated.shown_range(),
-                          stated.distribution, stated.reason)
+                          stated.distribution,
+                          stated.reason + (f" (moves {', '.join(stated.moves)} with it)" if stated.moves else ""))
         console.print(assumed)
     if preset.caveat:
         console.print(Text(f"Caveat ({preset.name}): {preset.caveat}"))

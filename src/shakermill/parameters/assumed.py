@@ -8,16 +8,22 @@ posterior says what it is) nor a key its own run does not read (a planetary jar 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any, Mapping
+from dataclasses import dataclass, replace
+from typing import Any, Mapping, Sequence
 
 from shakermill.parameters.engine_keys import Reader
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.geometry import bore_area, wall_volume
 from shakermill.parameters.keys import Parameters, bounds, field_unit
 
 # Uniform on [low, high], or uniform in the logarithm where the range spans orders of magnitude.
 DISTRIBUTIONS = ("uniform", "log-uniform")
 TABLE_FIELDS = ("low", "high", "distribution", "reason")
+# A table may also say which keys derived from the vial's dimensions follow the input (``moves``): a bowl whose bore
+# is uncertain has an inner area and a mass that go with it, and a member that moved one alone would be no bowl.
+MOVES_FIELD = "moves"
+BOWL_KEYS = ("vial_diameter", "vial_length", "outer_diameter", "outer_length")
+DERIVED_KEYS = ("inner_area", "vial_mass")
 
 
 @dataclass(frozen=True)
@@ -29,6 +35,7 @@ class AssumedInput:
     high: float
     distribution: str
     reason: str
+    moves: tuple[str, ...] = ()
 
     def shown_range(self) -> str:
         unit = field_unit(self.key)
@@ -45,9 +52,13 @@ def assumed_input(key: str, table: Any, where: str) -> AssumedInput:
     field = Parameters.model_fields.get(key)
     if field is None or field.annotation is not float:
         raise ParameterError(f"{name}: {key!r} is not a numeric key of a single value; only those can be assumed")
-    if not isinstance(table, Mapping) or set(table) != set(TABLE_FIELDS):
-        raise ParameterError(f"{name}: give exactly {', '.join(TABLE_FIELDS)}")
+    if not isinstance(table, Mapping) or set(table) - {MOVES_FIELD} != set(TABLE_FIELDS):
+        raise ParameterError(f"{name}: give exactly {', '.join(TABLE_FIELDS)} (and {MOVES_FIELD}, optionally)")
     low, high, distribution, reason = (table[field] for field in TABLE_FIELDS)
+    moves = table.get(MOVES_FIELD, [])
+    if key not in BOWL_KEYS and moves or not isinstance(moves, list) or not set(moves) <= set(DERIVED_KEYS):
+        raise ParameterError(f"{name}: {MOVES_FIELD} lists keys derived from the vial's dimensions "
+                             f"({', '.join(DERIVED_KEYS)}), only for {', '.join(BOWL_KEYS)}")
     if not all(isinstance(bound, (int, float)) and math.isfinite(bound) for bound in (low, high)) or not low < high:
         raise ParameterError(f"{name}: low and high must be finite numbers with low < high, not {low!r}, {high!r}")
     allowed = bounds(key)
@@ -57,7 +68,7 @@ def assumed_input(key: str, table: Any, where: str) -> AssumedInput:
         raise ParameterError(f"{name}: distribution must be one of {', '.join(DISTRIBUTIONS)} (log-uniform needs low > 0)")
     if not isinstance(reason, str) or not reason.strip():
         raise ParameterError(f"{name}: give the reason for the range")
-    return AssumedInput(key, float(low), float(high), str(distribution), reason)
+    return AssumedInput(key, float(low), float(high), str(distribution), reason, tuple(moves))
 
 
 def check_holds(assumed: AssumedInput, value: float, where: str) -> None:
@@ -65,6 +76,43 @@ def check_holds(assumed: AssumedInput, value: float, where: str) -> None:
     if not assumed.contains(float(value)):
         raise ParameterError(f"{where}: [assumed.{assumed.key}]: the preset's {assumed.key} = {value:g} lies outside "
                              f"its range {assumed.shown_range()}; state its own [assumed.{assumed.key}]")
+
+
+def check_derived(assumed: AssumedInput, values: Mapping[str, Any], where: str) -> None:
+    """A key an input ``moves`` must be what the preset's own dimensions give (to 1e-6), or moving it with them would
+    change the bowl in two ways at once (the bore's area; the wall's mass sets the density it moves with)."""
+    for key, expected in derived_values(assumed.moves, values, values).items():
+        if abs(float(values[key]) - expected) > 1e-6 * abs(expected):
+            raise ParameterError(f"{where}: [assumed.{assumed.key}]: moves {key}, but the preset's {key} = "
+                                 f"{float(values[key]):g} is not the {expected:g} its vial's dimensions give")
+
+
+def derived_values(keys: Sequence[str], values: Mapping[str, Any], base: Mapping[str, Any]) -> dict[str, float]:
+    """``keys`` (of DERIVED_KEYS) for the vial dimensions of ``values``: the bore's area, and the mass of the wall
+    at the density ``base``'s mass and dimensions imply (a preset states no density of its vial)."""
+    def wall(of: Mapping[str, Any]) -> float:
+        return wall_volume(*(float(of[key]) for key in ("outer_diameter", "outer_length", "vial_diameter", "vial_length")))
+
+    found = {}
+    if "inner_area" in keys:
+        found["inner_area"] = bore_area(float(values["vial_diameter"]), float(values["vial_length"]))
+    if "vial_mass" in keys:
+        found["vial_mass"] = float(base["vial_mass"]) * wall(values) / wall(base)
+    return found
+
+
+def with_derived(params: Parameters, inputs: Sequence[AssumedInput], point: Mapping[str, float]) -> dict[str, float]:
+    """A member's values (``point``) of ``params`` with the keys its varied inputs move, derived again."""
+    moved = tuple(dict.fromkeys(key for item in inputs if item.key in point for key in item.moves))
+    if not moved:
+        return dict(point)
+    base = params.model_dump()
+    return {**point, **derived_values(moved, {**base, **point}, base)}
+
+
+def keeping_moves(user: AssumedInput, stated: Mapping[str, AssumedInput]) -> AssumedInput:
+    """A user's range of an input with the derived keys the preset's range of it moves."""
+    return replace(user, moves=stated[user.key].moves) if user.key in stated else user
 
 
 def inherited_assumed(base: Mapping[str, AssumedInput], tables: Mapping[str, Any], values: Mapping[str, Any],
@@ -75,6 +123,7 @@ def inherited_assumed(base: Mapping[str, AssumedInput], tables: Mapping[str, Any
     kept = {key: assumed for key, assumed in {**base, **own}.items() if key not in fitted and reader.not_read(key) is None}
     for key, assumed in kept.items():
         check_holds(assumed, values[key], where)
+        check_derived(assumed, values, where)
     return kept
 
 

@@ -29,3 +29,13 @@ def balls_for_fill(fill: float, ball_radius: float, vial_length: float, vial_dia
 def end_faces_area(vial_diameter: float) -> float:
     """Area of the two circular end faces of a vial of inner diameter ``vial_diameter`` (m²)."""
     return 2.0 * math.pi * vial_diameter**2 / 4.0
+
+
+def bore_area(vial_diameter: float, vial_length: float) -> float:
+    """Inner area of a flat-ended cylindrical bore: its side and both ends (m²)."""
+    return math.pi * vial_diameter * vial_length + end_faces_area(vial_diameter)
+
+
+def wall_volume(outer_diameter: float, outer_length: float, vial_diameter: float, vial_length: float) -> float:
+    """Volume of the material between a cylinder's outside and its bore (m³)."""
+    return math.pi / 4.0 * (outer_diameter**2 * outer_length - vial_diameter**2 * vial_length)

@@ -26,6 +26,7 @@ from shakermill.studies.joint_calibration import (
     posterior_as_dict,
     predict,
     prior_sample,
+    reliability_problems,
     sample_posterior,
     train,
 )
@@ -51,15 +52,19 @@ class Direction:
     fitted: tuple[Prediction, ...]  # the fitted experiment's own points at the posterior
     predictions: tuple[Prediction, ...]
     prior_predictions: tuple[Prediction, ...]
+    problems: tuple[str, ...] = ()  # why it cannot be relied on (joint_calibration.reliability_problems)
 
     @property
     def verdict(self) -> str:
         inside = [prediction.inside for prediction in self.predictions]
-        held = "every" if all(inside) else "no" if not any(inside) else f"{sum(inside)} of {len(inside)}"
-        return f"fitted on {self.fitted_on.name}: {held} measured point of {self.predicted.name} inside its 90 % interval"
+        own = [prediction.inside for prediction in self.fitted]
+        return (f"fitted on {self.fitted_on.name} ({sum(own)} of its {len(own)} points inside their own 90 % "
+                f"intervals): {sum(inside)} of the {len(inside)} measured points of {self.predicted.name} inside "
+                "their 90 % intervals")
 
     def as_dict(self) -> dict[str, Any]:
         return {"fitted_on": self.fitted_on.name, "predicted": self.predicted.name, "verdict": self.verdict,
+                "unreliable": self.problems,
                 "posterior": posterior_as_dict(self.posterior),
                 "fitted_points": [prediction.as_dict() for prediction in self.fitted],
                 "predictions": [prediction.as_dict() for prediction in self.predictions],
@@ -108,4 +113,5 @@ def _direction(fitted_on: Experiment, predicted: Experiment, emulators: Mapping[
     posterior = sample_posterior([(source, measured)])
     return Direction(fitted_on, predicted, posterior, tuple(predict(source, posterior, measured)),
                      tuple(predict(target, posterior, measured_of(predicted))),
-                     tuple(predict(target, prior_sample(target.inputs), measured_of(predicted))))
+                     tuple(predict(target, prior_sample(target.inputs), measured_of(predicted))),
+                     tuple(reliability_problems((source, target), posterior)))

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from shakermill.analysis.regime import ACTIVE, PACK
-from shakermill.parameters.assumed import AssumedInput, parse_assumption
+from shakermill.parameters.assumed import AssumedInput, keeping_moves, parse_assumption, with_derived
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
@@ -189,7 +189,8 @@ def ensemble_inputs(preset: Preset, params: Parameters, assume: Sequence[str], v
     fitted values (a run that sets one asks about its own value, not the calibration's)."""
     reader = reader_of(params)
     stated = {key: item for key, item in preset.assumed.items() if reader.not_read(key) is None}
-    inputs = {**stated, **{item.key: item for item in (parse_assumption(text, reader) for text in assume)}}
+    users = (keeping_moves(parse_assumption(text, reader), stated) for text in assume)
+    inputs = {**stated, **{item.key: item for item in users}}
     missing = [key for key in vary if key not in inputs]
     if missing:
         raise ParameterError(f"--vary {missing[0]}: no range is stated for it; give one with --assume "
@@ -247,7 +248,9 @@ def check_members(members: int) -> None:
 def design_seed(base: Parameters, inputs: Sequence[AssumedInput]) -> int:
     """The design's seed: a hash of the configuration and the inputs' ranges, so that the same ensemble asked for
     twice has the same members (and resumes)."""
-    text = json.dumps([base.model_dump(mode="json"), [vars(item) for item in inputs]], sort_keys=True, default=str)
+    # An input that moves no derived key hashes as before that field existed: recorded ensembles keep their members.
+    described = [{key: value for key, value in vars(item).items() if key != "moves" or value} for item in inputs]
+    text = json.dumps([base.model_dump(mode="json"), described], sort_keys=True, default=str)
     return int.from_bytes(hashlib.sha256(text.encode()).digest()[:4], "big")
 
 
@@ -264,7 +267,7 @@ def run_ensemble(base: Parameters, inputs: Sequence[AssumedInput], out_dir: Path
         raise ParameterError("assumed inputs: none to vary; the preset states none that this run reads, give some "
                              "with --assume KEY=LOW:HIGH")
     seed = design_seed(base, inputs) + (0 if posterior is None else 1)
-    points = design(inputs, members, seed, posterior)
+    points = [with_derived(base, inputs, point) for point in design(inputs, members, seed, posterior)]
     say = announce or (lambda _: None)
     fitted = "" if posterior is None else f" and the posterior of {', '.join(posterior.keys)}"
     say(f"{members} members over {', '.join(item.key for item in inputs) or 'no assumed input'}{fitted}")

@@ -25,12 +25,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 
 from shakermill.engines.registry import describe, engine_named
-from shakermill.parameters.assumed import AssumedInput
+from shakermill.parameters.assumed import AssumedInput, with_derived
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
@@ -140,7 +140,7 @@ def train(params: Parameters, inputs: Sequence[AssumedInput], observables: Seque
     failed = []
     for member in range(members):
         rows = range(member * draws, (member + 1) * draws)
-        runs = [params.replace(**dict(zip(keys, map(float, values[row])))) for row in rows]
+        runs = [params.replace(**with_derived(params, inputs, dict(zip(keys, map(float, values[row]))))) for row in rows]
         result = thermal_variants(runs[0])(runs[0])
         if not result.success or result.load is None:
             failed.append(f"member {member}: {result.message}")
@@ -168,7 +168,8 @@ def _rises(observables: Sequence[Observable]) -> Callable[[Parameters, Any], np.
 
 @dataclass
 class Emulator:
-    """One Gaussian process per observable over the unit cube of ``inputs``, and its held-out Q²."""
+    """One Gaussian process per observable over the unit cube of ``inputs``, of the rises' logarithms where every
+    training rise is positive (``logarithmic``), and its held-out Q² (of the rises themselves)."""
 
     inputs: tuple[AssumedInput, ...]
     observables: tuple[Observable, ...]
@@ -177,11 +178,23 @@ class Emulator:
     training_points: int
     members: int
     failed: list[str]
+    logarithmic: bool = False
 
-    def predict(self, unit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The means and standard deviations (points, observables) at ``unit`` (points, inputs)."""
+    def _fitted_space(self, unit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         found = [model.predict(unit, return_std=True) for model in self.models]
         return np.column_stack([mean for mean, _ in found]), np.column_stack([sd for _, sd in found])
+
+    def predict(self, unit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The rises and their standard deviations (points, observables) at ``unit`` (points, inputs): for a
+        logarithmic emulator the median and its sd to first order."""
+        mean, sd = self._fitted_space(unit)
+        return (np.exp(mean), np.exp(mean) * sd) if self.logarithmic else (mean, sd)
+
+    def draw(self, unit: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """One rise of each observable at each point, with a draw of the emulator's error."""
+        mean, sd = self._fitted_space(unit)
+        values = mean + sd * rng.standard_normal(mean.shape)
+        return np.exp(values) if self.logarithmic else values
 
     def at(self, keys: Sequence[str], unit: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """Unit-cube points of this emulator's inputs from points over ``keys``: an input not among them drawn from
@@ -192,24 +205,29 @@ class Emulator:
 
 
 def emulate(training: Training) -> Emulator:
-    """Fit an emulator per observable; measure its Q² on mechanical members held out, FOLDS groups of them."""
+    """Fit an emulator per observable; measure its Q² on mechanical members held out, FOLDS groups of them. Rises
+    that are all positive are emulated in their logarithms: the model multiplies (a heat power by a network's
+    response), which the logarithm makes a sum, nearer the smooth function a Gaussian process assumes."""
     from sklearn.model_selection import GroupKFold
 
     members = np.unique(training.member)
     if members.size < FOLDS:
         raise ParameterError(f"members: {members.size} runs succeeded, too few to check an emulator on held-out runs "
                              f"(at least {FOLDS})")
+    logarithmic = bool(np.all(training.rises > 0))
+    fitted = np.log(training.rises) if logarithmic else training.rises
+    back = np.exp if logarithmic else (lambda values: values)
     q2 = {}
     for column, observable in enumerate(training.observables):
         values = training.rises[:, column]
         predicted = np.empty_like(values)
         for fit, held in GroupKFold(FOLDS).split(training.unit, values, training.member):
-            predicted[held] = gaussian_process(training.unit[fit], values[fit]).predict(training.unit[held])
+            predicted[held] = back(gaussian_process(training.unit[fit], fitted[fit, column]).predict(training.unit[held]))
         spread = np.sum((values - values.mean()) ** 2)
         q2[observable.name] = float(1.0 - np.sum((values - predicted) ** 2) / spread) if spread > 0 else math.nan
-    models = [gaussian_process(training.unit, training.rises[:, column]) for column in range(len(training.observables))]
+    models = [gaussian_process(training.unit, fitted[:, column]) for column in range(len(training.observables))]
     return Emulator(training.inputs, training.observables, models, q2, len(training.unit), int(members.size),
-                    training.failed)
+                    training.failed, logarithmic)
 
 
 @dataclass(frozen=True)
@@ -278,7 +296,10 @@ def sample_posterior(data: Data) -> Posterior:
 
     walkers = max(WALKERS_PER_INPUT * len(inputs), LEAST_WALKERS)
     rng = np.random.default_rng(SEED)
-    sampler = emcee.EnsembleSampler(walkers, len(inputs), log_probability, vectorize=True)
+    # Differential-evolution moves (ter Braak 2006; emcee's DEMove and DESnookerMove) mix faster than the default
+    # stretch in a dozen dimensions where most inputs are barely constrained.
+    moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+    sampler = emcee.EnsembleSampler(walkers, len(inputs), log_probability, vectorize=True, moves=moves)
     sampler.random_state = np.random.RandomState(SEED).get_state()
     sampler.run_mcmc(rng.uniform(0.05, 0.95, (walkers, len(inputs))), STEPS)
     chain = sampler.get_chain(discard=STEPS // 2, flat=True)
@@ -314,8 +335,7 @@ def predict(emulator: Emulator, posterior: Posterior, measured: Sequence[Measure
     """Each observable of ``emulator`` at the ``posterior``'s samples, an input it does not hold drawn from its prior,
     each with a draw of the emulator's error."""
     rng = np.random.default_rng(SEED + 1)
-    mean, sd = emulator.predict(emulator.at(posterior.keys, posterior.unit, rng))
-    draws = mean + sd * rng.standard_normal(mean.shape)
+    draws = emulator.draw(emulator.at(posterior.keys, posterior.unit, rng), rng)
     table = np.quantile(draws, [0.5 - LEVEL / 2, 0.5, 0.5 + LEVEL / 2], axis=0)
     known = {item.observable: item.rise_K for item in measured}
     return [Prediction(observable, tuple(float(v) for v in table[:, column]), known.get(observable))
@@ -371,13 +391,7 @@ class JointCalibration:
 
     @property
     def problems(self) -> list[str]:
-        found = [f"the emulator of {observable} predicts held-out runs with Q² {value:.2f} (< {LEAST_Q2:g})"
-                 for emulator in self.emulators.values() for observable, value in emulator.q2.items()
-                 if not value >= LEAST_Q2]
-        if not self.posterior.converged:
-            found.append(f"the chain is {STEPS // 2} steps after burn-in, under 25 of its autocorrelation times "
-                         f"({self.posterior.autocorrelation_steps:.0f} steps)")
-        return found
+        return reliability_problems(self.emulators.values(), self.posterior)
 
     @property
     def message(self) -> str:
@@ -393,6 +407,17 @@ class JointCalibration:
                               for conditions, emulator in self.emulators.items()},
                 "fitted_points": [item.as_dict() for item in self.fitted],
                 "predictions": [item.as_dict() for item in self.predictions], "curve": self.curve_source}
+
+
+def reliability_problems(emulators: Iterable[Emulator], posterior: Posterior) -> list[str]:
+    """Why a posterior and what it predicts cannot be relied on: an emulator that predicts runs it did not see with
+    Q² below LEAST_Q2, or a chain shorter than 25 of its autocorrelation times after burn-in."""
+    found = [f"the emulator of {observable} predicts held-out runs with Q² {value:.2f} (< {LEAST_Q2:g})"
+             for emulator in emulators for observable, value in emulator.q2.items() if not value >= LEAST_Q2]
+    if not posterior.converged:
+        found.append(f"the chain is {STEPS // 2} steps after burn-in, under 25 of its autocorrelation times "
+                     f"({posterior.autocorrelation_steps:.0f} steps)")
+    return found
 
 
 def calibrate_jointly(preset: Preset, base: Parameters, free: Sequence[str], curves: Sequence[Any], members: int,

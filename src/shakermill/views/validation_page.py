@@ -143,8 +143,10 @@ def cross_statement(cross: CrossPrediction) -> str:
     """The verdicts, what was freed and how, and how well the emulators predict runs they did not see."""
     from shakermill.studies.joint_calibration import ASSUMED_MEASUREMENT_SD_K
 
-    verdicts = "; ".join(direction.verdict for direction in cross.directions)
-    q2 = ", ".join(f"{name} {value:.2f}" for emulator in cross.emulators.values() for name, value in emulator.q2.items())
+    verdicts = "; ".join(direction.verdict + (f" (unreliable: {'; '.join(direction.problems)})" if direction.problems
+                                              else "") for direction in cross.directions)
+    q2 = ", ".join(f"{experiment} {name} {value:.2f}" for experiment, emulator in cross.emulators.items()
+                   for name, value in emulator.q2.items())
     freed = sorted({item.key for emulator in cross.emulators.values() for item in emulator.inputs})
     return (f"{verdicts[0].upper()}{verdicts[1:]}. Each fit starts from {cross.preset} and frees {', '.join(freed)} over their "
             f"stated ranges (the priors; pair keys only where two balls meet), the measurements with a standard "
@@ -154,7 +156,8 @@ def cross_statement(cross: CrossPrediction) -> str:
 
 QUICK_NOTE = ("A quick validation: the matrix holds the experiments of five balls and of none. `shakermill validate "
               "--full` adds those of one ball, the structure study, the engines' one-ball comparison and the "
-              "sensitivity to the assumed SPEX kinematics (~17 min on two cores).")
+              "sensitivity to the assumed SPEX kinematics and both SPEX experiments fitted over every uncertain input, each "
+              "predicting the other (~30 min on two cores).")
 
 
 def render_validation_page(report: ValidationReport) -> str:
