@@ -27,11 +27,13 @@ $(NOTEBOOK_STAMP): $(STAMP)
 run: install
 	$(BIN)/shakermill run --overwrite --out $(OUT)
 
-# scripts/ensure-browser installs Chromium for the report's browser test, or prints why it cannot
-# (the test then skips with that reason). One worker per core (pytest-xdist, at most 4): the suite is
-# mostly engine runs on one thread each.
+# The report's browser test needs Chromium. scripts/ensure-browser installs it only when asked (BROWSER=1, as CI
+# does; apt-get with --no-upgrade), so that a plain `make test` changes nothing outside this folder; otherwise, or
+# when it cannot, it prints why and the test skips with that reason. One worker per core (pytest-xdist, at most 4):
+# the suite is mostly engine runs on one thread each.
+BROWSER ?=
 test: install
-	@reason="$$(scripts/ensure-browser)"; SHAKERMILL_BROWSER_UNAVAILABLE="$$reason" $(BIN)/python -m pytest -n auto --maxprocesses 4
+	@reason="$$(BROWSER=$(BROWSER) scripts/ensure-browser)"; SHAKERMILL_BROWSER_UNAVAILABLE="$$reason" $(BIN)/python -m pytest -n auto --maxprocesses 4
 
 # The unit tests alone: every test not marked slow (pyproject.toml), in under a minute.
 test-fast: install

@@ -1,4 +1,5 @@
-"""`make test` on a fresh machine: the test target installs Chromium for the browser test, or says why not."""
+"""`make test` on a fresh machine: the test target installs Chromium for the browser test when asked (BROWSER=1, as
+CI does), and otherwise changes nothing on the machine and says how to run that test."""
 
 from __future__ import annotations
 
@@ -53,22 +54,37 @@ def test_make_test_runs_the_dependency_step_before_the_suite():
     assert "SHAKERMILL_BROWSER_UNAVAILABLE" in step
 
 
-def test_ci_calls_make_test():
-    assert (ROOT / ".ci" / "run").read_text().strip().splitlines()[-1] == "make test"
+def test_ci_calls_make_test_and_asks_for_the_browser():
+    lines = (ROOT / ".ci" / "run").read_text().strip().splitlines()
+    assert lines[-1] == "make test" and "export BROWSER=1" in lines
 
 
-def test_missing_chromium_is_installed_with_apt_get(tmp_path):
+def test_make_test_passes_the_request_for_the_browser_on():
+    plan = subprocess.run(["make", "-n", "test", "BROWSER=1"], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert "BROWSER=1 scripts/ensure-browser" in plan.stdout
+
+
+def test_missing_chromium_is_installed_with_apt_get_when_asked_and_nothing_else_upgraded(tmp_path):
     environment, log = machine_without_chromium(tmp_path, install_succeeds=True)
-    completed = ensure_browser(environment)
+    completed = ensure_browser({**environment, "BROWSER": "1"})
     assert completed.returncode == 0, completed.stderr
     assert completed.stdout == ""  # nothing to skip: the browser test runs
-    assert "install -y -qq chromium" in log.read_text()
+    assert "install -y -qq --no-upgrade chromium" in log.read_text()
     assert (tmp_path / "bin" / "chromium").exists()
+
+
+def test_a_plain_make_test_installs_nothing_and_says_how_to_run_the_browser_test(tmp_path):
+    environment, log = machine_without_chromium(tmp_path, install_succeeds=True)
+    completed = ensure_browser(environment)
+    assert completed.returncode == 0 and not log.exists()
+    reason = completed.stdout.strip()
+    assert len(reason.splitlines()) == 1 and "`make test BROWSER=1` installs it" in reason
+    assert not (tmp_path / "bin" / "chromium").exists()
 
 
 def test_impossible_install_gives_one_line_and_a_skip_reason(tmp_path):
     environment, log = machine_without_chromium(tmp_path, install_succeeds=False)
-    completed = ensure_browser(environment)
+    completed = ensure_browser({**environment, "BROWSER": "1"})
     assert completed.returncode == 0  # make goes on to the suite; the browser test skips
     reason = completed.stdout.strip()
     assert len(reason.splitlines()) == 1

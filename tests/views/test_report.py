@@ -286,7 +286,7 @@ def chromium() -> str:
         if found:
             return found
     pytest.fail(
-        "chromium is not installed: `apt-get install chromium` (`make test` does it), "
+        "chromium is not installed: `apt-get install chromium` (`make test BROWSER=1` does it), "
         "or set SHAKERMILL_SKIP_BROWSER=1 to skip the browser test"
     )
 

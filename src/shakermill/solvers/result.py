@@ -90,7 +90,13 @@ class MechanicsAverages:
         }
 
 
-@dataclass
+# What ``repr(result)`` shows of its summary, and the longest message it prints whole.
+REPR_HEADLINES = {"ball_C": "ball °C", "vial_C": "vial °C", "air_C": "air °C", "heat_power_W": "heat W",
+                  "impact_rate_hz": "impacts/s"}
+REPR_MESSAGE = 160
+
+
+@dataclass(repr=False)
 class Result:
     """Everything a run produced. ``success`` is False when the integrator stopped early."""
 
@@ -124,6 +130,23 @@ class Result:
     @property
     def success(self) -> bool:
         return self.status == REACHED_STOP
+
+    def __repr__(self) -> str:
+        """A few lines, as xarray and pandas objects print: what ran and how it ended, its headline numbers and the
+        sizes of its data; the data themselves are ``timeseries``, ``impacts``, ``windows`` and ``summary``."""
+        shown = [f"{REPR_HEADLINES[key]} {self.summary[key]:.4g}" for key in REPR_HEADLINES
+                 if isinstance(self.summary.get(key), (int, float))]
+        impacts = next(iter(self.impact_columns.values()), np.zeros(0)).size
+        lines = [
+            f"<shakermill.Result: engine {self.params.engine!r}, solver {self.solver!r}, "
+            f"{'success' if self.success else f'status {self.status}'}, {self.t_end:g} s simulated in {self.wall_time:.3g} s>",
+            f"  {self.message if len(self.message) <= REPR_MESSAGE else self.message[: REPR_MESSAGE - 1] + '…'}",
+            *([f"  {', '.join(shown)}"] if shown else []),
+            f"  data: {self.history.times.size} samples of {len(self.history.variables)} series, {impacts} impacts, "
+            f"{self.window_history.times.size} window samples, {len(self.summary)} summary keys",
+            *([f"  {len(self.warnings)} warning{'s' if len(self.warnings) != 1 else ''} (.warnings)"] if self.warnings else []),
+        ]
+        return "\n".join(lines)
 
     def warn(self, *lines: str | None, first: bool = False) -> None:
         """Add each of ``lines`` (None is skipped) to the warnings once: a run concluded again, or a scan attached
