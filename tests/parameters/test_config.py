@@ -207,3 +207,19 @@ def test_bad_values_in_a_file_are_one_line_naming_the_key(tmp_path, text, fragme
 def test_windows_with_units_in_a_file_are_converted(tmp_path):
     path = write_toml(tmp_path, 'record_windows = [["0 s", "100 ms"], [600, "1 min"]]\n')
     assert load_config(path).params.record_windows == ((0.0, 0.1), (600.0, 60.0))
+
+
+def test_a_balls_diameter_is_taken_as_twice_its_radius_from_the_command_line_and_a_file(tmp_path):
+    """Issue 37, point 6: `--set ball_diameter="10 mm"` answered "did you mean 'vial_diameter'?"."""
+    from shakermill.parameters.config import load_config
+    from shakermill.parameters.errors import ParameterError
+
+    assert load_config(preset="spex8000m-3d", overrides=['ball_diameter=10 mm']).params.ball_radius == pytest.approx(0.005)
+    assert load_config(preset="spex8000m-3d", overrides=["ball_diameter=0.0127"]).params.ball_radius == pytest.approx(0.00635)
+    mine = tmp_path / "mine.toml"
+    mine.write_text('preset = "spex8000m-3d"\nball_diameter = "8 mm"\n', encoding="utf-8")
+    assert load_config(mine).params.ball_radius == pytest.approx(0.004)
+    with pytest.raises(ParameterError, match=r"^ball_diameter: give ball_radius or ball_diameter \(twice ball_radius\), not both$"):
+        load_config(overrides=["ball_diameter=10 mm", "ball_radius=5 mm"])
+    with pytest.raises(ParameterError, match=r"^ball_diameter: .*allowed a length from 5e-05 to 0.2 m \(twice ball_radius\)$"):
+        load_config(overrides=["ball_diameter=10 kg"])

@@ -27,6 +27,7 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import (
     Parameters,
     build_parameters,
+    resolve_aliases,
     field_description,
     field_unit,
     layered,
@@ -83,7 +84,7 @@ def load_config(
         document = _config_document(source)
         written_by_hand = PROVENANCE_TABLE not in document
         tables = {"assumed_tables": document.pop(ASSUMED_TABLE, {}), "provenance": document.pop(PROVENANCE_TABLE, {})}
-        file_values = document
+        file_values = resolve_aliases(document)
         file_preset = _file_preset(file_values, source)
     # An empty --preset names no preset: refused as unknown, not read as "the default".
     chosen_preset = preset if preset is not None else file_preset or DEFAULT_PRESET
@@ -186,16 +187,17 @@ def _file_preset(values: dict[str, Any], path: Path) -> str | None:
     return name
 
 
-def parse_overrides(items: Sequence[str]) -> dict[str, str]:
-    """``["restitution=0.8", "duration=2 min"]`` -> ``{"restitution": "0.8", "duration": "2 min"}``; later wins."""
-    overrides: dict[str, str] = {}
+def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """``["restitution=0.8", "duration=2 min"]`` -> ``{"restitution": "0.8", "duration": "2 min"}``; later wins; an
+    alias people type (``ball_diameter="10 mm"``) becomes its key's SI value (``ball_radius`` 0.005)."""
+    overrides: dict[str, Any] = {}
     for item in items:
         key, separator, value = item.partition("=")
         key = key.strip()
         if not separator or not key:
             raise ParameterError(f"--set {quoted(item)}: expected KEY=VALUE, for example --set restitution=0.8")
         overrides[key] = value.strip()
-    return overrides
+    return resolve_aliases(overrides)
 
 
 def config_toml_text(

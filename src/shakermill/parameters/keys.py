@@ -56,7 +56,7 @@ class Parameters(BaseModel):
 
     # Geometry and drive (MODEL.md section 1)
     # 25 µm: the finest beads of bead mills (50 µm across); 0.1 m: larger than any milling ball (~50 mm).
-    ball_radius: float = quantity("m", "milling ball radius R", ge=2.5e-5, le=0.1)
+    ball_radius: float = quantity("m", "milling ball radius R (or give ball_diameter, twice it)", ge=2.5e-5, le=0.1)
     # 1 mm to 1 m: from micro-vials to twice the largest vibratory mill's vessel.
     vial_length: float = quantity("m", "inner length of the vial l_v", ge=1e-3, le=1.0)
     vial_diameter: float = quantity("m", "inner diameter of the vial d_v", ge=1e-3, le=1.0)
@@ -587,6 +587,27 @@ def checked_name(key: str, value: Any) -> str:
     if value not in choices_of(key):
         raise ParameterError(f"{key}: {quoted(value)} is not allowed; allowed {allowed_range(key)}")
     return str(value)
+
+
+# Names people type for a quantity that a key takes in another form: a ball's diameter is twice its radius.
+HALVED_ALIASES = {"ball_diameter": "ball_radius"}
+
+
+def resolve_aliases(layer: Mapping[str, Any]) -> dict[str, Any]:
+    """``layer`` with each alias of :data:`HALVED_ALIASES` replaced by its key, the value converted to SI and halved;
+    one line for a layer that gives both, or a value that is no length."""
+    found = dict(layer)
+    for alias, key in HALVED_ALIASES.items():
+        if alias not in found:
+            continue
+        if key in found:
+            raise ParameterError(f"{alias}: give {key} or {alias} (twice {key}), not both")
+        try:
+            found[key] = guards.quantity(alias, found.pop(alias), field_unit(key)) / 2.0
+        except UnitError as exc:
+            low, high = (2.0 * bound for bound in (bounds(key).low, bounds(key).high))
+            raise ParameterError(f"{exc}; allowed a length from {low:g} to {high:g} m (twice {key})") from None
+    return found
 
 
 def check_known_keys(keys: list[str] | tuple[str, ...], *, extra_allowed: tuple[str, ...] = ()) -> None:
