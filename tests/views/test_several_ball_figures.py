@@ -187,8 +187,9 @@ def test_the_report_has_a_table_per_ball_and_leaves_out_what_is_one_dimensional(
 
 def test_result_plot_and_html_of_a_dem_result(result):
     figures = result.plot()
-    assert list(figures) == ["temperatures", "trajectories", "heat_by_channel", "ball_heating_zoom"]
-    assert figures._repr_html_().count("data:image/png;base64,") == 4
+    # The spectrum a run of several balls with impacts promises (issue 37, point 3), after the main figures.
+    assert list(figures) == ["temperatures", "trajectories", "heat_by_channel", "ball_heating_zoom", "stress_energy_spectrum"]
+    assert figures._repr_html_().count("data:image/png;base64,") == 5
     assert "the 3 balls are at" in result._repr_html_()
 
 

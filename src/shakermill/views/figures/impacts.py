@@ -54,6 +54,20 @@ MIN_RATE_BIN_S = 1.0
 MINUTES_AXIS_FROM_S = 300.0
 
 
+def _spectrum(run: RunLike) -> dict[str, Figure]:
+    spectrum = run_stress_spectrum(run)
+    return {} if spectrum is None else {"stress_energy_spectrum": stress_energy_figure(spectrum)}
+
+
+def spectrum_figures(run: RunLike) -> dict[str, Figure]:
+    """The stress-energy spectrum alone, with the run's context: what a run of several balls with impacts draws
+    besides its main figures (the other impact statistics wait for ``plot --impacts``)."""
+    if run.impacts.empty:
+        return {}
+    context, window = run_context(run), averaging_window_note(run)
+    return {name: add_context(figure, context, window) for name, figure in _spectrum(run).items()}
+
+
 def impact_figures(run: RunLike) -> dict[str, Figure]:
     """Histograms of impact speed and dissipated energy, impacts per second at each wall, and (1-D) the
     impact phases; none without impacts."""
@@ -69,9 +83,7 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
         ),
         "impacts_per_second": impact_rate_figure(impacts),
     }
-    spectrum = run_stress_spectrum(run)
-    if spectrum is not None:
-        figures["stress_energy_spectrum"] = stress_energy_figure(spectrum)
+    figures.update(_spectrum(run))
     if not balls:
         # Regimes are sequences of end faces hit at fixed drive phases: a notion of one ball on the axis.
         figures["impact_phase_histogram"] = impact_phase_figure(run)

@@ -47,7 +47,7 @@ from shakermill.views.figures.common import (
     to_celsius,
     window_data,
 )
-from shakermill.views.figures.impacts import impact_figures, impact_kinds
+from shakermill.views.figures.impacts import impact_figures, impact_kinds, spectrum_figures
 from shakermill.views.trajectories import ANIMATION_DPI, animation_gif, ball_colours, trajectory_figure
 
 if TYPE_CHECKING:
@@ -69,10 +69,13 @@ def plot_run(run: RunLike, out_dir: Path | str, *, impacts: bool = False, dpi: i
 
 def run_figures(run: RunLike, *, impacts: bool = False, window: int = 0) -> dict[str, Figure]:
     """The figures of ``run`` by name: those of :func:`main_figure_names` its data allow, then the impact
-    figures; the motion (``ball_motion``, ``trajectories``) is drawn over record window ``window``."""
+    figures, or for a run of several balls at least its stress-energy spectrum; the motion (``ball_motion``,
+    ``trajectories``) is drawn over record window ``window``."""
     figures = paper_figures(run, window=window)
     if impacts:
         figures.update(impact_figures(run))
+    elif several_balls(run.params):
+        figures.update(spectrum_figures(run))
     return figures
 
 
