@@ -80,6 +80,8 @@ def test_a_key_the_preset_inherits_but_its_own_run_does_not_read_is_no_note():
     assert load_config(preset="spex8000m-3d-calibrated").params.outer_area != sm.default_parameters().outer_area
     assert load_config(preset="spex8000m-3d-calibrated").notes == ()
     assert load_config(preset="pulverisette7").notes == ()
+    # Issue 37, point 4: a preset's averaging settings under the full solver the run chose are not said.
+    assert load_config(preset="pulverisette7", overrides=["solver=full"]).notes == ()
 
 
 def test_the_keys_a_preset_sets_and_the_run_does_not_read_are_said_in_a_note():

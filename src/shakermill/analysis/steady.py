@@ -139,9 +139,19 @@ def run_length_note(duration: float, steady: SteadyState) -> str | None:
     slowest = steady.slowest_time_constant
     if not math.isfinite(slowest) or duration >= SETTLED_TIME_CONSTANTS * slowest:
         return None
+    if steady.balls and shorter_than_its_time_constant(duration, steady):
+        return (f"The run ({duration / 60:.3g} min) is shorter than the slowest time constant ({slowest / 60:.3g} min): "
+                "no exponential describes it, so theta_inf_C, tau_min and rate0_C_per_min are not shown; the steady "
+                "state is the answer to read.")
     # An empty mill fits no exponential.
     what = "its end and the exponential fitted over it (theta_inf_C) are" if steady.balls else "its end is"
     return (
         f"The run ({duration / 60:.3g} min) is shorter than {SETTLED_TIME_CONSTANTS:g} slowest time constants "
         f"({SETTLED_TIME_CONSTANTS:g} x {slowest / 60:.3g} min), so {what} not the steady state."
     )
+
+
+def shorter_than_its_time_constant(duration: float, steady: SteadyState) -> bool:
+    """Whether a run ends before one slowest time constant of its network: an exponential fitted to it describes
+    the start of the heating, not where it goes."""
+    return math.isfinite(steady.slowest_time_constant) and duration < steady.slowest_time_constant

@@ -212,15 +212,13 @@ def summary_table(result: Result, target: Path) -> Table:
         ("status", s["message"] if not result.success else "ok", ""),
         ("solver", s["solver"], ""),
         ("drive ω", f"{number(s['omega_rad_s'], '.4g')} rad/s = {number(s['omega_hz'], '.4g')} Hz = {number(s['omega_rpm'], '.0f')}", "rpm"),
-        ("amplitude; ball radius", f"{number(s['amplitude_mm'], '.4g')}; {_radii_mm(result.params)}", "mm"),
+        _size_row(result),
         ("ambient; initial temperature", f"{number(s['ambient_temperature_C'], '.4g')}; {number(s['initial_temperature_C'], '.4g')}", "°C"),
         ("simulated time", number(s["simulated_s"], ".6g"), "s"),
         (f"{ball} steady state", number(s["ball_steady_C"], ".2f"), "°C"),
         ("vial; air steady state", f"{number(s['vial_steady_C'], '.2f')}; {number(s['air_steady_C'], '.2f')}", "°C"),
         ("slowest time constant", number(s["slowest_time_constant_min"], ".1f"), "min"),
-        (f"{ball} θ∞ of the exponential fitted over {fit_window}", number(s["theta_inf_C"], ".2f"), "°C"),
-        ("τ of that fit", number(s["tau_min"], ".2f"), "min"),
-        ("initial heating rate θ̇₀ of that fit", number(s["rate0_C_per_min"], ".3f"), "°C/min"),
+        *_fit_rows(result, ball, fit_window),
         (f"{ball} at the end", number(s["ball_C"], ".2f"), "°C"),
         ("vial at the end", number(s["vial_C"], ".2f"), "°C"),
         ("air at the end", number(s["air_C"], ".2f"), "°C"),
@@ -241,6 +239,32 @@ def summary_table(result: Result, target: Path) -> Table:
     for row in rows:
         add_plain_row(table, *row)
     return table
+
+
+def _size_row(result: Result) -> tuple[str, str, str]:
+    """The vial's amplitude where its motion reads one (a planetary jar's does not) and the balls' radii (mm)."""
+    from shakermill.parameters.engine_keys import reader_of
+
+    radii = _radii_mm(result.params)
+    if reader_of(result.params).not_read("amplitude") is not None:
+        return ("ball radius", radii, "mm")
+    return ("amplitude; ball radius", f"{number(result.summary['amplitude_mm'], '.4g')}; {radii}", "mm")
+
+
+def _fit_rows(result: Result, ball: str, fit_window: str) -> list[tuple[str, str, str]]:
+    """The exponential fitted to the balls' heating, or one row saying why a run shorter than the network's slowest
+    time constant has none worth reading."""
+    from shakermill.analysis.steady import shorter_than_its_time_constant
+
+    s = result.summary
+    if result.steady is not None and result.params.n_balls > 0 and shorter_than_its_time_constant(result.t_end, result.steady):
+        return [("exponential fit", f"none: the run is shorter than the slowest time constant "
+                 f"({number(s['slowest_time_constant_min'], '.1f')} min)", "")]
+    return [
+        (f"{ball} θ∞ of the exponential fitted over {fit_window}", number(s["theta_inf_C"], ".2f"), "°C"),
+        ("τ of that fit", number(s["tau_min"], ".2f"), "min"),
+        ("initial heating rate θ̇₀ of that fit", number(s["rate0_C_per_min"], ".3f"), "°C/min"),
+    ]
 
 
 def interval_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:

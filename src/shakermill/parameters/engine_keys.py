@@ -148,9 +148,10 @@ class Reader:
         itself reads (``preset``, its own reader) and that this run does not, or None: inherited, not asked for, so
         ignored, but said. (A key the preset's own run does not read either, inherited from a preset it builds on,
         was never part of its answer.)"""
+        # A solver's own numerical settings say nothing of the answer of a run that chose another solver: not said.
         ignored = [key for key, value in values.items()
                    if key in defaults and value != defaults[key] and self.not_read(key) is not None
-                   and (preset is None or preset.not_read(key) is None)]
+                   and (preset is None or preset.not_read(key) is None) and key not in AVERAGED_ONLY]
         if not ignored:
             return None
         return f"Ignored, as this run does not read them: the preset's {', '.join(ignored)}."
