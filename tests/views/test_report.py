@@ -322,9 +322,9 @@ def test_report_renders_in_headless_chromium(run_folder, tmp_path):
 
 def test_report_shows_the_runs_warnings_and_its_steady_state(run_folder, report_html):
     summary = load_run(run_folder).summary
-    # 30 s is far shorter than three slowest time constants: the run says so in its answer, not as a warning.
-    assert any("slowest time constants" in line for line in summary["notes"])
-    assert not any("slowest time constants" in line for line in summary["warnings"])
+    # 30 s is far shorter than the slowest time constant: the run says so in its answer, not as a warning.
+    assert any("slowest time constant" in line for line in summary["notes"])
+    assert not any("slowest time constant" in line for line in summary["warnings"])
     answer = re.search(r'<p class="statement answer">(.*?)</p>', report_html).group(1)
     assert all(html.escape(note) in answer for note in summary["notes"])
     for line in summary["warnings"]:

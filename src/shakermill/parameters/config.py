@@ -11,9 +11,9 @@ ignored on loading, so a stored run's ``config.toml`` reproduces its parameters.
 
 from __future__ import annotations
 
+import dataclasses
 import platform
 import tomllib
-import dataclasses
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -21,20 +21,22 @@ from typing import Any, Mapping, Sequence
 
 import tomli_w
 
+from shakermill.parameters import guards
+from shakermill.parameters.assumed import inherited_assumed
 from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.engine_keys import READER_FIELDS, Reader, reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import (
     Parameters,
+    bounds,
     build_parameters,
-    resolve_aliases,
     field_description,
     field_unit,
     layered,
     with_materials,
 )
-from shakermill.parameters.assumed import inherited_assumed
 from shakermill.parameters.presets import PRESETS, Cited, Preset, default_parameters, preset_values
+from shakermill.parameters.units import UnitError
 from shakermill.support.atomic import write_text_atomically
 from shakermill.support.limits import MAX_CONFIG_BYTES, quoted
 from shakermill.support.version import __version__
@@ -185,6 +187,27 @@ def _file_preset(values: dict[str, Any], path: Path) -> str | None:
     if name is not None and not isinstance(name, str):
         raise ParameterError(f"{path}: preset must be a string naming a preset, got {quoted(name)}")
     return name
+
+
+# Names people type for a quantity that a key takes in another form: a ball's diameter is twice its radius.
+HALVED_ALIASES = {"ball_diameter": "ball_radius"}
+
+
+def resolve_aliases(layer: Mapping[str, Any]) -> dict[str, Any]:
+    """``layer`` with each alias of :data:`HALVED_ALIASES` replaced by its key, the value converted to SI and halved;
+    one line for a layer that gives both, or a value that is no length."""
+    found = dict(layer)
+    for alias, key in HALVED_ALIASES.items():
+        if alias not in found:
+            continue
+        if key in found:
+            raise ParameterError(f"{alias}: give {key} or {alias} (twice {key}), not both")
+        try:
+            found[key] = guards.quantity(alias, found.pop(alias), field_unit(key)) / 2.0
+        except UnitError as exc:
+            low, high = (2.0 * bound for bound in (bounds(key).low, bounds(key).high))
+            raise ParameterError(f"{exc}; allowed a length from {low:g} to {high:g} m (twice {key})") from None
+    return found
 
 
 def parse_overrides(items: Sequence[str]) -> dict[str, Any]:

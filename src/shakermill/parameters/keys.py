@@ -589,27 +589,6 @@ def checked_name(key: str, value: Any) -> str:
     return str(value)
 
 
-# Names people type for a quantity that a key takes in another form: a ball's diameter is twice its radius.
-HALVED_ALIASES = {"ball_diameter": "ball_radius"}
-
-
-def resolve_aliases(layer: Mapping[str, Any]) -> dict[str, Any]:
-    """``layer`` with each alias of :data:`HALVED_ALIASES` replaced by its key, the value converted to SI and halved;
-    one line for a layer that gives both, or a value that is no length."""
-    found = dict(layer)
-    for alias, key in HALVED_ALIASES.items():
-        if alias not in found:
-            continue
-        if key in found:
-            raise ParameterError(f"{alias}: give {key} or {alias} (twice {key}), not both")
-        try:
-            found[key] = guards.quantity(alias, found.pop(alias), field_unit(key)) / 2.0
-        except UnitError as exc:
-            low, high = (2.0 * bound for bound in (bounds(key).low, bounds(key).high))
-            raise ParameterError(f"{exc}; allowed a length from {low:g} to {high:g} m (twice {key})") from None
-    return found
-
-
 def check_known_keys(keys: list[str] | tuple[str, ...], *, extra_allowed: tuple[str, ...] = ()) -> None:
     """Raise :class:`ParameterError` with a did-you-mean suggestion for the first unknown key."""
     known = FIELD_NAMES + extra_allowed
