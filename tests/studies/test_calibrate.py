@@ -388,3 +388,14 @@ def test_a_ctrl_c_while_the_posterior_is_sampled_is_raised_without_emcee_printin
     with pytest.raises(KeyboardInterrupt):
         posterior_samples(residuals_of, np.zeros(2), np.full(2, -5.0), np.full(2, 5.0), 1.0)
     assert capsys.readouterr().err == "" and len(calls) == 5
+
+
+def test_a_fit_tells_its_progress_each_evaluation_with_its_rms_from_the_curve():
+    """Issue 37, point 2: a long fit says how far it has got and how close it is, on a terminal and piped."""
+    seen = []
+    calibration = calibrate(sm.default_parameters("spex8000m", record_windows=()), ("beta", "vial_mass"),
+                            progress=lambda done, rms: seen.append((done, rms)))
+    assert [done for done, _ in seen] == list(range(1, calibration.evaluations + 1))
+    # The start is far off the experiment's curve; the fit ends where its own RMS says, the last evaluations near it.
+    assert seen[0][1] > 10 * calibration.curve_rms_K
+    assert min(rms for _, rms in seen) == pytest.approx(calibration.curve_rms_K, rel=1e-6)

@@ -321,9 +321,11 @@ def calibrate(
             return
         with nothing_written_when_interrupted("the fit starts again from the beginning"), nothing_written_when_a_run_is_stopped(
             "the fit"
-        ), progress_bar("fitting", "{task.completed} model evaluations", None, delay_s=PROGRESS_DELAY_S) as update:
+        ), progress_bar("fitting", "{task.completed} model evaluations, the last {task.fields[rms]} K RMS from the curves",
+                        None, delay_s=PROGRESS_DELAY_S, rms="n/a") as update:
             calibration = fit_parameters(
-                run_config.params, free_keys, targets, measured, full_resolution=full_resolution, progress=update,
+                run_config.params, free_keys, targets, measured, full_resolution=full_resolution,
+                progress=lambda done, rms: update(done, rms=number(rms, ".3g")),
                 on_start=lambda: announce(run_config.params, free_keys, bool(free), [item.note for item in measured if item.note]),
             )
     # A fit that leaves its keys undetermined has values that any others would match as well: no preset of them.

@@ -245,7 +245,7 @@ def calibrate(
     curve: Curve | Sequence[Curve] | None = None,
     *,
     full_resolution: bool = False,
-    progress: Callable[[int], None] | None = None,
+    progress: Callable[[int, float | None], None] | None = None,
     sample_posterior: bool = True,
     on_start: Callable[[], None] | None = None,
 ) -> Calibration:
@@ -253,7 +253,8 @@ def calibrate(
     its own conditions (:class:`~shakermill.studies.validation.Curve`); see the module docstring.
 
     ``on_start()`` is called once every input has been checked, before the first evaluation;
-    ``progress(evaluations)`` after every model evaluation. With ``sample_posterior``, a fit whose
+    ``progress(evaluations, curve_rms_K)`` after every model evaluation (the RMS of that evaluation against the
+    curves, None without curves). With ``sample_posterior``, a fit whose
     evaluations integrate the network alone (the engine has thermal-only keys) also samples the posterior of its keys
     (:func:`posterior_samples`, a few minutes). A run that uses up its budget stops the fit
     (:class:`~shakermill.budget.BudgetExceeded`): its partial result is no evaluation.
@@ -340,7 +341,7 @@ Evaluation = tuple[np.ndarray, dict[tuple[str, ...], Result]]
 
 
 def _evaluator(fitting: Parameters, free: Sequence[str], targets: Mapping[str, float], curves: Sequence[Curve],
-               progress: Callable[[int], None] | None) -> tuple[Callable[[np.ndarray], Evaluation], dict[tuple[float, ...], Evaluation]]:
+               progress: Callable[[int, float | None], None] | None) -> tuple[Callable[[np.ndarray], Evaluation], dict[tuple[float, ...], Evaluation]]:
     """The model a fit evaluates at the logarithms ``x`` of its free keys: the residuals and the run of each set of
     conditions (the fitted parameters' own, ``()``, always: the targets and the predictions are of it), each
     evaluation once (the cache it returns); every set measures its mechanics once."""
@@ -355,7 +356,7 @@ def _evaluator(fitting: Parameters, free: Sequence[str], targets: Mapping[str, f
             results = {conditions: models[conditions](params.replace(**values)) for conditions, params in bases.items()}
             cache[key] = (_residuals(results, targets, curves), results)
             if progress is not None:
-                progress(len(cache))
+                progress(len(cache), _curve_rms(results, curves))
         return cache[key]
 
     return evaluate, cache
