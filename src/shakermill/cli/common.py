@@ -98,7 +98,9 @@ def _interrupt_in_one_line() -> Iterator[None]:
 app = typer.Typer(
     cls=OneLineUsageErrors,
     name="shakermill",
-    help="Simulate a high-energy shaker mill (SPEX 8000M type): ball motion, impacts and temperatures.",
+    help="Simulate a high-energy ball mill (SPEX 8000M-type shaker, mixer mills, planetary mills): ball motion, "
+    "impacts, the heat they make and the temperatures of the balls, the vial and the air; `presets` lists the mills. "
+    "Guides: docs/ (make docs).",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
@@ -119,7 +121,9 @@ def _root(
         bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
     ] = False,
 ) -> None:
-    """Simulate a high-energy shaker mill (SPEX 8000M type): ball motion, impacts and temperatures."""
+    """Simulate a high-energy ball mill (SPEX 8000M-type shaker, mixer mills, planetary mills): ball motion, impacts,
+    the heat they make and the temperatures of the balls, the vial and the air; `presets` lists the mills. Guides:
+    docs/ (make docs)."""
     from shakermill.parameters.environment import check_environment
 
     with user_errors():
