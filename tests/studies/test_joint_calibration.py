@@ -159,3 +159,17 @@ def test_a_users_configuration_narrows_an_assumed_range_and_a_wrong_table_is_ref
                      'distribution = "uniform"\nreason = "typo"\n', encoding="utf-8")
     with pytest.raises(ParameterError, match=r"wrong.toml: \[assumed.friction\]: low and high"):
         load_config(wrong)
+
+
+def test_a_free_key_the_run_does_not_read_or_that_moves_the_mechanics_is_refused_before_any_run():
+    from shakermill.parameters.errors import ParameterError
+    from shakermill.studies.joint_calibration import calibrate_jointly
+
+    preset = PRESETS["spex8000m-3d-mill-head"]
+    params = default_parameters(preset.name)
+    started = []
+    for free, refused in ((("h_outer",), r"^free: h_outer: fitted, but the 'mill-head' network does not read it"),
+                          (("friction",), r"^free: friction would change the dem engine's mechanics.*--with-assumed")):
+        with pytest.raises(ParameterError, match=refused):
+            calibrate_jointly(preset, params, free, [], 8, on_start=lambda: started.append(True))
+    assert started == []

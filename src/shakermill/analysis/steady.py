@@ -139,7 +139,7 @@ def run_length_note(duration: float, steady: SteadyState) -> str | None:
     slowest = steady.slowest_time_constant
     if not math.isfinite(slowest) or duration >= SETTLED_TIME_CONSTANTS * slowest:
         return None
-    if steady.balls and shorter_than_its_time_constant(duration, steady):
+    if fits_no_exponential(duration, steady):
         return (f"The run ({duration / 60:.3g} min) is shorter than the slowest time constant ({slowest / 60:.3g} min): "
                 "no exponential describes it, so theta_inf_C, tau_min and rate0_C_per_min are not shown; the steady "
                 "state is the answer to read.")
@@ -151,7 +151,7 @@ def run_length_note(duration: float, steady: SteadyState) -> str | None:
     )
 
 
-def shorter_than_its_time_constant(duration: float, steady: SteadyState) -> bool:
-    """Whether a run ends before one slowest time constant of its network: an exponential fitted to it describes
-    the start of the heating, not where it goes."""
-    return math.isfinite(steady.slowest_time_constant) and duration < steady.slowest_time_constant
+def fits_no_exponential(duration: float, steady: SteadyState) -> bool:
+    """Whether a run of balls ends before one slowest time constant of its network: an exponential fitted to it
+    describes the start of the heating, not where it goes (an empty mill fits none at all)."""
+    return bool(steady.balls) and math.isfinite(steady.slowest_time_constant) and duration < steady.slowest_time_constant

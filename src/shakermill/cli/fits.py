@@ -350,7 +350,6 @@ def calibrate_over_assumed(run_config: Any, free_keys: Sequence[str], targets: M
                            json_output: bool) -> None:
     """``calibrate --with-assumed``: the posterior of the network's free keys and the preset's assumed inputs given the
     curves, printed, and the preset of its medians written."""
-    from shakermill.engines.registry import describe
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import config_preset, values_beyond_preset
     from shakermill.studies.ensemble import check_members
@@ -364,21 +363,17 @@ def calibrate_over_assumed(run_config: Any, free_keys: Sequence[str], targets: M
         raise ParameterError("full-resolution: a calibration --with-assumed runs the averaged solver on a design of "
                              "runs; allowed without --full-resolution")
     check_members(members)
-    thermal_only = describe(run_config.params.engine).thermal_only_keys
-    moving = [key for key in free_keys if thermal_only and key not in thermal_only]
-    if moving:
-        raise ParameterError(f"free: {', '.join(moving)} move the mechanics; --with-assumed frees the preset's assumed "
-                             f"inputs over their stated ranges; allowed --free keys of the network: {', '.join(thermal_only)}")
     params = run_config.params.replace(solver="averaged", attractor_starts=1)
     curves = list(curves) or [experiment_curve()]
     sets = len({tuple(item.conditions) for item in curves} | {()})
-    typer.echo(f"calibrate: fitting {', '.join(free_keys)} and the assumed inputs of {run_config.preset} over "
-               f"{members} mechanical runs per set of conditions ({sets}), then emcee on their emulators", err=True)
+    said = (f"calibrate: fitting {', '.join(free_keys)} and the assumed inputs of {run_config.preset} over {members} "
+            f"mechanical runs per set of conditions ({sets}), then emcee on their emulators")
     with nothing_written_when_interrupted("the fit starts again from the beginning"), \
             nothing_written_when_a_run_is_stopped("the fit"), \
             progress_bar("fitting", "{task.completed}/{task.total} runs", members * sets, lines_when_piped=True) as update:
         joint = calibrate_jointly(config_preset(run_config), params, free_keys, curves, members,
-                                  progress=lambda done, total: update(done, total=total))
+                                  progress=lambda done, total: update(done, total=total),
+                                  on_start=lambda: typer.echo(said, err=True))
     if out is not None:
         command = "shakermill calibrate " + " ".join(sys.argv[2:])
         with writing(out, "the preset"):
@@ -396,8 +391,9 @@ def print_joint(joint: Any, out: Path | None) -> None:
     run's end with its interval."""
     console = stdout_console()
     table = Table("input", "prior", "posterior 5 %", "median", "95 %", title="calibration over every uncertain input")
+    quantiles = joint.posterior.quantiles()
     for item in joint.posterior.inputs:
-        low, middle, high = joint.posterior.quantiles()[item.key]
+        low, middle, high = quantiles[item.key]
         add_plain_row(table, item.key, f"{item.shown_range()} {item.distribution}", f"{low:.3g}", f"{middle:.3g}",
                       f"{high:.3g}")
     console.print(table)

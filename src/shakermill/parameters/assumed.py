@@ -44,6 +44,10 @@ class AssumedInput:
     def contains(self, value: float) -> bool:
         return self.low <= value <= self.high
 
+    def table(self) -> dict[str, Any]:
+        """Its ``[assumed.KEY]`` table: range, distribution and reason."""
+        return {field: getattr(self, field) for field in TABLE_FIELDS}
+
 
 def assumed_input(key: str, table: Any, where: str) -> AssumedInput:
     """The ``[assumed.KEY]`` ``table`` of ``where`` (a preset file, a command's option), checked: a numeric key,

@@ -130,11 +130,11 @@ def config_preset(config: RunConfig) -> Preset:
     tables = config.assumed_tables
     if not isinstance(tables, Mapping):
         raise ParameterError(f"{config.source}: [assumed] must hold tables [assumed.KEY]")
-    problem = reader_of(config.params).unread_problem([key for key in tables if key in Parameters.model_fields],
-                                                      how="given a range")
+    reader = reader_of(config.params)
+    problem = reader.unread_problem([key for key in tables if key in Parameters.model_fields], how="given a range")
     if problem is not None:
         raise ParameterError(f"{config.source}: [assumed]: {problem}")
-    assumed = inherited_assumed(base.assumed, tables, config.params.model_dump(), base.fitted, reader_of(config.params),
+    assumed = inherited_assumed(base.assumed, tables, config.params.model_dump(), base.fitted, reader,
                                 config.source.name)
     return dataclasses.replace(base, assumed=assumed)
 

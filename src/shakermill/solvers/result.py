@@ -14,7 +14,7 @@ import numpy as np
 from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
 from shakermill.analysis.regime import charge_regime
-from shakermill.analysis.steady import SteadyState, run_length_note, shorter_than_its_time_constant, steady_state
+from shakermill.analysis.steady import SteadyState, fits_no_exponential, run_length_note, steady_state
 from shakermill.analysis.stress_energy import stress_spectrum
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
@@ -266,7 +266,7 @@ def fit_warning(result: Result) -> str | None:
     fit = result.ball_fit
     if fit.success or result.params.n_balls == 0:  # an empty mill has no ball to fit
         return None
-    if result.steady is not None and shorter_than_its_time_constant(result.t_end, result.steady):
+    if result.steady is not None and fits_no_exponential(result.t_end, result.steady):
         return None  # no exponential was to be expected: run_length_note says why
     return (
         f"the exponential fit of the ball temperature failed ({fit.message}): theta_inf_C, tau_min and "

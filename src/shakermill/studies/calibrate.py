@@ -403,7 +403,7 @@ def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float]
         if measured.node == "ball" and str(conditions.get("n_balls", base.n_balls)).strip() == "0":
             raise ParameterError(f"curve: {measured.source or 'the curve'} is of the balls, and its run has none "
                                  "(n_balls = 0); allowed a vial_C curve for an empty mill")
-    _check_free_for_engine(base, free)
+    check_free_for_engine(base, free)
     check_determinable(free, targets, curves)
     for key in free:
         if getattr(base, key) <= 0:
@@ -411,7 +411,7 @@ def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float]
     return targets, curves, free
 
 
-def _check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
+def check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
     """A free key must be one the run reads (a fit of a key it ignores would wander its whole range), and an engine
     with thermal-only keys (the 'dem' engine) has its calibration measure the mechanics once: only keys of the
     thermal network may move."""
@@ -423,7 +423,8 @@ def _check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
     if thermal_only and moving:
         raise ParameterError(
             f"free: {', '.join(moving)} would change the {base.engine} engine's mechanics, which a calibration measures "
-            f"once; allowed for engine = {base.engine!r}: {', '.join(thermal_only)}"
+            f"once (calibrate --with-assumed frees the preset's assumed inputs, over their stated ranges); allowed for "
+            f"engine = {base.engine!r}: {', '.join(thermal_only)}"
         )
 
 
@@ -580,7 +581,6 @@ def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str
     """Write a preset TOML usable with ``shakermill run FILE`` and as a shipped preset, with provenance: the fitted
     values over ``base_preset`` and the ``settings`` (SI values) under which they were fitted, without which the
     fitted values would describe another mill."""
-    path = Path(path)
     values = {key: calibration.fitted[key] for key in calibration.free}
     document = {
         "preset": base_preset,
@@ -614,10 +614,16 @@ def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str
     if calibration.curve_rms_K is not None:
         document["provenance"]["curve_rms_K"] = calibration.curve_rms_K
         document["provenance"]["curve"] = calibration.curve_source
-    header = f"# shakermill preset fitted by calibration; keys not listed come from {base_preset!r}.\n"
+    return write_preset_file(path, f"# shakermill preset fitted by calibration; keys not listed come from {base_preset!r}.",
+                             document)
+
+
+def write_preset_file(path: Path | str, header: str, document: Mapping[str, Any]) -> Path:
+    """A fitted preset's TOML ``document`` under its comment ``header``, written atomically (its folder made)."""
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     remove_abandoned_writes(path.parent)
-    return write_text_atomically(path, header + tomli_w.dumps(document))
+    return write_text_atomically(path, f"{header}\n" + tomli_w.dumps(document))
 
 
 # Free sets compared by `validate` and the README: which follow the experiment's curve and which cannot.

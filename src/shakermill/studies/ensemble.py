@@ -164,8 +164,7 @@ class Ensemble:
         return _finite({
             "members": self.members,
             "failed": self.failed,
-            "inputs": [{"key": item.key, "low": item.low, "high": item.high, "distribution": item.distribution,
-                        "reason": item.reason} for item in self.inputs],
+            "inputs": [{"key": item.key, **item.table()} for item in self.inputs],
             "fitted": None if self.posterior is None else self.posterior.as_dict(),
             "headlines": {spread.key: spread.as_dict() for spread in self.headlines},
             "regimes": {name: dict(regime) for name, regime in self.regimes.items()},
@@ -345,7 +344,8 @@ def _sobol(surrogate: Any, names: list[str], groups: list[str] | None = None) ->
 
 
 def gaussian_process(unit: np.ndarray, values: np.ndarray) -> Any:
-    """A Gaussian process fitted to ``values`` at ``unit`` with one length scale per input (Matérn 5/2) and a noise term for the averaging error."""
+    """A Gaussian process fitted to ``values`` at ``unit``, with one length scale per input (Matérn 5/2) and a noise
+    term for the averaging error."""
     from sklearn.exceptions import ConvergenceWarning
     from sklearn.gaussian_process import GaussianProcessRegressor
     from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
@@ -366,7 +366,14 @@ def _cross_validated_q2(unit: np.ndarray, values: np.ndarray) -> float:
     predicted = np.empty_like(values)
     for train, test in KFold(FOLDS, shuffle=True, random_state=0).split(unit):
         predicted[test] = gaussian_process(unit[train], values[train]).predict(unit[test])
-    return float(1.0 - np.sum((values - predicted) ** 2) / np.sum((values - values.mean()) ** 2))
+    return q2_of(values, predicted)
+
+
+def q2_of(values: np.ndarray, predicted: np.ndarray) -> float:
+    """1 − (sum of squared errors of the predictions of held-out ``values``)/(their sum of squares about the mean);
+    NaN for values that do not vary."""
+    spread = float(np.sum((values - values.mean()) ** 2))
+    return 1.0 - float(np.sum((values - predicted) ** 2)) / spread if spread > 0 else math.nan
 
 
 def _regimes(finished: pd.DataFrame, keys: Sequence[str]) -> dict[str, dict[str, Any]]:

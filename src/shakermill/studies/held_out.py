@@ -176,10 +176,16 @@ class HeldOutStudies:
         }
 
 
+def held_out_steps() -> int:
+    """The runs of :func:`held_out_studies`: the prediction, the engines' cases, the sensitivity's baseline and its
+    factors of each assumed amplitude."""
+    assumed = KINEMATIC_MODELS[five_ball_parameters().kinematics].assumed
+    return 1 + len(ENGINE_CASES) + 1 + len(DEFAULT_FACTORS) * len(assumed)
+
+
 def held_out_studies(progress: Callable[[int, int], None] | None = None) -> HeldOutStudies:
     """All three; ``progress(done, total)`` counts their runs."""
-    assumed = KINEMATIC_MODELS[five_ball_parameters().kinematics].assumed
-    total = 1 + len(ENGINE_CASES) + 1 + len(DEFAULT_FACTORS) * len(assumed)
+    total = held_out_steps()
     show = progress if progress is not None else (lambda done, total: None)
     prediction = five_ball_prediction()
     show(1, total)

@@ -36,15 +36,15 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.simulate import thermal_variants
-from shakermill.studies.calibrate import log_bounds
+from shakermill.studies.calibrate import check_free_for_engine, log_bounds, write_preset_file
 from shakermill.studies.defensible import DEFENSIBLE_RANGES
-from shakermill.studies.ensemble import LEAST_Q2, design_seed, from_unit, gaussian_process
+from shakermill.studies.ensemble import QUANTILES, LEAST_Q2, design_seed, from_unit, gaussian_process, q2_of
 
 # A measured rise's standard deviation where its source states none (K): the one-ball curve is an exponential
 # fitted to intermittent calorimetric measurements, which a model following within 2 K follows within their likely
 # scatter (studies/validation_matrix.FOLLOWS_CURVE_K); the five-ball point is quoted without an error.
 ASSUMED_MEASUREMENT_SD_K = 2.0
-LEVEL = 0.90
+METHOD = "emulated Bayesian calibration over every uncertain input (MODEL.md §14.1)"
 # emcee: walkers per input (at least LEAST_WALKERS), steps (the first half burn-in), samples kept; the seed makes
 # the posterior reproducible.
 WALKERS_PER_INPUT, LEAST_WALKERS = 4, 16
@@ -138,6 +138,7 @@ def train(params: Parameters, inputs: Sequence[AssumedInput], observables: Seque
     keys = [item.key for item in inputs]
     rises = np.full((len(unit), len(observables)), np.nan)
     failed = []
+    rise_of = _rises(observables)
     for member in range(members):
         rows = range(member * draws, (member + 1) * draws)
         runs = [params.replace(**with_derived(params, inputs, dict(zip(keys, map(float, values[row]))))) for row in rows]
@@ -145,7 +146,6 @@ def train(params: Parameters, inputs: Sequence[AssumedInput], observables: Seque
         if not result.success or result.load is None:
             failed.append(f"member {member}: {result.message}")
         else:
-            rise_of = _rises(observables)
             for row, run in zip(rows, runs):
                 rises[row] = rise_of(run, result.load)
         if progress is not None:
@@ -223,8 +223,7 @@ def emulate(training: Training) -> Emulator:
         predicted = np.empty_like(values)
         for fit, held in GroupKFold(FOLDS).split(training.unit, values, training.member):
             predicted[held] = back(gaussian_process(training.unit[fit], fitted[fit, column]).predict(training.unit[held]))
-        spread = np.sum((values - values.mean()) ** 2)
-        q2[observable.name] = float(1.0 - np.sum((values - predicted) ** 2) / spread) if spread > 0 else math.nan
+        q2[observable.name] = q2_of(values, predicted)
     models = [gaussian_process(training.unit, fitted[:, column]) for column in range(len(training.observables))]
     return Emulator(training.inputs, training.observables, models, q2, len(training.unit), int(members.size),
                     training.failed, logarithmic)
@@ -248,7 +247,7 @@ class Posterior:
         return from_unit(self.inputs, self.unit)
 
     def quantiles(self) -> dict[str, tuple[float, float, float]]:
-        table = np.quantile(self.values, [0.5 - LEVEL / 2, 0.5, 0.5 + LEVEL / 2], axis=0)
+        table = np.quantile(self.values, QUANTILES, axis=0)
         return {key: tuple(float(v) for v in table[:, index]) for index, key in enumerate(self.keys)}
 
     @property
@@ -336,16 +335,16 @@ def predict(emulator: Emulator, posterior: Posterior, measured: Sequence[Measure
     each with a draw of the emulator's error."""
     rng = np.random.default_rng(SEED + 1)
     draws = emulator.draw(emulator.at(posterior.keys, posterior.unit, rng), rng)
-    table = np.quantile(draws, [0.5 - LEVEL / 2, 0.5, 0.5 + LEVEL / 2], axis=0)
+    table = np.quantile(draws, QUANTILES, axis=0)
     known = {item.observable: item.rise_K for item in measured}
     return [Prediction(observable, tuple(float(v) for v in table[:, column]), known.get(observable))
             for column, observable in enumerate(emulator.observables)]
 
 
 def posterior_as_dict(posterior: Posterior) -> dict[str, Any]:
+    quantiles = posterior.quantiles()
     return {
-        "inputs": {item.key: {"low": item.low, "high": item.high, "distribution": item.distribution,
-                              "reason": item.reason, **dict(zip(("p5", "p50", "p95"), posterior.quantiles()[item.key]))}
+        "inputs": {item.key: {**item.table(), **dict(zip(("p5", "p50", "p95"), quantiles[item.key]))}
                    for item in posterior.inputs},
         "samples": len(posterior.unit), "acceptance": posterior.acceptance,
         "autocorrelation_steps": posterior.autocorrelation_steps, "converged": posterior.converged,
@@ -400,7 +399,7 @@ class JointCalibration:
         return said + (f"; unreliable: {'; '.join(self.problems)}" if self.problems else "")
 
     def as_dict(self) -> dict[str, Any]:
-        return {"method": "emulated Bayesian calibration over every uncertain input (MODEL.md §14.1)",
+        return {"method": METHOD,
                 "network_free": list(self.free), "status": self.status, "message": self.message,
                 "posterior": posterior_as_dict(self.posterior),
                 "emulators": {", ".join(conditions) or "the run's own": emulator_as_dict(emulator)
@@ -421,12 +420,17 @@ def reliability_problems(emulators: Iterable[Emulator], posterior: Posterior) ->
 
 
 def calibrate_jointly(preset: Preset, base: Parameters, free: Sequence[str], curves: Sequence[Any], members: int,
-                      thermal_draws: int = 8, progress: Callable[[int, int], None] | None = None) -> JointCalibration:
+                      thermal_draws: int = 8, progress: Callable[[int, int], None] | None = None,
+                      on_start: Callable[[], None] | None = None) -> JointCalibration:
     """Fit ``curves`` (``studies/validation.Curve``) over the network's ``free`` keys and every assumed input of
-    ``preset`` that a run of ``base`` can feel (module docstring); ``progress(done, total)`` counts the mechanical
-    members of every set of conditions."""
+    ``preset`` that a run of ``base`` can feel (module docstring). As for ``calibrate``: the ``free`` keys must be
+    the network's and read by the run, ``on_start()`` is called once they are, before the first run; ``progress(done,
+    total)`` counts the mechanical members of every set of conditions."""
     from shakermill.parameters.config import parse_overrides
 
+    check_free_for_engine(base, free)
+    if on_start is not None:
+        on_start()
     groups: dict[tuple[str, ...], list[Any]] = {(): []}
     for curve in curves:
         groups.setdefault(tuple(curve.conditions), []).append(curve)
@@ -437,8 +441,8 @@ def calibrate_jointly(preset: Preset, base: Parameters, free: Sequence[str], cur
                              float(curve.temperature_C[point]) + 273.15 - params.initial_temperature,
                              curve.sigma_K if curve.sigma_K is not None else ASSUMED_MEASUREMENT_SD_K)
                     for curve in chosen for point in _spread_points(curve.times.size)]
-        ends = [Observable(node, params.duration) for node in ("ball", "vial")] if not conditions else []
-        observables = list(dict.fromkeys([item.observable for item in measured] + ends))
+        at_end = [Observable(node, params.duration) for node in ("ball", "vial")] if not conditions else []
+        observables = list(dict.fromkeys([item.observable for item in measured] + at_end))
         shown = None if progress is None else (lambda done, _, before=index * members: progress(before + done, total))
         emulator = emulate(train(params, fit_inputs(preset, params, free), observables, members, thermal_draws, shown))
         emulators[conditions] = emulator
@@ -447,7 +451,7 @@ def calibrate_jointly(preset: Preset, base: Parameters, free: Sequence[str], cur
     fitted = tuple(item for emulator, measured in data for item in predict(emulator, posterior, measured)
                    if item.measured_K is not None)
     ends = tuple(item for item in predict(emulators[()], posterior) if item.observable.time_s == base.duration)
-    source = "; ".join(getattr(curve, "source", "") for curve in curves)
+    source = "; ".join(curve.source for curve in curves)
     return JointCalibration(tuple(free), posterior, emulators, fitted, ends, source)
 
 
@@ -465,11 +469,7 @@ def write_joint_preset(joint: JointCalibration, path: Any, *, base_preset: str, 
     provenance: ``shakermill uncertainty`` carries them into any run of it, a run's own interval those of the keys its
     network alone reads."""
     from datetime import datetime, timezone
-    from pathlib import Path
 
-    import tomli_w
-
-    from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
     from shakermill.support.version import __version__
 
     keys = joint.posterior.keys
@@ -485,11 +485,10 @@ def write_joint_preset(joint: JointCalibration, path: Any, *, base_preset: str, 
                            f"{joint.curve_source} (MODEL.md §14.1)",
             "command": command,
             "fitted": list(keys),
-            "method": joint.as_dict()["method"],
+            "method": METHOD,
             "status": joint.status,
             "message": joint.message,
-            "priors": {item.key: {"low": item.low, "high": item.high, "distribution": item.distribution,
-                                  "reason": item.reason} for item in joint.posterior.inputs},
+            "priors": {item.key: item.table() for item in joint.posterior.inputs},
             "posterior_90": {key: [low, high] for key, (low, _, high) in joint.posterior.quantiles().items()},
             "posterior_log": np.log(chosen).tolist(),
             "predictions": {item.observable.name: list(item.quantiles) for item in joint.predictions},
@@ -498,8 +497,6 @@ def write_joint_preset(joint: JointCalibration, path: Any, *, base_preset: str, 
             "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         },
     }
-    header = f"# shakermill preset fitted over its uncertain inputs; keys not listed come from {base_preset!r}.\n"
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    remove_abandoned_writes(path.parent)
-    return write_text_atomically(path, header + tomli_w.dumps(document))
+    return write_preset_file(
+        path, f"# shakermill preset fitted over its uncertain inputs; keys not listed come from {base_preset!r}.", document
+    )

@@ -13,7 +13,7 @@ from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.keys import Parameters
 from shakermill.studies.calibrate import FREE_SET_STUDY, FreeSetOutcome, free_set_study
 from shakermill.studies.cross_prediction import CrossPrediction, cross_prediction
-from shakermill.studies.held_out import HeldOutStudies, held_out_studies
+from shakermill.studies.held_out import HeldOutStudies, held_out_steps, held_out_studies
 from shakermill.studies.validation import EXPERIMENT, TABLE5, VALIDATION_PRESETS, ValidationRun, validate
 from shakermill.studies.validation_matrix import (
     STRUCTURES,
@@ -129,14 +129,8 @@ def validation_report(solver: str, study: bool = True, three_d: bool = True,
     before = first + pairs
     structures = structure_study(progress=lambda done, total: show(before + done, before + total))
     before += len(STRUCTURES)
-    held_out_steps = [0]
-
-    def held(done: int, total: int) -> None:
-        held_out_steps[0] = total
-        show(before + done, before + total)
-
-    held_out = held_out_studies(held)
-    before += held_out_steps[0]
+    held_out = held_out_studies(lambda done, total: show(before + done, before + total))
+    before += held_out_steps()
     cross = cross_prediction(progress=lambda done, total: show(before + done, before + total))
     return ValidationReport(solver, runs, outcomes, held_out, matrix, structures, cross=cross)
 

@@ -62,10 +62,12 @@ def _spectrum(run: RunLike) -> dict[str, Figure]:
 def spectrum_figures(run: RunLike) -> dict[str, Figure]:
     """The stress-energy spectrum alone, with the run's context: what a run of several balls with impacts draws
     besides its main figures (the other impact statistics wait for ``plot --impacts``)."""
-    if run.impacts.empty:
-        return {}
+    return {} if run.impacts.empty else _in_context(run, _spectrum(run))
+
+
+def _in_context(run: RunLike, figures: dict[str, Figure]) -> dict[str, Figure]:
     context, window = run_context(run), averaging_window_note(run)
-    return {name: add_context(figure, context, window) for name, figure in _spectrum(run).items()}
+    return {name: add_context(figure, context, window) for name, figure in figures.items()}
 
 
 def impact_figures(run: RunLike) -> dict[str, Figure]:
@@ -87,8 +89,7 @@ def impact_figures(run: RunLike) -> dict[str, Figure]:
     if not balls:
         # Regimes are sequences of end faces hit at fixed drive phases: a notion of one ball on the axis.
         figures["impact_phase_histogram"] = impact_phase_figure(run)
-    context, window = run_context(run), averaging_window_note(run)
-    return {name: add_context(figure, context, window) for name, figure in figures.items()}
+    return _in_context(run, figures)
 
 
 # The spectrum's energy axis spans six decades below its largest energy.
