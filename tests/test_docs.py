@@ -21,8 +21,10 @@ REPOSITORY_PATH = re.compile(r"`((?:src|docs|benchmarks|examples|tests|scripts)/
 
 
 def pages() -> list[Path]:
-    """Every page written for the site; docs/MODEL.md is the shared specification, kept as it is."""
-    return sorted(path for path in DOCS.rglob("*.md") if path.name != "MODEL.md")
+    """Every page written for the site; docs/MODEL.md is the shared specification, kept as it is, and docs/generated
+    what a build of the examples wrote."""
+    return sorted(path for path in DOCS.rglob("*.md")
+                  if path.name != "MODEL.md" and DOCS / "generated" not in path.parents)
 
 
 def page_text(site: Path, page: str) -> str:
@@ -92,6 +94,11 @@ def test_the_site_builds_strictly_from_its_sources(tmp_path):
     assert len(headings) > 5
     for heading in headings:
         assert heading.removeprefix("## ").replace("`", "") in benchmarks, heading
+    # The examples ran at the build: their pages hold what the scripts printed and drew, with no traceback.
+    for example in ("plot_first_run", "plot_planetary"):
+        page = page_text(site, f"generated/gallery/{example}.html")
+        assert "<shakermill.Result: engine" in page and "success" in page and "Traceback" not in page, example
+        assert (site / "generated" / "gallery" / "images" / f"mkd_glr_{example}_001.png").stat().st_size > 10_000
     # The gallery's images are copied beside it, and the site opens from the disk.
     assert (site / "figures" / "temperatures.png").is_file() and (site / "figures" / "dem" / "trajectories.gif").is_file()
     assert 'href="guide/install.html"' in (site / "index.html").read_text(encoding="utf-8")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -79,6 +81,34 @@ def test_statistics_that_do_not_converge_are_refused() -> None:
     assert result.solver == "full"
     assert "did not converge" in result.message
     assert result.summary["averaging_converged"] is False
+
+
+
+def test_a_fall_back_that_could_not_end_within_the_budget_is_not_started() -> None:
+    """Issue 37, point 1: a 3-D hour whose means missed their target fell back to full resolution and ran for 13 min
+    into its step budget. Judged by the pace of the mechanics, it is refused at once instead."""
+    params = sm.default_parameters(solver="averaged", averaging_rel_error=1e-15, averaging_max_time=50.0,
+                                   record_windows=(), max_steps=300_000, attractor_starts=1)
+    result = sm.simulate(params)
+    assert result.status == AVERAGING_FAILED and result.solver == "averaged"
+    assert "would take ~" in result.message and "not started" in result.message
+    assert result.counters["steps"] < 100_000
+
+
+@pytest.mark.slow
+def test_means_cut_short_by_averaging_max_time_say_how_long_would_reach_the_target() -> None:
+    """The guide's two zirconia balls (docs/guide/calibrating.md) under the 1-D preset's 120 s of mechanics: their
+    uncorrelated batches miss 1 % by a little, and the run says how much mechanics would reach it."""
+    params = sm.default_parameters(
+        "spex8000m-3d", n_balls=2, ball_material="zirconia", omega=111.0, averaging_max_time=120.0, record_windows=(),
+    )
+    result = sm.simulate(params)
+    assert result.status == AVERAGING_FAILED and "not started" in result.message
+    hint = re.search(r"so about ([0-9.]+) s would reach it: allowed averaging_max_time >= ([0-9]+)", result.message)
+    needed, allowed = float(hint.group(1)), int(hint.group(2))
+    assert 120.0 < needed < allowed < 1.3 * needed
+    # The preset's own limit lets it converge.
+    assert allowed <= sm.default_parameters("spex8000m-3d").averaging_max_time
 
 
 @pytest.mark.slow

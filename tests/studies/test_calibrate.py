@@ -23,7 +23,12 @@ from shakermill.studies.calibrate import (
     write_preset,
 )
 from shakermill.parameters.engine_keys import reader_of
-from shakermill.studies.identifiability import check_determinable, informative_points, undetermined_keys
+from shakermill.studies.identifiability import (
+    check_determinable,
+    informative_points,
+    loosely_determined,
+    undetermined_keys,
+)
 from shakermill.studies.validation import CURVE_TOLERANCE_K, TABLE5, Curve, curve_from_option, experiment_curve
 
 TABLE5_TARGETS = {entry.key: entry.experiment for entry in TABLE5 if entry.key != "vial_ball_ratio"}
@@ -36,7 +41,7 @@ def test_recovers_known_parameters_from_a_noisy_simulated_curve() -> None:
     series = sm.simulate(generator).timeseries
     rng = np.random.default_rng(2026)
     measured = series["theta_ball"].values - 273.15 + rng.normal(0.0, 0.05, series["time"].size)
-    curve = Curve(series["time"].values, measured, "simulated with noise")
+    curve = Curve(series["time"].values, measured, "simulated with noise", sigma_K=0.05)
     start = sm.default_parameters(beta=0.3, vial_mass=0.05)
     fit = calibrate(start, ("beta", "vial_mass"), curve=curve)
     assert fit.success, fit.message
@@ -399,3 +404,30 @@ def test_a_fit_tells_its_progress_each_evaluation_with_its_rms_from_the_curve():
     # The start is far off the experiment's curve; the fit ends where its own RMS says, the last evaluations near it.
     assert seen[0][1] > 10 * calibration.curve_rms_K
     assert min(rms for _, rms in seen) == pytest.approx(calibration.curve_rms_K, rel=1e-6)
+
+
+def test_a_key_whose_standard_error_exceeds_its_value_is_named_loosely_determined():
+    assert loosely_determined(None, ("a", "b")) == ""
+    assert loosely_determined(np.diag([0.01, 0.25]), ("a", "b")) == ""
+    message = loosely_determined(np.diag([0.01, 4.0, 1.5]), ("h_outer", "beta", "lam"))
+    assert message.startswith("undetermined: the data leave beta, lam free") and "--free h_outer" in message
+    # A key its range holds on an edge is not free: the fit says it ended there, not that the data leave it.
+    assert loosely_determined(np.diag([0.01, 4.0]), ("h_outer", "lam"), on_bounds=("lam",)) == ""
+
+
+GUIDE_VIAL_CURVE = Curve(np.array([0.0, 5.0, 10.0, 20.0, 40.0, 60.0]) * 60.0,
+                         np.array([22.0, 25.1, 27.6, 31.0, 34.2, 35.3]), "vial.csv", node="vial")
+
+
+@pytest.mark.slow
+def test_four_keys_on_the_guides_six_vial_points_are_undetermined_and_predict_nothing():
+    """Issue 37, point 5: the 1-D fit of four keys met five points within a hundredth of a kelvin and reported a ball
+    steady state of 231 °C beside the vial's 36 °C, with no remark."""
+    base = sm.default_parameters("spex8000m", initial_temperature=295.15, ambient_temperature=295.15)
+    fit = calibrate(base, default_free(base), curve=GUIDE_VIAL_CURVE, sample_posterior=False)
+    assert len(fit.free) == 4 and fit.status == "undetermined" and not fit.success
+    assert "standard error larger than the value" in fit.message
+    # Fewer keys, the ones it names, are determined, and their predictions carry standard errors.
+    fewer = calibrate(base, ("h_outer",), curve=GUIDE_VIAL_CURVE, sample_posterior=False)
+    assert fewer.status != "undetermined", fewer.message
+    assert 0 < fewer.prediction_stderr["vial_steady_C"] < abs(fewer.predictions["vial_steady_C"] - 22.0)

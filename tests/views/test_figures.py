@@ -92,7 +92,14 @@ def test_figures_can_be_drawn_from_a_stored_run(result, tmp_path):
     assert {path.stem for path in paths} == set(ALL_FIGURES)
 
 
-def test_temperature_figure_shows_celsius_minutes_and_the_fit(result):
+@pytest.fixture(scope="module")
+def hour() -> sm.Result:
+    """An averaged hour: longer than the network's slowest time constant, so its exponential is drawn."""
+    return sm.simulate(sm.default_parameters(solver="averaged", record_windows=()))
+
+
+def test_temperature_figure_shows_celsius_minutes_and_the_fit(hour):
+    result = hour
     figure = temperature_figure(result)
     (axis,) = figure.axes
     assert axis.get_xlabel() == "time (min)"
@@ -258,8 +265,18 @@ def test_no_impacts_no_impact_figures(result):
     assert impact_figures(run) == {}
 
 
-def test_ball_only_temperature_figure_draws_vial_and_air_as_one_ambient_line(result):
-    run = dataclasses.replace(result, params=result.params.replace(model="ball_only"))
+def test_a_run_shorter_than_the_slowest_time_constant_draws_no_exponential_and_says_why(result):
+    """Issue 37, point 4: a fitted exponential that misses the curve was drawn as a headline."""
+    assert result.summary["exponential_fit_describes_run"] is False
+    (axis,) = temperature_figure(result).axes
+    assert not [line for line in axis.get_lines() if "exponential" in line.get_label()]
+    box = "\n".join(text.get_text() for text in axis.texts)
+    slowest = result.summary["slowest_time_constant_min"]
+    assert box.startswith("no exponential: the run") and f"({slowest:.3g} min)" in box
+
+
+def test_ball_only_temperature_figure_draws_vial_and_air_as_one_ambient_line(hour):
+    run = dataclasses.replace(hour, params=hour.params.replace(model="ball_only"))
     (axis,) = temperature_figure(run).axes
     labels = [line.get_label() for line in axis.get_lines()]
     assert labels[:2] == ["ball", "vial and air (held at ambient: ball_only model)"]

@@ -7,7 +7,7 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, Callable, Mapping, Sequence
 
 import typer
 from rich.console import Console
@@ -266,6 +266,12 @@ WithAssumedOption = Annotated[
 MembersOption = Annotated[
     int, typer.Option("--members", "-n", help="With --with-assumed: mechanical runs per set of conditions, a power of two.")
 ]
+PosteriorOption = Annotated[
+    bool,
+    typer.Option("--posterior/--no-posterior", help="Sample the posterior of the fitted keys where an evaluation is "
+                 "the thermal network alone (engine 'dem': ~2400 evaluations, a few minutes); without it, the "
+                 "standard errors are linear."),
+]
 
 
 def calibrate(
@@ -297,6 +303,7 @@ def calibrate(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
     with_assumed: WithAssumedOption = False,
     members: MembersOption = 32,
+    posterior: PosteriorOption = True,
 ) -> None:
     """Fit free parameters to measured curves (the experiment's by default) and/or Table 5 targets by bounded least
     squares; with --with-assumed, over every uncertain input by Bayesian inference."""
@@ -321,11 +328,10 @@ def calibrate(
             return
         with nothing_written_when_interrupted("the fit starts again from the beginning"), nothing_written_when_a_run_is_stopped(
             "the fit"
-        ), progress_bar("fitting", "{task.completed} model evaluations, the last {task.fields[rms]} K RMS from the curves",
-                        None, delay_s=PROGRESS_DELAY_S, rms="n/a") as update:
+        ), progress_bar("calibrate", "{task.fields[doing]}", None, delay_s=PROGRESS_DELAY_S, doing="starting") as update:
             calibration = fit_parameters(
-                run_config.params, free_keys, targets, measured, full_resolution=full_resolution,
-                progress=lambda done, rms: update(done, rms=number(rms, ".3g")),
+                run_config.params, free_keys, targets, measured, full_resolution=full_resolution, sample_posterior=posterior,
+                **fit_progress(update),
                 on_start=lambda: announce(run_config.params, free_keys, bool(free), [item.note for item in measured if item.note]),
             )
     # A fit that leaves its keys undetermined has values that any others would match as well: no preset of them.
@@ -343,6 +349,31 @@ def calibrate(
             verdict = "could not determine its keys" + (f" (nothing written to {out})" if out is not None else "")
         typer.echo(f"error: calibration {verdict}: {calibration.message}", err=True)
         raise typer.Exit(EXIT_FAILED_RUN)
+
+
+def fit_progress(update: Callable[..., None]) -> dict[str, Callable[..., None]]:
+    """The progress callbacks of a fit (``calibrate``'s keywords) that say what it is doing through ``update``: the
+    mechanics it measures once, its evaluations with their RMS from the curves, then the posterior's, of how many."""
+    # The fit's evaluations so far, and where the posterior's began with how many to come.
+    count = {"done": 0, "posterior_from": -1, "posterior": 0}
+
+    def evaluated(done: int, rms: float | None) -> None:
+        count["done"] = done
+        if count["posterior_from"] >= 0:
+            doing = f"sampling the posterior: {done - count['posterior_from']} of ~{count['posterior']} model evaluations"
+        else:
+            doing = f"{done} model evaluations, the last {number(rms, '.3g')} K RMS from the curves"
+        update(done, doing=doing)
+
+    def measuring(done: float, total: float) -> None:
+        update(done, doing=f"measuring the mechanics once for every evaluation: {done:.4g} s simulated (converged "
+                           f"means end it, at most {total:.4g} s)")
+
+    return {
+        "progress": evaluated,
+        "mechanics_progress": measuring,
+        "on_posterior": lambda total: count.update(posterior_from=count["done"], posterior=total),
+    }
 
 
 def calibrate_over_assumed(run_config: Any, free_keys: Sequence[str], targets: Mapping[str, float],
@@ -453,27 +484,52 @@ def write_fitted_preset(
         write_preset(calibration, out, base_preset=base_preset, command=command, description=description, settings=settings)
 
 
+# A prediction whose standard error exceeds this share of its size (a temperature's rise from the start) is one
+# the data do not support: shown as such, not as a number.
+SUPPORTED_SHARE = 0.5
+
+
+def prediction_table(calibration: Calibration) -> Table:
+    """What the fitted model says of what was not fitted, each with its standard error from the keys' covariance; a
+    value the data do not support (an error beyond SUPPORTED_SHARE of its size) is named so."""
+    start_C = calibration.params.initial_temperature - 273.15
+    table = Table("not fitted, predicted", "value", "std. error", title="what the fitted model predicts")
+    for key, value in calibration.predictions.items():
+        stderr = calibration.prediction_stderr.get(key, math.nan)
+        size = abs(value - start_C) if key.endswith("_C") else abs(value)
+        shown = number(value, ".4g")
+        if stderr > SUPPORTED_SHARE * size:
+            shown = f"not determined by the data ({shown})"
+        add_plain_row(table, key, shown, number(stderr, ".2g"))
+    return table
+
+
 def print_calibration(
     calibration: Calibration, free_keys: Sequence[str], targets: Mapping[str, float], out: Path | None
 ) -> None:
     """The fitted parameters, what the fitted model predicts, the residuals of the targets and of the curve."""
     console = stdout_console()
     ranges = calibration.posterior_ranges
-    table = Table("parameter", "start", "fitted", "std. error", "90 % of the posterior", "physically defensible?", title="calibration")
+    posterior_column = ["90 % of the posterior"] if ranges else []
+    table = Table("parameter", "start", "fitted", "std. error", *posterior_column, "physically defensible?", title="calibration")
     for key in free_keys:
-        posterior = f"{ranges[key][0]:.3g} to {ranges[key][1]:.3g}" if key in ranges else "—"
+        posterior = [f"{ranges[key][0]:.3g} to {ranges[key][1]:.3g}"] if ranges else []
         stderr = calibration.parameter_stderr[key]
         # A linear error beyond the value itself says the data leave the key undetermined, not how far it may move.
         shown = "undetermined" if stderr > calibration.fitted[key] else number(stderr, ".3g")
         add_plain_row(
-            table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}", shown, posterior,
+            table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}", shown, *posterior,
             calibration.defensible[key],
         )
     console.print(table)
-    predictions = Table("not fitted, predicted", "value", title="what the fitted model predicts")
-    for key, value in calibration.predictions.items():
-        add_plain_row(predictions, key, number(value, ".4g"))
-    console.print(predictions)
+    if not ranges:
+        console.print(Text("no posterior sampled (--no-posterior, or each of its thousands of evaluations would rerun "
+                           "the engine's mechanics): the standard errors are linear"))
+    if calibration.status == "undetermined":
+        console.print(Text("no predictions: the data do not determine the fitted keys, so they do not support what the "
+                           "model would say of anything else"))
+    else:
+        console.print(prediction_table(calibration))
     if targets:
         residuals = Table("target", "wanted", "achieved", "residual", *[f"∂ln/∂ln {key}" for key in free_keys])
         for key, wanted in targets.items():

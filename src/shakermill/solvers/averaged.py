@@ -275,11 +275,33 @@ def _stopped(mechanics: Mechanics, status: int, message: str, started: float) ->
     return concluded(engine, status, message, time.perf_counter() - started, solver="averaged", averages=averages)
 
 
+def _full_resolution_out_of_reach(params: Parameters, mechanics: Mechanics, started: float) -> str | None:
+    """Why the fall-back to full resolution could not end within the run's budget, judged by the pace of the mechanics
+    just run (steps and wall time per simulated second), or None: a three-dimensional hour at full resolution takes
+    a billion steps, and running it to learn that would take hours."""
+    engine = mechanics.engine
+    simulated = engine.t
+    if simulated <= 0:
+        return None
+    replicas = replica_count(params, engine.description)
+    steps = engine.counters()["steps"] / simulated * params.duration
+    wall = (time.perf_counter() - started) / (replicas * simulated) * params.duration
+    if steps <= params.max_steps and wall <= params.max_wall_time:
+        return None
+    return (
+        f"A full-resolution run instead (averaging_fallback = 'full') would take ~{steps:.2g} steps and ~{wall / 3600:.2g} h "
+        f"at the mechanics' pace, beyond max_steps = {params.max_steps} or max_wall_time = {params.max_wall_time:g} s: "
+        "not started. Allow the averaging more time (averaging_max_time) or ask for a shorter duration."
+    )
+
+
 def _refuse(params: Parameters, engine_class: type[Engine], mechanics: Mechanics, averages: MechanicsAverages,
             progress: ProgressCallback | None, budget: RunBudget, started: float) -> Result:
     """Averaging is not valid: fall back to full resolution, or fail, as ``averaging_fallback`` says."""
-    if params.averaging_fallback == "fail":
-        reason = f"Averaging is not valid: {averages.message}. Set averaging_fallback = 'full' to run at full resolution."
+    out_of_reach = None if params.averaging_fallback == "fail" else _full_resolution_out_of_reach(params, mechanics, started)
+    if params.averaging_fallback == "fail" or out_of_reach is not None:
+        advice = out_of_reach or "Set averaging_fallback = 'full' to run at full resolution."
+        reason = f"Averaging is not valid: {averages.message}. {advice}"
         result = _stopped(mechanics, AVERAGING_FAILED, reason, started)
         result.message, result.averages = reason, averages
     else:

@@ -25,7 +25,7 @@ from shakermill.analysis.batch_means import (
 from shakermill.engines.interface import Engine, Measured, ProgressCallback
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad
-from shakermill.parameters.keys import Parameters
+from shakermill.parameters.keys import Parameters, bounds
 from shakermill.solvers.replicas import ReplicaSet
 from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages
 
@@ -134,7 +134,7 @@ def measure_means(params: Parameters, engines: Sequence[Engine], progress: Progr
                 message = (
                     f"the averages did not converge to a relative standard error of {target:g} ({key}) in uncorrelated, "
                     f"stationary batches within {limit_name} = {limit:g} s{_in_each(engines)} (irregular or slowly "
-                    "settling motion)"
+                    f"settling motion){_longer_window_hint(settled, t, target, limit_name)}"
                 )
                 break
     if settled is None:
@@ -190,6 +190,23 @@ def _settled(cumulative: list[list[np.ndarray]], base: float, sources: int, ball
         drifting=grouping.uncorrelated and any(drifts(column, target) for column in totals.T),
         transient_heat_power=_mean(first),
     )
+
+
+def _longer_window_hint(settled: Settled | None, t: float, target: float, limit_name: str) -> str:
+    """Where averaging_max_time cut short batches that were uncorrelated and steady but too few, how much mechanics
+    would reach ``target``: a standard error falls as one over the root of the window."""
+    if settled is None or not settled.ready or limit_name != "averaging_max_time":
+        return ""
+    worst = max(relative_error(column) for column in settled.checked.T)
+    if not math.isfinite(worst) or worst <= target:
+        return ""
+    transient = settled.cuts[0] * settled.base
+    needed = transient + (t - transient) * (worst / target) ** 2
+    most = bounds(limit_name).high
+    if needed > most:
+        return f"; its largest relative error was {worst:.3g}, so about {needed:.3g} s would reach it, more than {limit_name} allows ({most:g} s)"
+    return (f"; its largest relative error was {worst:.3g}, so about {needed:.3g} s would reach it: allowed "
+            f"{limit_name} >= {math.ceil(min(1.2 * needed, most))}")
 
 
 def _in_each(engines: Sequence[Engine]) -> str:

@@ -222,7 +222,7 @@ def mean_path_flows(network: ThermalNetwork, history: StateHistory, drives: np.n
     """Each path's flow (W) averaged over the run: at the sampled temperatures and the motion's mean ``drives``,
     by the trapezoidal rule; for a run of no length, at its start."""
     theta = node_temperatures(network, history)
-    flows = np.array([network.flows(theta[:, index], drives) for index in range(theta.shape[1])])
+    flows = network.flows_over(theta, drives)
     times = history.times
     span = times[-1] - times[0]
     means = np.trapezoid(flows, times, axis=0) / span if span > 0 else flows[0]
@@ -326,6 +326,9 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         "tau_stderr_min": fit.tau_stderr / 60.0,
         "rate0_C_per_min": fit.initial_rate * 60.0,
         "fit_rms_residual_K": fit.rms_residual,
+        # Whether the exponential is worth reading: fitted, over a run no shorter than the slowest time constant.
+        "exponential_fit_describes_run": bool(fit.success) and not (
+            result.steady is not None and fits_no_exponential(result.t_end, result.steady)),
         "ball_C": kelvin_to_celsius(float(last["theta_ball"])),
         "vial_C": kelvin_to_celsius(float(last["theta_vial"])),
         "air_C": kelvin_to_celsius(float(last["theta_air"])),

@@ -111,11 +111,11 @@ _SETTLED: dict[Parameters, Mechanics] = {}
 _SETTLED_KEPT = 2
 
 
-def thermal_variants(params: Parameters) -> Callable[[Parameters], Result]:
+def thermal_variants(params: Parameters, progress: ProgressCallback | None = None) -> Callable[[Parameters], Result]:
     """:func:`simulate_whole` for runs that differ from ``params`` in the engine's thermal-only keys alone (a fit of
     the vial's heat loss). Where the engine has such keys and the solver averages, the mechanics is measured once,
     here, and each run then integrates only its network: a three-dimensional run's means take tens of seconds,
-    its network milliseconds."""
+    its network milliseconds. ``progress(done, total)`` is told the simulated seconds of that mechanics."""
     engine = engine_named(params.engine)
     # A run too short to average is at full resolution, each variant its own.
     if not engine.description.thermal_only_keys or params.solver != "averaged" or full_resolution_instead(params):
@@ -123,7 +123,7 @@ def thermal_variants(params: Parameters) -> Callable[[Parameters], Result]:
     mechanics = next((settled for settled in _SETTLED.values() if settled.serves(params)), None)
     if mechanics is None:
         budget = RunBudget.of(params)
-        mechanics = settle_mechanics(params, engine, budget=budget)
+        mechanics = settle_mechanics(params, engine, progress, budget)
         if mechanics.status != REACHED_STOP:
             _whole(simulate_averaged(params, engine, None, budget, mechanics), budget)  # raises for Ctrl-C and the budget
         else:

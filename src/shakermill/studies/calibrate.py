@@ -30,6 +30,7 @@ import numpy as np
 import tomli_w
 from scipy.optimize import least_squares
 
+from shakermill.engines.interface import ProgressCallback
 from shakermill.engines.registry import describe
 from shakermill.parameters.config import parse_overrides
 from shakermill.parameters.defaults import DEFAULT_FREE, DEFAULT_FREE_BY_NETWORK
@@ -39,7 +40,16 @@ from shakermill.parameters.keys import Parameters, bounds, check_known_keys
 from shakermill.solvers.result import Result
 from shakermill.solvers.simulate import preflight, thermal_variants
 from shakermill.studies.defensible import DEFENSIBLE_RANGES
-from shakermill.studies.identifiability import check_determinable, undetermined_keys
+from shakermill.studies.fit_statistics import (
+    CURVE_SCALE_K,
+    log_covariance,
+    posterior_evaluations,
+    posterior_samples,
+    residual_variance,
+    sensitivities,
+    standard_errors,
+)
+from shakermill.studies.identifiability import check_determinable, loosely_determined, undetermined_keys
 from shakermill.studies.validation import (
     CURVE_TOLERANCE_K,
     TARGET_KEYS,
@@ -64,8 +74,6 @@ JACOBIAN_STEP = 1e-2
 AT_BOUND = 1e-2
 # A scalar target further off than this (relative) after the fit counts as not met.
 TARGET_TOLERANCE = 5e-3
-# Scalar targets are matched relatively; curve points in kelvin: one kelvin weighs like 1 % on a target.
-CURVE_SCALE_K = 100.0
 # Quantities a calibration predicts without fitting them, reported beside the fit.
 PREDICTED_KEYS = ("vial_ball_ratio", "ball_steady_C", "vial_steady_C", "air_steady_C", "slowest_time_constant_min")
 
@@ -89,6 +97,7 @@ class Calibration:
     # target -> parameter -> d ln(target)/d ln(parameter); for a curve, "ball_C at T min" -> K per e-fold
     sensitivities: dict[str, dict[str, float]]
     predictions: dict[str, float]  # what the fitted model says of quantities that were not fitted
+    prediction_stderr: dict[str, float]  # their standard errors from the keys' covariance (NaN without one)
     at_bounds: list[str]
     success: bool
     message: str
@@ -141,6 +150,7 @@ class Calibration:
             "posterior_90": {key: list(bounds) for key, bounds in self.posterior_ranges.items()},
             "sensitivities": self.sensitivities,
             "predictions": self.predictions,
+            "prediction_stderr": self.prediction_stderr,
             "defensible": self.defensible,
             "at_bounds": self.at_bounds,
             "success": self.success,
@@ -246,6 +256,8 @@ def calibrate(
     *,
     full_resolution: bool = False,
     progress: Callable[[int, float | None], None] | None = None,
+    mechanics_progress: ProgressCallback | None = None,
+    on_posterior: Callable[[int], None] | None = None,
     sample_posterior: bool = True,
     on_start: Callable[[], None] | None = None,
 ) -> Calibration:
@@ -254,7 +266,9 @@ def calibrate(
 
     ``on_start()`` is called once every input has been checked, before the first evaluation;
     ``progress(evaluations, curve_rms_K)`` after every model evaluation (the RMS of that evaluation against the
-    curves, None without curves). With ``sample_posterior``, a fit whose
+    curves, None without curves); ``mechanics_progress(done, total)`` the simulated seconds of the mechanics measured
+    once for every evaluation, where the engine has thermal-only keys; ``on_posterior(evaluations)`` before the
+    posterior's evaluations begin, with their number. With ``sample_posterior``, a fit whose
     evaluations integrate the network alone (the engine has thermal-only keys) also samples the posterior of its keys
     (:func:`posterior_samples`, a few minutes). A run that uses up its budget stops the fit
     (:class:`~shakermill.budget.BudgetExceeded`): its partial result is no evaluation.
@@ -267,7 +281,7 @@ def calibrate(
     solver = fitting.solver
     if on_start is not None:
         on_start()
-    evaluate, cache = _evaluator(fitting, free, targets, curves, progress)
+    evaluate, cache = _evaluator(fitting, free, targets, curves, progress, mechanics_progress)
     solution = least_squares(
         lambda x: evaluate(x)[0], x0, bounds=(lower, upper), diff_step=JACOBIAN_STEP, x_scale=1.0, method="trf"
     )
@@ -281,13 +295,16 @@ def calibrate(
     missed = {key: (achieved[key] - value) / value for key, value in targets.items()}
     missed = {key: error for key, error in missed.items() if abs(error) > TARGET_TOLERANCE}
     curve_rms = _curve_rms(results, curves)
-    covariance = _log_covariance(solution.jac, residuals, len(free), curves)
+    covariance = log_covariance(solution.jac, residuals, len(free), curves)
+    predicted = [key for key in PREDICTED_KEYS if key not in targets]
+    prediction_stderr = {} if full_resolution else _prediction_stderr(evaluate, solution.x, covariance, predicted)
     # Sampled only where an evaluation is a network alone: thousands of them take minutes there, hours elsewhere.
-    posterior = None
-    if sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution:
-        variance = _residual_variance(residuals, len(free), curves)
-        posterior = posterior_samples(lambda x: evaluate(x)[0], solution.x, lower, upper, variance).tolist()
-    status, message = _verdict(solution, result.success, free, missed, at_bounds, curve_rms)
+    sampled = sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution
+    if sampled and on_posterior is not None:
+        on_posterior(posterior_evaluations(len(free)))
+    variance = residual_variance(residuals, len(free), curves) if sampled else math.nan
+    posterior = posterior_samples(lambda x: evaluate(x)[0], solution.x, lower, upper, variance).tolist() if sampled else None
+    status, message = _verdict(solution, result.success, free, missed, at_bounds, curve_rms, covariance)
     return Calibration(
         params=result.params.replace(solver=base.solver, attractor_starts=base.attractor_starts),
         free=free,
@@ -296,11 +313,12 @@ def calibrate(
         targets=targets,
         achieved=achieved,
         curve_rms_K=curve_rms,
-        parameter_stderr=_stderr(covariance, free, fitted),
+        parameter_stderr=standard_errors(covariance, free, fitted),
         covariance=None if covariance is None else covariance.tolist(),
         posterior=posterior,
-        sensitivities=_sensitivities(solution.jac, free, targets, curves),
-        predictions={key: float(result.summary[key]) for key in PREDICTED_KEYS if key not in targets},
+        sensitivities=sensitivities(solution.jac, free, targets, curves),
+        predictions={key: float(result.summary[key]) for key in predicted},
+        prediction_stderr=prediction_stderr,
         at_bounds=at_bounds,
         success=status == "fitted",
         message=message,
@@ -325,12 +343,14 @@ def _fitting_parameters(base: Parameters, curves: Sequence[Curve], full_resoluti
 
 
 def _verdict(solution: Any, run_success: bool, free: Sequence[str], missed: Mapping[str, float], at_bounds: Sequence[str],
-             curve_rms: float | None) -> tuple[str, str]:
-    """The fit's status ('fitted', 'undetermined' or 'not met') and its message."""
+             curve_rms: float | None, covariance: np.ndarray | None) -> tuple[str, str]:
+    """The fit's status ('fitted', 'undetermined' or 'not met') and its message: undetermined where a direction of
+    the keys leaves the residuals unmoved, or a key's standard error exceeds its value."""
     off_curve = curve_rms is not None and curve_rms > CURVE_TOLERANCE_K
     stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
     met = bool(solution.success) and not stuck and not missed and not off_curve and run_success
-    undetermined = undetermined_keys(solution.jac, free)
+    # A fit that misses its data has large errors for that reason: its verdict is the miss, not its errors.
+    undetermined = undetermined_keys(solution.jac, free) or ("" if missed or off_curve else loosely_determined(covariance, free, at_bounds))
     message = _outcome(str(solution.message), free, missed, at_bounds, curve_rms if off_curve else None)
     if undetermined:
         return "undetermined", f"{undetermined}; {message}"
@@ -340,24 +360,34 @@ def _verdict(solution: Any, run_success: bool, free: Sequence[str], missed: Mapp
 Evaluation = tuple[np.ndarray, dict[tuple[str, ...], Result]]
 
 
+# Runs a fit keeps whole, the latest: thousands of them (a posterior's) would fill the memory with their records.
+RUNS_KEPT = 8
+
+
 def _evaluator(fitting: Parameters, free: Sequence[str], targets: Mapping[str, float], curves: Sequence[Curve],
-               progress: Callable[[int, float | None], None] | None) -> tuple[Callable[[np.ndarray], Evaluation], dict[tuple[float, ...], Evaluation]]:
+               progress: Callable[[int, float | None], None] | None, mechanics_progress: ProgressCallback | None = None,
+               ) -> tuple[Callable[[np.ndarray], Evaluation], dict[tuple[float, ...], np.ndarray]]:
     """The model a fit evaluates at the logarithms ``x`` of its free keys: the residuals and the run of each set of
-    conditions (the fitted parameters' own, ``()``, always: the targets and the predictions are of it), each
-    evaluation once (the cache it returns); every set measures its mechanics once."""
+    conditions (the fitted parameters' own, ``()``, always: the targets and the predictions are of it). The
+    residuals of every evaluation are kept (the cache it returns), the runs of the latest RUNS_KEPT: an older one
+    asked for again is run again (the runs are deterministic), uncounted. Every set measures its mechanics once."""
     bases = {conditions: fitting.replace(**parse_overrides(conditions)) for conditions in ((), *(c.conditions for c in curves))}
-    models = {conditions: thermal_variants(params) for conditions, params in bases.items()}
-    cache: dict[tuple[float, ...], Evaluation] = {}
+    models = {conditions: thermal_variants(params, mechanics_progress) for conditions, params in bases.items()}
+    cache: dict[tuple[float, ...], np.ndarray] = {}
+    runs: dict[tuple[float, ...], dict[tuple[str, ...], Result]] = {}
 
     def evaluate(x: np.ndarray) -> Evaluation:
         key = tuple(np.round(x, 14))
-        if key not in cache:
+        if key not in runs:
             values = {name: float(math.exp(v)) for name, v in zip(free, x)}
-            results = {conditions: models[conditions](params.replace(**values)) for conditions, params in bases.items()}
-            cache[key] = (_residuals(results, targets, curves), results)
+            runs[key] = {conditions: models[conditions](params.replace(**values)) for conditions, params in bases.items()}
+            while len(runs) > RUNS_KEPT:
+                runs.pop(next(iter(runs)))
+        if key not in cache:
+            cache[key] = _residuals(runs[key], targets, curves)
             if progress is not None:
-                progress(len(cache), _curve_rms(results, curves))
-        return cache[key]
+                progress(len(cache), _curve_rms(runs[key], curves))
+        return cache[key], runs[key]
 
     return evaluate, cache
 
@@ -482,98 +512,19 @@ def _curve_rms(results: Mapping[tuple[str, ...], Result], curves: Sequence[Curve
     return math.sqrt(float(np.mean(residuals**2)))
 
 
-def _log_covariance(jacobian: np.ndarray, residuals: np.ndarray, free_count: int, curves: Sequence[Curve]) -> np.ndarray | None:
-    """The covariance of the logarithms of the fitted keys, (JᵀJ)⁻¹·s² with s² the residual variance; meaningful
-    only for curves of more points than parameters, None otherwise or where JᵀJ is singular.
-
-    The residual variance is floored at the curves' stated measurement error, if they state one: a
-    curve that is itself a smooth summary can be fitted exactly, which says nothing about how well
-    it was measured.
-    """
-    if not curves or residuals.size <= free_count:
-        return None
-    try:
-        return np.linalg.inv(jacobian.T @ jacobian) * _residual_variance(residuals, free_count, curves)
-    except np.linalg.LinAlgError:
-        return None
-
-
-def _residual_variance(residuals: np.ndarray, free_count: int, curves: Sequence[Curve]) -> float:
-    """The residuals' variance over their degrees of freedom, floored at the largest stated measurement error."""
-    variance = float(np.sum(residuals**2)) / (residuals.size - free_count)
-    stated = [measured.sigma_K for measured in curves if measured.sigma_K is not None]
-    if stated:
-        variance = max(variance, (max(stated) / CURVE_SCALE_K) ** 2)
-    return variance
-
-
-# The posterior: emcee's affine-invariant ensemble, WALKERS_PER_KEY walkers a key, POSTERIOR_STEPS steps of which the
-# first half is burn-in; POSTERIOR_KEPT samples are kept, evenly thinned. ~2400 evaluations of a three-key fit,
-# a few minutes of networks (benchmarks/bench_calibrate_3d.py); the seed makes it deterministic.
-WALKERS_PER_KEY = 4
-POSTERIOR_STEPS = 200
-POSTERIOR_KEPT = 200
-POSTERIOR_SEED = 20261125
-
-
-def posterior_samples(residuals_of: Callable[[np.ndarray], np.ndarray], best: np.ndarray, lower: np.ndarray,
-                      upper: np.ndarray, variance: float) -> np.ndarray:
-    """Samples (POSTERIOR_KEPT, keys) of the logarithms of the fitted keys: a Gaussian likelihood of the residuals with
-    ``variance`` (the fit's), a prior uniform in the logarithms within [``lower``, ``upper``] (the defensible
-    ranges). Where one curve leaves a direction of the keys undetermined, the ranges bound it, which the
-    covariance cannot."""
-    import emcee
-
-    # emcee prints a traceback of whatever the likelihood raises (a Ctrl-C, a spent budget) before raising it again:
-    # the first is kept, every later call refused at once, and it is raised after the sampler, with nothing printed.
-    raised: list[BaseException] = []
-
-    def log_probability(x: np.ndarray) -> float:
-        if raised or np.any(x < lower) or np.any(x > upper):
-            return -np.inf
-        try:
-            return -0.5 * float(np.sum(residuals_of(x) ** 2)) / variance
-        except BaseException as exc:  # noqa: BLE001 - raised again below, after the sampler
-            raised.append(exc)
-            return -np.inf
-
-    keys = best.size
-    walkers = WALKERS_PER_KEY * keys
-    rng = np.random.default_rng(POSTERIOR_SEED)
-    start = np.clip(best + 1e-3 * rng.standard_normal((walkers, keys)), lower, upper)
-    sampler = emcee.EnsembleSampler(walkers, keys, log_probability)
-    sampler.random_state = np.random.RandomState(POSTERIOR_SEED).get_state()
-    sampler.run_mcmc(start, POSTERIOR_STEPS)
-    if raised:
-        raise raised[0]
-    chain = sampler.get_chain(discard=POSTERIOR_STEPS // 2, flat=True)
-    return chain[np.linspace(0, len(chain) - 1, POSTERIOR_KEPT).astype(int)]
-
-
-def _stderr(covariance: np.ndarray | None, free: Sequence[str], fitted: Mapping[str, float]) -> dict[str, float]:
-    """Each fitted key's standard error in its own unit: in log space the standard error is relative."""
+def _prediction_stderr(evaluate: Callable[[np.ndarray], Evaluation], best: np.ndarray,
+                       covariance: np.ndarray | None, keys: Sequence[str]) -> dict[str, float]:
+    """Each prediction's standard error (its own unit) by the delta method: its forward differences in the logarithms
+    of the keys (one run each) through their covariance; NaN without a covariance."""
     if covariance is None:
-        return {key: math.nan for key in free}
-    return {key: float(fitted[key] * math.sqrt(max(covariance[i, i], 0.0))) for i, key in enumerate(free)}
-
-
-def _sensitivities(
-    jacobian: np.ndarray, free: Sequence[str], targets: Mapping[str, float], curves: Sequence[Curve]
-) -> dict[str, dict[str, float]]:
-    """From the least-squares Jacobian: d ln(target)/d ln(parameter) for scalar targets, and for each curve
-    d θ/d ln(parameter) of its node in K at its middle and last point."""
-    values = {
-        target: {key: float(jacobian[row, column]) for column, key in enumerate(free)}
-        for row, target in enumerate(targets)
-    }
-    offset = len(targets)
-    for measured in curves:
-        conditions = f" ({', '.join(measured.conditions)})" if measured.conditions else ""
-        for point in (measured.times.size // 2, measured.times.size - 1):
-            label = f"{measured.node}_C at {measured.times[point] / 60.0:g} min{conditions}"
-            values[label] = {key: float(CURVE_SCALE_K * jacobian[offset + point, column]) for column, key in enumerate(free)}
-        offset += measured.times.size
-    return values
+        return {key: math.nan for key in keys}
+    summary = evaluate(best)[1][()].summary
+    gradients = np.array([
+        [(evaluate(best + JACOBIAN_STEP * unit)[1][()].summary[key] - summary[key]) / JACOBIAN_STEP for key in keys]
+        for unit in np.eye(best.size)
+    ])
+    variances = np.einsum("ik,ij,jk->k", gradients, covariance, gradients)
+    return {key: float(math.sqrt(max(variance, 0.0))) for key, variance in zip(keys, variances)}
 
 
 def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str, command: str, description: str,

@@ -53,3 +53,24 @@ def undetermined_keys(jacobian: np.ndarray, free: Sequence[str]) -> str:
         return (f"undetermined: the data fix no more than a combination of {', '.join(leaning)} (a singular "
                 "Jacobian); fix one of them or add a measurement that separates them")
     return ""
+
+
+# A key whose standard error in log space exceeds this (one standard error spans a factor e: the error is larger than
+# the value) is not determined by the data, however well the fit follows them: an overfit of few points.
+LOOSE_LOG_ERROR = 1.0
+
+
+def loosely_determined(covariance: np.ndarray | None, free: Sequence[str], on_bounds: Sequence[str] = ()) -> str:
+    """Why the data leave keys of ``free`` statistically undetermined, from the covariance of their logarithms, in
+    words; "" when every key's standard error is below its value (or there is no covariance to judge by). A key that
+    ended on a bound (``on_bounds``) is held there by its range, not left free: its linear error means nothing."""
+    if covariance is None:
+        return ""
+    errors = np.sqrt(np.clip(np.diag(np.asarray(covariance, dtype=float)), 0.0, None))
+    loose = [key for key, error in zip(free, errors) if not error <= LOOSE_LOG_ERROR and key not in on_bounds]
+    if not loose:
+        return ""
+    determined = [key for key, error in zip(free, errors) if error <= LOOSE_LOG_ERROR]
+    keep = f" (e.g. --free {','.join(determined)})" if determined else ""
+    return (f"undetermined: the data leave {', '.join(loose)} free (a standard error larger than the value: "
+            f"{len(free)} keys on too few or too similar points); free fewer keys{keep}")

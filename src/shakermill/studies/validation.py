@@ -59,6 +59,10 @@ ABSOLUTE_ZERO_C = -273.15
 # The experiment's curve is an exponential with these three numbers: a calibration to the curve fits them.
 CURVE_QUANTITIES = ("theta_inf_C", "tau_min", "rate0_C_per_min")
 # A model that follows the experiment's curve this closely (RMS over the hour) reproduces its shape.
+# The measurement error of a curve's point where the curve states none (K), an assumption: a thermocouple read to
+# 0.1 K scatters by a few tenths of a kelvin from run to run (its fixed offset, up to 1.1 K for type K, moves every
+# point alike). Without it a fit of as many keys as points meets them exactly and calls its keys known.
+ASSUMED_CURVE_SD_K = 0.5
 CURVE_TOLERANCE_K = 1.0
 # The experiment's curve as Son 2025 summarises Takacs & McHenry 2006 (Table 5): θ_0 = 20 °C,
 # θ∞ = 48 °C, τ = 16.7 min, sampled every minute over the hour.
@@ -118,7 +122,8 @@ class Curve:
     times: np.ndarray
     temperature_C: np.ndarray
     source: str = ""
-    # Measurement error of each point (K) where the curve itself has no scatter to estimate it from.
+    # Measurement error of each point (K) where the curve itself has no scatter to estimate it from; a fit takes
+    # ASSUMED_CURVE_SD_K for a curve that states none.
     sigma_K: float | None = None
     node: str = "ball"
     conditions: tuple[str, ...] = ()

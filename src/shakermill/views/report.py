@@ -91,6 +91,9 @@ RESULT_QUANTITIES = (
     ("mean_impact_speed_m_s", "mean impact speed", "m/s", ".4g"),
 )
 
+# The rows of the exponential fit, left out where it does not describe the run (summary "exponential_fit_describes_run").
+FIT_KEYS = ("theta_inf_C", "tau_min", "rate0_C_per_min")
+
 COMPARED_QUANTITIES = RESULT_QUANTITIES + (
     ("impacts", "impacts", "", "d"),
     ("mean_dissipated_per_impact_J", "mean dissipated energy per impact", "J", ".4g"),
@@ -272,11 +275,15 @@ def answer_html(run: RunData, preset: Preset | None) -> str:
 
 def results_section(run: RunData) -> str:
     summary = run.summary
-    rows = [(label, number(summary.get(key), spec), unit) for key, label, unit, spec in RESULT_QUANTITIES]
+    rows = [(label, number(summary.get(key), spec), unit) for key, label, unit, spec in RESULT_QUANTITIES
+            if key not in FIT_KEYS or summary.get("exponential_fit_describes_run", True)]
     uncertainty = (
         f"Standard errors of the fit: θ∞ ± {number(summary.get('theta_inf_stderr_K'), '.2g')} K, "
         f"τ ± {number(summary.get('tau_stderr_min'), '.2g')} min; "
         f"RMS residual {number(summary.get('fit_rms_residual_K'), '.2g')} K."
+    ) if summary.get("exponential_fit_describes_run", True) else (
+        "No exponential: the run is shorter than the network's slowest time constant, so one fitted to it describes "
+        "the start of the heating, not where it goes; the steady state is the answer to read."
     )
     return section("Results", table(("quantity", "value", "unit"), rows, numeric=(1,)), paragraph(uncertainty, "note"))
 

@@ -97,6 +97,14 @@ def path_flows(theta: np.ndarray, drives: np.ndarray, net: NetworkArrays, out: n
 
 
 @njit(cache=True)
+def path_flows_over(theta: np.ndarray, drives: np.ndarray, net: NetworkArrays, out: np.ndarray) -> None:
+    """:func:`path_flows` at each column of ``theta`` (node, time) into the rows of ``out`` (time, path): a run's
+    thousands of samples in one call."""
+    for sample in range(theta.shape[1]):
+        path_flows(np.ascontiguousarray(theta[:, sample]), drives, net, out[sample])
+
+
+@njit(cache=True)
 def balance(heat: np.ndarray, flows: np.ndarray, span: float, net: NetworkArrays, out: np.ndarray) -> float:
     """Heat into each node (``heat`` and the fixed heat over ``span`` in, each path's flow out of its hot end and
     into its cold end) into ``out``, in the unit of ``heat`` and ``flows`` (W with ``span`` = 1, or J over

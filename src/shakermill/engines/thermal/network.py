@@ -105,6 +105,13 @@ class ThermalNetwork:
         kernel.path_flows(np.asarray(theta, dtype=float), np.asarray(drives, dtype=float), self.arrays, out)
         return out
 
+    def flows_over(self, theta: np.ndarray, drives: np.ndarray) -> np.ndarray:
+        """:meth:`flows` at each column of ``theta`` (node, time), over (time, path)."""
+        theta = np.asarray(theta, dtype=float)
+        out = np.empty((theta.shape[1], len(self.paths)))
+        kernel.path_flows_over(theta, np.asarray(drives, dtype=float), self.arrays, out)
+        return out
+
     def rates(self, theta: np.ndarray, heat: np.ndarray, drives: np.ndarray) -> tuple[np.ndarray, float]:
         """dθ/dt (K/s) of every node with mean ``heat`` (W) into each from the contacts (the first nodes: those
         after the last it names get none), and the heat leaving the system (W)."""

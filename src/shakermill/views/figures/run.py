@@ -149,7 +149,9 @@ def temperature_figure(run: RunLike) -> Figure:
     balls = several_balls(run.params)
     fit = run.ball_fit
     window = f"0–{minutes[-1]:.3g} min"
-    if math.isfinite(fit.theta_inf) and math.isfinite(fit.tau):
+    # A summary written before the key existed drew the fit wherever it was finite.
+    describes = run.summary.get("exponential_fit_describes_run", True)
+    if describes and math.isfinite(fit.theta_inf) and math.isfinite(fit.tau):
         fitted = "balls' mean, exponential fitted" if balls else f"ball, exponential fitted over {window}"
         axis.plot(minutes, to_celsius(fit.evaluate(series["time"].values)), "k--", lw=1, label=fitted)
     steady = run.summary.get("ball_steady_C")
@@ -159,13 +161,14 @@ def temperature_figure(run: RunLike) -> Figure:
         low, high = axis.get_ylim()
         axis.set_ylim(low, max(high, steady + 0.05 * (steady - low)))
     if run.params.n_balls:
-        axis.text(
-            0.98, 0.55, f"exponential fitted over {window}:\n{_fit_text(fit)}", transform=axis.transAxes, ha="right",
-            va="bottom", bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
-        )
+        slowest = run.summary.get("slowest_time_constant_min", math.nan)
+        said = (f"exponential fitted over {window}:\n{_fit_text(fit)}" if describes else
+                f"no exponential: the run ({window}) is shorter\nthan the slowest time constant ({slowest:.3g} min)")
+        axis.text(0.98, 0.55, said, transform=axis.transAxes, ha="right", va="bottom",
+                  bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85})
     axis.set_xlabel("time (min)")
     axis.set_ylabel("temperature (°C)")
-    named = f"the {run.params.n_balls} balls" if balls else "ball"
+    named = f"the {run.params.n_balls} balls" if balls and run.params.n_balls > 1 else "ball"
     axis.set_title(f"Temperatures of {named}, vial and inner air (cf. paper Fig. 5a)" if run.params.n_balls
                    else "Temperatures of an empty mill's vial and inner air (no balls)")
     if balls:
