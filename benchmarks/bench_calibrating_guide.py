@@ -45,7 +45,8 @@ def main() -> None:
             completed = subprocess.run([str(SHAKERMILL), *arguments], cwd=work, capture_output=True, text=True)
             elapsed = time.perf_counter() - started
             print(f"$ shakermill {shlex.join(arguments)}\n  {elapsed:.0f} s, exit code {completed.returncode}")
-            tail = (completed.stdout + completed.stderr).strip().splitlines()[-4:]
+            # The end of what it printed, then the last of what it said on stderr (its progress, its error).
+            tail = completed.stdout.strip().splitlines()[-5:] + completed.stderr.strip().splitlines()[-1:]
             print("\n".join(f"  | {line[:160]}" for line in tail))
         fitted = tomllib.loads((work / "my-mill-fitted.toml").read_text(encoding="utf-8"))
         print("my-mill-fitted.toml: " + ", ".join(f"{key} = {value}" for key, value in fitted.items() if not isinstance(value, dict)))

@@ -135,7 +135,7 @@ def test_validate_is_quick_by_default_and_says_each_run_when_piped(quick_runs, t
     steps = len(VALIDATION_PRESETS) + len(quick) * len(THERMAL_MODEL_PRESETS)
     lines = [line for line in outcome.stderr.splitlines() if line.startswith("validation: ")]
     assert [line.split(",")[0] for line in lines] == [f"validation: {done}/{steps} steps" for done in range(1, steps + 1)]
-    assert outcome.stderr.startswith("validate: quick, ~2 min; --full for everything")
+    assert outcome.stderr.startswith("validate: quick, ~45 s; --full for everything")
     # Its page says it is the quick one, and what --full adds.
     assert html.escape(QUICK_NOTE) in page.read_text(encoding="utf-8")
 

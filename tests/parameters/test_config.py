@@ -11,7 +11,7 @@ from shakermill.parameters import presets as params_module
 from shakermill.parameters.config import load_config, parse_overrides, write_config_toml
 from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.errors import ParameterError
-from shakermill.parameters.presets import Cited, Preset, default_parameters
+from shakermill.parameters.presets import Cited, Preset, default_parameters, preset_values
 
 
 def write_toml(tmp_path: Path, text: str, name: str = "run.toml") -> Path:
@@ -223,3 +223,15 @@ def test_a_balls_diameter_is_taken_as_twice_its_radius_from_the_command_line_and
         load_config(overrides=["ball_diameter=10 mm", "ball_radius=5 mm"])
     with pytest.raises(ParameterError, match=r"^ball_diameter: .*allowed a length from 5e-05 to 0.2 m \(twice ball_radius\)$"):
         load_config(overrides=["ball_diameter=10 kg"])
+
+
+def test_a_fitted_files_run_says_the_presets_caveat_is_of_the_preset_as_shipped():
+    """Issue 37, point 1: the guide's fitted file was told 'its thermal network is not calibrated' by its base preset."""
+    from shakermill.parameters.presets import PRESETS
+
+    preset = PRESETS["spex8000m-3d"]
+    values = preset_values("spex8000m-3d")
+    assert preset.caveat_for(values) == preset.caveat
+    refitted = preset.caveat_for(values, refitted=("beta", "vial_mass", "h_outer"))
+    assert refitted.startswith(preset.caveat) and "refits beta, vial_mass, h_outer" in refitted
+    assert "of the preset as shipped" in refitted

@@ -47,7 +47,7 @@ def validate(
         typer.Option("--full", help="Everything (~30 min on two cores): Table 5 at full resolution, the matrix's "
                      "experiments of one ball, the structure study, the engines' one-ball comparison and the "
                      "sensitivity to the assumed SPEX kinematics, and both SPEX experiments fitted over every uncertain input, "
-                     "each predicting the other. Without it, a quick validation (~2 min)."),
+                     "each predicting the other. Without it, a quick validation (~45 s on two cores)."),
     ] = False,
     solver: Annotated[
         str | None,
@@ -88,7 +88,7 @@ def validate(
         if not three_d:
             fail("report: the page holds the three-dimensional studies; allowed --report with --three-d (the default)")
         check_report_target(html, overwrite)
-    typer.echo(f"validate: {'everything (--full), ~30 min' if full else 'quick, ~2 min; --full for everything (~30 min)'}; "
+    typer.echo(f"validate: {'everything (--full), ~30 min' if full else 'quick, ~45 s; --full for everything (~30 min)'}; "
                f"Table 5 with the {solver} solver" + (", then the 3-D validation matrix" if three_d else ""), err=True)
     with (nothing_written_when_interrupted("validate prints and writes once every run has ended"),
           nothing_written_when_a_run_is_stopped("validate"),

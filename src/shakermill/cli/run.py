@@ -77,7 +77,8 @@ def run(
     # A run returns what it computed when interrupted; Ctrl-C in the thermal network leaves none.
     with nothing_written_when_interrupted("the run had no results to keep yet"):
         result = simulate_with_progress(run_config.params)
-    stopped = result.status == INTERRUPTED or not preset_findings_added(result, run_config.preset)
+    refitted = tuple(run_config.provenance.get("fitted", ()))
+    stopped = result.status == INTERRUPTED or not preset_findings_added(result, run_config.preset, refitted)
     provenance = {"command": "shakermill run", "config_file": str(config) if config else None, "overrides": overrides}
     # What was computed is written whole: a Ctrl-C meanwhile takes effect once it is.
     with interrupts_held(deliver=False) as held:
@@ -107,24 +108,24 @@ def solver_choice(params: Parameters) -> list[str]:
     return [] if reason is None else [reason]
 
 
-def preset_findings_added(result: Result, preset: str | None) -> bool:
+def preset_findings_added(result: Result, preset: str | None, refitted: Sequence[str] = ()) -> bool:
     """:func:`with_preset_findings`; False when Ctrl-C stopped it (the run is then written without them)."""
     try:
-        with_preset_findings(result, preset)
+        with_preset_findings(result, preset, refitted)
     except KeyboardInterrupt:
         return False
     return True
 
 
-def with_preset_findings(result: Result, preset: str | None) -> None:
+def with_preset_findings(result: Result, preset: str | None, refitted: Sequence[str] = ()) -> None:
     """Add to the summary of any preset's run what its validation found where it failed or is missing
-    (``validation_caveat``), and of a calibrated preset's run the 90 % intervals of its headline temperatures
+    (``validation_caveat``, said of the preset as shipped where the configuration ``refitted`` keys), and of a calibrated preset's run the 90 % intervals of its headline temperatures
     (``studies.uncertainty``), which carry the calibration's uncertainty and the averaging error."""
     from shakermill.parameters.presets import PRESETS
     from shakermill.studies.uncertainty import intervals, uncertainty_of
 
     known = PRESETS.get(preset) if preset is not None else None
-    caveat = known.caveat_for(result.params.model_dump()) if known is not None else None
+    caveat = known.caveat_for(result.params.model_dump(), refitted) if known is not None else None
     if caveat:
         result.summary["validation_caveat"] = caveat
     uncertainty = uncertainty_of(known) if known is not None else None

@@ -11,7 +11,7 @@ import dataclasses
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 from shakermill.parameters.assumed import AssumedInput, inherited_assumed
 from shakermill.parameters.defaults import DEFAULT_PRESET
@@ -55,12 +55,15 @@ class Preset:
         tested (``[provenance.validation] caveat`` of its file): every run and report of the preset says it."""
         return self.provenance.get("validation", {}).get("caveat")
 
-    def caveat_for(self, values: Mapping[str, Any]) -> str | None:
-        """:attr:`caveat`, said of a run with ``values``: where the run changed keys a calibration fitted, what was
-        found is of the preset as shipped."""
+    def caveat_for(self, values: Mapping[str, Any], refitted: Sequence[str] = ()) -> str | None:
+        """:attr:`caveat`, said of a run with ``values``: where the run changed keys a calibration fitted, or its
+        configuration is a fitted file that refits ``refitted``, what was found is of the preset as shipped."""
         if not self.caveat:
             return None
         changed = [key for key in self.fitted if key in values and values[key] != self.values[key].value]
+        if refitted:
+            return (f"{self.caveat} (This run's configuration refits {', '.join(refitted)} to its own measurement "
+                    "(calibrate): what was found is of the preset as shipped; read the fit's own errors.)")
         if not changed:
             return self.caveat
         return (f"{self.caveat} (This run changes {', '.join(changed)}, which the calibration fitted: what was found "
