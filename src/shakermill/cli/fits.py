@@ -492,7 +492,9 @@ SUPPORTED_SHARE = 0.5
 def prediction_table(calibration: Calibration) -> Table:
     """What the fitted model says of what was not fitted, each with its standard error from the keys' covariance; a
     value the data do not support (an error beyond SUPPORTED_SHARE of its size) is named so."""
-    start_C = calibration.params.initial_temperature - 273.15
+    from shakermill.engines.records import kelvin_to_celsius
+
+    start_C = kelvin_to_celsius(calibration.params.initial_temperature)
     table = Table("not fitted, predicted", "value", "std. error", title="what the fitted model predicts")
     for key, value in calibration.predictions.items():
         stderr = calibration.prediction_stderr.get(key, math.nan)
@@ -508,6 +510,8 @@ def print_calibration(
     calibration: Calibration, free_keys: Sequence[str], targets: Mapping[str, float], out: Path | None
 ) -> None:
     """The fitted parameters, what the fitted model predicts, the residuals of the targets and of the curve."""
+    from shakermill.studies.identifiability import LOOSE_LOG_ERROR
+
     console = stdout_console()
     ranges = calibration.posterior_ranges
     posterior_column = ["90 % of the posterior"] if ranges else []
@@ -516,7 +520,7 @@ def print_calibration(
         posterior = [f"{ranges[key][0]:.3g} to {ranges[key][1]:.3g}"] if ranges else []
         stderr = calibration.parameter_stderr[key]
         # A linear error beyond the value itself says the data leave the key undetermined, not how far it may move.
-        shown = "undetermined" if stderr > calibration.fitted[key] else number(stderr, ".3g")
+        shown = "undetermined" if stderr > LOOSE_LOG_ERROR * calibration.fitted[key] else number(stderr, ".3g")
         add_plain_row(
             table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}", shown, *posterior,
             calibration.defensible[key],

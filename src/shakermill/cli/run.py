@@ -255,10 +255,10 @@ def _size_row(result: Result) -> tuple[str, str, str]:
 def _fit_rows(result: Result, ball: str, fit_window: str) -> list[tuple[str, str, str]]:
     """The exponential fitted to the balls' heating, or one row saying why a run shorter than the network's slowest
     time constant has none worth reading."""
-    from shakermill.analysis.steady import fits_no_exponential
+    from shakermill.solvers.result import shorter_than_its_network
 
     s = result.summary
-    if result.steady is not None and fits_no_exponential(result.t_end, result.steady):
+    if shorter_than_its_network(result):
         return [("exponential fit", f"none: the run is shorter than the slowest time constant "
                  f"({number(s['slowest_time_constant_min'], '.1f')} min)", "")]
     return [

@@ -261,12 +261,18 @@ def energy_audit_problem(result: Result) -> str | None:
     )
 
 
+def shorter_than_its_network(result: Result) -> bool:
+    """Whether the run ended before its network's slowest time constant, so that no exponential was to be expected
+    (:func:`~shakermill.analysis.steady.fits_no_exponential`)."""
+    return result.steady is not None and fits_no_exponential(result.t_end, result.steady)
+
+
 def fit_warning(result: Result) -> str | None:
     """A line when the exponential fit of the ball temperature failed: the summary's θ∞, τ and θ̇₀ then mean nothing."""
     fit = result.ball_fit
     if fit.success or result.params.n_balls == 0:  # an empty mill has no ball to fit
         return None
-    if result.steady is not None and fits_no_exponential(result.t_end, result.steady):
+    if shorter_than_its_network(result):
         return None  # no exponential was to be expected: run_length_note says why
     return (
         f"the exponential fit of the ball temperature failed ({fit.message}): theta_inf_C, tau_min and "
@@ -327,8 +333,7 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         "rate0_C_per_min": fit.initial_rate * 60.0,
         "fit_rms_residual_K": fit.rms_residual,
         # Whether the exponential is worth reading: fitted, over a run no shorter than the slowest time constant.
-        "exponential_fit_describes_run": bool(fit.success) and not (
-            result.steady is not None and fits_no_exponential(result.t_end, result.steady)),
+        "exponential_fit_describes_run": bool(fit.success) and not shorter_than_its_network(result),
         "ball_C": kelvin_to_celsius(float(last["theta_ball"])),
         "vial_C": kelvin_to_celsius(float(last["theta_vial"])),
         "air_C": kelvin_to_celsius(float(last["theta_air"])),

@@ -300,10 +300,7 @@ def calibrate(
     prediction_stderr = {} if full_resolution else _prediction_stderr(evaluate, solution.x, covariance, predicted)
     # Sampled only where an evaluation is a network alone: thousands of them take minutes there, hours elsewhere.
     sampled = sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution
-    if sampled and on_posterior is not None:
-        on_posterior(posterior_evaluations(len(free)))
-    variance = residual_variance(residuals, len(free), curves) if sampled else math.nan
-    posterior = posterior_samples(lambda x: evaluate(x)[0], solution.x, lower, upper, variance).tolist() if sampled else None
+    posterior = _sampled_posterior(evaluate, solution.x, (lower, upper), residuals, curves, on_posterior) if sampled else None
     status, message = _verdict(solution, result.success, free, missed, at_bounds, curve_rms, covariance)
     return Calibration(
         params=result.params.replace(solver=base.solver, attractor_starts=base.attractor_starts),
@@ -510,6 +507,17 @@ def _curve_rms(results: Mapping[tuple[str, ...], Result], curves: Sequence[Curve
         return None
     residuals = np.concatenate([_curve_residuals_K(results, measured) for measured in curves])
     return math.sqrt(float(np.mean(residuals**2)))
+
+
+def _sampled_posterior(evaluate: Callable[[np.ndarray], Evaluation], best: np.ndarray,
+                       limits: tuple[np.ndarray, np.ndarray], residuals: np.ndarray, curves: Sequence[Curve],
+                       on_posterior: Callable[[int], None] | None) -> list[list[float]]:
+    """The posterior samples of a fit's keys at the fit's residual variance, ``on_posterior`` told how many
+    evaluations they take before they begin."""
+    if on_posterior is not None:
+        on_posterior(posterior_evaluations(best.size))
+    variance = residual_variance(residuals, best.size, curves)
+    return posterior_samples(lambda x: evaluate(x)[0], best, *limits, variance).tolist()
 
 
 def _prediction_stderr(evaluate: Callable[[np.ndarray], Evaluation], best: np.ndarray,

@@ -275,13 +275,15 @@ def answer_html(run: RunData, preset: Preset | None) -> str:
 
 def results_section(run: RunData) -> str:
     summary = run.summary
+    # A summary written before the key existed showed the fit's rows whatever the run's length.
+    describes = summary.get("exponential_fit_describes_run", True)
     rows = [(label, number(summary.get(key), spec), unit) for key, label, unit, spec in RESULT_QUANTITIES
-            if key not in FIT_KEYS or summary.get("exponential_fit_describes_run", True)]
+            if key not in FIT_KEYS or describes]
     uncertainty = (
         f"Standard errors of the fit: θ∞ ± {number(summary.get('theta_inf_stderr_K'), '.2g')} K, "
         f"τ ± {number(summary.get('tau_stderr_min'), '.2g')} min; "
         f"RMS residual {number(summary.get('fit_rms_residual_K'), '.2g')} K."
-    ) if summary.get("exponential_fit_describes_run", True) else (
+    ) if describes else (
         "No exponential: the run is shorter than the network's slowest time constant, so one fitted to it describes "
         "the start of the heating, not where it goes; the steady state is the answer to read."
     )

@@ -97,11 +97,11 @@ def path_flows(theta: np.ndarray, drives: np.ndarray, net: NetworkArrays, out: n
 
 
 @njit(cache=True)
-def path_flows_over(theta: np.ndarray, drives: np.ndarray, net: NetworkArrays, out: np.ndarray) -> None:
-    """:func:`path_flows` at each column of ``theta`` (node, time) into the rows of ``out`` (time, path): a run's
+def path_flows_over(samples: np.ndarray, drives: np.ndarray, net: NetworkArrays, out: np.ndarray) -> None:
+    """:func:`path_flows` at each row of ``samples`` (time, node) into the rows of ``out`` (time, path): a run's
     thousands of samples in one call."""
-    for sample in range(theta.shape[1]):
-        path_flows(np.ascontiguousarray(theta[:, sample]), drives, net, out[sample])
+    for sample in range(samples.shape[0]):
+        path_flows(samples[sample], drives, net, out[sample])
 
 
 @njit(cache=True)

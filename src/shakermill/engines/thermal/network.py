@@ -107,9 +107,9 @@ class ThermalNetwork:
 
     def flows_over(self, theta: np.ndarray, drives: np.ndarray) -> np.ndarray:
         """:meth:`flows` at each column of ``theta`` (node, time), over (time, path)."""
-        theta = np.asarray(theta, dtype=float)
-        out = np.empty((theta.shape[1], len(self.paths)))
-        kernel.path_flows_over(theta, np.asarray(drives, dtype=float), self.arrays, out)
+        samples = np.ascontiguousarray(np.asarray(theta, dtype=float).T)
+        out = np.empty((samples.shape[0], len(self.paths)))
+        kernel.path_flows_over(samples, np.asarray(drives, dtype=float), self.arrays, out)
         return out
 
     def rates(self, theta: np.ndarray, heat: np.ndarray, drives: np.ndarray) -> tuple[np.ndarray, float]:
