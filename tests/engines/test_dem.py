@@ -9,6 +9,7 @@ import pytest
 
 import shakermill as sm
 from shakermill.engines.dem import model
+from shakermill.engines.dem.contacts import pair_values
 from shakermill.engines.dem.engine import DemEngine
 from shakermill.physics import contact
 
@@ -134,7 +135,7 @@ def test_an_enduring_contact_steps_at_its_own_period_and_rests_where_the_finest_
         engine.advance(0.3)
         runs[fraction], resting_steps[fraction] = engine, engine.steps_taken() - settled
     k = runs[0.05].constants
-    slot = model.slot_count(1) - model.N_WALLS + model.SIDE  # the ball's slot against the bore
+    slot = model.SIDE  # the ball's slot against the bore: ball 0's walls come first
     overlap = runs[0.05].state.contacts.max_overlap[slot]
     period = contact.contact_period(k.mass[0], k.wall_radius[0, model.SIDE], k.wall_modulus[0], k.wall_shear_modulus[0],
                                     overlap, 0.0)
@@ -168,7 +169,7 @@ def test_per_ball_radii_and_densities_set_each_ball():
     assert k.radius == pytest.approx([6e-3, 5e-3, 4e-3])
     assert k.mass == pytest.approx([7800 * 4 / 3 * math.pi * 6e-3**3, 6000 * 4 / 3 * math.pi * 5e-3**3,
                                     3900 * 4 / 3 * math.pi * 4e-3**3])
-    assert k.pair_radius[0, 1] == pytest.approx(6e-3 * 5e-3 / 11e-3)
+    assert pair_values(0, 1, k)[2] == pytest.approx(6e-3 * 5e-3 / 11e-3)
     assert k.wall_radius[2, model.SIDE] == pytest.approx(contact.concave_radius(4e-3, 19e-3))
     centres = params.initial_positions()
     gaps = [np.linalg.norm(centres[i] - centres[j]) - k.radius[i] - k.radius[j] for i in range(3) for j in range(i)]

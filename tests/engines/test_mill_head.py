@@ -27,7 +27,8 @@ def test_the_network_has_a_clamp_node_and_every_path_of_a_real_mill():
     assert [node.name for node in network.nodes] == ["ball 0", "ball 1", "vial", "air", "clamp"]
     assert [path.name for path in network.paths] == [
         "ball 0 → air", "ball 1 → air", "vial → air", "vial → room, convection", "vial → room, radiation",
-        "ball 0 → vial, contacts", "ball 1 → vial, contacts", "ball 0 → ball 1, contacts", "vial → clamp", "clamp → room",
+        "ball 0 → vial, contacts", "ball 1 → vial, contacts", "ball 0 → other balls, contacts",
+        "ball 1 → other balls, contacts", "vial → clamp", "clamp → room",
     ]
     assert list(network.arrays.fixed_heat) == [0.0, 0.0, 0.0, 0.0, 7.0]
     assert all(path.correlation and path.source and path.validity for path in network.paths)
@@ -45,19 +46,40 @@ def test_the_vials_speed_and_outer_convection_follow_from_its_motion():
     assert faster.coefficient == pytest.approx(outer.coefficient * math.sqrt(2.0), rel=0.02)  # laminar: h ∝ √u
 
 
-def test_each_contact_has_its_own_drive():
+def test_each_ball_has_a_drive_for_its_contacts_with_the_vial_and_one_with_the_other_balls():
+    """Issue 38: drives grow linearly with the balls (3 per ball), not with the pairs."""
     n = 5
-    indices = [kernel.contact_drive(i, -1, n) for i in range(n)]
-    indices += [kernel.contact_drive(i, j, n) for i in range(n) for j in range(i + 1, n)]
-    assert sorted(indices) == list(range(n, kernel.drive_count(n)))
-    assert kernel.contact_drive(3, 1, n) == kernel.contact_drive(1, 3, n)
+    indices = [kernel.contact_drive(i, -1, n) for i in range(n)] + [kernel.contact_drive(i, (i + 1) % n, n) for i in range(n)]
+    assert sorted(indices) == list(range(n, kernel.drive_count(n))) and kernel.drive_count(n) == 3 * n
+    assert kernel.contact_drive(3, 1, n) == kernel.contact_drive(3, 4, n) != kernel.contact_drive(1, 3, n)
+
+
+def test_conduction_among_balls_conserves_energy_and_is_exact_for_two_balls_and_equal_couplings():
+    """kernel.among_balls_mean: flows sum to zero; for balls that touch each other alike (G_ij = g, so G_i = (m−1)g)
+    each ball's flow is the sum of its exact pair flows g·(θ_i − θ_j)."""
+    params = mill_head(n_balls=4)
+    network = DemEngine.network_for(params)
+    theta = np.array([350.0, 340.0, 325.0, 301.0, 310.0, 305.0, 300.0])
+    g = 2e-3
+    drives = np.array([10.0] * 4 + [0.0] * 4 + [3 * g] * 4)
+    flows = dict(zip((path.name for path in network.paths), network.flows(theta, drives)))
+    among = [flows[f"ball {i} → other balls, contacts"] for i in range(4)]
+    exact = [sum(g * (theta[i] - theta[j]) for j in range(4) if j != i) for i in range(4)]
+    assert among == pytest.approx(exact, rel=1e-12)
+    assert sum(among) == pytest.approx(0.0, abs=1e-15 * sum(abs(flow) for flow in among))
+    # Unequal couplings: still no heat made or lost among the balls.
+    drives[8:] = [1e-3, 4e-3, 2e-3, 0.5e-3]
+    rates, lost = network.rates(theta, np.zeros(len(network.nodes)), drives)
+    unequal = network.flows(theta, drives)
+    stored = float(np.dot(network.arrays.capacity, rates))
+    assert stored + lost == pytest.approx(0.0, abs=1e-9 * np.abs(unequal).sum())
 
 
 def test_each_new_path_flows_as_its_correlation_says():
     params = mill_head(n_balls=2, emissivity=0.3)
     network = DemEngine.network_for(params)
     theta = np.array([340.0, 330.0, 310.0, 305.0, 300.0])
-    drives = np.array([10.0, 10.0, 0.004, 0.006, 0.001])
+    drives = np.array([10.0, 10.0, 0.004, 0.006, 0.001, 0.001])
     flows = dict(zip((path.name for path in network.paths), network.flows(theta, drives)))
     ambient = params.ambient_temperature
     outer = vial_outer_convection(params)
@@ -66,7 +88,8 @@ def test_each_new_path_flows_as_its_correlation_says():
     assert flows["vial → room, radiation"] == pytest.approx(radiated, rel=1e-12)
     assert flows["ball 0 → vial, contacts"] == pytest.approx(0.004 * 30.0)
     assert flows["ball 1 → vial, contacts"] == pytest.approx(0.006 * 20.0)
-    assert flows["ball 0 → ball 1, contacts"] == pytest.approx(0.001 * 10.0)
+    assert flows["ball 0 → other balls, contacts"] == pytest.approx(0.001 * 10.0)
+    assert flows["ball 1 → other balls, contacts"] == pytest.approx(-0.001 * 10.0)
     assert flows["vial → clamp"] == pytest.approx(params.clamp_conductance * 10.0)
     assert flows["clamp → room"] == pytest.approx(params.clamp_loss * (300.0 - ambient))
 

@@ -10,6 +10,7 @@ import pytest
 import shakermill as sm
 from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import WINDOW_INTERVAL, DemEngine
+from shakermill.engines.dem.stepper import RECORD_COLUMNS
 from shakermill.parameters.config import load_config, write_config_toml
 from shakermill.parameters.engine_keys import AVERAGED_ONLY, ENGINE_KEYS, MILL_HEAD_ONLY, MOTION_KEYS, NETWORK_ONLY, Reader
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
@@ -125,7 +126,12 @@ def test_the_records_of_a_dem_run_are_counted_before_they_are_allocated(monkeypa
     params = sm.default_parameters("spex8000m-3d", duration=2.0, record_windows="0:1", solver="full")
     nodes = len(DemEngine.network_for(params).nodes)
     rows = 3 + 1.0 / WINDOW_INTERVAL  # the samples at 0, 1 and 2 s, and the window at 10 kHz
-    assert DemEngine.memory_needed(params, 3) == int(rows * model.row_width(params.n_balls, nodes) * 8)
+    contacts = model.contact_memory(model.constants_from(params), len(RECORD_COLUMNS))
+    assert DemEngine.memory_needed(params, 3) == int(rows * model.row_width(params.n_balls, nodes) * 8 + contacts)
+    # The contacts' memory grows linearly with the balls: 2000 balls hold well under 100 MB of it.
+    crowd = sm.default_parameters("pulverisette7", n_balls=2000, ball_radius=2.5e-3, vial_diameter=0.12, vial_length=0.07,
+                                  outer_diameter=0.13, outer_length=0.08, record_windows=())
+    assert 20e6 < model.contact_memory(model.constants_from(crowd), len(RECORD_COLUMNS)) < 100e6
     monkeypatch.setattr("psutil.virtual_memory", lambda: SimpleNamespace(available=2**20))
     with pytest.raises(ParameterError, match=r"record_windows: the run would keep .* GiB of records .*allowed shorter record_windows"):
         sm.simulate(params)
@@ -170,5 +176,5 @@ def test_the_fifty_balls_of_the_issue_are_refused_in_one_line_before_any_memory_
     assert outcome.exit_code == 2 and "Traceback" not in outcome.stderr
     line, = outcome.stderr.strip().splitlines()
     assert line.startswith("error: record_windows: the run would keep ") and "of the 8 GiB free" in line
-    assert "GiB of records (50 balls, 600 s of record windows" in line
+    assert "GiB of records and contacts (50 balls, 600 s of record windows" in line
     assert not (tmp_path / "run").exists()

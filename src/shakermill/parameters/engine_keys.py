@@ -12,8 +12,9 @@ from typing import Any, Callable, Iterable, Mapping
 
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 
-# The most balls any engine moves; the pair search of the 'dem' engine is O(N²).
-MAX_BALLS = 50
+# The most balls any engine moves: the 'dem' engine's contact search (a neighbour list, engines/dem/neighbours.py) and
+# its memory grow linearly with them; a run's preflight refuses what the machine cannot hold or finish.
+MAX_BALLS = 2000
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,9 @@ def packed(radii: np.ndarray, vial_length: float, vial_diameter: float) -> np.nd
     """Centres (k, 3) in m of the first k balls of ``radii`` that fit, placed one after another until one does not.
 
     Each ball goes to the first free candidate whatever comes after it, so the first k balls of any longer list
-    lie where k balls alone would: ``len(packed(...))`` is how many of these balls the vial takes.
+    lie where k balls alone would: ``len(packed(...))`` is how many of these balls the vial takes. A placed ball
+    changes only the candidates within its padded radius plus the largest padded radius of it, a box of the grid,
+    so that placing thousands of balls costs thousands of small boxes, not thousands of sweeps over the grid.
     """
     step = max(GRID_STEP * float(np.max(radii)), (vial_length * vial_diameter**2 / MAX_CANDIDATES) ** (1.0 / 3.0))
     axis = _centred_grid(0.5 * vial_length, step)
@@ -38,19 +40,38 @@ def packed(radii: np.ndarray, vial_length: float, vial_diameter: float) -> np.nd
     x, y, z = np.meshgrid(axis, across, across, indexing="ij")
     candidates = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
     # Bottom first, then from the vial's left end, then from its back: a stable, reproducible order.
-    candidates = candidates[np.lexsort((candidates[:, 1], candidates[:, 0], candidates[:, 2]))]
+    order = np.lexsort((candidates[:, 1], candidates[:, 0], candidates[:, 2]))
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    candidates = candidates[order]
     centres = np.empty((radii.size, 3))
-    # Distance from each candidate to the nearest placed ball's surface, its clearance included.
+    largest = float(np.max(radii)) * (1.0 + CLEARANCE)
+    # Distance from each candidate to the nearest placed ball's surface, its clearance included, where that is
+    # under the largest padded radius (elsewhere it does not matter, and it is left at its last value).
     room = np.full(len(candidates), np.inf)
+    inside = {}
     for ball, radius in enumerate(radii):
         padded = radius * (1.0 + CLEARANCE)
-        found = np.flatnonzero(_inside(candidates, padded, vial_length, vial_diameter) & (room >= padded))
-        if found.size == 0:
+        if padded not in inside:
+            inside[padded] = _inside(candidates, padded, vial_length, vial_diameter)
+        free = inside[padded] & (room >= padded)
+        first = int(np.argmax(free))
+        if not free[first]:
             return centres[:ball]
-        centres[ball] = candidates[found[0]]
-        surface = np.linalg.norm(candidates - centres[ball], axis=1) - padded
-        np.minimum(room, surface, out=room)
+        centres[ball] = candidates[first]
+        near = rank[_box(centres[ball], padded + largest, (axis, across, across)).ravel()]
+        surface = np.linalg.norm(candidates[near] - centres[ball], axis=1) - padded
+        room[near] = np.minimum(room[near], surface)
     return centres
+
+
+def _box(centre: np.ndarray, reach: float, grids: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+    """Flat indices (in meshgrid 'ij' order) of the grid points within ``reach`` of ``centre`` along every axis."""
+    ranges = [np.arange(np.searchsorted(grid, c - reach), np.searchsorted(grid, c + reach, side="right"))
+              for grid, c in zip(grids, centre, strict=True)]
+    sizes = [grid.size for grid in grids]
+    i, j, k = np.meshgrid(*ranges, indexing="ij")
+    return (i * sizes[1] + j) * sizes[2] + k
 
 
 def _centred_grid(half_extent: float, step: float) -> np.ndarray:

@@ -231,8 +231,15 @@ def restitution_warning(params: Parameters) -> str | None:
     return (
         f"contact_step_fraction = {params.contact_step_fraction:g} resolves a head-on impact at {speed:.3g} m/s with a "
         f"restitution of {achieved:.3f}, {100 * error:.1f} % off the configured restitution = {params.restitution:g}; "
-        f"a smaller contact_step_fraction (0.05 is the default) keeps it within {100 * RESTITUTION_TOLERANCE:g} %"
+        f"a smaller contact_step_fraction ({_default_step_fraction():g} is the default) keeps it within "
+        f"{100 * RESTITUTION_TOLERANCE:g} %"
     )
+
+
+def _default_step_fraction() -> float:
+    from shakermill.parameters.presets import default_parameters
+
+    return default_parameters().contact_step_fraction
 
 
 def _check_resolved(engine: DemEngine, target: str, speed: float, angle_deg: float) -> None:
@@ -240,14 +247,11 @@ def _check_resolved(engine: DemEngine, target: str, speed: float, angle_deg: flo
     :data:`MIN_OVERLAP_POSITIONS` representable positions of the incoming ball's centre, with the least speed."""
     import numpy as np
 
-    from shakermill.engines.dem.model import LEFT_END
     from shakermill.physics.contact import hertz_max_overlap
 
     k = engine.constants
-    if target == "wall":
-        mass, radius, modulus, where = k.mass[0], k.wall_radius[0, LEFT_END], k.wall_modulus[0], k.half_length
-    else:
-        mass, radius, modulus, where = k.pair_mass[0, 1], k.pair_radius[0, 1], k.pair_modulus[0, 1], 0.0
+    mass, radius, modulus = _effective(engine, target)
+    where = k.half_length if target == "wall" else 0.0
     # Scaled from 1 m/s, as the overlap grows as v^(4/5): computed at 1e-300 m/s it would underflow to 0.
     per_speed = hertz_max_overlap(mass, radius, modulus, 1.0)
     normal_speed = speed * math.cos(math.radians(angle_deg))
@@ -264,16 +268,23 @@ def _check_resolved(engine: DemEngine, target: str, speed: float, angle_deg: flo
     )
 
 
-def _hertz_scales(engine: DemEngine, target: str, normal_speed: float) -> tuple[float, float]:
-    """The Hertz contact time (s) and the start gap (m) of an impact at ``normal_speed``."""
+def _effective(engine: DemEngine, target: str) -> tuple[float, float, float]:
+    """m* (kg), R* (m) and E* (Pa) of the impact: ball 0 on the left end, or balls 0 and 1."""
+    from shakermill.engines.dem.contacts import pair_values
     from shakermill.engines.dem.model import LEFT_END
-    from shakermill.physics.contact import hertz_contact_time, hertz_max_overlap
 
     k = engine.constants
     if target == "wall":
-        mass, radius, modulus = k.mass[0], k.wall_radius[0, LEFT_END], k.wall_modulus[0]
-    else:
-        mass, radius, modulus = k.pair_mass[0, 1], k.pair_radius[0, 1], k.pair_modulus[0, 1]
+        return float(k.mass[0]), float(k.wall_radius[0, LEFT_END]), float(k.wall_modulus[0])
+    modulus, _, radius, mass, _ = pair_values(0, 1, k)
+    return mass, radius, modulus
+
+
+def _hertz_scales(engine: DemEngine, target: str, normal_speed: float) -> tuple[float, float]:
+    """The Hertz contact time (s) and the start gap (m) of an impact at ``normal_speed``."""
+    from shakermill.physics.contact import hertz_contact_time, hertz_max_overlap
+
+    mass, radius, modulus = _effective(engine, target)
     overlap = hertz_max_overlap(mass, radius, modulus, normal_speed)
     return hertz_contact_time(mass, radius, modulus, normal_speed), START_GAP_FRACTION * overlap
 

@@ -82,7 +82,7 @@ def _check_memory(params: Parameters, needed_by: Callable[[Parameters, int], int
     free = psutil.virtual_memory().available
     if needed > MEMORY_SHARE * free:
         raise ParameterError(
-            f"record_windows: the run would keep {needed / 2**30:.3g} GiB of records ({params.n_balls} balls, "
+            f"record_windows: the run would keep {needed / 2**30:.3g} GiB of records and contacts ({params.n_balls} balls, "
             f"{sum(length for _, length in params.record_windows):g} s of record windows, a sample every "
             f"{params.output_interval:g} s), more than the {MEMORY_SHARE * free / 2**30:.3g} GiB it may take of the "
             f"{free / 2**30:.3g} GiB free; allowed shorter record_windows or a longer output_interval"

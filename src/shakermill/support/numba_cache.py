@@ -25,6 +25,7 @@ _COMPILED_SOURCES = tuple(
         "engines/one_d/contacts.py",
         "engines/one_d/integrator.py",
         "engines/dem/vectors.py",
+        "engines/dem/neighbours.py",
         "engines/dem/contacts.py",
         "engines/dem/stepper.py",
     )

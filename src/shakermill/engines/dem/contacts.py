@@ -1,6 +1,7 @@
 """Contacts of the 'dem' engine, compiled (MODEL.md sections 12.3-12.4): the gap to each wall, the Hertz–Mindlin
-response of a touching pair or ball and wall, the forces summed on each ball, and each contact's work over a step
-booked by dissipation channel and turned into heat in the balls and the vial."""
+response of a touching pair or ball and wall, the forces summed on each ball, each contact's work over a step
+booked by dissipation channel and turned into heat in the balls and the vial, and the contacts carried to their
+entries when the neighbour list is rebuilt."""
 
 from __future__ import annotations
 
@@ -21,9 +22,11 @@ from shakermill.engines.dem.model import (
     WORK_STIFFENING,
     WORK_VIAL,
     Constants,
+    Contacts,
     Scratch,
     State,
 )
+from shakermill.engines.dem import neighbours
 from shakermill.engines.dem.vectors import copy_into, cross_into, difference_into, distance, dot, norm, scaled_into
 from shakermill.engines.thermal import kernel
 from shakermill.physics import contact, heat_paths
@@ -52,6 +55,30 @@ def wall_gap(position: np.ndarray, radius: float, wall: int, k: Constants, w: Sc
     else:
         scaled_into(q[:, 2], -1.0, w.normal)
     return k.bore_radius - off_axis - radius
+
+
+@njit(cache=True)
+def pair_values(i: int, j: int, k: Constants) -> tuple[float, float, float, float, float]:
+    """E*, G* (Pa), R* (m) and m* (kg) of balls i and j (MODEL.md §12.3), and the share of their contacts' heat that
+    goes to ball i (by effusivity, MODEL.md §12.4)."""
+    youngs, poisson = k.youngs_modulus, k.poisson_ratio
+    return (
+        contact.effective_modulus(youngs[i], poisson[i], youngs[j], poisson[j]),
+        contact.effective_shear_modulus(youngs[i], poisson[i], youngs[j], poisson[j]),
+        k.radius[i] * k.radius[j] / (k.radius[i] + k.radius[j]),
+        k.mass[i] * k.mass[j] / (k.mass[i] + k.mass[j]),
+        k.effusivity[i] / (k.effusivity[i] + k.effusivity[j]),
+    )
+
+
+@njit(cache=True, inline="always")
+def bodies(slot: int, k: Constants, s: State) -> tuple[int, int, int]:
+    """The ball of a contact slot, the other ball (−1 for a wall) and the wall (−1 for a pair)."""
+    walls = N_WALLS * k.n_balls
+    if slot < walls:
+        return slot // N_WALLS, -1, slot % N_WALLS
+    entry = slot - walls
+    return s.neighbours.first_ball[entry], s.neighbours.second_ball[entry], -1
 
 
 @njit(cache=True, inline="always")
@@ -168,7 +195,7 @@ def _engage(slot: int, t: float, overlap: float, modulus: float, shear_modulus: 
     ``ball_radius``); returns the live-slot count."""
     if not s.contacts.active[slot]:
         _touch(slot, t, s, w)
-    pair = slot < k.n_balls * k.n_balls
+    pair = slot >= N_WALLS * k.n_balls
     beta_e, friction = (k.pair_beta_e, k.pair_friction) if pair else (k.beta_e, k.friction)
     _response(slot, overlap, w.relative_spin, modulus, shear_modulus, radius, mass, beta_e, friction, dt, k, s, w)
     scaled_into(w.normal, -ball_radius, w.lever)
@@ -180,28 +207,29 @@ def _engage(slot: int, t: float, overlap: float, modulus: float, shear_modulus: 
 
 @njit(cache=True, inline="always")
 def pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live: int) -> tuple[int, float]:
-    """Responses of the touching ball pairs; returns the live-slot count and the deepest overlap (m)."""
-    n = k.n_balls
+    """Responses of the touching pairs of the neighbour list; returns the live-slot count and the deepest overlap (m)."""
+    nb = s.neighbours
+    walls = N_WALLS * k.n_balls
     deepest = 0.0
-    for i in range(n):
-        for j in range(i + 1, n):
-            slot = i * n + j
-            centres = distance(s.position[i], s.position[j])
-            overlap = k.radius[i] + k.radius[j] - centres
-            if overlap <= 0.0:
-                live = _release_if_touching(slot, s, w, live)
-                continue
-            deepest = max(deepest, overlap)
-            for axis in range(3):
-                w.normal[axis] = (s.position[i, axis] - s.position[j, axis]) / centres
-            _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
-            _contact_point_velocity(j, k.radius[j], s, w, w.other_velocity)
-            difference_into(w.point_velocity, w.other_velocity, w.point_velocity)
-            difference_into(s.spin[i], s.spin[j], w.relative_spin)
-            live = _engage(slot, t, overlap, k.pair_modulus[i, j], k.pair_shear_modulus[i, j], k.pair_radius[i, j],
-                           k.pair_mass[i, j], k.radius[i], dt, k, s, w, live)
-            scaled_into(w.lever_torque_i[slot], k.radius[j] / k.radius[i], w.lever_torque_j[slot])
-            w.wall_velocity[slot, :] = 0.0
+    for entry in range(nb.count[0]):
+        i, j = nb.first_ball[entry], nb.second_ball[entry]
+        slot = walls + entry
+        centres = distance(s.position[i], s.position[j])
+        overlap = k.radius[i] + k.radius[j] - centres
+        if overlap <= 0.0:
+            live = _release_if_touching(slot, s, w, live)
+            continue
+        deepest = max(deepest, overlap)
+        for axis in range(3):
+            w.normal[axis] = (s.position[i, axis] - s.position[j, axis]) / centres
+        _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
+        _contact_point_velocity(j, k.radius[j], s, w, w.other_velocity)
+        difference_into(w.point_velocity, w.other_velocity, w.point_velocity)
+        difference_into(s.spin[i], s.spin[j], w.relative_spin)
+        modulus, shear_modulus, radius, mass, _ = pair_values(i, j, k)
+        live = _engage(slot, t, overlap, modulus, shear_modulus, radius, mass, k.radius[i], dt, k, s, w, live)
+        scaled_into(w.lever_torque_i[slot], k.radius[j] / k.radius[i], w.lever_torque_j[slot])
+        w.wall_velocity[slot, :] = 0.0
     return live, deepest
 
 
@@ -212,7 +240,7 @@ def wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
     deepest = 0.0
     for i in range(n):
         for wall in range(N_WALLS):
-            slot = n * n + N_WALLS * i + wall
+            slot = N_WALLS * i + wall
             overlap = -wall_gap(s.position[i], k.radius[i], wall, k, w)
             if overlap <= 0.0:
                 live = _release_if_touching(slot, s, w, live)
@@ -236,18 +264,16 @@ def wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
 @njit(cache=True, inline="always")
 def sum_forces(live: int, k: Constants, s: State, w: Scratch) -> None:
     """The new contact forces and torques on every ball (gravity apart)."""
-    n = k.n_balls
     s.force[:, :] = 0.0
     s.torque[:, :] = 0.0
     for index in range(live):
         slot = w.live[index]
-        i = slot // n if slot < n * n else (slot - n * n) // N_WALLS
+        i, j, _ = bodies(slot, k, s)
         for axis in range(3):
             force = w.normal_force[slot, axis] + w.tangential_force[slot, axis]
             s.force[i, axis] += force
             s.torque[i, axis] += w.lever_torque_i[slot, axis] + w.rolling_torque[slot, axis]
-            if slot < n * n:
-                j = slot % n
+            if j >= 0:
                 s.force[j, axis] -= force
                 s.torque[j, axis] += w.lever_torque_j[slot, axis] - w.rolling_torque[slot, axis]
 
@@ -286,11 +312,9 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
             count: int) -> int:
     """Book the step's work of the contact in ``slot`` by channel, turn it into heat, keep the new forces,
     and close the contact's record if it ended. Returns the record count."""
-    n = k.n_balls
     c = s.contacts
-    pair = slot < n * n
-    i = slot // n if pair else (slot - n * n) // N_WALLS
-    j = slot % n if pair else -1
+    i, j, wall = bodies(slot, k, s)
+    pair = j >= 0
     normal, tangential, rolling, vial = _mean_work(slot, i, j, dt, s, w)
     normal -= w.elastic_energy[slot] - c.elastic_energy[slot]
     # The spring energy ½k_t|δ_t|² changes by stretching (its own work, from the tangential work) and by
@@ -315,8 +339,8 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
         s.totals[totals[channel]] += channels[channel]
         dissipated += channels[channel]
     heat = k.eta * dissipated
-    share = k.pair_heat_share[i, j] if pair else k.lam
-    other = j if pair else n
+    share = pair_values(i, j, k)[4] if pair else k.lam
+    other = j if pair else k.n_balls
     s.totals[WORK_VIAL] += vial
     s.totals[HEAT_GENERATED] += heat
     for node, part in ((i, share * heat), (other, (1.0 - share) * heat)):
@@ -335,7 +359,6 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
     if w.touching[slot]:
         return count
     row = records[count]
-    wall = -1 if pair else (slot - n * n) % N_WALLS
     row[0], row[1], row[2] = c.started[slot], i, j if pair else -1 - wall
     row[3], row[4] = c.normal_speed_in[slot], c.tangential_speed_in[slot]
     for channel in range(4):
@@ -354,14 +377,76 @@ def _conduct(slot: int, i: int, j: int, wall: int, duration: float, k: Constants
     (or ``wall`` of the vial, ``j`` = −1) over its ``duration`` (MODEL.md §13.1), gathered for the thermal network;
     returned for its record. Counted when the contact ends, so that a lasting one adds all its conduction at once."""
     if j >= 0:
-        radius, effusivity, conductivity = k.pair_radius[i, j], k.effusivity[j], k.conductivity[j]
+        radius, effusivity, conductivity = pair_values(i, j, k)[2], k.effusivity[j], k.conductivity[j]
     else:
         radius, effusivity, conductivity = k.wall_radius[i, wall], k.vial_effusivity, k.vial_conductivity
     contact_radius = heat_paths.hertz_contact_radius(radius, s.contacts.max_overlap[slot])
     conducted = heat_paths.contact_conduction(
         contact_radius, duration, k.effusivity[i], effusivity, k.conductivity[i], conductivity
     )
-    drive = kernel.contact_drive(i, j, k.n_balls)
+    _add_conduction(kernel.contact_drive(i, j, k.n_balls), conducted, s)
+    if j >= 0:  # a pair's conduction counts for its two balls
+        _add_conduction(kernel.contact_drive(j, i, k.n_balls), conducted, s)
+    return conducted
+
+
+@njit(cache=True, inline="always")
+def _add_conduction(drive: int, conducted: float, s: State) -> None:
     s.pending_drives[drive] += conducted
     s.drive_integrals[drive] += conducted
-    return conducted
+
+
+@njit(cache=True)
+def _copy_slot(source: Contacts, a: int, target: Contacts, b: int) -> None:
+    """Contact memory of slot ``a`` of ``source`` into slot ``b`` of ``target``."""
+    target.active[b] = source.active[a]
+    for field_from, field_to in ((source.normal_force, target.normal_force), (source.tangential_force, target.tangential_force),
+                                 (source.lever_torque_i, target.lever_torque_i), (source.lever_torque_j, target.lever_torque_j),
+                                 (source.rolling_torque, target.rolling_torque), (source.wall_velocity, target.wall_velocity),
+                                 (source.spring, target.spring)):
+        copy_into(field_from[a], field_to[b])
+    for scalar_from, scalar_to in ((source.elastic_energy, target.elastic_energy), (source.stiffness, target.stiffness),
+                                   (source.stretch, target.stretch), (source.slip_loss, target.slip_loss),
+                                   (source.period, target.period), (source.started, target.started),
+                                   (source.normal_speed_in, target.normal_speed_in),
+                                   (source.tangential_speed_in, target.tangential_speed_in),
+                                   (source.peak_force, target.peak_force), (source.max_overlap, target.max_overlap)):
+        scalar_to[b] = scalar_from[a]
+    for channel in range(source.dissipated.shape[1]):
+        target.dissipated[b, channel] = source.dissipated[a, channel]
+
+
+@njit(cache=True)
+def _clear_slot(c: Contacts, slot: int) -> None:
+    """A slot no contact holds: what a step reads of a slot that did not touch at its start (forces, stored energies,
+    spring) at zero."""
+    c.active[slot] = False
+    for vectors in (c.normal_force, c.tangential_force, c.lever_torque_i, c.lever_torque_j, c.rolling_torque,
+                    c.wall_velocity, c.spring):
+        vectors[slot, :] = 0.0
+    c.elastic_energy[slot] = 0.0
+    c.stiffness[slot] = 0.0
+    c.stretch[slot] = 0.0
+
+
+@njit(cache=True)
+def rebuild_neighbours(k: Constants, s: State, centre: np.ndarray) -> bool:
+    """Build the neighbour list anew at the balls' positions and carry each touching pair's contact to its new entry
+    (every touching pair is listed again: it lies within r_i + r_j); False if the list cannot hold the pairs."""
+    nb, c = s.neighbours, s.contacts
+    walls = N_WALLS * k.n_balls
+    carried = 0
+    for entry in range(nb.count[0]):
+        if c.active[walls + entry]:
+            _copy_slot(c, walls + entry, nb.carried, carried)
+            nb.carried_first[carried], nb.carried_second[carried] = nb.first_ball[entry], nb.second_ball[entry]
+            carried += 1
+            _clear_slot(c, walls + entry)
+    if not neighbours.build(k, s.position, centre, nb):
+        return False
+    for index in range(carried):
+        entry = neighbours.entry_of(nb, nb.carried_first[index], nb.carried_second[index])
+        if entry < 0:
+            return False
+        _copy_slot(nb.carried, index, c, walls + entry)
+    return True

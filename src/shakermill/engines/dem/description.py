@@ -8,6 +8,9 @@ from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STO
 from shakermill.parameters.engine_keys import THREE_DIMENSIONAL
 
 CHANNELS = ("normal", "tangential", "sliding", "rolling")
+# The neighbour list could not hold the pairs near each other (engines/dem/neighbours.py): only balls far deeper in
+# each other than OVERLAP_TOO_LARGE allows, which stops a run first, could make it.
+NEIGHBOURS_FULL = -5
 
 STATUS_MESSAGES = {
     REACHED_STOP: "The engine reached the end of the integration interval.",
@@ -16,6 +19,7 @@ STATUS_MESSAGES = {
         "A contact overlap exceeded 5 % of the smallest ball radius: the materials are too soft for these impact "
         "speeds, or contact_step_fraction is too large."
     ),
+    NEIGHBOURS_FULL: "The neighbour list could not hold the pairs of balls near each other: balls overlap far more than a step allows.",
 }
 
 IMPACT_UNITS = {

@@ -67,12 +67,13 @@ class DemEngine(CompiledRun):
         self.state = model.initial_state(params, self.constants, self.network)
         if replica:
             model.kick_for_replica(self.state, replica)
-        self.scratch = model.scratch_for(params.n_balls, model.slot_count(params.n_balls))
+        self.scratch = model.scratch_for(params.n_balls, self.state.contacts.active.size)
         self.stepper_counters = np.zeros(len(stepper.COUNTER_NAMES) + 1, dtype=np.int64)
         times, self._is_sample, self._in_window = marks(params, np.asarray(samples, dtype=float), horizon)
         self.marks = times[1:]
         self._rows = np.zeros((self.marks.size, model.row_width(params.n_balls, self.node_count)))
-        self._records = np.zeros((INITIAL_RECORDS, len(stepper.RECORD_COLUMNS)))
+        # The stepping hands back when fewer rows are free than there are slots: a large charge starts with room.
+        self._records = np.zeros((max(INITIAL_RECORDS, 2 * self.state.contacts.active.size), len(stepper.RECORD_COLUMNS)))
         self._count = 0
         self.start = self.row_now()
 
@@ -82,11 +83,13 @@ class DemEngine(CompiledRun):
 
     @classmethod
     def memory_needed(cls, params: Parameters, samples: int) -> int:
-        """Bytes of the state rows a run of ``params`` allocates at its start: one at each of its ``samples`` and every
-        WINDOW_INTERVAL of its record windows (50 balls over 600 s of windows: ~28 GiB)."""
+        """Bytes a run of ``params`` allocates at its start: the state rows, one at each of its ``samples`` and every
+        WINDOW_INTERVAL of its record windows (50 balls over 600 s of windows: ~28 GiB), and its contacts' memory
+        (:func:`model.contact_memory`: ~40 MB for 2000 balls)."""
         windows = sum(max(0.0, min(length, params.duration - start)) for start, length in params.record_windows)
         rows = samples + windows / WINDOW_INTERVAL
-        return int(rows * model.row_width(params.n_balls, len(cls.network_for(params).nodes)) * 8)
+        row_bytes = rows * model.row_width(params.n_balls, len(cls.network_for(params).nodes)) * 8
+        return int(row_bytes + model.contact_memory(model.constants_from(params), len(stepper.RECORD_COLUMNS)))
 
     @classmethod
     def least_steps(cls, params: Parameters, simulated: float) -> float:
@@ -322,7 +325,7 @@ def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Consta
     variables["velocity_term_integral"] = (network.mean_ball(terms), attributes("s", "the balls' mean of velocity_term_integrals"))
     variables["contact_conduction"] = (
         fields["drive_integrals"][:, n:],
-        attributes("J K-1", "heat per kelvin conducted by the contacts of each ball with the vial, then of each pair"),
+        attributes("J K-1", "heat per kelvin conducted by the contacts of each ball with the vial, then with the other balls"),
     )
     dimensions = {name: _PER_BALL for name in (BALL_TEMPERATURES, f"{BALL_TEMPERATURES}_C", "heat_into_balls", "velocity_term_integrals")}
     dimensions["contact_conduction"] = ("time", "contact")

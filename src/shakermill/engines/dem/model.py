@@ -2,8 +2,8 @@
 
 Frames: the lab frame has z up (gravity −z) and, for every motion but a planetary jar's (whose axis stands
 along z), x along the vial's axis at rest; the vial frame moves with the vial (its axis is its x). Contacts
-live in slots: ball pair (i, j), i < j, in slot ``i·N + j``; ball i against the left end, the right end or the
-cylindrical side in slot ``N² + 3i + wall``.
+live in slots: ball i against the left end, the right end or the cylindrical side in slot ``3i + wall``; the pair
+of entry e of the neighbour list (:class:`Neighbours`) in slot ``3N + e``.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from shakermill.engines.dem import neighbours as neighbour_list
 from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.network import ThermalNetwork, air_constants, build_network
 from shakermill.parameters.keys import Parameters
@@ -54,18 +55,16 @@ TOTAL_NAMES = (
 
 
 class Constants(NamedTuple):
-    """Everything the compiled stepping needs. Per-ball arrays have length N; pair arrays are N×N."""
+    """Everything the compiled stepping needs. Per-ball arrays have length N: a pair's effective values are formed
+    from its two balls' when it touches (``contacts.pair_values``), so that nothing grows as N²."""
 
     n_balls: int
     radius: np.ndarray
     mass: np.ndarray
     inertia: np.ndarray
-    # Ball-ball contacts (symmetric N×N) and ball-wall contacts (per ball, per wall kind)
-    pair_modulus: np.ndarray  # E*, Pa
-    pair_shear_modulus: np.ndarray  # G*, Pa
-    pair_radius: np.ndarray  # R*, m
-    pair_mass: np.ndarray  # m*, kg
-    pair_heat_share: np.ndarray  # share of a pair contact's heat that goes to ball i (row), by effusivity
+    youngs_modulus: np.ndarray  # Pa
+    poisson_ratio: np.ndarray
+    # Ball-wall contacts (per ball, per wall kind)
     wall_modulus: np.ndarray  # E* with the vial, per ball
     wall_shear_modulus: np.ndarray
     wall_radius: np.ndarray  # (N, 3): R* against the left end, the right end, the side
@@ -100,6 +99,13 @@ class Constants(NamedTuple):
     max_flight_step: float  # s
     max_overlap: float  # m: beyond it the step control failed
     thermal_step: float  # s: the thermal network is advanced on this clock
+    # The neighbour list (:class:`Neighbours`, ``neighbours.py``): pairs listed within r_i + r_j + skin of each other,
+    # found through a grid of cubic cells that covers the cube of half-width ``grid_reach`` about the vial's centre.
+    # An infinite skin lists every pair once and for all (a few balls: :func:`neighbour_skin`).
+    skin: float  # m
+    cell_size: float  # m
+    cells_per_side: int
+    grid_reach: float  # m
     # Convection (MODEL.md §§4, 12.5): each ball's Re. The thermal network it drives is an argument of its own:
     # every array in these constants costs a reference count at each use inside the compiled step (~10 % of its time).
     relative_convection: bool
@@ -119,12 +125,13 @@ class State(NamedTuple):
     temperature: np.ndarray  # (nodes,) K: the balls, the vial, the air (and the clamp: the thermal network's nodes)
     pending_heat: np.ndarray  # (nodes,) J from the contacts into the balls and the vial since the last thermal update
     # The network's drives (engines.thermal.kernel): each ball's Whitaker term integral ∫w dt (s), then the heat per
-    # kelvin of the contacts (J/K) of each ball with the vial and of each pair, since the last thermal update...
+    # kelvin of the contacts (J/K) of each ball with the vial and with the other balls, since the last thermal update...
     pending_drives: np.ndarray  # (D,)
     totals: np.ndarray  # (len(TOTAL_NAMES),) J
     heat_into: np.ndarray  # (N + 1,) J: all heat into each ball and the vial so far
     drive_integrals: np.ndarray  # (D,) ...and since the start
     contacts: "Contacts"
+    neighbours: "Neighbours"
 
 
 class Contacts(NamedTuple):
@@ -152,8 +159,67 @@ class Contacts(NamedTuple):
     max_overlap: np.ndarray  # (S,) m
 
 
-def slot_count(n_balls: int) -> int:
-    return n_balls * n_balls + N_WALLS * n_balls
+class Neighbours(NamedTuple):
+    """The pairs of balls near enough to touch before the list is next built (a Verlet list built through a cell grid,
+    Allen & Tildesley, *Computer Simulation of Liquids*, 2nd ed. (2017) §5.3): entry e pairs ``first_ball[e]`` <
+    ``second_ball[e]``; ball i's entries are ``first[i]`` to ``first[i + 1]``. It is rebuilt once a ball has moved
+    a quarter of the skin relative to the vial's centre since the last build, and no step lets a ball move half of
+    it (``stepper._flight_step``), so that no pair left out can touch. The contacts of listed pairs that touch are
+    carried to their new entries through ``carried``."""
+
+    first_ball: np.ndarray  # (P,) int64
+    second_ball: np.ndarray  # (P,) int64
+    first: np.ndarray  # (N + 1,) int64
+    count: np.ndarray  # (1,) int64: entries in use
+    reference: np.ndarray  # (N, 3) m: each ball's centre relative to the vial's at the last build
+    cell_head: np.ndarray  # (cells,) int64: a ball in each cell (−1: none), the others chained by cell_next
+    cell_next: np.ndarray  # (N,) int64
+    carried_first: np.ndarray  # (P,) int64: the pairs of the touching contacts being carried
+    carried_second: np.ndarray  # (P,) int64
+    carried: "Contacts"  # (P slots)
+
+
+def slot_count(n_balls: int, pair_capacity: int) -> int:
+    return N_WALLS * n_balls + pair_capacity
+
+
+# A finite skin of this fraction of the smallest radius; a few balls list every pair instead (:func:`neighbour_skin`).
+SKIN_FRACTION = 0.3
+# The grid has at most this many cells a side: a small ball in a large bowl gets cells larger than it needs.
+MOST_CELLS_PER_SIDE = 128
+
+
+def pair_capacity(radius: np.ndarray, skin: float) -> int:
+    """Entries the neighbour list can need for balls of ``radius`` (m) with ``skin`` (m; inf: every pair).
+
+    A bound, not an estimate: balls overlap by at most MAX_OVERLAP_FRACTION of the smallest radius, so spheres of
+    0.95 of each radius are disjoint; those of ball i's neighbours lie within r_i + 1.95·r_max + skin of its centre,
+    and there are at most (that distance / (0.95·r_min))³ of them. Each pair counts for its two balls."""
+    n = radius.size
+    all_pairs = n * (n - 1) // 2
+    if not math.isfinite(skin) or n < 2:
+        return all_pairs
+    core = (1.0 - MAX_OVERLAP_FRACTION) * float(radius.min())
+    reach = radius + (2.0 - MAX_OVERLAP_FRACTION) * float(radius.max()) + skin
+    return min(all_pairs, int(np.ceil(np.sum(np.floor((reach / core) ** 3)) / 2.0)))
+
+
+def neighbour_skin(radius: np.ndarray) -> float:
+    """The skin of the neighbour list (m): SKIN_FRACTION of the smallest radius, or infinite (every pair listed,
+    never rebuilt) where the bound on a finite list's entries holds every pair anyway, as for a few balls."""
+    if radius.size < 2:
+        return math.inf
+    skin = SKIN_FRACTION * float(radius.min())
+    return math.inf if pair_capacity(radius, skin) >= radius.size * (radius.size - 1) // 2 else skin
+
+
+def neighbour_grid(radius: np.ndarray, skin: float, reach: float) -> tuple[float, int]:
+    """Cell size (m) and cells a side of a grid over the cube of half-width ``reach`` (m): a cell holds no pair
+    farther apart than the list takes unless the grid would exceed MOST_CELLS_PER_SIDE."""
+    if not math.isfinite(skin):
+        return 2.0 * reach, 1
+    cell = max(2.0 * float(radius.max()) + skin, 2.0 * reach / MOST_CELLS_PER_SIDE)
+    return cell, max(1, int(math.ceil(2.0 * reach / cell)))
 
 
 def harmonics_of(params: Parameters) -> np.ndarray:
@@ -211,19 +277,14 @@ def constants_from(params: Parameters) -> Constants:
     mass = _masses(params)
     effusivity = np.sqrt(conductivity * density * heat_capacity)
     vial_effusivity = math.sqrt(params.vial_conductivity * params.vial_density * params.vial_heat_capacity)
-    pair_modulus, pair_shear, pair_radius, pair_mass, share = (np.zeros((n, n)) for _ in range(5))
-    for i in range(n):
-        for j in range(n):
-            pair_modulus[i, j] = contact.effective_modulus(youngs[i], poisson[i], youngs[j], poisson[j])
-            pair_shear[i, j] = contact.effective_shear_modulus(youngs[i], poisson[i], youngs[j], poisson[j])
-            pair_radius[i, j] = radius[i] * radius[j] / (radius[i] + radius[j])
-            pair_mass[i, j] = mass[i] * mass[j] / (mass[i] + mass[j])
-            share[i, j] = effusivity[i] / (effusivity[i] + effusivity[j])
     bore = 0.5 * params.vial_diameter
     wall_radius = np.column_stack([radius, radius, [contact.concave_radius(r, bore) for r in radius]])
     e_v, nu_v = params.vial_youngs_modulus, params.vial_poisson_ratio
     harmonics = harmonics_of(params)
-    angular_bound, acceleration_bound = _motion_bounds(harmonics, params.omega, math.hypot(0.5 * params.vial_length, bore))
+    reach = math.hypot(0.5 * params.vial_length, bore)
+    angular_bound, acceleration_bound = _motion_bounds(harmonics, params.omega, reach)
+    skin = neighbour_skin(radius)
+    cell_size, cells_per_side = neighbour_grid(radius, skin, reach)
     rayleigh = min(
         (contact.rayleigh_time(r, rho, e, nu) for r, rho, e, nu in zip(radius, density, youngs, poisson, strict=True)),
         # An empty mill (n_balls = 0) has no contact to resolve: it takes flight steps, short for its thermal network.
@@ -239,11 +300,8 @@ def constants_from(params: Parameters) -> Constants:
         radius=radius,
         mass=mass,
         inertia=0.4 * mass * radius**2,
-        pair_modulus=pair_modulus,
-        pair_shear_modulus=pair_shear,
-        pair_radius=pair_radius,
-        pair_mass=pair_mass,
-        pair_heat_share=share,
+        youngs_modulus=youngs,
+        poisson_ratio=poisson,
         wall_modulus=np.array([contact.effective_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]),
         wall_shear_modulus=np.array([contact.effective_shear_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]),
         wall_radius=wall_radius,
@@ -274,6 +332,10 @@ def constants_from(params: Parameters) -> Constants:
         max_flight_step=params.max_flight_step,
         max_overlap=MAX_OVERLAP_FRACTION * float(radius.min(initial=math.inf)),
         thermal_step=min(THERMAL_STEP, THERMAL_STEP_FRACTION * fastest_node),
+        skin=skin,
+        cell_size=cell_size,
+        cells_per_side=cells_per_side,
+        grid_reach=reach,
     )
 
 
@@ -315,7 +377,6 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
     ``ball_momentum`` along the axis, as the 1-D engine) or, in a vial that rotates steadily (a planetary jar),
     carried with it; every node of ``network`` at the initial temperature (held ones at the ambient)."""
     n = params.n_balls
-    slots = slot_count(n)
     centre = np.zeros(6)
     rates = np.zeros(6)
     fourier_coordinates(0.0, k.omega, k.phase, k.harmonics, centre, rates)
@@ -334,6 +395,8 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
     elif n == 1:
         velocity[0, 0] = params.ball_momentum / k.mass[0]
     drives = kernel.drive_count(n)
+    neighbours = neighbours_of(k, position, centre[:3])
+    capacity = neighbours.first_ball.size
     return State(
         clock=np.zeros(2),
         position=position,
@@ -347,28 +410,60 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
         totals=np.zeros(len(TOTAL_NAMES)),
         heat_into=np.zeros(n + 1),
         drive_integrals=np.zeros(drives),
-        contacts=Contacts(
-            active=np.zeros(slots, dtype=np.bool_),
-            normal_force=np.zeros((slots, 3)),
-            tangential_force=np.zeros((slots, 3)),
-            lever_torque_i=np.zeros((slots, 3)),
-            lever_torque_j=np.zeros((slots, 3)),
-            rolling_torque=np.zeros((slots, 3)),
-            wall_velocity=np.zeros((slots, 3)),
-            spring=np.zeros((slots, 3)),
-            elastic_energy=np.zeros(slots),
-            stiffness=np.zeros(slots),
-            stretch=np.zeros(slots),
-            slip_loss=np.zeros(slots),
-            period=np.zeros(slots),
-            started=np.zeros(slots),
-            normal_speed_in=np.zeros(slots),
-            tangential_speed_in=np.zeros(slots),
-            dissipated=np.zeros((slots, 4)),
-            peak_force=np.zeros(slots),
-            max_overlap=np.zeros(slots),
-        ),
+        contacts=empty_contacts(slot_count(n, capacity)),
+        neighbours=neighbours,
     )
+
+
+# Contacts' fields by shape per slot (the rest are one number per slot).
+CONTACT_VECTORS = ("normal_force", "tangential_force", "lever_torque_i", "lever_torque_j", "rolling_torque",
+                   "wall_velocity", "spring")
+
+
+def empty_contacts(slots: int) -> Contacts:
+    """The memory of ``slots`` contacts, none touching."""
+    numbers = set(Contacts._fields) - {"active", "dissipated", *CONTACT_VECTORS}
+    return Contacts(
+        active=np.zeros(slots, dtype=np.bool_),
+        dissipated=np.zeros((slots, 4)),
+        **{name: np.zeros((slots, 3)) for name in CONTACT_VECTORS},
+        **{name: np.zeros(slots) for name in sorted(numbers)},
+    )
+
+
+def contact_memory(k: Constants, record_columns: int) -> int:
+    """Bytes the contacts of balls of ``k`` hold whatever the run's length: each slot's memory and scratch, the
+    neighbour list and the carried contacts of each of its entries, its grid, and the impact buffer's least size
+    (a row of ``record_columns`` per slot, the stepping's margin, doubled as it grows)."""
+    capacity = pair_capacity(k.radius, k.skin)
+    slots = slot_count(k.n_balls, capacity)
+    per_slot = sum(array.nbytes for array in empty_contacts(1)) + sum(
+        array.nbytes for array in scratch_for(0, 1) if array.shape[:1] == (1,)
+    )
+    per_entry = 4 * 8 + sum(array.nbytes for array in empty_contacts(1))
+    per_ball = 8 * (1 + 3 + 1)
+    return slots * (per_slot + 2 * 8 * record_columns) + capacity * per_entry + k.n_balls * per_ball + 8 * k.cells_per_side**3
+
+
+def neighbours_of(k: Constants, position: np.ndarray, centre: np.ndarray) -> Neighbours:
+    """The neighbour list of balls at ``position`` in a vial centred at ``centre`` (m), built."""
+    n = k.n_balls
+    capacity = pair_capacity(k.radius, k.skin)
+    listed = Neighbours(
+        first_ball=np.zeros(capacity, dtype=np.int64),
+        second_ball=np.zeros(capacity, dtype=np.int64),
+        first=np.zeros(n + 1, dtype=np.int64),
+        count=np.zeros(1, dtype=np.int64),
+        reference=np.zeros((n, 3)),
+        cell_head=np.zeros(k.cells_per_side**3, dtype=np.int64),
+        cell_next=np.zeros(n, dtype=np.int64),
+        carried_first=np.zeros(capacity, dtype=np.int64),
+        carried_second=np.zeros(capacity, dtype=np.int64),
+        carried=empty_contacts(capacity),
+    )
+    if not neighbour_list.build(k, position, centre, listed):
+        raise ValueError("the balls start deeper in each other than a run allows: no neighbour list holds their pairs")
+    return listed
 
 
 def row_fields(n_balls: int, nodes: int) -> tuple[tuple[str, tuple[int, ...]], ...]:

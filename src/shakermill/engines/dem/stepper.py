@@ -27,7 +27,7 @@ import math
 import numpy as np
 from numba import njit
 
-from shakermill.engines.dem.contacts import pair_contacts, settle, sum_forces, wall_contacts, wall_gap
+from shakermill.engines.dem.contacts import pair_contacts, rebuild_neighbours, settle, sum_forces, wall_contacts, wall_gap
 from shakermill.engines.dem.model import (
     ENDURING_AFTER,
     HEAT_LOST,
@@ -39,6 +39,8 @@ from shakermill.engines.dem.model import (
     Scratch,
     State,
 )
+from shakermill.engines.dem.description import NEIGHBOURS_FULL
+from shakermill.engines.dem.neighbours import moved_since_build, needs_rebuild
 from shakermill.engines.dem.vectors import copy_into, cross_into, distance, dot, norm
 from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.engines.thermal import kernel
@@ -65,8 +67,8 @@ RECORD_COLUMNS = (
     "heat_to_other",
     "conduction",
 )
-COUNTER_NAMES = ("steps", "contact_steps", "flight_steps", "impacts", "thermal_updates")
-STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES, ROWS_WRITTEN = range(len(COUNTER_NAMES) + 1)
+COUNTER_NAMES = ("steps", "contact_steps", "flight_steps", "impacts", "thermal_updates", "neighbour_builds")
+STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES, NEIGHBOUR_BUILDS, ROWS_WRITTEN = range(len(COUNTER_NAMES) + 1)
 # ``other`` of a record: the other ball's index, or −1 − wall for the vial's left end, right end and side.
 
 
@@ -139,12 +141,17 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
     forces on it (taken twice their last value: they are those of slow contacts, or the step is a contact step
     anyway; in flight they are zero). Its distance from an end face closes at most at the axial part of that
     velocity, its distance from the axis grows at most at the part across the axis (a norm bound, so the
-    bore's curvature needs no term of its own). Touching slots are left out: their contacts have begun.
+    bore's curvature needs no term of its own). Touching slots are left out: their contacts have begun. Pairs the
+    neighbour list leaves out cannot touch while no ball has moved half the skin since its build: each ball's
+    distance from that bound closes at most at its speed relative to the vial's centre.
     """
     n = k.n_balls
+    walls = N_WALLS * n
     step = k.max_flight_step
     axis = w.orientation[:, 0]
     active = s.contacts.active
+    nb = s.neighbours
+    listed = math.isfinite(k.skin)
     for i in range(n):
         for component in range(3):
             w.lever[component] = s.position[i, component] - w.coordinates[component]
@@ -157,18 +164,24 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
         acceleration = (norm(k.gravity) + k.wall_acceleration_bound + 2.0 * k.angular_speed_bound * (abs(along) + across)
                         + pushed)
         for wall in range(N_WALLS):
-            if active[n * n + N_WALLS * i + wall]:
+            if active[N_WALLS * i + wall]:
                 continue
             gap = wall_gap(s.position[i], k.radius[i], wall, k, w)
             closing = across if wall == SIDE else (-along if wall == LEFT_END else along)
             step = min(step, _time_to_close(gap, max(closing, 0.0), acceleration))
-        for j in range(i + 1, n):
-            if active[i * n + j]:
-                continue
-            # Both balls fall alike in flight: their relative motion changes only by the contact forces.
-            gap = distance(s.position[i], s.position[j]) - k.radius[i] - k.radius[j]
-            relative_acceleration = pushed + 2.0 * norm(s.force[j]) / k.mass[j]
-            step = min(step, _time_to_close(gap, distance(s.velocity[i], s.velocity[j]), relative_acceleration))
+        if listed:
+            margin = 0.5 * k.skin - moved_since_build(i, s.position, w.coordinates, nb)
+            relative_speed = math.sqrt((s.velocity[i, 0] - w.rates[0]) ** 2 + (s.velocity[i, 1] - w.rates[1]) ** 2
+                                       + (s.velocity[i, 2] - w.rates[2]) ** 2)
+            step = min(step, _time_to_close(margin, relative_speed, norm(k.gravity) + k.wall_acceleration_bound + pushed))
+    for entry in range(nb.count[0]):
+        if active[walls + entry]:
+            continue
+        i, j = nb.first_ball[entry], nb.second_ball[entry]
+        # Both balls fall alike in flight: their relative motion changes only by the contact forces.
+        gap = distance(s.position[i], s.position[j]) - k.radius[i] - k.radius[j]
+        relative_acceleration = 2.0 * norm(s.force[i]) / k.mass[i] + 2.0 * norm(s.force[j]) / k.mass[j]
+        step = min(step, _time_to_close(gap, distance(s.velocity[i], s.velocity[j]), relative_acceleration))
     return max(step, k.contact_step)
 
 
@@ -288,6 +301,11 @@ def advance(t_stop: float, max_steps: int, k: Constants, net: NetworkArrays, s: 
         if count + slots > records.shape[0]:
             status = RECORDS_FULL
             break
+        if needs_rebuild(k, s.position, w.coordinates, s.neighbours):
+            if not rebuild_neighbours(k, s, w.coordinates):
+                status = NEIGHBOURS_FULL
+                break
+            counters[NEIGHBOUR_BUILDS] += 1
         dt = _step_length(touching, limit, k, s, w)
         mark = counters[ROWS_WRITTEN]
         end = min(t_stop, marks[mark]) if mark < marks.size else t_stop

@@ -2,9 +2,10 @@
 
 A network is arrays (:class:`NetworkArrays`): each node's heat capacity, whether it is held at the room
 temperature and the heat it receives whatever the balls do (the drive's, into a mill head), and each heat
-path's model (:data:`WHITAKER`, :data:`CONSTANT`, :data:`CONTACT`, :data:`RADIATION`), its two ends (a node,
-or :data:`ROOM`) and its coefficients. Paths that depend on the motion read it from ``drives``: each ball's
-mean Whitaker velocity term, then the mean conductances of the balls' contacts (:func:`drive_count`). The flows are positive from a path's ``hot`` end to its ``cold`` end.
+path's model (:data:`WHITAKER`, :data:`CONSTANT`, :data:`CONTACT`, :data:`RADIATION`, :data:`AMONG_BALLS`), its
+two ends (a node, :data:`ROOM` or :data:`BALLS`) and its coefficients. Paths that depend on the motion read it from
+``drives``: each ball's mean Whitaker velocity term, then the mean conductances of each ball's contacts with the
+vial and with the other balls (:func:`drive_count`). The flows are positive from a path's ``hot`` end to its ``cold`` end.
 Every engine and solver evaluates the network through these functions: the 'dem' engine's stepping, the
 averaged solvers' integration and the steady state. The 1-D engine's right-hand side keeps the three-node
 network written out for speed (``engines.one_d.model.thermal_network``); a test holds it to these, term by term.
@@ -21,10 +22,13 @@ from shakermill.physics import thermal
 
 # Path models. WHITAKER: a ball's convection to the air, Whitaker's correlation at the ball's own mean velocity
 # term (MODEL.md §4); CONSTANT: a fixed conductance h·A (Newton cooling, MODEL.md §5); CONTACT: conduction
-# through contacts at their measured mean conductance; RADIATION: ε·σ·A·(θ_hot⁴ − θ_cold⁴) (MODEL.md §13.1).
-WHITAKER, CONSTANT, CONTACT, RADIATION = 0, 1, 2, 3
+# through contacts at their measured mean conductance; RADIATION: ε·σ·A·(θ_hot⁴ − θ_cold⁴) (MODEL.md §13.1);
+# AMONG_BALLS: conduction through a ball's contacts with the other balls (:func:`among_balls_flows`).
+WHITAKER, CONSTANT, CONTACT, RADIATION, AMONG_BALLS = 0, 1, 2, 3, 4
 # The cold end of a path that leaves the system: the surroundings at the ambient temperature.
 ROOM = -1
+# The cold end of an AMONG_BALLS path: the other balls, whose flows in sum to nothing.
+BALLS = -2
 
 
 class NetworkArrays(NamedTuple):
@@ -53,19 +57,16 @@ class NetworkArrays(NamedTuple):
 
 
 def drive_count(n_balls: int) -> int:
-    """Entries of ``drives`` for ``n_balls``: a velocity term each, a contact conductance with the vial each, and
-    one per pair of balls."""
-    return 2 * n_balls + n_balls * (n_balls - 1) // 2
+    """Entries of ``drives`` for ``n_balls``: per ball a velocity term, a contact conductance with the vial and one
+    with the other balls. Linear in the balls: a charge of thousands has no per-pair entry."""
+    return 3 * n_balls
 
 
 @njit(cache=True)
 def contact_drive(ball: int, other: int, n_balls: int) -> int:
-    """Index into ``drives`` of the contact conductance of ``ball`` with the vial (``other`` < 0) or with ball
-    ``other``."""
-    if other < 0:
-        return n_balls + ball
-    low, high = min(ball, other), max(ball, other)
-    return 2 * n_balls + low * n_balls - low * (low + 1) // 2 + high - low - 1
+    """Index into ``drives`` of the contact conductance of ``ball`` with the vial (``other`` < 0) or with the other
+    balls (``other`` ≥ 0: any ball; a pair's conduction counts for both of its balls)."""
+    return n_balls + ball if other < 0 else 2 * n_balls + ball
 
 
 @njit(cache=True)
@@ -79,14 +80,39 @@ def whitaker_flow(theta_ball: float, theta_air: float, velocity_term: float, rad
 
 
 @njit(cache=True)
+def among_balls_mean(theta: np.ndarray, drives: np.ndarray, net: NetworkArrays) -> tuple[float, float]:
+    """The balls' temperature that AMONG_BALLS paths conduct toward, their mean weighted by each ball's conductance
+    with the others (K), and the factor m/(m − 1) of m such paths (0 for fewer than two).
+
+    Ball i conducts G_i·m/(m − 1)·(θ_i − θ̄) (G_i the mean conductance of its contacts with any ball, each pair's
+    counted for both): the flows sum to zero, so energy is conserved exactly; the flow is exact for two balls and
+    for balls that touch each other alike (G_ij = g), and a mean-field one otherwise, O(N) where per-pair paths
+    would be O(N²) (MODEL.md §13.1 leaves the network's form of ball-ball conduction open)."""
+    weighted = total = 0.0
+    among = 0
+    for p in range(net.kind.shape[0]):
+        if net.kind[p] == AMONG_BALLS:
+            conductance = drives[net.drive[p]]
+            weighted += conductance * theta[net.hot[p]]
+            total += conductance
+            among += 1
+    if among < 2 or total <= 0.0:
+        return 0.0, 0.0
+    return weighted / total, among / (among - 1.0)
+
+
+@njit(cache=True)
 def path_flows(theta: np.ndarray, drives: np.ndarray, net: NetworkArrays, out: np.ndarray) -> None:
     """Each path's heat flow (W, hot end to cold end) into ``out``, at node temperatures ``theta`` (K) and the
     motion's ``drives``."""
+    balls_mean, among_factor = among_balls_mean(theta, drives, net)
     for p in range(net.kind.shape[0]):
         hot = theta[net.hot[p]]
-        cold = net.ambient if net.cold[p] == ROOM else theta[net.cold[p]]
+        cold = net.ambient if net.cold[p] == ROOM else (balls_mean if net.cold[p] == BALLS else theta[net.cold[p]])
         kind = net.kind[p]
-        if kind == WHITAKER:
+        if kind == AMONG_BALLS:
+            out[p] = among_factor * drives[net.drive[p]] * (hot - cold)
+        elif kind == WHITAKER:
             out[p] = whitaker_flow(hot, cold, drives[net.drive[p]], net.radius[p], net)
         elif kind == CONTACT:
             out[p] = drives[net.drive[p]] * (hot - cold)
@@ -119,6 +145,8 @@ def balance(heat: np.ndarray, flows: np.ndarray, span: float, net: NetworkArrays
             lost -= flows[p]
         else:
             out[hot] -= flows[p]
+        if cold == BALLS:
+            continue  # the other balls receive these flows, which sum to zero
         if cold == ROOM or net.held[cold]:
             lost += flows[p]
         else:

@@ -14,6 +14,7 @@ import numpy as np
 from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.paths import (
     HeatPath,
+    among_balls_conduction,
     ball_convection,
     contact_conduction,
     fixed_conductance,
@@ -206,16 +207,16 @@ def build_network(params: Parameters, radii: Sequence[float], capacities: Sequen
 
 def mill_head_paths(params: Parameters, ball_names: Sequence[str], vial: int, clamp: int) -> list[HeatPath]:
     """The paths of a real mill beyond the paper's (MODEL.md §13.1): the vial's outside to the room by convection
-    at its own speed and by radiation, conduction through the contacts of each ball with the vial and with every
-    other ball, the vial to the clamp and the clamp to the room."""
+    at its own speed and by radiation, conduction through the contacts of each ball with the vial and with the
+    other balls, the vial to the clamp and the clamp to the room."""
     n = len(ball_names)
     outer = vial_outer_convection(params)
     return [
         newton_cooling("vial → room, convection", vial, kernel.ROOM, outer.coefficient, outer.area, outer.source, outer.validity),
         radiation("vial → room, radiation", vial, kernel.ROOM, params.emissivity, outer.area),
         *(contact_conduction(f"{ball_names[i]} → vial, contacts", i, vial, kernel.contact_drive(i, -1, n)) for i in range(n)),
-        *(contact_conduction(f"{ball_names[i]} → {ball_names[j]}, contacts", i, j, kernel.contact_drive(i, j, n))
-          for i in range(n) for j in range(i + 1, n)),
+        *(among_balls_conduction(f"{ball_names[i]} → other balls, contacts", i, kernel.contact_drive(i, i, n))
+          for i in range(n) if n > 1),
         fixed_conductance("vial → clamp", vial, clamp, params.clamp_conductance, "clamp_conductance (see its source)",
                           "a steady joint: the vial's and the clamp's own conduction are fast beside it"),
         fixed_conductance("clamp → room", clamp, kernel.ROOM, params.clamp_loss, "clamp_loss (see its source)",

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from shakermill.engines.thermal.kernel import CONSTANT, CONTACT, RADIATION, WHITAKER
+from shakermill.engines.thermal.kernel import AMONG_BALLS, BALLS, CONSTANT, CONTACT, RADIATION, WHITAKER
 from shakermill.physics.heat_paths import STEFAN_BOLTZMANN
 
 WHITAKER_CORRELATION = (
@@ -57,10 +57,11 @@ def fixed_conductance(name: str, hot: int, cold: int, conductance: float, source
     return HeatPath(name, hot, cold, CONSTANT, "Q = G·(θ_hot − θ_cold), G constant", source, validity, conductance=conductance)
 
 
-CONTACT_CORRELATION = (
-    "Q = G·(θ_hot − θ_cold), G the mean over the motion of each contact's heat per kelvin: the larger of "
-    "0.87·π·a²·√t_c/(1/e₁ + 1/e₂) (an impact) and 4a·t_c/(1/k₁ + 1/k₂) (a lasting contact), a = √(R*·δ_max)"
+CONTACT_HEAT_PER_KELVIN = (
+    "each contact's heat per kelvin: the larger of 0.87·π·a²·√t_c/(1/e₁ + 1/e₂) (an impact) and "
+    "4a·t_c/(1/k₁ + 1/k₂) (a lasting contact), a = √(R*·δ_max)"
 )
+CONTACT_CORRELATION = f"Q = G·(θ_hot − θ_cold), G the mean over the motion of {CONTACT_HEAT_PER_KELVIN}"
 CONTACT_SOURCE = (
     "Sun & Chen, Int. J. Heat Mass Transfer 31 (1988) 969 (impacts); Holm's constriction resistance 1/(4ka) of each "
     "half-space (lasting contacts); the contacts' radii and durations from the 'dem' engine's records"
@@ -74,6 +75,20 @@ CONTACT_VALIDITY = (
 def contact_conduction(name: str, hot: int, cold: int, drive: int) -> HeatPath:
     """Conduction through the contacts of a ball with the vial or another ball, at their measured mean conductance."""
     return HeatPath(name, hot, cold, CONTACT, CONTACT_CORRELATION, CONTACT_SOURCE, CONTACT_VALIDITY, drive=drive)
+
+
+AMONG_BALLS_CORRELATION = (
+    "Q_i = G_i·m/(m − 1)·(θ_i − θ̄), G_i the mean over the motion of the sum of ball i's contacts with any other "
+    f"ball, of {CONTACT_HEAT_PER_KELVIN}; "
+    "θ̄ the balls' temperatures weighted by G, m the balls: the flows sum to zero; exact for two balls and for balls "
+    "that touch each other alike, a mean field otherwise"
+)
+
+
+def among_balls_conduction(name: str, ball: int, drive: int) -> HeatPath:
+    """Conduction through the contacts of ``ball`` with the other balls (``kernel.among_balls_mean``): one path per
+    ball, however many balls it touches."""
+    return HeatPath(name, ball, BALLS, AMONG_BALLS, AMONG_BALLS_CORRELATION, CONTACT_SOURCE, CONTACT_VALIDITY, drive=drive)
 
 
 def radiation(name: str, hot: int, cold: int, emissivity: float, area: float) -> HeatPath:
