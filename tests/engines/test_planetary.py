@@ -88,7 +88,8 @@ def test_a_ball_carried_on_the_wall_of_a_jar_that_does_not_spin_feels_the_centri
     centre, _, orientation, _ = jar_motion(params, engine.t)
     distance = math.hypot(*s.position[0, :2])
     centripetal = -k.mass[0] * params.omega**2 * np.array([*s.position[0, :2], 0.0])
-    assert s.force[0] == pytest.approx(centripetal, rel=1e-4, abs=1e-6 * k.mass[0] * params.omega**2 * distance)
+    # Across the wall, the tangential spring keeps ~1e-6 of the force from the contact's first oscillations.
+    assert s.force[0] == pytest.approx(centripetal, rel=1e-4, abs=2e-6 * k.mass[0] * params.omega**2 * distance)
     # It stays where it was put, sunk into the wall by the static Hertz overlap of that force (within a tenth of it:
     # the tangential spring keeps the few nanometres the first oscillations of the contact stretched it by).
     modulus = contact.effective_modulus(params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus,

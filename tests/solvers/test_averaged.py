@@ -10,6 +10,7 @@ import pytest
 import shakermill as sm
 from shakermill.analysis.batch_means import mser_truncation
 from shakermill.solvers.averaged import AVERAGING_FAILED, full_resolution_instead, least_mechanics
+from shakermill.solvers.driver import CHANGE_SHARE
 
 NUDGE_SPEED = 1.0  # m/s: with amplitudes below the free gap a ball at rest is never hit
 
@@ -97,16 +98,16 @@ def test_a_fall_back_that_could_not_end_within_the_budget_is_not_started() -> No
 
 @pytest.mark.slow
 def test_means_cut_short_by_averaging_max_time_say_how_long_would_reach_the_target() -> None:
-    """The guide's two zirconia balls (docs/guide/calibrating.md) under the 1-D preset's 120 s of mechanics: their
-    uncorrelated batches miss 1 % by a little, and the run says how much mechanics would reach it."""
+    """The guide's two zirconia balls (docs/guide/calibrating.md) under 150 s of mechanics (they converge after ~183 s):
+    their uncorrelated batches miss 1 % by a little, and the run says how much mechanics would reach it."""
     params = sm.default_parameters(
-        "spex8000m-3d", n_balls=2, ball_material="zirconia", omega=111.0, averaging_max_time=120.0, record_windows=(),
+        "spex8000m-3d", n_balls=2, ball_material="zirconia", omega=111.0, averaging_max_time=150.0, record_windows=(),
     )
     result = sm.simulate(params)
     assert result.status == AVERAGING_FAILED and "not started" in result.message
     hint = re.search(r"so about ([0-9.]+) s would reach it: allowed averaging_max_time >= ([0-9]+)", result.message)
     needed, allowed = float(hint.group(1)), int(hint.group(2))
-    assert 120.0 < needed < allowed < 1.3 * needed
+    assert 150.0 < needed < allowed < 1.3 * needed
     # The preset's own limit lets it converge.
     assert allowed <= sm.default_parameters("spex8000m-3d").averaging_max_time
 
@@ -166,18 +167,19 @@ def test_averaged_solver_reports_the_progress_of_each_phase() -> None:
 
 @pytest.mark.slow
 def test_a_planetary_charge_that_collapses_into_a_pack_is_averaged_after_the_change() -> None:
-    # pulverisette7 starts active (~25 W of impacts) and collapses after ~1 s into a pack rolling on the wall
-    # (~18 W); a 1-s run averaged both (MODEL.md §14.2, issue 36). The averages must be of the pack alone, and the
-    # run must say when the motion changed and what it was before. Four-batch minimum: 3 s of mechanics.
+    # pulverisette7 at friction 0.4 starts active (~25 W of impacts) and collapses after ~1.1 s into a pack rolling on
+    # the wall (~19 W); a 1-s run averaged both (MODEL.md §14.2, issue 36). The averages must be of the pack alone, and
+    # the run must say when the motion changed and what it was before. Four-batch minimum: 3 s of mechanics. (At the
+    # preset's friction 0.3 the charge collapses within the first 0.4-0.6 s, the start-up's own batches.)
     params = sm.default_parameters(
-        "pulverisette7", duration=3600.0, solver="averaged", averaging_min_batches=4, averaging_max_time=4.0,
-        averaging_fallback="fail", record_windows=(),
+        "pulverisette7", friction=0.4, duration=3600.0, solver="averaged", averaging_min_batches=4,
+        averaging_max_time=4.0, averaging_fallback="fail", record_windows=(),
     )
     result = sm.simulate(params)
     averages = result.averages
     assert result.success and averages.converged
     assert averages.transient >= 0.9
-    assert averages.transient_heat_power > 1.2 * averages.heat_power
+    assert averages.transient_heat_power > (1.0 + CHANGE_SHARE) * averages.heat_power
     assert f"the motion changed at t = {averages.transient:.3g} s" in result.message
     assert result.summary["averaging_transient_heat_power_W"] == averages.transient_heat_power
     # The pack: its dissipation in contacts that last, as measured over the window after the change alone.

@@ -6,8 +6,9 @@ from __future__ import annotations
 import json
 import re
 import shutil
+from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Mapping, NoReturn, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, ContextManager, Iterator, Mapping, NoReturn, Sequence
 
 import typer
 from rich.table import Table
@@ -33,7 +34,7 @@ from shakermill.cli.common import (
     writing,
 )
 from shakermill.engines.budget import interrupts_held
-from shakermill.parameters.defaults import HIT_SPEED
+from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S, HIT_SPEED
 
 if TYPE_CHECKING:
 
@@ -54,6 +55,14 @@ def run(
     json_output: JsonOption = False,
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
     overwrite: OverwriteOption = False,
+    scheduler: Annotated[
+        str | None,
+        typer.Option("--scheduler", metavar="ADDRESS",
+                     help="Advance an averaged run's replicas after the first on this Dask scheduler (tcp://host:8786)."),
+    ] = None,
+    scheduler_timeout: Annotated[
+        float, typer.Option("--scheduler-timeout", min=0.1, max=86400.0, metavar="SECONDS", help="Give up connecting to the scheduler after this long.")
+    ] = DEFAULT_SCHEDULER_TIMEOUT_S,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
     from shakermill.io.runs import check_target, import_writers, to_jsonable
@@ -68,6 +77,7 @@ def run(
         target = out if out is not None else timestamped_folder("run")
         check_target(target, overwrite=overwrite)
         preflight(run_config.params)
+        cluster = replica_cluster(run_config.params, scheduler, scheduler_timeout)
     import_writers()
     # Unit slips and the solver's choice are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)
@@ -75,7 +85,7 @@ def run(
     said_notes = solver_choice(run_config.params)
     echo_notes([*run_config.notes, *said_notes])
     # A run returns what it computed when interrupted; Ctrl-C in the thermal network leaves none.
-    with nothing_written_when_interrupted("the run had no results to keep yet"):
+    with nothing_written_when_interrupted("the run had no results to keep yet"), cluster:
         result = simulate_with_progress(run_config.params)
     refitted = tuple(run_config.provenance.get("fitted", ()))
     stopped = result.status == INTERRUPTED or not preset_findings_added(result, run_config.preset, refitted)
@@ -98,6 +108,37 @@ def run(
     if not finished:
         _exit_interrupted(result, target)
     _exit_for_status(result, target)
+
+
+def replica_cluster(params: Parameters, scheduler: str | None, timeout: float) -> ContextManager[None]:
+    """Where the replicas of an averaged run after its first advance: on the Dask scheduler at ``scheduler``
+    (solvers/replicas.py), or here. A scheduler a run would not use is refused in one line."""
+    from contextlib import nullcontext
+
+    from shakermill.engines.registry import describe
+    from shakermill.parameters.errors import ParameterError
+    from shakermill.solvers.averaged import full_resolution_instead, replica_count
+    from shakermill.studies.sweep_backends import connect
+
+    if scheduler is None:
+        return nullcontext()
+    replicas = replica_count(params, describe(params.engine))
+    if params.solver != "averaged" or full_resolution_instead(params) is not None or replicas < 2:
+        key = describe(params.engine).replicas_key
+        wanted = f"{key} >= 2" if key else "an engine with replicas (engine = 'dem', dem_replicas >= 2)"
+        raise ParameterError(
+            f"--scheduler: this run sends nothing to a cluster (solver = {params.solver!r}, {replicas} replica); allowed "
+            f"with solver = 'averaged' and {wanted}"
+        )
+    return _sending_replicas(connect(scheduler, timeout))
+
+
+@contextmanager
+def _sending_replicas(client: Any) -> Iterator[None]:
+    from shakermill.solvers.replicas import replicas_on
+
+    with client, replicas_on(client):
+        yield
 
 
 def solver_choice(params: Parameters) -> list[str]:

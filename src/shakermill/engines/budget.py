@@ -52,6 +52,14 @@ class RunBudget:
     def unlimited(cls) -> RunBudget:
         return cls(float("inf"), sys.maxsize)
 
+    def __getstate__(self) -> dict:
+        """A copy for another process (a replica advanced on a Dask worker): everything but the lock."""
+        return {name: value for name, value in vars(self).items() if name != "_counting"}
+
+    def __setstate__(self, state: dict) -> None:
+        vars(self).update(state)
+        self._counting = threading.Lock()
+
     def count_steps(self, steps: int) -> None:
         with self._counting:
             self.steps += steps

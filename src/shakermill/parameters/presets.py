@@ -226,9 +226,10 @@ SPEX_8000M = Preset(
         "jar_tilt": Cited(0.0, "upright jars, as in the Pulverisette 7 and PM 100 (kinematics = 'planetary')"),
         **{key: Cited(value, source) for key, (value, source) in ASSUMED_DEFAULTS.items()},
         "contact_step_fraction": Cited(
-            0.05,
-            "numerical choice: restitution within 1e-3, the 1-D limit's heat power within 0.25 % of the converged "
-            "value, five balls' within the ~1 % their statistics resolve (benchmarks/README.md, dem engine)",
+            0.025,
+            "numerical choice: restitution within 1e-3 of e for ball-ball and ball-wall impacts at 0.5-5 m/s (at most "
+            "6.4e-4; 0.05 left 1.45e-3), the 1-D limit's heat power within 0.25 % of the converged value, five balls' "
+            "within the ~1 % their statistics resolve (benchmarks/README.md, dem engine)",
         ),
         "enduring_step_fraction": Cited(
             0.05,

@@ -38,7 +38,7 @@ from shakermill.parameters.keys import Parameters
 from shakermill.solvers.attractors import probe_attractors
 from shakermill.solvers.driver import Means, least_rounds, measure_means, sample_times
 from shakermill.solvers.full import concluded, simulate_full
-from shakermill.solvers.replicas import replica_threads
+from shakermill.solvers.replicas import replicas_of
 from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages, Result, conclude, summarize
 
 # The thermal time constant of each impact-heated node must exceed the mean time between the impacts that heat it
@@ -78,8 +78,9 @@ def settle_mechanics(params: Parameters, engine_class: type[Engine], progress: P
     engine = engine_class(params, budget, np.zeros(1), params.averaging_max_time)
     count = replica_count(params, engine_class.description)
     others = [engine_class(params, budget, np.zeros(1), 0.0, replica=number) for number in range(1, count)]
+    replicas, threads = replicas_of(engine, others)
     try:
-        means, status = measure_means(params, [engine, *others], progress, replica_threads(count))
+        means, status = measure_means(params, replicas, progress, threads)
     except KeyboardInterrupt:
         means, status = None, INTERRUPTED
     return Mechanics(params, engine, means, status)

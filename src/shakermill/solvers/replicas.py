@@ -11,14 +11,107 @@ never its numbers.
 
 from __future__ import annotations
 
+import contextvars
 import os
 import threading
 from concurrent.futures import FIRST_EXCEPTION, Future, ThreadPoolExecutor, wait
-from typing import Callable, Sequence
+from contextlib import contextmanager
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
+import numpy as np
+
+from shakermill.engines.budget import RunBudget
 from shakermill.engines.calls import CALL_SECONDS
 from shakermill.engines.interface import Engine
 from shakermill.parameters.environment import threads_cap
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+_CLUSTER: contextvars.ContextVar[Client | None] = contextvars.ContextVar("shakermill_replica_cluster", default=None)
+
+
+@contextmanager
+def replicas_on(client: Client) -> Iterator[None]:
+    """Inside this block, the replicas of an averaged run after its first advance as tasks of ``client``'s Dask cluster
+    (:class:`RemoteReplica`); the first stays here, with its record windows and impacts. Same numbers as threads."""
+    token = _CLUSTER.set(client)
+    try:
+        yield
+    finally:
+        _CLUSTER.reset(token)
+
+
+def replica_cluster() -> Client | None:
+    """The Dask client replicas are sent to (:func:`replicas_on`), or None: threads of this process."""
+    return _CLUSTER.get()
+
+
+def _advance_elsewhere(engine: Any, t_stop: float) -> tuple[Any, int, np.ndarray]:
+    """A Dask task: ``engine`` advanced to ``t_stop``, its status and the start times of the impacts it recorded. Its
+    budget here is unlimited: the run's own is counted where the run is (:meth:`RemoteReplica.advance`)."""
+    engine.budget = RunBudget.unlimited()
+    status = engine.advance(t_stop)
+    return engine, status, engine.take_impact_times()
+
+
+class RemoteReplica:
+    """A replica advanced as one Dask task per round: the task takes the engine as the last round left it and gives it
+    back advanced, with the times of its impacts (the only records the averaged solver reads of a replica after the
+    first). The numbers are those of the same engine advanced here, to the same round ends. A worker lost in a round
+    loses that round alone: the scheduler runs the task again elsewhere from the same engine, to the same numbers."""
+
+    def __init__(self, engine: Engine, client: Client) -> None:
+        self._engine = engine
+        self._budget = engine.budget
+        self._client = client
+        self._impact_times: list[np.ndarray] = []
+        self.description = engine.description
+
+    @property
+    def t(self) -> float:
+        return self._engine.t
+
+    def advance(self, t_stop: float, heartbeat: Callable[[float], None] | None = None) -> int:
+        """Advance to ``t_stop`` on the cluster; ``heartbeat(t)`` is called while it runs (its exception cancels the
+        task: this replica stays where the last round left it)."""
+        future = self._client.submit(_advance_elsewhere, self._engine, t_stop, pure=False)
+        try:
+            while True:
+                try:
+                    engine, status, times = future.result(timeout=CALL_SECONDS)
+                    break
+                except TimeoutError:
+                    if heartbeat is not None:
+                        heartbeat(self.t)
+        except BaseException:
+            future.cancel()
+            raise
+        self._budget.count_steps(engine.steps_taken() - self._engine.steps_taken())
+        engine.budget = self._budget
+        self._engine = engine
+        self._impact_times.append(times)
+        return status
+
+    def measured(self) -> Any:
+        return self._engine.measured()
+
+    def explain(self, status: int) -> str:
+        return self._engine.explain(status)
+
+    def impact_columns(self, since: float = -np.inf) -> dict[str, np.ndarray]:
+        """The start times of its impacts from ``since`` (s): what is counted of a replica's impacts."""
+        times = np.concatenate([np.empty(0), *self._impact_times])
+        return {"time": times[times >= since]}
+
+
+def replicas_of(first: Engine, others: Sequence[Engine]) -> tuple[list[Engine | RemoteReplica], int]:
+    """The replicas of a run, the first here and the others on the cluster of :func:`replicas_on` if any, and the
+    threads that advance them: one per replica with a cluster (they wait on it), else :func:`replica_threads`."""
+    client = replica_cluster()
+    if client is None:
+        return [first, *others], replica_threads(1 + len(others))
+    return [first, *(RemoteReplica(engine, client) for engine in others)], 1 + len(others)
 
 def replica_threads(replicas: int) -> int:
     """The threads ``replicas`` replicas share: one per replica, at most the cores this process may use or

@@ -150,6 +150,14 @@ class DemEngine(CompiledRun):
     def _history(self, rows: np.ndarray) -> StateHistory:
         return history_of(*model.unpack_rows(rows, self.params.n_balls, self.node_count), self.constants, self.network)
 
+    def take_impact_times(self) -> np.ndarray:
+        """The start times (s) of the contacts recorded since the last call, which are then forgotten: a replica
+        advanced elsewhere (solvers/replicas.py) sends back only what the averaged solver counts of its impacts."""
+        column = stepper.RECORD_COLUMNS.index("time")
+        times = np.sort(self._records[: self._count, column])
+        self._count = 0
+        return times
+
     def impact_columns(self, since: float = -math.inf) -> dict[str, np.ndarray]:
         return impact_columns(self.records, since)
 
