@@ -153,3 +153,17 @@ def test_packing_a_thousand_balls_places_them_apart_and_inside_the_bowl():
     assert np.all(np.hypot(centres[:, 1], centres[:, 2]) <= 0.5 * diameter - radius)
     # Bottom first: the lowest layer fills before any ball sits higher.
     assert np.all(np.diff(centres[:, 2]) >= -1e-12)
+
+
+def test_a_bowl_filled_with_small_balls_runs_on_its_neighbour_list():
+    """Issue 38: ``fill`` of a planetary bowl with Ø5-mm balls makes a charge of hundreds, which starts apart, runs,
+    rebuilds its list and closes its energy audit."""
+    params = sm.default_parameters("pulverisette7", fill=0.3, ball_radius="2.5 mm", duration=0.002, record_windows=(),
+                                   output_interval=0.001, solver="full")
+    assert params.n_balls > 100  # hundreds of balls
+    result = sm.simulate(params)
+    assert result.success and result.counters["neighbour_builds"] > 0 and result.impact_count > 0
+    audit = result.energy
+    supplied = audit.work_by_vial + audit.work_by_gravity + audit.work_by_stiffening
+    stored = audit.kinetic_energy_change + audit.elastic_energy_change + audit.dissipated
+    assert abs(supplied - stored) <= 1e-6 * max(audit.dissipated, abs(supplied))
