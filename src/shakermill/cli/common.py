@@ -213,6 +213,17 @@ OverwriteOption = Annotated[
 ]
 
 
+SchedulerOption = Annotated[
+    str | None, typer.Option("--scheduler", metavar="ADDRESS", help="Run on this Dask distributed scheduler (tcp://host:8786).")
+]
+
+
+SchedulerTimeoutOption = Annotated[
+    float,
+    typer.Option("--scheduler-timeout", min=0.1, max=86400.0, metavar="SECONDS", help="Give up connecting to the scheduler after this long."),
+]
+
+
 FullResolutionOption = Annotated[
     bool, typer.Option("--full-resolution", help="Use the full-resolution solver (default: averaged).")
 ]

@@ -15,6 +15,7 @@ from shakermill.cli.common import (
     FullResolutionOption,
     JsonOption,
     PresetOption,
+    SchedulerOption,
     SettingsOption,
     add_plain_row,
     fail,
@@ -51,9 +52,7 @@ def uncertainty(
         Path | None, typer.Option("--out", "-o", show_default="results/uncertainty-<timestamp>", help="Ensemble folder; re-run into it to resume.")
     ] = None,
     workers: Annotated[int | None, typer.Option("--workers", "-w", show_default="one per core", help="Local worker processes.")] = None,
-    scheduler: Annotated[
-        str | None, typer.Option("--scheduler", metavar="ADDRESS", help="Run on this Dask distributed scheduler (tcp://host:8786).")
-    ] = None,
+    scheduler: SchedulerOption = None,
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
 ) -> None:

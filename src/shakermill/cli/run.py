@@ -21,6 +21,7 @@ from shakermill.cli.common import (
     JsonOption,
     OverwriteOption,
     PresetOption,
+    SchedulerTimeoutOption,
     SettingsOption,
     add_plain_row,
     echo_notes,
@@ -60,9 +61,7 @@ def run(
         typer.Option("--scheduler", metavar="ADDRESS",
                      help="Advance an averaged run's replicas after the first on this Dask scheduler (tcp://host:8786)."),
     ] = None,
-    scheduler_timeout: Annotated[
-        float, typer.Option("--scheduler-timeout", min=0.1, max=86400.0, metavar="SECONDS", help="Give up connecting to the scheduler after this long.")
-    ] = DEFAULT_SCHEDULER_TIMEOUT_S,
+    scheduler_timeout: SchedulerTimeoutOption = DEFAULT_SCHEDULER_TIMEOUT_S,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
     from shakermill.io.runs import check_target, import_writers, to_jsonable

@@ -18,6 +18,8 @@ from shakermill.cli.common import (
     JsonOption,
     OverwriteOption,
     PresetOption,
+    SchedulerOption,
+    SchedulerTimeoutOption,
     SettingsOption,
     add_plain_row,
     fail,
@@ -75,12 +77,8 @@ def sweep(
     workers: Annotated[
         int | None, typer.Option("--workers", "-w", show_default="one per core", help="Local worker processes.")
     ] = None,
-    scheduler: Annotated[
-        str | None, typer.Option("--scheduler", metavar="ADDRESS", help="Run on this Dask distributed scheduler (tcp://host:8786).")
-    ] = None,
-    scheduler_timeout: Annotated[
-        float, typer.Option("--scheduler-timeout", min=0.1, max=86400.0, metavar="SECONDS", help="Give up connecting to the scheduler after this long.")
-    ] = DEFAULT_SCHEDULER_TIMEOUT_S,
+    scheduler: SchedulerOption = None,
+    scheduler_timeout: SchedulerTimeoutOption = DEFAULT_SCHEDULER_TIMEOUT_S,
     keep_runs: Annotated[bool, typer.Option("--keep-runs", help="Also write each point's run folder under DIR/runs.")] = False,
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,

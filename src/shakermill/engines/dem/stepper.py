@@ -171,8 +171,7 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
             step = min(step, _time_to_close(gap, max(closing, 0.0), acceleration))
         if listed:
             margin = 0.5 * k.skin - moved_since_build(i, s.position, w.coordinates, nb)
-            relative_speed = math.sqrt((s.velocity[i, 0] - w.rates[0]) ** 2 + (s.velocity[i, 1] - w.rates[1]) ** 2
-                                       + (s.velocity[i, 2] - w.rates[2]) ** 2)
+            relative_speed = distance(s.velocity[i], w.rates[:3])
             step = min(step, _time_to_close(margin, relative_speed, norm(k.gravity) + k.wall_acceleration_bound + pushed))
     for entry in range(nb.count[0]):
         if active[walls + entry]:
