@@ -167,12 +167,13 @@ def test_averaged_solver_reports_the_progress_of_each_phase() -> None:
 
 @pytest.mark.slow
 def test_a_planetary_charge_that_collapses_into_a_pack_is_averaged_after_the_change() -> None:
-    # pulverisette7 at friction 0.4 starts active (~25 W of impacts) and collapses after ~1.1 s into a pack rolling on
+    # pulverisette7 at friction 0.38 starts active (~24 W of impacts) and collapses after ~1 s into a pack rolling on
     # the wall (~19 W); a 1-s run averaged both (MODEL.md §14.2, issue 36). The averages must be of the pack alone, and
-    # the run must say when the motion changed and what it was before. Four-batch minimum: 3 s of mechanics. (At the
-    # preset's friction 0.3 the charge collapses within the first 0.4-0.6 s, the start-up's own batches.)
+    # the run must say when the motion changed and what it was before. Four-batch minimum: 3 s of mechanics. When the
+    # charge collapses is chaotic, so any change of the stepping moves it: at the preset's friction 0.3 and at 0.35 it
+    # collapses within the start-up's own batches, at 0.36 and 0.4 not within 5 s (the stepping of issue 38).
     params = sm.default_parameters(
-        "pulverisette7", friction=0.4, duration=3600.0, solver="averaged", averaging_min_batches=4,
+        "pulverisette7", friction=0.38, duration=3600.0, solver="averaged", averaging_min_batches=4,
         averaging_max_time=4.0, averaging_fallback="fail", record_windows=(),
     )
     result = sm.simulate(params)

@@ -507,6 +507,7 @@ class Scratch(NamedTuple):
     half_spin: np.ndarray  # (N, 3)
     velocity_before: np.ndarray  # (N, 3) at the step's start
     spin_before: np.ndarray  # (N, 3)
+    pushed: np.ndarray  # (N,) twice each ball's contact acceleration |F|/m, the flight step's bound on it
     normal_force: np.ndarray  # (S, 3) new forces and torques on ball i per slot
     tangential_force: np.ndarray
     lever_torque_i: np.ndarray
@@ -536,6 +537,7 @@ def scratch_for(n_balls: int, slots: int) -> Scratch:
         half_spin=np.zeros((n_balls, 3)),
         velocity_before=np.zeros((n_balls, 3)),
         spin_before=np.zeros((n_balls, 3)),
+        pushed=np.zeros(n_balls),
         normal_force=np.zeros((slots, 3)),
         tangential_force=np.zeros((slots, 3)),
         lever_torque_i=np.zeros((slots, 3)),

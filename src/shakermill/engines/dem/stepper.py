@@ -41,7 +41,7 @@ from shakermill.engines.dem.model import (
 )
 from shakermill.engines.dem.description import NEIGHBOURS_FULL
 from shakermill.engines.dem.neighbours import moved_since_build, needs_rebuild
-from shakermill.engines.dem.vectors import copy_into, cross_into, distance, dot, norm
+from shakermill.engines.dem.vectors import copy_into, cross_into, distance, dot, norm, squared_distance
 from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.kernel import NetworkArrays
@@ -124,7 +124,8 @@ def advance_thermal(k: Constants, net: NetworkArrays, s: State) -> None:
 
 @njit(cache=True)
 def _time_to_close(gap: float, speed: float, acceleration: float) -> float:
-    """Shortest time in which a gap (m) closing at most at ``speed`` and ``acceleration`` can close (s)."""
+    """Shortest time in which a gap (m) closing at most at ``speed`` (negative: opening) and ``acceleration`` can
+    close (s)."""
     if gap <= 0.0:
         return 0.0
     if acceleration <= 0.0:
@@ -141,7 +142,8 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
     forces on it (taken twice their last value: they are those of slow contacts, or the step is a contact step
     anyway; in flight they are zero). Its distance from an end face closes at most at the axial part of that
     velocity, its distance from the axis grows at most at the part across the axis (a norm bound, so the
-    bore's curvature needs no term of its own). Touching slots are left out: their contacts have begun. Pairs the
+    bore's curvature needs no term of its own). Two balls' gap closes at most at its present rate and their relative
+    acceleration. Touching slots are left out: their contacts have begun. Pairs the
     neighbour list leaves out cannot touch while no ball has moved half the skin since its build: each ball's
     distance from that bound closes at most at its speed relative to the vial's centre.
     """
@@ -152,6 +154,7 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
     active = s.contacts.active
     nb = s.neighbours
     listed = math.isfinite(k.skin)
+    fastest = hardest = 0.0
     for i in range(n):
         for component in range(3):
             w.lever[component] = s.position[i, component] - w.coordinates[component]
@@ -161,6 +164,9 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
         along = dot(w.point_velocity, axis)
         across = math.sqrt(max(dot(w.point_velocity, w.point_velocity) - along * along, 0.0))
         pushed = 2.0 * norm(s.force[i]) / k.mass[i]
+        w.pushed[i] = pushed
+        fastest = max(fastest, norm(s.velocity[i]))
+        hardest = max(hardest, pushed)
         acceleration = (norm(k.gravity) + k.wall_acceleration_bound + 2.0 * k.angular_speed_bound * (abs(along) + across)
                         + pushed)
         for wall in range(N_WALLS):
@@ -177,10 +183,21 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
         if active[walls + entry]:
             continue
         i, j = nb.first_ball[entry], nb.second_ball[entry]
-        # Both balls fall alike in flight: their relative motion changes only by the contact forces.
-        gap = distance(s.position[i], s.position[j]) - k.radius[i] - k.radius[j]
-        relative_acceleration = 2.0 * norm(s.force[i]) / k.mass[i] + 2.0 * norm(s.force[j]) / k.mass[j]
-        step = min(step, _time_to_close(gap, distance(s.velocity[i], s.velocity[j]), relative_acceleration))
+        # Both balls fall alike in flight: their relative motion changes only by the contact forces. No pair
+        # closes faster than at twice the fastest ball's speed and twice the hardest push, so a pair farther apart
+        # than that reaches within the step found so far cannot shorten it (most pairs: no square root).
+        reach = k.radius[i] + k.radius[j] + 2.0 * fastest * step + hardest * step * step
+        if squared_distance(s.position[i], s.position[j]) >= reach * reach:
+            continue
+        centres = distance(s.position[i], s.position[j])
+        gap = centres - k.radius[i] - k.radius[j]
+        relative_acceleration = w.pushed[i] + w.pushed[j]
+        # The centres' distance is at least its projection on their line now, which changes at the closing speed
+        # and by the relative acceleration alone: balls sliding or rolling past each other only part.
+        closing = 0.0
+        for axis in range(3):
+            closing -= (s.position[i, axis] - s.position[j, axis]) * (s.velocity[i, axis] - s.velocity[j, axis])
+        step = min(step, _time_to_close(gap, closing / centres, relative_acceleration))
     return max(step, k.contact_step)
 
 

@@ -47,6 +47,11 @@ def difference_into(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
 
 
 @njit(cache=True)
-def distance(a: np.ndarray, b: np.ndarray) -> float:
+def squared_distance(a: np.ndarray, b: np.ndarray) -> float:
     dx, dy, dz = a[0] - b[0], a[1] - b[1], a[2] - b[2]
-    return math.sqrt(dx * dx + dy * dy + dz * dz)
+    return dx * dx + dy * dy + dz * dz
+
+
+@njit(cache=True)
+def distance(a: np.ndarray, b: np.ndarray) -> float:
+    return math.sqrt(squared_distance(a, b))
