@@ -195,8 +195,9 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
         # The centres' distance is at least its projection on their line now, which changes at the closing speed
         # and by the relative acceleration alone: balls sliding or rolling past each other only part.
         closing = 0.0
-        for axis in range(3):
-            closing -= (s.position[i, axis] - s.position[j, axis]) * (s.velocity[i, axis] - s.velocity[j, axis])
+        for component in range(3):
+            closing -= ((s.position[i, component] - s.position[j, component])
+                        * (s.velocity[i, component] - s.velocity[j, component]))
         step = min(step, _time_to_close(gap, closing / centres, relative_acceleration))
     return max(step, k.contact_step)
 
