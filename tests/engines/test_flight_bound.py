@@ -32,8 +32,7 @@ def test_time_to_close_by_hand(gap, speed, acceleration, expected):
 def test_no_pair_touches_within_its_bound_whatever_pushes_it():
     """Sampled pairs of Ø10-mm balls a micrometre or less apart, moving at up to 1 m/s in any direction, each pushed
     within the bound by a constant acceleration aimed to close the gap soonest (along the line of centres, towards
-    each other) or at random: the gap stays open up to the bound, and closes soon after it when aimed head-on and
-    approaching."""
+    each other) or at random: the gap stays open up to the bound."""
     rng = np.random.default_rng(7)
     radius_sum = 0.01
     for _ in range(2000):

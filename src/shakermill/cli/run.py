@@ -76,7 +76,7 @@ def run(
         target = out if out is not None else timestamped_folder("run")
         check_target(target, overwrite=overwrite)
         preflight(run_config.params)
-        cluster = replica_cluster(run_config.params, scheduler, scheduler_timeout)
+        cluster = cluster_for_replicas(run_config.params, scheduler, scheduler_timeout)
     import_writers()
     # Unit slips and the solver's choice are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)
@@ -109,7 +109,7 @@ def run(
     _exit_for_status(result, target)
 
 
-def replica_cluster(params: Parameters, scheduler: str | None, timeout: float) -> ContextManager[None]:
+def cluster_for_replicas(params: Parameters, scheduler: str | None, timeout: float) -> ContextManager[None]:
     """Where the replicas of an averaged run after its first advance: on the Dask scheduler at ``scheduler``
     (solvers/replicas.py), or here. A scheduler a run would not use is refused in one line."""
     from contextlib import nullcontext
@@ -121,9 +121,10 @@ def replica_cluster(params: Parameters, scheduler: str | None, timeout: float) -
 
     if scheduler is None:
         return nullcontext()
-    replicas = replica_count(params, describe(params.engine))
+    description = describe(params.engine)
+    replicas = replica_count(params, description)
     if params.solver != "averaged" or full_resolution_instead(params) is not None or replicas < 2:
-        key = describe(params.engine).replicas_key
+        key = description.replicas_key
         wanted = f"{key} >= 2" if key else "an engine with replicas (engine = 'dem', dem_replicas >= 2)"
         raise ParameterError(
             f"--scheduler: this run sends nothing to a cluster (solver = {params.solver!r}, {replicas} replica); allowed "

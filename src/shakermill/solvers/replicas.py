@@ -113,6 +113,7 @@ def replicas_of(first: Engine, others: Sequence[Engine]) -> tuple[list[Engine | 
         return [first, *others], replica_threads(1 + len(others))
     return [first, *(RemoteReplica(engine, client) for engine in others)], 1 + len(others)
 
+
 def replica_threads(replicas: int) -> int:
     """The threads ``replicas`` replicas share: one per replica, at most the cores this process may use or
     THREADS_VARIABLE, if set (refused in one line where it is not a number of threads)."""

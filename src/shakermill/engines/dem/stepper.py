@@ -165,7 +165,8 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
         across = math.sqrt(max(dot(w.point_velocity, w.point_velocity) - along * along, 0.0))
         pushed = 2.0 * norm(s.force[i]) / k.mass[i]
         w.pushed[i] = pushed
-        fastest = max(fastest, norm(s.velocity[i]))
+        relative_speed = distance(s.velocity[i], w.rates[:3])  # relative to the vial's centre
+        fastest = max(fastest, relative_speed)
         hardest = max(hardest, pushed)
         acceleration = (norm(k.gravity) + k.wall_acceleration_bound + 2.0 * k.angular_speed_bound * (abs(along) + across)
                         + pushed)
@@ -177,14 +178,14 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
             step = min(step, _time_to_close(gap, max(closing, 0.0), acceleration))
         if listed:
             margin = 0.5 * k.skin - moved_since_build(i, s.position, w.coordinates, nb)
-            relative_speed = distance(s.velocity[i], w.rates[:3])
             step = min(step, _time_to_close(margin, relative_speed, norm(k.gravity) + k.wall_acceleration_bound + pushed))
     for entry in range(nb.count[0]):
         if active[walls + entry]:
             continue
         i, j = nb.first_ball[entry], nb.second_ball[entry]
         # Both balls fall alike in flight: their relative motion changes only by the contact forces. No pair
-        # closes faster than at twice the fastest ball's speed and twice the hardest push, so a pair farther apart
+        # closes faster than at twice the fastest ball's speed relative to the vial's centre and twice the hardest
+        # push, so a pair farther apart
         # than that reaches within the step found so far cannot shorten it (most pairs: no square root).
         reach = k.radius[i] + k.radius[j] + 2.0 * fastest * step + hardest * step * step
         if squared_distance(s.position[i], s.position[j]) >= reach * reach:
