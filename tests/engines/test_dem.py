@@ -125,23 +125,26 @@ def test_a_ball_resting_on_the_bore_sinks_in_by_the_hertz_overlap_of_the_concave
 @pytest.mark.slow
 def test_an_enduring_contact_steps_at_its_own_period_and_rests_where_the_finest_steps_put_it():
     """A ball resting on the bore outlasts two of its contact periods T: it steps at enduring_step_fraction x T
-    (within 0.9 t_R), not at the impact's 0.05/9.5 x T, and comes to rest at the same depth."""
+    (within 0.9 t_R), not at an impact's contact_step_fraction x IMPACT_STEP_SCALE x T, and comes to rest at the same
+    depth."""
     base = sm.default_parameters(engine="dem", **RESTING_VIAL, duration=0.3, record_windows=())
     runs, resting_steps = {}, {}
-    for fraction in (0.001, 0.05):  # 0.001: below the impact's fraction, every step as an impact's
+    for fraction in (0.001, 0.05):  # 0.001: below an impact's fraction, which it then takes
         engine = DemEngine(base.replace(enduring_step_fraction=fraction))
         engine.advance(0.2)  # fallen from the axis and settled
         settled = engine.steps_taken()
         engine.advance(0.3)
         runs[fraction], resting_steps[fraction] = engine, engine.steps_taken() - settled
     k = runs[0.05].constants
-    slot = model.SIDE  # the ball's slot against the bore: ball 0's walls come first
-    overlap = runs[0.05].state.contacts.max_overlap[slot]
+    # Resting on the bore's bottom line of a vial at rest (axis x, centre at the origin): the overlap from the depth.
+    overlap = k.radius[0] - k.bore_radius - runs[0.05].state.position[0, 2]
     period = contact.contact_period(k.mass[0], k.wall_radius[0, model.SIDE], k.wall_modulus[0], k.wall_shear_modulus[0],
                                     overlap, 0.0)
     step = min(0.05 * period, k.longest_contact_step)
     assert resting_steps[0.05] == pytest.approx(0.1 / step, rel=0.05)
-    assert resting_steps[0.001] > 5 * resting_steps[0.05]
+    impact_step = base.contact_step_fraction * model.IMPACT_STEP_SCALE * period
+    assert resting_steps[0.001] == pytest.approx(0.1 / impact_step, rel=0.05)
+    assert resting_steps[0.001] > 3 * resting_steps[0.05]
     depths = [engine.state.position[0, 2] for engine in runs.values()]
     assert depths[0] == pytest.approx(depths[1], abs=0.01 * overlap)
 

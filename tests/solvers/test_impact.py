@@ -19,12 +19,12 @@ from shakermill.physics.contact import (
 from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.solvers.impact import UNREAD_KEYS, check_keys_read, restitution_warning, single_impact
 
-# A contact step of 2 % of the Rayleigh time: ~250 steps a contact, restitution within 4e-4 of e, contact
-# time within 0.4 % (one step). The default 0.025 leaves restitution errors up to ~6.4e-4 (0.05 left 1.45e-3).
+# A contact step of 2 % of the Rayleigh time: an impact at 1/125 of its period, restitution within 6e-4 of e, contact
+# time within one contact step. The default 0.025 (1/100 of the period) leaves restitution errors up to ~8e-4.
 FINE = {"contact_step_fraction": 0.02}
-# e = 1: what the bookkeeping books as dissipated is then the integrator's energy error, ~1e-7 of the
-# incident energy at 0.01 (up to ~1e-6 at 0.02).
-FINER = {"contact_step_fraction": 0.01}
+# e = 1: what the bookkeeping books as dissipated is then the integrator's energy error, up to 2.5e-7 of the
+# incident energy at 0.004 (up to 2.4e-6 at 0.01).
+FINER = {"contact_step_fraction": 0.004}
 # The stiffest vial allowed stands in for the benchmarks' rigid plane; the formulas take the E* it gives.
 RIGID_WALL = {"vial_youngs_modulus": 1.2e12}
 GLASS = {"ball_radius": 0.01, "ball_density": 2800.0, "ball_youngs_modulus": 4.8e10, "ball_poisson_ratio": 0.20}

@@ -307,8 +307,9 @@ class Parameters(BaseModel):
             "steadily by that many radians per radian of θ",
         },
     )
-    # The step inside a contact as a fraction of the smallest Rayleigh time, or of a slow contact's own period over
-    # 9.5 where that is longer (engines/dem/model.py, RAYLEIGH_TIMES_PER_PERIOD); 0.9 is the 1-D engine's bound.
+    # The shortest step, at a contact's start and release, as a fraction of the smallest Rayleigh time; an impact
+    # steps at 0.4 of this fraction of its own period (engines/dem/model.py, IMPACT_STEP_SCALE); 0.9 is the 1-D
+    # engine's bound.
     contact_step_fraction: float = quantity(
         "", "contact step of the 'dem' engine as a fraction of the smallest Rayleigh time", ge=1e-3, le=0.9
     )

@@ -36,9 +36,10 @@ START_GAP_FRACTION = 0.1
 # this many has gone wrong (a damped contact lasts at most a few Hertz times).
 MAX_CHUNKS = 100
 # The largest overlap must span this many representable positions of the incoming ball's centre: fewer, and
-# rounding moves the restitution by per cents (the 6.35-mm steel ball at 1e-11 m/s, 450 of them: 0.713 for
-# 0.7); far fewer, and the ball never moves and the engine steps in flight for ever (1e-20 m/s: 31 s).
-MIN_OVERLAP_POSITIONS = 1e4
+# rounding moves the restitution by per mille to per cents (the 6.35-mm steel ball on the end face: 1e4 of them,
+# 0.6987 for 0.7; 450, 0.713); far fewer, and the ball never moves and the engine steps in flight for ever
+# (1e-20 m/s: 31 s).
+MIN_OVERLAP_POSITIONS = 2e4
 # A head-on impact at the vial's peak speed stands for a run's impacts, within speeds that mills reach.
 GUARD_SPEEDS = (0.1, 20.0)  # m/s
 RESTITUTION_TOLERANCE = 0.01  # relative

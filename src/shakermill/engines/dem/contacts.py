@@ -58,6 +58,14 @@ def wall_gap(position: np.ndarray, radius: float, wall: int, k: Constants, w: Sc
 
 
 @njit(cache=True)
+def measure_wall_gaps(k: Constants, s: State, w: Scratch) -> None:
+    """Every ball's gap to every wall now into ``w.wall_gaps`` (:func:`wall_contacts` keeps them as it goes)."""
+    for i in range(k.n_balls):
+        for wall in range(N_WALLS):
+            w.wall_gaps[N_WALLS * i + wall] = wall_gap(s.position[i], k.radius[i], wall, k, w)
+
+
+@njit(cache=True)
 def pair_values(i: int, j: int, k: Constants) -> tuple[float, float, float, float, float]:
     """E*, G* (Pa), R* (m) and m* (kg) of balls i and j (MODEL.md §12.3), and the share of their contacts' heat that
     goes to ball i (by effusivity, MODEL.md §12.4)."""
@@ -135,6 +143,9 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     for axis in range(3):
         w.rolling_torque[slot, axis] = -k.rolling_friction * radius * pressing * relative_spin[axis] / spin if spin > 0 else 0.0
     c.period[slot] = contact.contact_period(mass, radius, modulus, shear_modulus, overlap, approach)
+    if not c.active[slot]:
+        c.impact_period[slot] = c.period[slot]
+    c.release[slot] = overlap / approach if approach > 0.0 else math.inf
     c.peak_force[slot] = max(c.peak_force[slot], abs(magnitude))
     c.max_overlap[slot] = max(c.max_overlap[slot], overlap)
 
@@ -241,7 +252,8 @@ def wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
     for i in range(n):
         for wall in range(N_WALLS):
             slot = N_WALLS * i + wall
-            overlap = -wall_gap(s.position[i], k.radius[i], wall, k, w)
+            w.wall_gaps[slot] = wall_gap(s.position[i], k.radius[i], wall, k, w)
+            overlap = -w.wall_gaps[slot]
             if overlap <= 0.0:
                 live = _release_if_touching(slot, s, w, live)
                 continue
@@ -407,7 +419,8 @@ def _copy_slot(source: Contacts, a: int, target: Contacts, b: int) -> None:
         copy_into(field_from[a], field_to[b])
     for scalar_from, scalar_to in ((source.elastic_energy, target.elastic_energy), (source.stiffness, target.stiffness),
                                    (source.stretch, target.stretch), (source.slip_loss, target.slip_loss),
-                                   (source.period, target.period), (source.started, target.started),
+                                   (source.period, target.period), (source.impact_period, target.impact_period),
+                                   (source.release, target.release), (source.started, target.started),
                                    (source.normal_speed_in, target.normal_speed_in),
                                    (source.tangential_speed_in, target.tangential_speed_in),
                                    (source.peak_force, target.peak_force), (source.max_overlap, target.max_overlap)):

@@ -93,7 +93,7 @@ class Constants(NamedTuple):
     gravity: np.ndarray  # (3,), m/s², lab frame
     # Steps
     contact_step: float  # s: contact_step_fraction × the smallest Rayleigh time
-    period_step_fraction: float  # a contact's step at most this fraction of its period (MODEL.md §12.6)
+    period_step_fraction: float  # an impact's step at most this fraction of its period (MODEL.md §12.6)
     enduring_step_fraction: float  # the same for a contact older than ENDURING_AFTER of its periods
     longest_contact_step: float  # s: 0.9 × the smallest Rayleigh time, MODEL.md §7's bound inside contacts
     max_flight_step: float  # s
@@ -151,6 +151,8 @@ class Contacts(NamedTuple):
     stretch: np.ndarray  # (S,) m²: |δ_t|²
     slip_loss: np.ndarray  # (S,) J: energy the Coulomb limit took in this step, μF_n⁺·|slip|
     period: np.ndarray  # (S,) s: shortest oscillation period of the contact at its last evaluation
+    impact_period: np.ndarray  # (S,) s: that period at its first evaluation, the shortest of its impact
+    release: np.ndarray  # (S,) s: time its overlap takes to open at its rate at the last evaluation (inf: closing)
     started: np.ndarray  # (S,) s
     normal_speed_in: np.ndarray  # (S,) m/s: closing speed at first touch
     tangential_speed_in: np.ndarray  # (S,) m/s: sliding speed of the contact points at first touch
@@ -290,7 +292,7 @@ def constants_from(params: Parameters) -> Constants:
         # An empty mill (n_balls = 0) has no contact to resolve: it takes flight steps, short for its thermal network.
         default=params.max_flight_step / params.contact_step_fraction,
     )
-    impact_fraction = params.contact_step_fraction / RAYLEIGH_TIMES_PER_PERIOD
+    impact_fraction = params.contact_step_fraction * IMPACT_STEP_SCALE
     fastest_node = min(value for value, _ in params.thermal_time_constants_at_rest.values())
     return Constants(
         relative_convection=params.relative_convection,
@@ -339,14 +341,15 @@ def constants_from(params: Parameters) -> Constants:
     )
 
 
-# The step inside contacts is contact_step_fraction × max(t_R, T/RAYLEIGH_TIMES_PER_PERIOD), T the shortest
-# oscillation period of the touching contacts (contact.contact_period, the tangential one with the balls' spin).
-# T/t_R depends on the material only through (E/ρv²)^{1/10}; for steel impacts at 0.1 m/s T is 8.2 t_R between two
-# balls, 7.6–8.7 t_R on a bore of 19–38 mm and 9.47 t_R on an end face, the longest: with 9.5, impacts of 0.1 m/s
-# and faster keep the Rayleigh step (N = 9.5/fraction = 190 steps a period at the default fraction 0.05, and a
-# finer fraction refines every contact alike), while a ball resting under gravity on the bore (T ≈ 25 t_R) or
-# hopping on it at mm/s steps 1.5–2.7 times longer.
-RAYLEIGH_TIMES_PER_PERIOD = 9.5
+# An impact steps at contact_step_fraction × IMPACT_STEP_SCALE of its own period T₀ (contact.contact_period at its
+# first evaluation, the tangential one with the balls' spin, taken at the peak overlap its approach will reach: the
+# shortest period of the impact), 1/100 of it at the default 0.025; its start (the flight step shrinks to
+# contact_step as the gap closes) and its release (stepper._contact_limit) at the contact step. Verlet's restitution
+# error is then the same at every speed: head-on steel, e = 0.7, 0.1–5 m/s, 40 speeds, it is at most 8e-4 on the
+# end face (first order in the step: the damper) and 7e-4 between balls, where the contact step throughout (1/380 of
+# T at 0.1 m/s, 1/170 at 5 m/s), which stepped impacts before, left 6.4e-4 at two to four times the steps
+# (benchmarks/README.md, "An impact at its own pace"). A finer contact_step_fraction refines every impact alike.
+IMPACT_STEP_SCALE = 0.4
 # An impact is over within about one of its periods (T above is the tangential period, ~0.6 of the normal one, and a
 # Hertz impact lasts about half a normal period, ~0.85 T); a contact that has lasted ENDURING_AFTER periods rolls,
 # slides or rests. Its restitution is no longer at stake, only its forces and the heat of its slip, which Verlet
@@ -508,6 +511,7 @@ class Scratch(NamedTuple):
     velocity_before: np.ndarray  # (N, 3) at the step's start
     spin_before: np.ndarray  # (N, 3)
     pushed: np.ndarray  # (N,) twice each ball's contact acceleration |F|/m, the flight step's bound on it
+    wall_gaps: np.ndarray  # (N·N_WALLS,) m: each ball's gap to each wall at the last evaluation, by wall slot
     normal_force: np.ndarray  # (S, 3) new forces and torques on ball i per slot
     tangential_force: np.ndarray
     lever_torque_i: np.ndarray
@@ -538,6 +542,7 @@ def scratch_for(n_balls: int, slots: int) -> Scratch:
         velocity_before=np.zeros((n_balls, 3)),
         spin_before=np.zeros((n_balls, 3)),
         pushed=np.zeros(n_balls),
+        wall_gaps=np.zeros(N_WALLS * n_balls),
         normal_force=np.zeros((slots, 3)),
         tangential_force=np.zeros((slots, 3)),
         lever_torque_i=np.zeros((slots, 3)),

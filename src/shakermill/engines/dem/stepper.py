@@ -1,14 +1,14 @@
 """Compiled velocity-Verlet stepping of the 'dem' engine (MODEL.md section 12).
 
 One step: half kick with the last forces, drift, forces at the new positions (with the velocities
-predicted to the step's end), second half kick with the new forces. Inside contacts the step is
-``contact_step_fraction`` of the smallest Rayleigh time, or of the touching contacts' shortest oscillation
-period over 9.5 where that is longer (model.RAYLEIGH_TIMES_PER_PERIOD: a ball hopping on the bore steps longer;
-impacts of 0.1 m/s and faster keep the Rayleigh step); a contact that outlasted model.ENDURING_AFTER of its periods
-(rolling, sliding, resting) steps at ``enduring_step_fraction`` of its period; never beyond 0.9 t_R. In free
-flight, and for the slots not touching when a contact's step is the longer one, it is as long as no contact
-can begin inside it (each gap over its largest closing speed and acceleration), but never shorter than the
-Rayleigh step nor longer than ``max_flight_step``.
+predicted to the step's end), second half kick with the new forces. Inside contacts the step is the shortest the
+touching contacts allow: an impact ``contact_step_fraction`` × model.IMPACT_STEP_SCALE of its own period, its
+release at the contact step (``contact_step_fraction`` of the smallest Rayleigh time, the shortest step there is);
+a contact that outlasted model.ENDURING_AFTER of its periods (rolling, sliding, resting) ``enduring_step_fraction``
+of its period; never beyond 0.9 t_R. In free flight, and for the slots not touching when a contact's step is the
+longer one, it is as long as no contact can begin inside it (each gap over its largest closing speed and
+acceleration), so that a contact begins inside a contact step, but never shorter than that nor longer than
+``max_flight_step``.
 
 The energy bookkeeping is exact per step. The second half kick makes each ball's change of kinetic
 energy dt·(F̄·v̄ + M̄·w̄), with F̄, M̄ the means of its forces and torques at the step's two ends and
@@ -27,7 +27,14 @@ import math
 import numpy as np
 from numba import njit
 
-from shakermill.engines.dem.contacts import pair_contacts, rebuild_neighbours, settle, sum_forces, wall_contacts, wall_gap
+from shakermill.engines.dem.contacts import (
+    measure_wall_gaps,
+    pair_contacts,
+    rebuild_neighbours,
+    settle,
+    sum_forces,
+    wall_contacts,
+)
 from shakermill.engines.dem.model import (
     ENDURING_AFTER,
     HEAT_LOST,
@@ -134,8 +141,18 @@ def _time_to_close(gap: float, speed: float, acceleration: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def _flight_step(k: Constants, s: State, w: Scratch) -> float:
-    """The longest step in which no contact can begin (MODEL.md §12.6), within [contact_step, max_flight_step].
+def _shortened(step: float, gap: float, speed: float, acceleration: float) -> float:
+    """``step``, or the shorter :func:`_time_to_close` of the gap; no square root where the gap cannot close within
+    ``step`` (the case of most gaps inside contacts, whose steps are short)."""
+    if gap > 0.0 and gap >= step * (max(speed, 0.0) + 0.5 * max(acceleration, 0.0) * step):
+        return step
+    return min(step, _time_to_close(gap, speed, acceleration))
+
+
+@njit(cache=True, inline="always")
+def _flight_step(cap: float, k: Constants, s: State, w: Scratch) -> float:
+    """The longest step in which no contact can begin (MODEL.md §12.6), within [contact_step, min(cap,
+    max_flight_step)]. Inside contacts ``cap`` is the step they allow: the pairs are sifted against it from the start.
 
     A ball's centre moves in the vial frame at its velocity relative to the vial's point under it, which can
     change at most by gravity, the vial's acceleration and the Coriolis term within a step, and by the contact
@@ -149,12 +166,13 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
     """
     n = k.n_balls
     walls = N_WALLS * n
-    step = k.max_flight_step
+    step = min(cap, k.max_flight_step)
     axis = w.orientation[:, 0]
     active = s.contacts.active
     nb = s.neighbours
     listed = math.isfinite(k.skin)
     fastest = hardest = 0.0
+    falling = norm(k.gravity) + k.wall_acceleration_bound
     for i in range(n):
         for component in range(3):
             w.lever[component] = s.position[i, component] - w.coordinates[component]
@@ -168,17 +186,16 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
         relative_speed = distance(s.velocity[i], w.rates[:3])  # relative to the vial's centre
         fastest = max(fastest, relative_speed)
         hardest = max(hardest, pushed)
-        acceleration = (norm(k.gravity) + k.wall_acceleration_bound + 2.0 * k.angular_speed_bound * (abs(along) + across)
-                        + pushed)
+        acceleration = falling + 2.0 * k.angular_speed_bound * (abs(along) + across) + pushed
         for wall in range(N_WALLS):
             if active[N_WALLS * i + wall]:
                 continue
-            gap = wall_gap(s.position[i], k.radius[i], wall, k, w)
+            gap = w.wall_gaps[N_WALLS * i + wall]  # of this step's end, where the next one starts
             closing = across if wall == SIDE else (-along if wall == LEFT_END else along)
-            step = min(step, _time_to_close(gap, max(closing, 0.0), acceleration))
+            step = _shortened(step, gap, max(closing, 0.0), acceleration)
         if listed:
             margin = 0.5 * k.skin - moved_since_build(i, s.position, w.coordinates, nb)
-            step = min(step, _time_to_close(margin, relative_speed, norm(k.gravity) + k.wall_acceleration_bound + pushed))
+            step = _shortened(step, margin, relative_speed, falling + pushed)
     for entry in range(nb.count[0]):
         if active[walls + entry]:
             continue
@@ -199,32 +216,39 @@ def _flight_step(k: Constants, s: State, w: Scratch) -> float:
         for component in range(3):
             closing -= ((s.position[i, component] - s.position[j, component])
                         * (s.velocity[i, component] - s.velocity[j, component]))
-        step = min(step, _time_to_close(gap, closing / centres, relative_acceleration))
+        step = _shortened(step, gap, closing / centres, relative_acceleration)
     return max(step, k.contact_step)
 
 
 @njit(cache=True, inline="always")
 def _contact_limit(slot: int, t: float, k: Constants, s: State) -> float:
-    """The longest step the touching contact in ``slot`` allows at ``t`` (s): a fraction of its period
-    (:func:`contact.contact_period`, from its overlap and normal speed at its last evaluation), the enduring
-    fraction once it has lasted ENDURING_AFTER periods."""
-    period = s.contacts.period[slot]
-    enduring = t - s.contacts.started[slot] >= ENDURING_AFTER * period
-    return (k.enduring_step_fraction if enduring else k.period_step_fraction) * period
+    """The longest step the touching contact in ``slot`` allows at ``t`` (s). An impact: a fraction of its period
+    (:func:`contact.contact_period`: its first one, the impact's shortest, or a shorter one where another impact
+    loads it), and the contact step once its overlap would open within two of those steps; once it has lasted
+    ENDURING_AFTER periods, the enduring fraction of its period now."""
+    c = s.contacts
+    period = c.period[slot]
+    if t - c.started[slot] >= ENDURING_AFTER * period:
+        return k.enduring_step_fraction * period
+    step = min(k.period_step_fraction * min(period, c.impact_period[slot]), k.longest_contact_step)
+    # The release is resolved as the start is: ended inside a long step, an impact's restitution depends on where in
+    # that step (its phase), by up to 1.2e-3 at T/83. Two steps ahead, as the overlap's rate changes meanwhile; of
+    # the step as taken (a gentle touch's period, at a tiny overlap, is far longer than 0.9 t_R).
+    return k.contact_step if c.release[slot] < 2.0 * step else step
 
 
 @njit(cache=True, inline="always")
 def _step_length(touching: int, limit: float, k: Constants, s: State, w: Scratch) -> float:
     """The next step (MODEL.md §12.6). In flight, :func:`_flight_step`. Inside contacts, the shortest of the touching
-    contacts' limits (``limit``, :func:`_contact_limit`) but not below the Rayleigh step, so that impacts keep it and
-    slow or lasting contacts take longer ones (never beyond 0.9 t_R, MODEL.md §7); a step longer than the Rayleigh
-    one is also bounded as a flight step by the slots not touching, so that no contact begins inside it."""
+    contacts' limits (``limit``, :func:`_contact_limit`) but not below the contact step nor beyond 0.9 t_R (MODEL.md
+    §7); a step longer than the contact step is also bounded as a flight step by the slots not touching, so that no
+    contact begins inside it."""
     if not touching:
-        return _flight_step(k, s, w)
+        return _flight_step(math.inf, k, s, w)
     step = max(k.contact_step, min(limit, k.longest_contact_step))
     if step <= k.contact_step:
         return k.contact_step
-    return min(step, _flight_step(k, s, w))
+    return _flight_step(step, k, s, w)
 
 
 @njit(cache=True, inline="always")
@@ -304,6 +328,7 @@ def advance(t_stop: float, max_steps: int, k: Constants, net: NetworkArrays, s: 
     reached either way."""
     slots = s.contacts.active.size
     vial_frame(s.clock[0], k, w)
+    measure_wall_gaps(k, s, w)
     touching = 0
     limit = math.inf
     for slot in range(slots):
