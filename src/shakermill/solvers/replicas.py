@@ -28,6 +28,8 @@ from shakermill.parameters.environment import threads_cap
 if TYPE_CHECKING:
     from distributed import Client
 
+# Times a round is sent before its cancellation is taken as the cluster's answer (future.result() then raises it).
+ROUND_ATTEMPTS = 3
 _CLUSTER: contextvars.ContextVar[Client | None] = contextvars.ContextVar("shakermill_replica_cluster", default=None)
 
 
@@ -74,19 +76,24 @@ class RemoteReplica:
 
     def advance(self, t_stop: float, heartbeat: Callable[[float], None] | None = None) -> int:
         """Advance to ``t_stop`` on the cluster; ``heartbeat(t)`` is called while it runs (its exception cancels the
-        task: this replica stays where the last round left it)."""
-        future = self._client.submit(_advance_elsewhere, self._engine, t_stop, pure=False)
-        try:
-            while True:
-                try:
-                    engine, status, times = future.result(timeout=CALL_SECONDS)
-                    break
-                except TimeoutError:
+        task: this replica stays where the last round left it). A round the cluster cancels (a client that lost its
+        scheduler for a moment on a busy machine cancels its futures) is sent again, from the same engine."""
+        for _ in range(ROUND_ATTEMPTS):
+            future = self._client.submit(_advance_elsewhere, self._engine, t_stop, pure=False)
+            finished = threading.Event()
+            future.add_done_callback(lambda _: finished.set())
+            try:
+                # Polled through the callback's event, not future.result(timeout=...): distributed answers a future
+                # cancelled while that waits with an UnboundLocalError of its own.
+                while not finished.wait(CALL_SECONDS):
                     if heartbeat is not None:
                         heartbeat(self.t)
-        except BaseException:
-            future.cancel()
-            raise
+            except BaseException:
+                future.cancel()
+                raise
+            if future.status != "cancelled":
+                break
+        engine, status, times = future.result()
         self._budget.count_steps(engine.steps_taken() - self._engine.steps_taken())
         engine.budget = self._budget
         self._engine = engine
