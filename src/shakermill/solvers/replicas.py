@@ -81,7 +81,8 @@ class RemoteReplica:
         for _ in range(ROUND_ATTEMPTS):
             future = self._client.submit(_advance_elsewhere, self._engine, t_stop, pure=False)
             finished = threading.Event()
-            future.add_done_callback(lambda _: finished.set())
+            # Bound now: a cancelled round's callback, run late, must not wake the wait of the round sent after it.
+            future.add_done_callback(lambda _, event=finished: event.set())
             try:
                 # Polled through the callback's event, not future.result(timeout=...): distributed answers a future
                 # cancelled while that waits with an UnboundLocalError of its own.
