@@ -28,6 +28,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import resource
 from contextlib import ExitStack
 
 from reference_tree import ROOT, measured_in, reference_tree
@@ -65,40 +66,36 @@ def restitution_part() -> None:
         print(f"  contact_step_fraction {fraction:<7g} " + "   ".join(cells), flush=True)
 
 
+def cpu_seconds() -> float:
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
 def measure_second() -> dict:
-    import resource
-
     import shakermill as sm
-
-    def cpu() -> float:
-        usage = resource.getrusage(resource.RUSAGE_SELF)
-        return usage.ru_utime + usage.ru_stime
 
     sm.simulate(sm.default_parameters("spex8000m-3d", duration=0.001, solver="full", record_windows=()))  # compile
     figures = {}
     for mill, (preset, settings) in SECOND_MILLS.items():
         params = sm.default_parameters(preset, **settings, duration=1.0, solver="full", record_windows=())
-        started = cpu()
+        started = cpu_seconds()
         result = sm.simulate(params)
-        figures[mill] = {"cpu": cpu() - started, "steps": result.counters["steps"],
+        figures[mill] = {"cpu": cpu_seconds() - started, "steps": result.counters["steps"],
                          "impacts": result.counters["impacts"], "heat": result.summary["heat_power_W"]}
     return figures
 
 
 def measure_averaged(fraction_scale: float) -> dict:
-    import resource
-
     import shakermill as sm
 
     figures = {}
     for mill, (preset, settings) in AVERAGED_MILLS.items():
         params = sm.default_parameters(preset, **settings, attractor_starts=1)
         params = params.replace(contact_step_fraction=params.contact_step_fraction * fraction_scale)
-        started = resource.getrusage(resource.RUSAGE_SELF)
+        started = cpu_seconds()
         summary = sm.simulate(params).summary
-        ended = resource.getrusage(resource.RUSAGE_SELF)
         figures[mill] = {key: summary[key] for key in AVERAGED_KEYS}
-        figures[mill]["cpu"] = ended.ru_utime + ended.ru_stime - started.ru_utime - started.ru_stime
+        figures[mill]["cpu"] = cpu_seconds() - started
     return figures
 
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.engines.dem.engine import DemEngine
 from shakermill.engines.dem.contacts import measure_wall_gaps
+from shakermill.engines.dem.engine import DemEngine
 from shakermill.engines.dem.stepper import _flight_step, _time_to_close, vial_frame
 
 
