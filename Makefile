@@ -27,12 +27,15 @@ $(NOTEBOOK_STAMP): $(STAMP)
 run: install
 	$(BIN)/shakermill run --overwrite --out $(OUT)
 
-# The report's browser test needs Chromium. scripts/ensure-browser installs it only when asked (BROWSER=1, as CI
+# First the formatter and the linter (ruff, pyproject.toml), then the static type check of the engine contract
+# (mypy), then pytest. The report's browser test needs Chromium. scripts/ensure-browser installs it only when asked (BROWSER=1, as CI
 # does; apt-get with --no-upgrade), so that a plain `make test` changes nothing outside this folder; otherwise, or
 # when it cannot, it prints why and the test skips with that reason. One worker per core (pytest-xdist, at most 4):
 # the suite is mostly engine runs on one thread each.
 BROWSER ?=
 test: install
+	$(BIN)/ruff format --check --quiet .
+	$(BIN)/ruff check --quiet .
 	@reason="$$(BROWSER=$(BROWSER) scripts/ensure-browser)"; SHAKERMILL_BROWSER_UNAVAILABLE="$$reason" $(BIN)/python -m pytest -n auto --maxprocesses 4
 
 # The unit tests alone: every test not marked slow (pyproject.toml), in under a minute.

@@ -67,7 +67,8 @@ def main() -> None:
         probed_ratios.append(full_time / probed_time)
         note = "fell back to full resolution" if averaged.solver == "full" else a["averaging_message"]
         print(
-            f"{omega:6.0f} {amplitude * 1e3:5.0f} | {f['theta_inf_C']:8.2f} {d_inf:7.3f} | {f['tau_min']:7.2f} {d_tau:7.3f} | "
+            f"{omega:6.0f} {amplitude * 1e3:5.0f} | {f['theta_inf_C']:8.2f} {d_inf:7.3f} | {f['tau_min']:7.2f} "
+            f"{d_tau:7.3f} | "
             f"{d_steady:9.3f} | {d_temp:8.3f} | {full_time:6.2f} {averaged_time:6.3f} {ratios[-1]:6.0f} "
             f"{probed_time:8.3f} {probed_ratios[-1]:6.0f} | {note}"
         )

@@ -71,24 +71,34 @@ def judge(name: str, overrides: dict, span: float) -> None:
     grouping = uncorrelated_grouping([kept], params.averaging_min_batches)
     after = grouped(kept, grouping.size)
     before_error, after_error = standard_error(heat), standard_error(after[:, 0])
-    print(f"\n{name} {overrides or ''}: {span:g} s of mechanics in {len(rates)} batches of {batch:.3g} s "
-          f"({cpu_seconds() - started:.0f} CPU-s); MSER cut {cut} batches")
-    print(f"  lag-1 autocorrelation of the batches as shipped: heat {lag1_autocorrelation([heat]):+.2f}, "
-          f"velocity term {lag1_autocorrelation([kept[:, 1]]):+.2f} (insignificant below {2 / np.sqrt(len(kept)):.2f})")
+    print(
+        f"\n{name} {overrides or ''}: {span:g} s of mechanics in {len(rates)} batches of {batch:.3g} s "
+        f"({cpu_seconds() - started:.0f} CPU-s); MSER cut {cut} batches"
+    )
+    print(
+        f"  lag-1 autocorrelation of the batches as shipped: heat {lag1_autocorrelation([heat]):+.2f}, "
+        f"velocity term {lag1_autocorrelation([kept[:, 1]]):+.2f} (insignificant below {2 / np.sqrt(len(kept)):.2f})"
+    )
     print(f"  before: {heat.mean():.4g} ± {before_error:.2g} W ({relative_error(heat):.2%}), {len(kept)} batches")
     verdict = "uncorrelated" if grouping.uncorrelated else "still correlated: more mechanics needed"
-    print(f"  after:  {after[:, 0].mean():.4g} ± {after_error:.2g} W ({relative_error(after[:, 0]):.2%}), "
-          f"{grouping.groups} groups of {grouping.size} batches ({grouping.size * batch:.3g} s), "
-          f"|r1| {grouping.autocorrelation:.2f}, {verdict}")
-    print(f"  error after / before: {after_error / before_error:.2f}; the halves drift: "
-          f"{any(drifts(column) for column in after.T)}")
+    print(
+        f"  after:  {after[:, 0].mean():.4g} ± {after_error:.2g} W ({relative_error(after[:, 0]):.2%}), "
+        f"{grouping.groups} groups of {grouping.size} batches ({grouping.size * batch:.3g} s), "
+        f"|r1| {grouping.autocorrelation:.2f}, {verdict}"
+    )
+    print(
+        f"  error after / before: {after_error / before_error:.2f}; the halves drift: "
+        f"{any(drifts(column) for column in after.T)}"
+    )
     # The solver's own rule: a column whose batch means spread less than the target error is known well enough
     # whatever their correlation (the variance of a mean never exceeds its values').
-    target = getattr(params, "dem_averaging_rel_error")
+    target = params.dem_averaging_rel_error
     spread = kept.std(axis=0) / np.abs(kept.mean(axis=0))
     solver = uncorrelated_grouping([kept], params.averaging_min_batches, target)
-    print(f"  the solver's verdict (target {target:g}): batch spread {spread[0]:.2%} (heat), {spread[1]:.2%} (term); "
-          f"{'accepted' if solver.uncorrelated else 'not yet'}: {solver.groups} groups of {solver.size}")
+    print(
+        f"  the solver's verdict (target {target:g}): batch spread {spread[0]:.2%} (heat), {spread[1]:.2%} (term); "
+        f"{'accepted' if solver.uncorrelated else 'not yet'}: {solver.groups} groups of {solver.size}"
+    )
 
 
 def main() -> None:

@@ -29,15 +29,20 @@ def main() -> None:
     started = time.perf_counter()
     calibration = sm.calibrate(base, free)
     elapsed = time.perf_counter() - started
-    print(f"calibration with its covariance: {elapsed:.0f} s (target <= {TARGET_S:.0f} s: {'met' if elapsed <= TARGET_S else 'MISSED'}); "
-          f"{calibration.evaluations} network evaluations")
+    print(
+        f"calibration with its covariance: {elapsed:.0f} s (target <= {TARGET_S:.0f} s: "
+        f"{'met' if elapsed <= TARGET_S else 'MISSED'}); "
+        f"{calibration.evaluations} network evaluations"
+    )
     print(f"curve RMS {calibration.curve_rms_K:.2f} K; on a range edge: {', '.join(calibration.at_bounds) or 'none'}")
     covariance = np.array(calibration.covariance)
     ranges = calibration.posterior_ranges
     for index, key in enumerate(free):
-        print(f"  {key} = {calibration.fitted[key]:.4g} ± {calibration.parameter_stderr[key]:.3g} "
-              f"(σ of its logarithm {math.sqrt(covariance[index, index]):.3g}); posterior 90 %: "
-              f"{ranges[key][0]:.4g} to {ranges[key][1]:.4g}")
+        print(
+            f"  {key} = {calibration.fitted[key]:.4g} ± {calibration.parameter_stderr[key]:.3g} "
+            f"(σ of its logarithm {math.sqrt(covariance[index, index]):.3g}); posterior 90 %: "
+            f"{ranges[key][0]:.4g} to {ranges[key][1]:.4g}"
+        )
     correlation = covariance / np.sqrt(np.outer(np.diag(covariance), np.diag(covariance)))
     print("correlation of the logarithms:\n" + np.array2string(correlation, precision=4))
     fitted = base.replace(**calibration.fitted)

@@ -29,8 +29,12 @@ def fenced(text: str, language: str, first_line: str) -> str:
 def guide_commands(text: str) -> list[list[str]]:
     """The guide's commands on my-mill.toml, in order: its check run, its fit, its prediction."""
     check = re.search(r"`shakermill (run my-mill\.toml [^`]*)`", text).group(1)
-    fits = [line for line in text.splitlines() if line.startswith(".venv/bin/shakermill calibrate my-mill.toml --curve")]
-    predictions = [line for line in text.splitlines() if line.startswith(".venv/bin/shakermill run my-mill-fitted.toml")]
+    fits = [
+        line for line in text.splitlines() if line.startswith(".venv/bin/shakermill calibrate my-mill.toml --curve")
+    ]
+    predictions = [
+        line for line in text.splitlines() if line.startswith(".venv/bin/shakermill run my-mill-fitted.toml")
+    ]
     return [shlex.split(check), *(shlex.split(line)[1:] for line in (fits[0], predictions[0]))]
 
 
@@ -49,7 +53,10 @@ def main() -> None:
             tail = completed.stdout.strip().splitlines()[-5:] + completed.stderr.strip().splitlines()[-1:]
             print("\n".join(f"  | {line[:160]}" for line in tail))
         fitted = tomllib.loads((work / "my-mill-fitted.toml").read_text(encoding="utf-8"))
-        print("my-mill-fitted.toml: " + ", ".join(f"{key} = {value}" for key, value in fitted.items() if not isinstance(value, dict)))
+        print(
+            "my-mill-fitted.toml: "
+            + ", ".join(f"{key} = {value}" for key, value in fitted.items() if not isinstance(value, dict))
+        )
 
 
 if __name__ == "__main__":

@@ -20,8 +20,14 @@ import shakermill as sm
 from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import DemEngine
 
-BOWL = {"ball_radius": 2.5e-3, "vial_diameter": 0.1, "vial_length": 0.0637, "outer_diameter": 0.12,
-        "outer_length": 0.08, "record_windows": ()}
+BOWL = {
+    "ball_radius": 2.5e-3,
+    "vial_diameter": 0.1,
+    "vial_length": 0.0637,
+    "outer_diameter": 0.12,
+    "outer_length": 0.08,
+    "record_windows": (),
+}
 
 
 def measure(balls: int, window: float, every_pair: bool) -> dict[str, float]:
@@ -39,8 +45,13 @@ def measure(balls: int, window: float, every_pair: bool) -> dict[str, float]:
         pass
     cpu = time.process_time() - start
     counters = engine.counters()
-    return {"cpu_per_second": cpu / window, "steps": counters["steps"], "builds": counters["neighbour_builds"],
-            "ns_per_ball_step": 1e9 * cpu / (counters["steps"] * balls), "cpu": cpu}
+    return {
+        "cpu_per_second": cpu / window,
+        "steps": counters["steps"],
+        "builds": counters["neighbour_builds"],
+        "ns_per_ball_step": 1e9 * cpu / (counters["steps"] * balls),
+        "cpu": cpu,
+    }
 
 
 def main() -> None:
@@ -61,8 +72,11 @@ def main() -> None:
             if not every_pair:
                 listed.append(figures["cpu_per_second"])
             name = "every pair" if every_pair else "list"
-            print(f"{balls:>6} {name:>10} {figures['cpu_per_second']:>10.1f} {figures['steps']:>9} "
-                  f"{figures['ns_per_ball_step']:>13.0f} {figures['builds']:>7}", flush=True)
+            print(
+                f"{balls:>6} {name:>10} {figures['cpu_per_second']:>10.1f} {figures['steps']:>9} "
+                f"{figures['ns_per_ball_step']:>13.0f} {figures['builds']:>7}",
+                flush=True,
+            )
     exponent = np.polyfit(np.log(counts), np.log(listed), 1)[0]
     print(f"cost ∝ balls^{exponent:.2f} with the neighbour list over {counts[0]}-{counts[-1]} balls (1: linear)")
 

@@ -55,15 +55,20 @@ def main() -> None:
     parser.add_argument("--only", help="run only the cases whose name contains this text")
     args = parser.parse_args()
     DemEngine(sm.default_parameters(engine="dem", n_balls=2, vial_diameter="38 mm")).advance(0.01)  # compile
-    header = (f"{'case':<22} {'sim s':>5} | {'wall/sim s':>10} {'CPU/sim s':>9} | {'steps/sim s':>11} "
-              f"{'contact %':>9} | {'impacts/s':>9} | {'heat W':>9} {'±SE W':>8}")
+    header = (
+        f"{'case':<22} {'sim s':>5} | {'wall/sim s':>10} {'CPU/sim s':>9} | {'steps/sim s':>11} "
+        f"{'contact %':>9} | {'impacts/s':>9} | {'heat W':>9} {'±SE W':>8}"
+    )
     print(header + "\n" + "-" * len(header))
     for name, (keys, seconds) in CASES.items():
         if args.only and args.only not in name:
             continue
         r = run(keys, seconds)
-        print(f"{name:<22} {seconds:5d} | {r['wall']:10.2f} {r['cpu']:9.2f} | {r['steps']:11,.0f} {r['contact']:9.1f} | "
-              f"{r['impacts']:9.1f} | {r['heat']:9.5f} {r['se']:8.5f}", flush=True)
+        print(
+            f"{name:<22} {seconds:5d} | {r['wall']:10.2f} {r['cpu']:9.2f} | {r['steps']:11,.0f} {r['contact']:9.1f} | "
+            f"{r['impacts']:9.1f} | {r['heat']:9.5f} {r['se']:8.5f}",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

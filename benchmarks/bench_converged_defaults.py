@@ -75,7 +75,8 @@ def grid(workers: int) -> None:
     with ProcessPoolExecutor(max_workers=workers) as pool:
         runs = list(pool.map(_point, points))
     header = (
-        f"{'omega':>5} {'X mm':>4} | {'heat 1e-3':>9} {'1e-5':>7} {'1e-6':>7} | {'rate 1e-3':>9} {'1e-5':>6} {'1e-6':>6} | "
+        f"{'omega':>5} {'X mm':>4} | {'heat 1e-3':>9} {'1e-5':>7} {'1e-6':>7} | {'rate 1e-3':>9} {'1e-5':>6} "
+        f"{'1e-6':>6} | "
         f"{'dheat %':>7} {'drate %':>7} | verdict"
     )
     print(header)
@@ -97,9 +98,12 @@ def grid(workers: int) -> None:
         f"verdict: {counted} of {len(points)} points counted (references agree), {passed} of {counted} pass "
         f"(default within {100 * HEAT_MARGIN:g} % heat, {100 * RATE_MARGIN:g} % rate)"
     )
-    print(f"wall time per {DURATION:g} s run, mean over the grid: " + ", ".join(
-        f"rtol {rtol:g} {wall:.3f} s" for rtol, wall in zip((DEFAULT_RTOL, *REFERENCE_RTOLS), walls.mean(axis=0))
-    ))
+    print(
+        f"wall time per {DURATION:g} s run, mean over the grid: "
+        + ", ".join(
+            f"rtol {rtol:g} {wall:.3f} s" for rtol, wall in zip((DEFAULT_RTOL, *REFERENCE_RTOLS), walls.mean(axis=0))
+        )
+    )
 
 
 def _worst_restitution_error(rtol: float) -> float:
@@ -113,7 +117,9 @@ def _worst_restitution_error(rtol: float) -> float:
 
 def study() -> None:
     """The README's table: 60 simulated s of the default preset at the default atol, and single impacts."""
-    print("\nrtol  | heat W  | rate Hz | projection/dissipated | steps/impact | s per sim. hour | worst restitution error")
+    print(
+        "\nrtol  | heat W  | rate Hz | projection/dissipated | steps/impact | s per sim. hour | worst restitution error"
+    )
     base = sm.default_parameters(duration=60.0, record_windows=())
     for rtol in (1e-3, 1e-4, 1e-5, 1e-6):
         started = time.perf_counter()

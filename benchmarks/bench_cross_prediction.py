@@ -34,20 +34,29 @@ def main() -> None:
 
     found = cross_prediction(members=arguments.members, thermal_draws=arguments.thermal_draws, progress=progress)
     wall = time.perf_counter() - started
-    print(f"\nwall time {wall:.0f} s for {2 * arguments.members} mechanical runs x {arguments.thermal_draws} network "
-          "points, the emulators and two posteriors")
+    print(
+        f"\nwall time {wall:.0f} s for {2 * arguments.members} mechanical runs x {arguments.thermal_draws} network "
+        "points, the emulators and two posteriors"
+    )
     for name, emulator in found.emulators.items():
-        print(f"{name}: held-out Q² " + ", ".join(f"{key} {value:.2f}" for key, value in emulator.q2.items())
-              + (f"; failed runs: {emulator.failed}" if emulator.failed else ""))
+        print(
+            f"{name}: held-out Q² "
+            + ", ".join(f"{key} {value:.2f}" for key, value in emulator.q2.items())
+            + (f"; failed runs: {emulator.failed}" if emulator.failed else "")
+        )
     for direction in found.directions:
-        print(f"\nfitted on {direction.fitted_on.name} (acceptance {direction.posterior.acceptance:.2f}, "
-              f"autocorrelation {direction.posterior.autocorrelation_steps:.0f} steps, "
-              f"{'converged' if direction.posterior.converged else 'NOT converged'}):")
+        print(
+            f"\nfitted on {direction.fitted_on.name} (acceptance {direction.posterior.acceptance:.2f}, "
+            f"autocorrelation {direction.posterior.autocorrelation_steps:.0f} steps, "
+            f"{'converged' if direction.posterior.converged else 'NOT converged'}):"
+        )
         for key, (low, middle, high) in direction.posterior.quantiles().items():
             print(f"  {key:20s} {low:10.4g} {middle:10.4g} {high:10.4g}")
         for point in direction.fitted:
-            print(f"  fitted point {point.observable.label}: measured {point.measured_K:.3g} K, 90 % "
-                  f"{point.quantiles[0]:.3g} to {point.quantiles[2]:.3g} K, {'inside' if point.inside else 'OUTSIDE'}")
+            print(
+                f"  fitted point {point.observable.label}: measured {point.measured_K:.3g} K, 90 % "
+                f"{point.quantiles[0]:.3g} to {point.quantiles[2]:.3g} K, {'inside' if point.inside else 'OUTSIDE'}"
+            )
     print()
     for row in cross_rows(found):
         print(" | ".join(row))

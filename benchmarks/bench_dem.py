@@ -20,8 +20,9 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, TypeVar
+from typing import TypeVar
 
 import numpy as np
 
@@ -131,7 +132,9 @@ def table(header: str) -> None:
 
 
 def full_run(plan: Plan) -> None:
-    heading(f"1. Five balls, {plan.full_seconds:g} simulated s at full resolution (vial 38 mm, friction 0.3, gravity on)")
+    heading(
+        f"1. Five balls, {plan.full_seconds:g} simulated s at full resolution (vial 38 mm, friction 0.3, gravity on)"
+    )
     result, timing = timed(lambda: simulate(**FIVE_BALLS, duration=plan.full_seconds), 1)
     c, s = result.counters, result.summary
     scale = 60.0 / plan.full_seconds
@@ -139,8 +142,10 @@ def full_run(plan: Plan) -> None:
     scaled = "" if scale == 1.0 else scaled
     print(f"time: {timing}{scaled}; target <= {FULL_TARGET:g} s: {verdict(timing, scale, FULL_TARGET)}")
     print(
-        f"steps {c['steps']:,} (contact {c['contact_steps']:,}, flight {c['flight_steps']:,}), impacts {c['impacts']:,}; "
-        f"{c['steps'] / timing.median:,.0f} steps per wall second, {c['steps'] / timing.cpu_median:,.0f} per CPU second "
+        f"steps {c['steps']:,} (contact {c['contact_steps']:,}, flight {c['flight_steps']:,}), impacts "
+        f"{c['impacts']:,}; "
+        f"{c['steps'] / timing.median:,.0f} steps per wall second, {c['steps'] / timing.cpu_median:,.0f} per "
+        "CPU second "
         f"({1e6 * timing.cpu_median / c['steps']:.2f} µs a step)"
     )
     print(f"heat power {s['heat_power_W']:.3f} W, impact rate {s['impact_rate_hz']:.1f} Hz (transient included)")
@@ -152,7 +157,8 @@ def averaged_run() -> None:
     a, s = result.averages, result.summary
     print(f"time: {timing}; target <= {AVERAGED_TARGET:g} s: {verdict(timing, 1.0, AVERAGED_TARGET)}")
     print(
-        f"mechanics: {a.transient + a.window:.1f} simulated s ({a.transient:.1f} s transient cut, a window of {a.batches} "
+        f"mechanics: {a.transient + a.window:.1f} simulated s ({a.transient:.1f} s transient cut, a window of "
+        f"{a.batches} "
         f"batches = {a.window:.1f} s), {result.counters['steps']:,} steps; {a.message}"
     )
     print(f"heat power {s['heat_power_W']:.3f} ± {a.heat_power_stderr:.3f} W, θ∞ {s['theta_inf_C']:.1f} °C")
@@ -165,11 +171,14 @@ def ball_counts(plan: Plan, repeats: int) -> None:
         f"{'steps/sim s':>11} {'contact %':>9} {'impacts/sim s':>13} | {'µs/step':>7}"
     )
     for n, seconds in plan.ball_counts.items():
-        result, timing = timed(lambda: simulate(**{**FIVE_BALLS, "n_balls": n}, duration=seconds), repeats)
+        result, timing = timed(
+            lambda n=n, seconds=seconds: simulate(**{**FIVE_BALLS, "n_balls": n}, duration=seconds), repeats
+        )
         c = result.counters
         print(
             f"{n:3d} {seconds:5g} | {timing.median:7.2f} {timing.cpu_median:7.2f} | {timing.median / seconds:10.3f} "
-            f"{timing.cpu_median / seconds:9.3f} | {c['steps'] / seconds:11,.0f} {100 * c['contact_steps'] / c['steps']:9.1f} "
+            f"{timing.cpu_median / seconds:9.3f} | {c['steps'] / seconds:11,.0f} "
+            f"{100 * c['contact_steps'] / c['steps']:9.1f} "
             f"{c['impacts'] / seconds:13,.0f} | {1e6 * timing.cpu_median / c['steps']:7.2f}"
         )
     print(repeat_note(repeats))
@@ -214,7 +223,8 @@ def limit_convergence(plan: Plan, repeats: int) -> None:
     for fraction, (result, timing) in zip(plan.fractions, runs):
         heat, later = result.summary["heat_power_W"], settled_heat(result)
         print(
-            f"{fraction:8g} | {heat:8.5f} {percent(heat, whole):+9.3f} {percent(heat, finest.summary['heat_power_W']):+11.3f} | "
+            f"{fraction:8g} | {heat:8.5f} {percent(heat, whole):+9.3f} "
+            f"{percent(heat, finest.summary['heat_power_W']):+11.3f} | "
             f"{later:10.5f} {percent(later, half):+9.3f} {percent(later, settled_heat(finest)):+11.3f} | "
             f"{result.summary['impact_rate_hz']:7.2f} | {timing.median:6.2f} {timing.cpu_median:6.2f}"
         )
@@ -264,7 +274,8 @@ def five_ball_convergence(plan: Plan) -> None:
     heat_ref, rate_ref = runs[plan.fractions[-1]].rates(0, seconds)
     print(f"\n(c) five balls, {seconds} simulated s (defaults otherwise), against the finest fraction")
     table(
-        f"{'fraction':>8} | {'heat W':>7} {'vs finest %':>11} {'±SE %':>6} | {'rate Hz':>7} {'vs finest %':>11} {'±SE %':>6} | "
+        f"{'fraction':>8} | {'heat W':>7} {'vs finest %':>11} {'±SE %':>6} | {'rate Hz':>7} "
+        f"{'vs finest %':>11} {'±SE %':>6} | "
         f"{'wall s':>6} {'CPU s':>6} {'60 s est. CPU':>13}"
     )
     errors = {fraction: run.relative_errors(seconds) for fraction, run in runs.items()}
@@ -301,7 +312,8 @@ def flight_step_convergence(plan: Plan, repeats: int) -> None:
         heat = result.summary["heat_power_W"]
         print(
             f"{step:17g} | {heat:8.5f} {percent(heat, reference.summary['heat_power_W']):+9.4f} "
-            f"{percent(settled_heat(result), settled_heat(reference)):+10.4f} | {result.summary['impact_rate_hz']:7.2f} | "
+            f"{percent(settled_heat(result), settled_heat(reference)):+10.4f} | "
+            f"{result.summary['impact_rate_hz']:7.2f} | "
             f"{timing.median:6.2f} {timing.cpu_median:6.2f}"
         )
 
@@ -309,16 +321,21 @@ def flight_step_convergence(plan: Plan, repeats: int) -> None:
 def converged_means(plan: Plan) -> None:
     print("\n(f) five balls: the averaged solver's converged means (its mechanics phase) against the fraction")
     table(
-        f"{'fraction':>8} | {'heat W':>7} {'±SE W':>6} {'vs finest %':>11} {'±σ %':>5} | {'rate Hz':>7} {'vs finest %':>11} | "
+        f"{'fraction':>8} | {'heat W':>7} {'±SE W':>6} {'vs finest %':>11} {'±σ %':>5} | {'rate Hz':>7} "
+        f"{'vs finest %':>11} | "
         f"{'mechanics s':>11} | {'wall s':>6} {'CPU s':>6}"
     )
-    runs = {f: timed(lambda: simulate(**FIVE_BALLS, solver="averaged", contact_step_fraction=f), 1) for f in plan.fractions}
+    runs = {
+        f: timed(lambda f=f: simulate(**FIVE_BALLS, solver="averaged", contact_step_fraction=f), 1)
+        for f in plan.fractions
+    }
     finest, _ = runs[plan.fractions[-1]]
     for fraction, (result, timing) in runs.items():
         a, rate, reference = result.averages, result.summary["impact_rate_hz"], finest.averages
         sigma = 100 * np.hypot(a.heat_power_stderr, reference.heat_power_stderr) / reference.heat_power
         print(
-            f"{fraction:8g} | {a.heat_power:7.3f} {a.heat_power_stderr:6.3f} {percent(a.heat_power, reference.heat_power):+11.2f} "
+            f"{fraction:8g} | {a.heat_power:7.3f} {a.heat_power_stderr:6.3f} "
+            f"{percent(a.heat_power, reference.heat_power):+11.2f} "
             f"{sigma:5.2f} | {rate:7.1f} {percent(rate, finest.summary['impact_rate_hz']):+11.2f} | "
             f"{a.transient + a.window:11.1f} | {timing.median:6.2f} {timing.cpu_median:6.2f}"
         )
@@ -343,11 +360,12 @@ def one_d_limit(plan: Plan, repeats: int) -> None:
         "(dem: defaults, no gravity, no friction, convection from the ball)"
     )
     table(
-        f"{'omega':>5} | {'heat dem':>8} {'1-D':>8} {'1-D tight':>9} | {'vs 1-D %':>8} {'vs tight %':>10} {'2nd half %':>10} | "
+        f"{'omega':>5} | {'heat dem':>8} {'1-D':>8} {'1-D tight':>9} | {'vs 1-D %':>8} {'vs tight %':>10} "
+        f"{'2nd half %':>10} | "
         f"{'rate dem':>8} {'1-D':>6} {'tight':>6} | {'vs 1-D %':>8} {'vs tight %':>10} | {'dem s':>5} | targets"
     )
     for omega in OMEGAS:
-        dem, timing = timed(lambda: simulate(**ONE_D_LIMIT, omega=omega, duration=seconds), repeats)
+        dem, timing = timed(lambda omega=omega: simulate(**ONE_D_LIMIT, omega=omega, duration=seconds), repeats)
         loose = simulate(engine="1d", omega=omega, duration=seconds)
         tight = simulate(**TIGHT_1D, omega=omega, duration=seconds)
         heat = [run.summary["heat_power_W"] for run in (dem, loose, tight)]
@@ -356,12 +374,14 @@ def one_d_limit(plan: Plan, repeats: int) -> None:
         print(
             f"{omega:5.0f} | {heat[0]:8.5f} {heat[1]:8.5f} {heat[2]:9.5f} | "
             f"{percent(heat[0], heat[1]):+8.3f} {percent(heat[0], heat[2]):+10.3f} "
-            f"{percent(settled_heat(dem), settled_heat(tight)):+10.3f} | {rate[0]:8.2f} {rate[1]:6.2f} {rate[2]:6.2f} | "
+            f"{percent(settled_heat(dem), settled_heat(tight)):+10.3f} | {rate[0]:8.2f} {rate[1]:6.2f} "
+            f"{rate[2]:6.2f} | "
             f"{percent(rate[0], rate[1]):+8.2f} {percent(rate[0], rate[2]):+10.2f} | {timing.median:5.2f} | "
             f"{'met' if met else 'MISSED'}"
         )
     print(
-        f"targets: heat within {100 * HEAT_TARGET:g} %, impact rate within {100 * RATE_TARGET:g} % of the 1-D engine at "
+        f"targets: heat within {100 * HEAT_TARGET:g} %, impact rate within {100 * RATE_TARGET:g} % of the 1-D "
+        "engine at "
         "rtol 1e-6 (whole run); '2nd half': heat of dem against tight over the run's second half"
     )
 

@@ -34,8 +34,9 @@ FRACTIONS = (BEFORE, 0.02, 0.05, 0.1)
 
 
 def one_second(preset: str, settings: dict, fraction: float) -> tuple[float, dict]:
-    params = sm.default_parameters(preset, **settings, duration=1.0, solver="full", record_windows=(),
-                                   enduring_step_fraction=fraction)
+    params = sm.default_parameters(
+        preset, **settings, duration=1.0, solver="full", record_windows=(), enduring_step_fraction=fraction
+    )
     started = time.process_time()
     result = sm.simulate(params)
     return time.process_time() - started, result.summary
@@ -54,10 +55,16 @@ def main() -> None:
     parser.add_argument("--no-averaged", action="store_true", help="only the cost of one simulated second")
     parser.add_argument("--no-second", action="store_true", help="only the averaged solver's means")
     parser.add_argument("--fractions", type=float, nargs="*", default=FRACTIONS, help="enduring_step_fraction values")
-    parser.add_argument("--rel-error", type=float, help="dem_averaging_rel_error of the averaged rows (default: the preset's)")
+    parser.add_argument(
+        "--rel-error", type=float, help="dem_averaging_rel_error of the averaged rows (default: the preset's)"
+    )
     parser.add_argument("--replicas", type=int, default=1, help="dem_replicas of the averaged rows")
     options = parser.parse_args()
-    tighter = {} if options.rel_error is None else {"dem_averaging_rel_error": options.rel_error, "averaging_max_time": 3600.0}
+    tighter = (
+        {}
+        if options.rel_error is None
+        else {"dem_averaging_rel_error": options.rel_error, "averaging_max_time": 3600.0}
+    )
     sm.simulate(sm.default_parameters("spex8000m-3d", duration=0.01, solver="full", record_windows=()))  # compile
     for mill in options.mills:
         preset, settings = MILLS[mill]
@@ -66,8 +73,10 @@ def main() -> None:
             print("  one simulated second at full resolution:")
             for fraction in options.fractions:
                 cpu, summary = one_second(preset, settings, fraction)
-                print(f"    enduring_step_fraction {fraction:<5g}  {cpu:6.2f} CPU-s  {summary['steps']:>9,} steps  "
-                      f"{summary['impacts']:>5} impacts")
+                print(
+                    f"    enduring_step_fraction {fraction:<5g}  {cpu:6.2f} CPU-s  {summary['steps']:>9,} steps  "
+                    f"{summary['impacts']:>5} impacts"
+                )
         if options.no_averaged:
             continue
         print("  averaged solver (the preset's hour):")
@@ -76,14 +85,19 @@ def main() -> None:
             cpu, summary = averaged(preset, {**settings, **tighter, "dem_replicas": options.replicas}, fraction)
             power, error = summary["averaged_heat_power_W"], summary["averaged_heat_power_stderr_W"]
             rate, speed = summary["impact_rate_hz"], summary["mean_impact_speed_m_s"]
-            line = (f"    enduring_step_fraction {fraction:<5g}  {cpu:6.1f} CPU-s  heat {power:.4g} ± {error:.2g} W  "
-                    f"impacts {rate:.4g} /s  mean impact speed {speed:.4g} m/s  mechanics {summary['averaging_window_s']:.3g} s")
+            line = (
+                f"    enduring_step_fraction {fraction:<5g}  {cpu:6.1f} CPU-s  heat {power:.4g} ± {error:.2g} W  "
+                f"impacts {rate:.4g} /s  mean impact speed {speed:.4g} m/s  mechanics "
+                f"{summary['averaging_window_s']:.3g} s"
+            )
             if reference is None:
                 reference = (power, error, rate, speed)
             else:
                 combined = math.hypot(error, reference[1])
-                line += (f"  | heat {(power - reference[0]) / combined:+.2f} σ, impacts {rate / reference[2] - 1:+.1%}, "
-                         f"speed {speed / reference[3] - 1:+.1%}")
+                line += (
+                    f"  | heat {(power - reference[0]) / combined:+.2f} σ, impacts {rate / reference[2] - 1:+.1%}, "
+                    f"speed {speed / reference[3] - 1:+.1%}"
+                )
             print(line, flush=True)
 
 

@@ -39,7 +39,9 @@ INTERRUPT_AFTER_S = 6.0
 
 def run_time(arguments: list[str], out: Path) -> float:
     started = time.perf_counter()
-    subprocess.run([str(SHAKERMILL), "run", *arguments, "--no-plots", "--out", str(out)], check=True, capture_output=True)
+    subprocess.run(
+        [str(SHAKERMILL), "run", *arguments, "--no-plots", "--out", str(out)], check=True, capture_output=True
+    )
     return time.perf_counter() - started
 
 
@@ -50,8 +52,9 @@ def cpu_seconds(pid: int) -> float:
 
 def interrupt(arguments: list[str], out: Path) -> tuple[float, float]:
     """Wall and CPU seconds from a SIGINT to the exit of ``shakermill run ARGUMENTS``."""
-    process = subprocess.Popen([str(SHAKERMILL), "run", *arguments, "--out", str(out)], stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
+    process = subprocess.Popen(
+        [str(SHAKERMILL), "run", *arguments, "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     time.sleep(INTERRUPT_AFTER_S)
     used = cpu_seconds(process.pid)
     signalled = time.perf_counter()
@@ -75,7 +78,10 @@ def main() -> None:
         for label, arguments in SHORT_RUNS.items():
             run_time([*arguments, "--set", "solver=full"], folder / f"warm-{len(label)}")  # Numba's cache warm
             preset = [run_time(arguments, folder / f"preset-{label}-{index}") for index in range(repeats)]
-            full = [run_time([*arguments, "--set", "solver=full"], folder / f"full-{label}-{index}") for index in range(repeats)]
+            full = [
+                run_time([*arguments, "--set", "solver=full"], folder / f"full-{label}-{index}")
+                for index in range(repeats)
+            ]
             print(f"{label:<28} preset's solver {spread(preset)}")
             print(f"{'':<28} solver=full     {spread(full)}")
             print(f"{'':<28} ratio of medians {statistics.median(preset) / statistics.median(full):.2f} (target ≤ 1.5)")

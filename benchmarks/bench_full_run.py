@@ -28,7 +28,9 @@ print(time.perf_counter() - started)
 
 def _fresh_process_seconds(cache_dir: str) -> float:
     environment = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
-    output = subprocess.run([sys.executable, "-c", _COLD_START], env=environment, capture_output=True, text=True, check=True)
+    output = subprocess.run(
+        [sys.executable, "-c", _COLD_START], env=environment, capture_output=True, text=True, check=True
+    )
     return float(output.stdout.strip().splitlines()[-1])
 
 
@@ -56,7 +58,8 @@ def main() -> None:
     print(
         f"default 60-min run, warm: median {median:.2f} s over {args.repeats} "
         f"(min {min(times):.2f}, max {max(times):.2f}); {summary['impacts']} impacts, {summary['steps']} steps, "
-        f"{summary['rhs_evaluations']} RHS evaluations ({1e9 * median / summary['rhs_evaluations']:.0f} ns each, all included)"
+        f"{summary['rhs_evaluations']} RHS evaluations ({1e9 * median / summary['rhs_evaluations']:.0f} ns each, all "
+        "included)"
     )
     paper_seconds = 41.3 * 60
     print(f"paper's MATLAB ode23 run of the same 60 min: {paper_seconds:.0f} s -> {paper_seconds / median:.0f}x faster")

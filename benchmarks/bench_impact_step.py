@@ -45,8 +45,15 @@ AVERAGED_MILLS = {
     "pulverisette7, 10 balls": ("pulverisette7", {}),
     "mm400, 2 balls": ("mm400", {}),
 }
-AVERAGED_KEYS = ("averaged_heat_power_W", "averaged_heat_power_stderr_W", "impact_rate_hz", "mean_impact_speed_m_s",
-                 "stress_energy_median_J", "stress_energy_p90_J", "averaging_window_s")
+AVERAGED_KEYS = (
+    "averaged_heat_power_W",
+    "averaged_heat_power_stderr_W",
+    "impact_rate_hz",
+    "mean_impact_speed_m_s",
+    "stress_energy_median_J",
+    "stress_energy_p90_J",
+    "averaging_window_s",
+)
 
 
 def restitution_part() -> None:
@@ -80,8 +87,12 @@ def measure_second() -> dict:
         params = sm.default_parameters(preset, **settings, duration=1.0, solver="full", record_windows=())
         started = cpu_seconds()
         result = sm.simulate(params)
-        figures[mill] = {"cpu": cpu_seconds() - started, "steps": result.counters["steps"],
-                         "impacts": result.counters["impacts"], "heat": result.summary["heat_power_W"]}
+        figures[mill] = {
+            "cpu": cpu_seconds() - started,
+            "steps": result.counters["steps"],
+            "impacts": result.counters["impacts"],
+            "heat": result.summary["heat_power_W"],
+        }
     return figures
 
 
@@ -105,12 +116,16 @@ def second_part(trees: dict) -> None:
     for mill in SECOND_MILLS:
         for name, figures in runs.items():
             row = figures[mill]
-            print(f"  {mill:<26} {name:<22} {row['cpu']:6.2f} CPU-s {row['steps']:>10,} steps "
-                  f"{row['impacts']:>6} impacts heat {row['heat']:.4g} W")
+            print(
+                f"  {mill:<26} {name:<22} {row['cpu']:6.2f} CPU-s {row['steps']:>10,} steps "
+                f"{row['impacts']:>6} impacts heat {row['heat']:.4g} W"
+            )
         if len(runs) == 2:
             before, after = (figures[mill] for figures in runs.values())
-            print(f"  {mill:<26} {'ratio':<22} {before['cpu'] / after['cpu']:6.2f}x less CPU, "
-                  f"{before['steps'] / after['steps']:.2f}x fewer steps")
+            print(
+                f"  {mill:<26} {'ratio':<22} {before['cpu'] / after['cpu']:6.2f}x less CPU, "
+                f"{before['steps'] / after['steps']:.2f}x fewer steps"
+            )
 
 
 def averaged_part(trees: dict) -> None:
@@ -122,16 +137,24 @@ def averaged_part(trees: dict) -> None:
         base = reference[mill]
         for name, figures in runs.items():
             row = figures[mill]
-            line = (f"  {mill:<24} {name:<24} {row['cpu']:6.1f} CPU-s  heat {row['averaged_heat_power_W']:.4g} "
-                    f"± {row['averaged_heat_power_stderr_W']:.2g} W  impacts {row['impact_rate_hz']:.4g}/s  "
-                    f"speed {row['mean_impact_speed_m_s']:.4g} m/s  stress energy median "
-                    f"{1e6 * row['stress_energy_median_J']:.4g} µJ, p90 {1e6 * row['stress_energy_p90_J']:.4g} µJ  "
-                    f"mechanics {row['averaging_window_s']:.3g} s")
+            line = (
+                f"  {mill:<24} {name:<24} {row['cpu']:6.1f} CPU-s  heat {row['averaged_heat_power_W']:.4g} "
+                f"± {row['averaged_heat_power_stderr_W']:.2g} W  impacts {row['impact_rate_hz']:.4g}/s  "
+                f"speed {row['mean_impact_speed_m_s']:.4g} m/s  stress energy median "
+                f"{1e6 * row['stress_energy_median_J']:.4g} µJ, p90 {1e6 * row['stress_energy_p90_J']:.4g} µJ  "
+                f"mechanics {row['averaging_window_s']:.3g} s"
+            )
             if row is not base:
                 combined = math.hypot(row["averaged_heat_power_stderr_W"], base["averaged_heat_power_stderr_W"])
-                shifts = ", ".join(f"{label} {row[key] / base[key] - 1:+.1%}" for label, key in (
-                    ("impacts", "impact_rate_hz"), ("speed", "mean_impact_speed_m_s"),
-                    ("median", "stress_energy_median_J"), ("p90", "stress_energy_p90_J")))
+                shifts = ", ".join(
+                    f"{label} {row[key] / base[key] - 1:+.1%}"
+                    for label, key in (
+                        ("impacts", "impact_rate_hz"),
+                        ("speed", "mean_impact_speed_m_s"),
+                        ("median", "stress_energy_median_J"),
+                        ("p90", "stress_energy_p90_J"),
+                    )
+                )
                 sigmas = (row["averaged_heat_power_W"] - base["averaged_heat_power_W"]) / combined
                 line += f"\n  {'':<24} {'':<24} heat {sigmas:+.2f} σ, {shifts}"
             print(line, flush=True)

@@ -79,8 +79,10 @@ def contact_law(params: sm.Parameters) -> tuple[str, str]:
         raise SystemExit("bench_lammps: the charge's vial and balls must be of one material")
 
     def model(e: float, mu: float) -> str:
-        return (f"hertz/material {params.ball_youngs_modulus} {e} {nu} tangential mindlin NULL {x_gamma_t} {mu} "
-                f"damping coeff_restitution")
+        return (
+            f"hertz/material {params.ball_youngs_modulus} {e} {nu} tangential mindlin NULL {x_gamma_t} {mu} "
+            f"damping coeff_restitution"
+        )
 
     return model(params.pair_restitution, params.pair_friction), model(params.restitution, params.friction)
 
@@ -124,8 +126,9 @@ def lammps_restitution(lammps, params: sm.Parameters, dt: float, speed: float, w
         lmp.command(f"set atom 1 vz {speed / 2}")
         lmp.command(f"set atom 2 vz {-speed / 2}")
     # The wall contact is the longest of the two (m* = m, R* = R); twice it leaves each ball free again.
-    e_star = effective_modulus(params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus,
-                               params.vial_poisson_ratio)
+    e_star = effective_modulus(
+        params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus, params.vial_poisson_ratio
+    )
     lmp.command(f"run {int(2.0 * hertz_contact_time(params.ball_mass, radius, e_star, speed) / dt) + 100}")
     velocity = lmp.numpy.extract_atom("v")
     achieved = velocity[0, 2] / speed if wall else (velocity[1, 2] - velocity[0, 2]) / speed
@@ -137,13 +140,19 @@ def worst_restitution_errors(lammps, params: sm.Parameters, contact_step: float)
     """shakermill's worst |e_achieved - e| over SPEEDS at its default step, and LAMMPS's at each candidate step, in
     units of shakermill's ``contact_step`` (s)."""
     kinds = (("wall", params.restitution), ("ball", params.pair_restitution))
-    ours = max(abs(single_impact(params, float(speed), target=target).normal_restitution - e)
-               for speed in SPEEDS for target, e in kinds)
+    ours = max(
+        abs(single_impact(params, float(speed), target=target).normal_restitution - e)
+        for speed in SPEEDS
+        for target, e in kinds
+    )
     theirs = {}
     for factor in STEP_CANDIDATES:
         dt = factor * contact_step
-        theirs[dt] = max(abs(lammps_restitution(lammps, params, dt, float(speed), target == "wall") - e)
-                         for speed in SPEEDS for target, e in kinds)
+        theirs[dt] = max(
+            abs(lammps_restitution(lammps, params, dt, float(speed), target == "wall") - e)
+            for speed in SPEEDS
+            for target, e in kinds
+        )
     return ours, theirs
 
 
@@ -164,8 +173,7 @@ def lammps_charge(lammps, params: sm.Parameters, dt: float, duration: float, blo
     # At rest in the lab is moving against the vial, whose speed at t = 0 is X·ω·cos φ.
     velocity[:, 2] -= amplitude * omega * math.cos(phase)
     lmp, wall = new_lammps(lammps, dt, params, k.bore_radius * 1.05, k.half_length * 1.05)
-    lmp.create_atoms(len(position), None, [1] * len(position), position.ravel().tolist(),
-                     velocity.ravel().tolist())
+    lmp.create_atoms(len(position), None, [1] * len(position), position.ravel().tolist(), velocity.ravel().tolist())
     gravity = -k.gravity[2]
     lmp.commands_string(f"""set type 1 diameter {2 * params.ball_radius}
 set type 1 density {params.ball_density}
@@ -199,8 +207,12 @@ thermo_modify norm no
         kinetic = kinetic_energy(lmp)
         dissipated.append(drive_work - mass * gravity * (height - height0) - (kinetic - kinetic0))
     lmp.close()
-    return {"dissipated": np.array(dissipated), "cpu": cpu, "steps": steps_per_block * blocks,
-            "duration": steps_per_block * blocks * dt}
+    return {
+        "dissipated": np.array(dissipated),
+        "cpu": cpu,
+        "steps": steps_per_block * blocks,
+        "duration": steps_per_block * blocks * dt,
+    }
 
 
 def shakermill_charge(params: sm.Parameters, duration: float, blocks: int) -> dict[str, object]:
@@ -220,9 +232,16 @@ def shakermill_charge(params: sm.Parameters, duration: float, blocks: int) -> di
             raise RuntimeError(engine.explain(status))
         balance.append(totals[WORK_VIAL] + totals[WORK_GRAVITY] - (engine.kinetic_energy() - kinetic0))
         channels.append(float(totals[DISSIPATED_NORMAL : DISSIPATED_ROLLING + 1].sum()))
-    return {"dissipated": np.array(balance), "channels": np.array(channels), "cpu": cpu, "setup": setup,
-            "steps": engine.steps_taken(), "stored": engine.stored_contact_energy(),
-            "stiffening": float(totals[WORK_STIFFENING]), "duration": duration}
+    return {
+        "dissipated": np.array(balance),
+        "channels": np.array(channels),
+        "cpu": cpu,
+        "setup": setup,
+        "steps": engine.steps_taken(),
+        "stored": engine.stored_contact_energy(),
+        "stiffening": float(totals[WORK_STIFFENING]),
+        "duration": duration,
+    }
 
 
 def power_rows(name: str, result: dict[str, object], blocks: int, balls: int) -> str:
@@ -230,8 +249,10 @@ def power_rows(name: str, result: dict[str, object], blocks: int, balls: int) ->
     block = result["duration"] / blocks
     half = blocks // 2
     second_half = (energy[-1] - energy[half - 1]) / (block * (blocks - half))
-    return (f"{name:<34} {energy[-1] / result['duration']:>12.3f} {second_half:>12.3f} {result['cpu']:>10.1f} "
-            f"{result['steps']:>10d} {1e9 * result['cpu'] / (result['steps'] * balls):>8.1f}")
+    return (
+        f"{name:<34} {energy[-1] / result['duration']:>12.3f} {second_half:>12.3f} {result['cpu']:>10.1f} "
+        f"{result['steps']:>10d} {1e9 * result['cpu'] / (result['steps'] * balls):>8.1f}"
+    )
 
 
 def main() -> None:
@@ -246,8 +267,10 @@ def main() -> None:
     duration = options.duration or 2.0 * math.pi / sm.default_parameters("spex8000m-3d", **CHARGE).omega
     params = sm.default_parameters("spex8000m-3d", duration=duration, **CHARGE)
     version = lammps.lammps(cmdargs=QUIET)
-    print(f"LAMMPS {version.version()}; {params.n_balls} balls of Ø{2e3 * params.ball_radius:g} mm, "
-          f"{duration * 1e3:.1f} ms simulated")
+    print(
+        f"LAMMPS {version.version()}; {params.n_balls} balls of Ø{2e3 * params.ball_radius:g} mm, "
+        f"{duration * 1e3:.1f} ms simulated"
+    )
     version.close()
     contact_step = DemEngine(params).constants.contact_step
     ours, theirs = worst_restitution_errors(lammps, params, contact_step)
@@ -264,13 +287,19 @@ def main() -> None:
     print(power_rows("shakermill", mine, options.blocks, params.n_balls))
     print(power_rows("LAMMPS", other, options.blocks, params.n_balls))
     total_ours, total_theirs = mine["dissipated"][-1], other["dissipated"][-1]
-    print(f"\ndissipated energy: shakermill {total_ours:.5f} J, LAMMPS {total_theirs:.5f} J, "
-          f"difference {100 * (total_ours / total_theirs - 1):+.2f} %")
-    print(f"shakermill's channels {mine['channels'][-1]:.5f} J; stored in its contacts at the end "
-          f"{mine['stored']:.2e} J; work of stiffening Mindlin springs {mine['stiffening']:.2e} J "
-          "(neither is in the balance of either code)")
-    print(f"CPU time of the stepping: LAMMPS / shakermill = {other['cpu'] / mine['cpu']:.2f} "
-          f"(shakermill's set-up, packing included, {mine['setup']:.1f} s more)")
+    print(
+        f"\ndissipated energy: shakermill {total_ours:.5f} J, LAMMPS {total_theirs:.5f} J, "
+        f"difference {100 * (total_ours / total_theirs - 1):+.2f} %"
+    )
+    print(
+        f"shakermill's channels {mine['channels'][-1]:.5f} J; stored in its contacts at the end "
+        f"{mine['stored']:.2e} J; work of stiffening Mindlin springs {mine['stiffening']:.2e} J "
+        "(neither is in the balance of either code)"
+    )
+    print(
+        f"CPU time of the stepping: LAMMPS / shakermill = {other['cpu'] / mine['cpu']:.2f} "
+        f"(shakermill's set-up, packing included, {mine['setup']:.1f} s more)"
+    )
 
 
 if __name__ == "__main__":

@@ -9,9 +9,10 @@ temperature after 1 h in °C), the wall time per point (median) and in total, an
 into ``docs/figures/mill-study.png``. A second part runs one hour of five 12.7-mm balls at the preset's own
 settings and prints its wall time, heat power and the balls' and vial's temperatures.
 
-The preset is ``spex8000m-3d-calibrated-paper`` (the paper's three-node network), fitted to the one-ball curve only. A point whose
-mechanics do not converge within ``averaging_max_time`` fails with its reason (``averaging_fallback =
-'fail'``) instead of falling back to a full-resolution hour, which would take hours for a lone ball.
+The preset is ``spex8000m-3d-calibrated-paper`` (the paper's three-node network), fitted to the one-ball curve
+only. A point whose mechanics do not converge within ``averaging_max_time`` fails with its reason
+(``averaging_fallback = 'fail'``) instead of falling back to a full-resolution hour, which would take hours for a
+lone ball.
 
     .venv/bin/python benchmarks/bench_mill_study.py                          # all 30 points and the five-ball hour
     .venv/bin/python benchmarks/bench_mill_study.py --rel-error 0.02         # a quarter of the mechanics per point
@@ -83,7 +84,9 @@ def report_progress(started: float):
 
 def temperature_tables(table: pd.DataFrame) -> dict[str, pd.DataFrame]:
     """Per material: the balls' mean temperature after 1 h (°C), rows n_balls, columns the diameter in mm."""
-    table = table.assign(diameter_mm=(2e3 * table["ball_radius"]).round(1), ball_C=table["ball_C"].where(table["error"].isna()))
+    table = table.assign(
+        diameter_mm=(2e3 * table["ball_radius"]).round(1), ball_C=table["ball_C"].where(table["error"].isna())
+    )
     return {
         material: rows.pivot(index="n_balls", columns="diameter_mm", values="ball_C")
         for material, rows in table.groupby("ball_material", sort=False)
@@ -104,7 +107,8 @@ def print_costs(table: pd.DataFrame, elapsed: float) -> None:
     unfinished = table["error"].str.startswith("not finished", na=False)
     sweep = "" if math.isnan(elapsed) else f"; the sweep {elapsed:.0f} s on {os.cpu_count()} cores"
     print(
-        f"\nwall time per point: median {statistics.median(times):.1f} s (min {times.min():.1f}, max {times.max():.1f}); "
+        f"\nwall time per point: median {statistics.median(times):.1f} s (min {times.min():.1f}, max "
+        f"{times.max():.1f}); "
         f"Σ points {times.sum():.0f} s over {len(times)} points{sweep} (points of an earlier run of this folder keep "
         "their times)"
     )
@@ -143,7 +147,9 @@ def five_balls(base: sm.Parameters, preset: str) -> None:
     result = sm.simulate(params)
     wall = time.perf_counter() - started
     summary = result.summary
-    print(f"\nfive 12.7-mm steel balls, one hour, averaged (dem_averaging_rel_error {params.dem_averaging_rel_error:g}):")
+    print(
+        f"\nfive 12.7-mm steel balls, one hour, averaged (dem_averaging_rel_error {params.dem_averaging_rel_error:g}):"
+    )
     print(f"  status {result.status}: {result.message}")
     print(
         f"  wall {wall:.1f} s; heat power {summary['heat_power_W']:.3f} W; balls {summary['ball_C']:.1f} °C, "
@@ -151,7 +157,9 @@ def five_balls(base: sm.Parameters, preset: str) -> None:
     )
 
 
-def run_study(base: sm.Parameters, preset: str, counts: list[int], out: Path, workers: int) -> tuple[pd.DataFrame, float]:
+def run_study(
+    base: sm.Parameters, preset: str, counts: list[int], out: Path, workers: int
+) -> tuple[pd.DataFrame, float]:
     """The sweep's table and its wall time; Ctrl-C ends it with the points finished so far (a re-run goes on)."""
     started = time.perf_counter()
     try:
@@ -164,7 +172,9 @@ def run_study(base: sm.Parameters, preset: str, counts: list[int], out: Path, wo
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", type=Path, help="sweep folder (resumable; default results/mill-study-<preset>-<counts>-<target>)")
+    parser.add_argument(
+        "--out", type=Path, help="sweep folder (resumable; default results/mill-study-<preset>-<counts>-<target>)"
+    )
     parser.add_argument("--workers", type=int, default=2, help="local processes")
     parser.add_argument("--rel-error", type=float, help="dem_averaging_rel_error of the sweep (default: the preset's)")
     parser.add_argument("--max-time", type=float, help="averaging_max_time of the sweep, s (default: the preset's)")
@@ -180,7 +190,10 @@ def main() -> None:
     preset = PRESET
     base = study_parameters(preset, args.rel_error, args.max_time)
     # A folder holds one sweep: another choice of counts or target gets a folder of its own.
-    out = args.out or ROOT / "results" / f"mill-study-{preset}-{'-'.join(map(str, counts))}-{base.dem_averaging_rel_error:g}"
+    out = (
+        args.out
+        or ROOT / "results" / f"mill-study-{preset}-{'-'.join(map(str, counts))}-{base.dem_averaging_rel_error:g}"
+    )
     print(
         f"preset {preset}; averaged solver, {HOUR_S:g} s, dem_averaging_rel_error {base.dem_averaging_rel_error:g}, "
         f"averaging_max_time {base.averaging_max_time:g} s; {len(counts) * len(DIAMETERS_MM) * len(MATERIALS)} "

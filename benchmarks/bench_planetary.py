@@ -40,7 +40,11 @@ SPEX = ("spex8000m-3d", {"n_balls": 5})
 # (preset, overrides, simulated seconds): five SPEX balls for five seconds hold about as many impacts as a planetary
 # jar's second.
 SECOND_RUNS = ((*SPEX, 5.0), ("pulverisette7", {}, 1.0), ("pm100", {}, 1.0))
-STYLES = ({"color": "tab:blue", "lw": 2.0}, {"color": "tab:red", "lw": 2.0}, {"color": "tab:green", "lw": 2.0, "ls": "--"})
+STYLES = (
+    {"color": "tab:blue", "lw": 2.0},
+    {"color": "tab:red", "lw": 2.0},
+    {"color": "tab:green", "lw": 2.0, "ls": "--"},
+)
 HOUR_S = 3600.0
 
 
@@ -59,11 +63,16 @@ def timed(params: sm.Parameters) -> tuple[sm.Result, float, float]:
 
 def spectrum_line(summary: dict) -> str:
     thresholds = [key for key in summary if key.startswith("stress_power_above_")]
-    above = ", ".join(f"{key.removeprefix('stress_power_above_').removesuffix('_W')}: {summary[key]:.3g} W" for key in thresholds)
-    return (f"stress energy median {summary['stress_energy_median_J'] * 1e3:.3g} mJ, 90th percentile "
-            f"{summary['stress_energy_p90_J'] * 1e3:.3g} mJ (normal {summary['stress_energy_normal_median_J'] * 1e3:.3g}, "
-            f"tangential {summary['stress_energy_tangential_median_J'] * 1e3:.3g} mJ median); power above {above}; "
-            f"contacts lasting over 1 ms {summary['stress_lasting_contacts_hz']:.3g}/s, {summary['stress_lasting_power_W']:.3g} W")
+    above = ", ".join(
+        f"{key.removeprefix('stress_power_above_').removesuffix('_W')}: {summary[key]:.3g} W" for key in thresholds
+    )
+    return (
+        f"stress energy median {summary['stress_energy_median_J'] * 1e3:.3g} mJ, 90th percentile "
+        f"{summary['stress_energy_p90_J'] * 1e3:.3g} mJ (normal {summary['stress_energy_normal_median_J'] * 1e3:.3g}, "
+        f"tangential {summary['stress_energy_tangential_median_J'] * 1e3:.3g} mJ median); power above {above}; "
+        f"contacts lasting over 1 ms {summary['stress_lasting_contacts_hz']:.3g}/s, "
+        f"{summary['stress_lasting_power_W']:.3g} W"
+    )
 
 
 def second_part() -> None:
@@ -71,9 +80,12 @@ def second_part() -> None:
         params = sm.default_parameters(preset, solver="full", duration=seconds, record_windows=(), **overrides)
         result, wall, cpu = timed(params)
         summary = result.summary
-        print(f"{LABELS[preset]}: {seconds:g} simulated s in {cpu:.1f} CPU-s ({wall:.1f} wall-s), {cpu / seconds:.3g} CPU-s "
-              f"per simulated s; {result.counters['steps']} steps, {summary['impact_rate_hz']:.4g} impacts/s, heat "
-              f"{summary['heat_power_W']:.3g} W, audit residual {summary['energy_audit_residual']:.1e}")
+        print(
+            f"{LABELS[preset]}: {seconds:g} simulated s in {cpu:.1f} CPU-s ({wall:.1f} wall-s), {cpu / seconds:.3g} "
+            "CPU-s "
+            f"per simulated s; {result.counters['steps']} steps, {summary['impact_rate_hz']:.4g} impacts/s, heat "
+            f"{summary['heat_power_W']:.3g} W, audit residual {summary['energy_audit_residual']:.1e}"
+        )
         print(f"  {spectrum_line(summary)}")
 
 
@@ -87,19 +99,30 @@ def hour_part(presets: list[str], batch_periods: int | None) -> None:
         result, wall, cpu = timed(params)
         summary = result.summary
         paths = sorted(summary["heat_paths_W"].items(), key=lambda item: -abs(item[1]))[:4]
-        print(f"{LABELS[preset]}, averaged hour (batches of {params.averaging_batch_periods} periods): {wall:.0f} "
-              f"wall-s, {cpu:.0f} CPU-s; {summary.get('averaging_window_s', float('nan')):.3g} s of mechanics kept; "
-              f"status {result.status}: {result.message}")
-        print(f"  balls {summary['ball_C']:.1f} °C (mean; hottest {summary['hottest_ball_C']:.1f} °C), jar "
-              f"{summary['vial_C']:.1f} °C, air {summary['air_C']:.1f} °C, holder {summary.get('clamp_C', float('nan')):.1f} °C; "
-              f"heat {summary['heat_power_W']:.3g} W at {summary['impact_rate_hz']:.4g} impacts/s")
+        print(
+            f"{LABELS[preset]}, averaged hour (batches of {params.averaging_batch_periods} periods): {wall:.0f} "
+            f"wall-s, {cpu:.0f} CPU-s; {summary.get('averaging_window_s', float('nan')):.3g} s of mechanics kept; "
+            f"status {result.status}: {result.message}"
+        )
+        print(
+            f"  balls {summary['ball_C']:.1f} °C (mean; hottest {summary['hottest_ball_C']:.1f} °C), jar "
+            f"{summary['vial_C']:.1f} °C, air {summary['air_C']:.1f} °C, holder "
+            f"{summary.get('clamp_C', float('nan')):.1f} °C; "
+            f"heat {summary['heat_power_W']:.3g} W at {summary['impact_rate_hz']:.4g} impacts/s"
+        )
         print(f"  {spectrum_line(summary)}")
         print("  largest heat paths: " + "; ".join(f"{name} {flow:.3g} W" for name, flow in paths))
-        spectrum = stress_spectrum(result.impact_columns, summary["stress_window_s"], params.stress_energy_thresholds,
-                                   summary["dissipated_power_W"])
+        spectrum = stress_spectrum(
+            result.impact_columns,
+            summary["stress_window_s"],
+            params.stress_energy_thresholds,
+            summary["dissipated_power_W"],
+        )
         curves.append((LABELS[preset], spectrum, "total", "all", style))
     figure = spectra_figure(curves, params.stress_energy_thresholds)
-    figure.suptitle("Stress-energy spectra of the settled motion: a SPEX 8000M and two planetary mills (not calibrated)")
+    figure.suptitle(
+        "Stress-energy spectra of the settled motion: a SPEX 8000M and two planetary mills (not calibrated)"
+    )
     figure.savefig(FIGURE, dpi=110)
     print(f"figure: {FIGURE.relative_to(ROOT)}")
 
@@ -108,7 +131,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--only", choices=("second", "hour"), help="one part only")
     parser.add_argument("--presets", default=",".join(PLANETARY), help="planetary presets of the hour part")
-    parser.add_argument("--batch-periods", type=int, help="averaging_batch_periods of the hour part (default: the preset's)")
+    parser.add_argument(
+        "--batch-periods", type=int, help="averaging_batch_periods of the hour part (default: the preset's)"
+    )
     args = parser.parse_args()
     if args.only in (None, "second"):
         second_part()

@@ -41,8 +41,11 @@ def reference_row(commit: str, settings: dict, repeats: int) -> None:
     """The five-ball hour with ``commit``'s code (one replica: the solver as it was), in fresh processes."""
     with reference_tree(commit) as tree:
         figures = [measured_in(tree, __file__, "--measure-reference", json.dumps(settings)) for _ in range(repeats)]
-    print(f"reference {commit}: wall {statistics.median(f['wall'] for f in figures):6.1f} s  "
-          f"heat {figures[0]['heat']:.5g} ± {figures[0]['stderr']:.2g} W  balls {figures[0]['ball_C']:.1f} °C", flush=True)
+    print(
+        f"reference {commit}: wall {statistics.median(f['wall'] for f in figures):6.1f} s  "
+        f"heat {figures[0]['heat']:.5g} ± {figures[0]['stderr']:.2g} W  balls {figures[0]['ball_C']:.1f} °C",
+        flush=True,
+    )
 
 
 def measure_reference(settings: dict) -> None:
@@ -51,8 +54,16 @@ def measure_reference(settings: dict) -> None:
     sm.simulate(params.replace(duration=1.0, solver="full"))  # compile, load the caches
     wall = time.perf_counter()
     result = sm.simulate(params)
-    print(json.dumps({"wall": time.perf_counter() - wall, "heat": result.averages.heat_power,
-                      "stderr": result.averages.heat_power_stderr, "ball_C": result.summary["ball_C"]}))
+    print(
+        json.dumps(
+            {
+                "wall": time.perf_counter() - wall,
+                "heat": result.averages.heat_power,
+                "stderr": result.averages.heat_power_stderr,
+                "ball_C": result.summary["ball_C"],
+            }
+        )
+    )
 
 
 def main() -> None:
@@ -60,7 +71,9 @@ def main() -> None:
     parser.add_argument("--reference", help="a commit whose code times the hour first (a git worktree of it)")
     parser.add_argument("--measure-reference", help=argparse.SUPPRESS)
     parser.add_argument("--replicas", type=int, nargs="*", default=[1, 2, 4], help="replica counts to time")
-    parser.add_argument("--threads", type=int, default=len(os.sched_getaffinity(0)), help="threads of the parallel rows")
+    parser.add_argument(
+        "--threads", type=int, default=len(os.sched_getaffinity(0)), help="threads of the parallel rows"
+    )
     parser.add_argument("--repeats", type=int, default=1, help="runs per row (median wall time)")
     parser.add_argument("--rel-error", type=float, default=None, help="dem_averaging_rel_error (default: the preset's)")
     options = parser.parse_args()
@@ -71,7 +84,10 @@ def main() -> None:
     if options.reference:
         reference_row(options.reference, settings, options.repeats)
     run(1, 1, {**settings, "duration": 1.0, "solver": "full"})  # compile, load the caches
-    print(f"{PRESET}, 5 balls, one hour, averaged; {os.cpu_count()} cores; threads of the parallel rows: {options.threads}")
+    print(
+        f"{PRESET}, 5 balls, one hour, averaged; {os.cpu_count()} cores; threads of the parallel rows: "
+        f"{options.threads}"
+    )
     reference = None
     for replicas in options.replicas:
         for threads in sorted({1, min(options.threads, replicas)}):
@@ -82,9 +98,11 @@ def main() -> None:
                 cpus.append(cpu)
             averages = result.averages
             line = (
-                f"replicas {replicas} threads {threads}: wall {statistics.median(walls):6.1f} s (CPU {statistics.median(cpus):6.1f} s)  "
+                f"replicas {replicas} threads {threads}: wall {statistics.median(walls):6.1f} s (CPU "
+                f"{statistics.median(cpus):6.1f} s)  "
                 f"mechanics {averages.transient + averages.window:5.1f} s "
-                f"each, {averages.batches} batches pooled  heat {averages.heat_power:.5g} ± {averages.heat_power_stderr:.2g} W  "
+                f"each, {averages.batches} batches pooled  heat {averages.heat_power:.5g} ± "
+                f"{averages.heat_power_stderr:.2g} W  "
                 f"balls {result.summary['ball_C']:.1f} °C"
             )
             if reference is None:

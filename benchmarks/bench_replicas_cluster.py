@@ -45,18 +45,25 @@ def main() -> None:
     reference_wall, reference = hour(args.replicas)
     del os.environ[THREADS_VARIABLE]
     print(f"# {PRESET}, averaged hour, {args.replicas} replicas; reference: one thread, {reference_wall:.1f} s wall")
-    print(f"# reference: heat {reference.summary['heat_power_W']:.6g} W, balls {reference.summary['ball_C']:.6g} °C, "
-          f"{reference.counters['steps']} steps; {reference.message[:120]}")
+    print(
+        f"# reference: heat {reference.summary['heat_power_W']:.6g} W, balls {reference.summary['ball_C']:.6g} °C, "
+        f"{reference.counters['steps']} steps; {reference.message[:120]}"
+    )
     print(f"{'workers':>7} {'wall s':>8} {'speed-up':>9} {'efficiency':>10} {'same numbers':>13}")
     for workers in range(1, args.workers + 1):
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-                Client(cluster) as client:
+        with (
+            LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+            Client(cluster) as client,
+        ):
             client.run(lambda: __import__("shakermill.engines.dem.stepper"))  # compiled code loaded before the clock
             with replicas_on(client):
                 wall, result = hour(args.replicas)
         speedup = reference_wall / wall
-        print(f"{workers:>7} {wall:>8.1f} {speedup:>9.2f} {speedup / (workers + 1):>10.2f} "
-              f"{str(fingerprint(result) == fingerprint(reference)):>13}", flush=True)
+        print(
+            f"{workers:>7} {wall:>8.1f} {speedup:>9.2f} {speedup / (workers + 1):>10.2f} "
+            f"{str(fingerprint(result) == fingerprint(reference)):>13}",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -74,15 +74,20 @@ def main() -> None:
 
 
 def report(runs: dict[str, list[dict]]) -> None:
-    print(f"one simulated second at full resolution, CPU-s (median of {len(next(iter(runs.values())))}), steps, µs per step")
+    print(
+        f"one simulated second at full resolution, CPU-s (median of {len(next(iter(runs.values())))}), steps, µs per "
+        "step"
+    )
     for mill in MILLS:
         medians = {}
         for name, repeats in runs.items():
             cpu = statistics.median(figures[mill]["cpu"] for figures in repeats)
             steps = repeats[0][mill]["steps"]
             medians[name] = cpu
-            print(f"  {mill:<34} {name:<20} {cpu:6.2f} CPU-s {steps:>9,} steps {1e6 * cpu / steps:6.2f} µs/step  "
-                  f"state {repeats[0][mill]['digest']}")
+            print(
+                f"  {mill:<34} {name:<20} {cpu:6.2f} CPU-s {steps:>9,} steps {1e6 * cpu / steps:6.2f} µs/step  "
+                f"state {repeats[0][mill]['digest']}"
+            )
         if len(medians) == 2:
             before, after = medians.values()
             digests = {repeats[0][mill]["digest"] for repeats in runs.values()}

@@ -57,7 +57,10 @@ def main() -> None:
     print(f"machine: {os.cpu_count()} cores; warm-up {time.perf_counter() - started:.2f} s; median of {args.repeats}")
     print()
 
-    header = f"{'workers':>7} | {'median s':>8} {'min s':>6} {'max s':>6} | {'s/point':>7} | {'Σ point s':>9} | target ≤ {TARGET_S:g} s"
+    header = (
+        f"{'workers':>7} | {'median s':>8} {'min s':>6} {'max s':>6} | {'s/point':>7} | {'Σ point s':>9} | "
+        f"target ≤ {TARGET_S:g} s"
+    )
     print(header)
     print("-" * len(header))
     medians, tables = {}, {}
@@ -70,7 +73,9 @@ def main() -> None:
             f"{medians[workers] / len(plan.points):7.3f} | {table['wall_time_s'].sum():9.2f} | {verdict}"
         )
     print("Σ point s: the points' own run times (last repeat), summed over workers; the rest is the sweep's own")
-    print("work (regime classification, attractor probes, point files, table) and, with workers > 1, the pool's start-up.")
+    print(
+        "work (regime classification, attractor probes, point files, table) and, with workers > 1, the pool's start-up."
+    )
     print()
 
     if 1 in medians:
@@ -87,7 +92,10 @@ def main() -> None:
         f"of point time ({worker_counts[0]} worker{'s' if worker_counts[0] > 1 else ''})"
     )
     for _, row in reference[fallback].iterrows():
-        print(f"  ω {row['omega']:6.2f} rad/s, X {row['amplitude'] * 1e3:5.2f} mm: {row['regime']}, {row['wall_time_s']:.2f} s")
+        print(
+            f"  ω {row['omega']:6.2f} rad/s, X {row['amplitude'] * 1e3:5.2f} mm: {row['regime']}, "
+            f"{row['wall_time_s']:.2f} s"
+        )
     print(f"failed points: {len(failed)}")
     for _, row in failed.iterrows():
         print(f"  {row['point_id']}: {row['error']}")

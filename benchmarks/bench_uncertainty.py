@@ -34,26 +34,39 @@ def ensemble(preset: str, overrides: dict, members: int, only: tuple[str, ...] =
     inputs, posterior = ensemble_inputs(PRESETS[preset], params, [], only)
     with tempfile.TemporaryDirectory(prefix="bench_uncertainty_") as folder:
         wall = time.perf_counter()
-        found = run_ensemble(params, inputs, Path(folder) / "ensemble", members, workers=2, preset=preset,
-                             posterior=posterior)
+        found = run_ensemble(
+            params, inputs, Path(folder) / "ensemble", members, workers=2, preset=preset, posterior=posterior
+        )
         wall = time.perf_counter() - wall
     fitted = "" if posterior is None else f" and the posterior of {', '.join(posterior.keys)}"
-    print(f"\n{preset} {overrides}: {members} members over {len(inputs)} inputs ({', '.join(i.key for i in inputs)})"
-          f"{fitted}")
-    print(f"  wall {wall:.0f} s on 2 workers ({wall / TARGET_S:.0%} of the 15-min target); "
-          f"{found.failed} failed")
+    print(
+        f"\n{preset} {overrides}: {members} members over {len(inputs)} inputs ({', '.join(i.key for i in inputs)})"
+        f"{fitted}"
+    )
+    print(f"  wall {wall:.0f} s on 2 workers ({wall / TARGET_S:.0%} of the 15-min target); {found.failed} failed")
     for spread in found.headlines:
         deciding = ", ".join(f"{key} {spread.total[key]:.2f}" for key in spread.deciding[:3]) or "n/a"
         measured = MEASURED_RISES_K.get(spread.key)
-        inside = "" if measured is None else (
-            f"; measured {measured:+g} K {'inside' if spread.quantiles[0] <= measured <= spread.quantiles[2] else 'OUTSIDE'}")
-        print(f"  {spread.label}: 5/50/95 % {spread.quantiles[0]:.4g} / {spread.quantiles[1]:.4g} / "
-              f"{spread.quantiles[2]:.4g} {spread.unit} (Q² {spread.surrogate_q2:.2f}; deciding: {deciding}){inside}")
+        inside = (
+            ""
+            if measured is None
+            else (
+                f"; measured {measured:+g} K "
+                f"{'inside' if spread.quantiles[0] <= measured <= spread.quantiles[2] else 'OUTSIDE'}"
+            )
+        )
+        print(
+            f"  {spread.label}: 5/50/95 % {spread.quantiles[0]:.4g} / {spread.quantiles[1]:.4g} / "
+            f"{spread.quantiles[2]:.4g} {spread.unit} (Q² {spread.surrogate_q2:.2f}; deciding: {deciding}){inside}"
+        )
     for name, regime in found.regimes.items():
         medians = regime["medians"]
-        print(f"  regime {name}: {regime['members']} members ({regime['share']:.0%}); heat {medians['heat_power_W']:.3g} W, "
-              f"stress energy median {medians['stress_energy_median_J'] * 1e3:.3g} mJ, "
-              f"fast impacts {medians.get('fast_impact_rate_hz', float('nan')):.0f}/s")
+        print(
+            f"  regime {name}: {regime['members']} members ({regime['share']:.0%}); heat {medians['heat_power_W']:.3g} "
+            "W, "
+            f"stress energy median {medians['stress_energy_median_J'] * 1e3:.3g} mJ, "
+            f"fast impacts {medians.get('fast_impact_rate_hz', float('nan')):.0f}/s"
+        )
 
 
 def main() -> None:

@@ -7,9 +7,10 @@ import os
 import subprocess
 import sys
 import tempfile
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -19,8 +20,9 @@ def reference_tree(commit: str) -> Iterator[Path]:
     """``commit`` in a temporary git worktree, removed afterwards."""
     with tempfile.TemporaryDirectory() as scratch:
         tree = Path(scratch) / "reference"
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), commit], check=True,
-                       capture_output=True)
+        subprocess.run(
+            ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), commit], check=True, capture_output=True
+        )
         try:
             yield tree
         finally:
@@ -30,6 +32,7 @@ def reference_tree(commit: str) -> Iterator[Path]:
 def measured_in(tree: Path, script: str, *arguments: str) -> Any:
     """Run ``script`` (a path) with ``tree``'s package first on the path; the JSON its last line of output holds."""
     environment = {**os.environ, "PYTHONPATH": str(tree / "src")}
-    completed = subprocess.run([sys.executable, script, *arguments], env=environment, capture_output=True, text=True,
-                               check=True)
+    completed = subprocess.run(
+        [sys.executable, script, *arguments], env=environment, capture_output=True, text=True, check=True
+    )
     return json.loads(completed.stdout.strip().splitlines()[-1])

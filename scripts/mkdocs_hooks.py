@@ -23,8 +23,10 @@ def _shown(match: re.Match[str]) -> str:
 
 
 def _opens_list_under_paragraph(previous: str, line: str) -> bool:
-    return bool(LIST_ITEM.match(line)) and bool(previous.strip()) and not (
-        LIST_ITEM.match(previous) or previous[:1].isspace() or previous.startswith(("#", "|", ">", "!!!"))
+    return (
+        bool(LIST_ITEM.match(line))
+        and bool(previous.strip())
+        and not (LIST_ITEM.match(previous) or previous[:1].isspace() or previous.startswith(("#", "|", ">", "!!!")))
     )
 
 

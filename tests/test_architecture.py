@@ -143,16 +143,28 @@ def test_the_engine_check_sees_a_specific_engine_where_one_is_imported():
 
 
 def test_no_module_is_longer_than_a_reader_can_hold():
-    long = {name: lines for name, path in MODULES.items() if (lines := len(path.read_text(encoding="utf-8").splitlines())) > LONGEST_MODULE_LINES}
+    long = {
+        name: lines
+        for name, path in MODULES.items()
+        if (lines := len(path.read_text(encoding="utf-8").splitlines())) > LONGEST_MODULE_LINES
+    }
     assert long == {}
+
+
+def body_lines(function: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    """The lines of ``function``'s body after its docstring: what a reader must hold. The signature is left out, as
+    the formatter writes a command's many options one per line."""
+    body = function.body
+    if len(body) > 1 and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+        body = body[1:]
+    return function.end_lineno - body[0].lineno + 1
 
 
 def test_no_function_is_longer_than_a_reader_can_hold():
     long = [
-        f"{name}.{node.name}: {node.end_lineno - node.lineno + 1} lines"
+        f"{name}.{node.name}: {body_lines(node)} lines"
         for name, path in MODULES.items()
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
-        and node.end_lineno - node.lineno + 1 > LONGEST_FUNCTION_LINES
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and body_lines(node) > LONGEST_FUNCTION_LINES
     ]
     assert long == []

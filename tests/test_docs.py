@@ -23,8 +23,9 @@ REPOSITORY_PATH = re.compile(r"`((?:src|docs|benchmarks|examples|tests|scripts)/
 def pages() -> list[Path]:
     """Every page written for the site; docs/MODEL.md is the shared specification, kept as it is, and docs/generated
     what a build of the examples wrote."""
-    return sorted(path for path in DOCS.rglob("*.md")
-                  if path.name != "MODEL.md" and DOCS / "generated" not in path.parents)
+    return sorted(
+        path for path in DOCS.rglob("*.md") if path.name != "MODEL.md" and DOCS / "generated" not in path.parents
+    )
 
 
 def page_text(site: Path, page: str) -> str:
@@ -73,9 +74,22 @@ def test_the_site_builds_strictly_from_its_sources(tmp_path):
         )
     site = tmp_path / "site"
     completed = subprocess.run(
-        [sys.executable, "-m", "mkdocs", "build", "--strict", "--config-file", str(ROOT / "mkdocs.yml"),
-         "--site-dir", str(site)],
-        cwd=ROOT, capture_output=True, text=True, timeout=300, env={**os.environ, "NO_MKDOCS_2_WARNING": "1"},
+        [
+            sys.executable,
+            "-m",
+            "mkdocs",
+            "build",
+            "--strict",
+            "--config-file",
+            str(ROOT / "mkdocs.yml"),
+            "--site-dir",
+            str(site),
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "NO_MKDOCS_2_WARNING": "1"},
     )
     assert completed.returncode == 0, completed.stderr[-4000:]
     assert "WARNING" not in completed.stderr, completed.stderr[-4000:]
@@ -89,8 +103,11 @@ def test_the_site_builds_strictly_from_its_sources(tmp_path):
     assert section_13.removeprefix("## ") in page_text(site, "MODEL.html")
     # The benchmarks page includes benchmarks/README.md, to its last section.
     benchmarks = page_text(site, "benchmarks.html")
-    headings = [line for line in (ROOT / "benchmarks" / "README.md").read_text(encoding="utf-8").splitlines()
-                if line.startswith("## ")]
+    headings = [
+        line
+        for line in (ROOT / "benchmarks" / "README.md").read_text(encoding="utf-8").splitlines()
+        if line.startswith("## ")
+    ]
     assert len(headings) > 5
     for heading in headings:
         assert heading.removeprefix("## ").replace("`", "") in benchmarks, heading
@@ -100,5 +117,7 @@ def test_the_site_builds_strictly_from_its_sources(tmp_path):
         assert "<shakermill.Result: engine" in page and "success" in page and "Traceback" not in page, example
         assert (site / "generated" / "gallery" / "images" / f"mkd_glr_{example}_001.png").stat().st_size > 10_000
     # The gallery's images are copied beside it, and the site opens from the disk.
-    assert (site / "figures" / "temperatures.png").is_file() and (site / "figures" / "dem" / "trajectories.gif").is_file()
+    assert (site / "figures" / "temperatures.png").is_file() and (
+        site / "figures" / "dem" / "trajectories.gif"
+    ).is_file()
     assert 'href="guide/install.html"' in (site / "index.html").read_text(encoding="utf-8")

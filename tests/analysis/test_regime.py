@@ -71,7 +71,15 @@ def test_bifurcation_lists_every_attractor_with_basins_summing_to_one() -> None:
     base = sm.default_parameters(solver="averaged", duration=60.0, record_windows=(), amplitude=0.023)
     scan = bifurcation(base, [100.0, 110.0])
     attractors = scan.attractors
-    assert list(attractors.columns[:7]) == ["omega", "attractor", "regime", "period", "basin_fraction", "impact_rate_hz", "heat_power_W"]
+    assert list(attractors.columns[:7]) == [
+        "omega",
+        "attractor",
+        "regime",
+        "period",
+        "basin_fraction",
+        "impact_rate_hz",
+        "heat_power_W",
+    ]
     for omega, rows in attractors.groupby("omega"):
         assert rows["basin_fraction"].sum() == pytest.approx(1.0)
         assert list(rows["attractor"]) == list(range(len(rows)))
@@ -96,11 +104,15 @@ def test_bifurcation_scans_any_numeric_key_and_writes_its_tables(tmp_path) -> No
     assert str(scan.regimes["period"].dtype) == "Int64"  # whole drive periods, missing for irregular motion
     paths = write_bifurcation(scan, tmp_path)
     assert sorted(path.name for path in paths) == sorted(
-        f"bifurcation_{table}.{suffix}" for table in ("regimes", "attractors", "phases") for suffix in ("parquet", "csv")
+        f"bifurcation_{table}.{suffix}"
+        for table in ("regimes", "attractors", "phases")
+        for suffix in ("parquet", "csv")
     )
     pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "bifurcation_phases.parquet"), scan.phases)
     pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "bifurcation_attractors.parquet"), scan.attractors)
-    assert list(pd.read_csv(tmp_path / "bifurcation_attractors.csv")["heat_power_W"]) == pytest.approx(list(scan.attractors["heat_power_W"]))
+    assert list(pd.read_csv(tmp_path / "bifurcation_attractors.csv")["heat_power_W"]) == pytest.approx(
+        list(scan.attractors["heat_power_W"])
+    )
 
 
 def test_settled_impacts_of_a_full_run_are_its_second_half() -> None:

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import shakermill as sm
-from shakermill.views.notebook import answer_sentences
 from shakermill.analysis.steady import SETTLED_TIME_CONSTANTS, run_length_note, settled_rates, steady_state
 from shakermill.engines.registry import engine_named
+from shakermill.views.notebook import answer_sentences
 
 
 def _steady(params, heat, term):
@@ -67,14 +67,18 @@ def test_steady_state_with_moving_ball_is_a_root_of_the_nonlinear_network():
     rates = model.thermal_network(steady.ball, steady.vial, steady.air, 1.2, 30.0, model.constants_from(params))
     assert np.max(np.abs(rates[:3])) < 1e-10
     # Every watt leaves through the outer surface.
-    assert params.h_outer * params.outer_area * (steady.vial - params.ambient_temperature) == pytest.approx(1.2, rel=1e-9)
+    assert params.h_outer * params.outer_area * (steady.vial - params.ambient_temperature) == pytest.approx(
+        1.2, rel=1e-9
+    )
 
 
 def test_ball_only_model_has_vial_and_air_at_ambient():
     params = sm.default_parameters(model="ball_only")
     steady = _steady(params, 0.5, 0.0)
     h_ball = 2.0 * params.air_conductivity / (2.0 * params.ball_radius)
-    expected_ball = params.ambient_temperature + params.lam * 0.5 / (4 * math.pi * params.ball_radius**2 * params.beta * h_ball)
+    expected_ball = params.ambient_temperature + params.lam * 0.5 / (
+        4 * math.pi * params.ball_radius**2 * params.beta * h_ball
+    )
     assert steady.vial == steady.air == params.ambient_temperature
     assert steady.ball == pytest.approx(expected_ball, abs=1e-9)
     assert len(steady.time_constants) == 1

@@ -45,7 +45,11 @@ def test_the_spectrum_of_five_impacts_counted_by_hand():
 
 
 def test_one_ball_on_the_axis_stresses_head_on_and_hits_no_ball():
-    impacts = {"wall": np.array(["left", "right"]), "dissipated_energy": np.array([2e-3, 4e-3]), "duration": np.full(2, 5e-5)}
+    impacts = {
+        "wall": np.array(["left", "right"]),
+        "dissipated_energy": np.array([2e-3, 4e-3]),
+        "duration": np.full(2, 5e-5),
+    }
     summary = stress_spectrum(impacts, 1.0).as_summary()
     assert summary["stress_energy_normal_median_J"] == summary["stress_energy_median_J"] == pytest.approx(3e-3)
     assert summary["stress_energy_tangential_p90_J"] == 0.0
@@ -55,11 +59,21 @@ def test_one_ball_on_the_axis_stresses_head_on_and_hits_no_ball():
 
 def test_a_lasting_contact_is_no_stress_event_but_the_power_of_steady_grinding():
     """A ball that slid on the wall for 0.4 s dissipated 0.5 J: counted apart, not in the spectrum's tail."""
-    impacts = {**DEM_IMPACTS, "dissipated_energy": np.append(DEM_IMPACTS["dissipated_energy"], 0.5),
-               "duration": np.append(DEM_IMPACTS["duration"], 0.4), "target": np.append(DEM_IMPACTS["target"], "side"),
-               **{name: np.append(DEM_IMPACTS[name], value) for name, value in (
-                   ("dissipated_normal", 0.0), ("dissipated_tangential", 0.0), ("dissipated_sliding", 0.5),
-                   ("dissipated_rolling", 0.0))}}
+    impacts = {
+        **DEM_IMPACTS,
+        "dissipated_energy": np.append(DEM_IMPACTS["dissipated_energy"], 0.5),
+        "duration": np.append(DEM_IMPACTS["duration"], 0.4),
+        "target": np.append(DEM_IMPACTS["target"], "side"),
+        **{
+            name: np.append(DEM_IMPACTS[name], value)
+            for name, value in (
+                ("dissipated_normal", 0.0),
+                ("dissipated_tangential", 0.0),
+                ("dissipated_sliding", 0.5),
+                ("dissipated_rolling", 0.0),
+            )
+        },
+    }
     with_lasting, without = stress_spectrum(impacts, 2.0), stress_spectrum(DEM_IMPACTS, 2.0)
     assert with_lasting.percentile(90) == without.percentile(90)
     assert with_lasting.power() == without.power()
@@ -86,7 +100,9 @@ def test_the_stress_power_of_a_run_is_the_power_its_impacts_dissipate():
     result = sm.simulate(sm.default_parameters(duration=30.0))
     spectrum = stress_spectrum(result.impact_columns, result.t_end)
     assert spectrum.lasting_power() == 0.0
-    assert result.summary["stress_lasting_power_W"] == pytest.approx(0.0, abs=1e-3 * result.summary["dissipated_power_W"])
+    assert result.summary["stress_lasting_power_W"] == pytest.approx(
+        0.0, abs=1e-3 * result.summary["dissipated_power_W"]
+    )
     assert spectrum.power() == pytest.approx(result.summary["dissipated_power_W"], rel=1e-3)
     assert spectrum.events_per_second() == pytest.approx(result.summary["impact_rate_hz"], rel=1e-12)
 
@@ -97,13 +113,17 @@ def test_distinct_thresholds_get_distinct_summary_keys():
 
     assert threshold_name(1e-3) == "0.001J" and threshold_name(1e-2) == "0.01J" and threshold_name(1000.0) == "1000J"
     assert threshold_name(0.0010000001) == "0.0010000001J" != threshold_name(0.001)
-    spectrum = stress_spectrum({"dissipated_energy": np.array([2e-3]), "duration": np.array([1e-5])}, 1.0, (0.001, 0.0010000001))
+    spectrum = stress_spectrum(
+        {"dissipated_energy": np.array([2e-3]), "duration": np.array([1e-5])}, 1.0, (0.001, 0.0010000001)
+    )
     keys = [key for key in spectrum.as_summary() if key.startswith("stress_events_above_")]
     assert len(keys) == 2
 
 
 def test_a_threshold_given_twice_is_refused():
-    with pytest.raises(sm.ParameterError, match=r"^stress_energy_thresholds: 0\.001 J is given 2 times; allowed distinct"):
+    with pytest.raises(
+        sm.ParameterError, match=r"^stress_energy_thresholds: 0\.001 J is given 2 times; allowed distinct"
+    ):
         sm.default_parameters("spex8000m-3d", stress_energy_thresholds=(0.001, 1e-3))
 
 
@@ -112,8 +132,13 @@ def test_kwades_stress_energy_is_the_pairs_relative_kinetic_energy_at_first_touc
     brings 2 J; the 3-kg ball on the vial at 1 m/s 1.5 J."""
     from shakermill.analysis.stress_energy import collision_energy
 
-    impacts = {"impact_speed": np.array([2.0, 2.0, 1.0]), "ball": np.array([0, 0, 1]), "other_ball": np.array([1, -1, -1]),
-               "dissipated_energy": np.array([0.5, 1.0, 0.2]), "duration": np.full(3, 1e-4)}
+    impacts = {
+        "impact_speed": np.array([2.0, 2.0, 1.0]),
+        "ball": np.array([0, 0, 1]),
+        "other_ball": np.array([1, -1, -1]),
+        "dissipated_energy": np.array([0.5, 1.0, 0.2]),
+        "duration": np.full(3, 1e-4),
+    }
     np.testing.assert_allclose(collision_energy(impacts, (1.0, 3.0)), [1.5, 2.0, 1.5], rtol=1e-15)
     summary = stress_spectrum(impacts, 1.0, masses=(1.0, 3.0), dissipated_power=2.0).as_summary()
     assert summary["stress_energy_kinetic_median_J"] == pytest.approx(1.5)
@@ -131,8 +156,11 @@ def test_a_head_on_impact_dissipates_one_minus_e_squared_of_kwades_stress_energy
 
     params = sm.default_parameters("spex8000m-3d")
     outcome = single_impact(params, 2.0)
-    impacts = {"impact_speed": np.array([outcome.normal_speed_in]), "dissipated_energy": np.array([outcome.dissipated_J]),
-               "duration": np.array([outcome.contact_time_s])}
+    impacts = {
+        "impact_speed": np.array([outcome.normal_speed_in]),
+        "dissipated_energy": np.array([outcome.dissipated_J]),
+        "duration": np.array([outcome.contact_time_s]),
+    }
     kinetic = stress_spectrum(impacts, 1.0, masses=params.ball_masses()).percentile(50, "kinetic")
     assert kinetic == pytest.approx(0.5 * params.ball_mass * 2.0**2, rel=1e-12)
     assert outcome.dissipated_J == pytest.approx((1 - outcome.normal_restitution**2) * kinetic, rel=1e-3)

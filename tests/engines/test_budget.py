@@ -66,7 +66,11 @@ def test_a_3d_run_that_cannot_end_within_its_budget_stops_at_its_pace_not_at_the
     monkeypatch.setattr(budget_module, "PACE_JUDGED_AFTER_S", 0.3)
     params = sm.default_parameters("spex8000m-3d", duration=600.0, solver="full", record_windows=(), max_wall_time=30.0)
     result = sm.simulate(params)
-    assert result.status == BUDGET_EXCEEDED and "stopped early" in result.message and "max_wall_time = 30 s" in result.message
+    assert (
+        result.status == BUDGET_EXCEEDED
+        and "stopped early" in result.message
+        and "max_wall_time = 30 s" in result.message
+    )
     assert 0.0 < result.t_end < 600.0 and result.summary["wall_time_s"] < 10.0
     assert result.history.times[-1] == result.t_end
 

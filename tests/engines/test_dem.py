@@ -74,8 +74,12 @@ def test_the_energy_audit_closes_with_friction_gravity_and_rolling_resistance():
 def test_the_audit_closes_in_a_rotating_vial():
     """The wall's velocity at a contact point includes Ω × r: a vial that yaws and pitches as it shakes."""
     params = sm.default_parameters(
-        **FIVE_BALLS, kinematics="fourier", motion="x:1:0:25 mm, yaw:2:0.2:0, pitch:1:0:0.1, z:2:0:2 mm",
-        rolling_friction=0.01, duration=1.0, record_windows=(),
+        **FIVE_BALLS,
+        kinematics="fourier",
+        motion="x:1:0:25 mm, yaw:2:0.2:0, pitch:1:0:0.1, z:2:0:2 mm",
+        rolling_friction=0.01,
+        duration=1.0,
+        record_windows=(),
     )
     result = sm.simulate(params)
     assert result.success
@@ -138,8 +142,9 @@ def test_an_enduring_contact_steps_at_its_own_period_and_rests_where_the_finest_
     k = runs[0.05].constants
     # Resting on the bore's bottom line of a vial at rest (axis x, centre at the origin): the overlap from the depth.
     overlap = k.radius[0] - k.bore_radius - runs[0.05].state.position[0, 2]
-    period = contact.contact_period(k.mass[0], k.wall_radius[0, model.SIDE], k.wall_modulus[0], k.wall_shear_modulus[0],
-                                    overlap, 0.0)
+    period = contact.contact_period(
+        k.mass[0], k.wall_radius[0, model.SIDE], k.wall_modulus[0], k.wall_shear_modulus[0], overlap, 0.0
+    )
     step = min(0.05 * period, k.longest_contact_step)
     assert resting_steps[0.05] == pytest.approx(0.1 / step, rel=0.05)
     impact_step = base.contact_step_fraction * model.IMPACT_STEP_SCALE * period
@@ -153,7 +158,11 @@ def test_an_enduring_contact_steps_at_its_own_period_and_rests_where_the_finest_
 def test_a_ball_ball_contact_splits_its_heat_by_effusivity():
     """MODEL.md §12.4: in proportion to √(kρc); here the second ball conducts four times as well."""
     params = sm.default_parameters(
-        engine="dem", n_balls=2, vial_diameter="38 mm", ball_conductivities=(20.0, 80.0), duration=1.0,
+        engine="dem",
+        n_balls=2,
+        vial_diameter="38 mm",
+        ball_conductivities=(20.0, 80.0),
+        duration=1.0,
         record_windows=(),
     )
     columns = sm.simulate(params).impact_columns
@@ -170,8 +179,9 @@ def test_per_ball_radii_and_densities_set_each_ball():
     )
     k = model.constants_from(params)
     assert k.radius == pytest.approx([6e-3, 5e-3, 4e-3])
-    assert k.mass == pytest.approx([7800 * 4 / 3 * math.pi * 6e-3**3, 6000 * 4 / 3 * math.pi * 5e-3**3,
-                                    3900 * 4 / 3 * math.pi * 4e-3**3])
+    assert k.mass == pytest.approx(
+        [7800 * 4 / 3 * math.pi * 6e-3**3, 6000 * 4 / 3 * math.pi * 5e-3**3, 3900 * 4 / 3 * math.pi * 4e-3**3]
+    )
     assert pair_values(0, 1, k)[2] == pytest.approx(6e-3 * 5e-3 / 11e-3)
     assert k.wall_radius[2, model.SIDE] == pytest.approx(contact.concave_radius(4e-3, 19e-3))
     centres = params.initial_positions()
@@ -181,8 +191,9 @@ def test_per_ball_radii_and_densities_set_each_ball():
 
 def test_the_engine_stops_with_a_status_when_a_contact_overlaps_too_far():
     """A very coarse contact step lets the first impact sink past 5 % of the radius: reported, not raised."""
-    params = sm.default_parameters(engine="dem", contact_step_fraction=0.9, ball_youngs_modulus=1e6, duration=0.2,
-                                   record_windows=())
+    params = sm.default_parameters(
+        engine="dem", contact_step_fraction=0.9, ball_youngs_modulus=1e6, duration=0.2, record_windows=()
+    )
     result = sm.simulate(params)
     assert not result.success
     assert "overlap" in result.message and "t = " in result.message

@@ -28,8 +28,13 @@ def test_the_declared_per_ball_variables_are_those_with_a_ball_dimension(run):
 def test_every_declared_variable_and_column_is_in_the_run(run):
     description = describe(run.params.engine)
     variables = set(run.history.variables) | {"time"}
-    for declared in (description.motion, description.averaged_flows, description.heat_variables,
-                     description.term_variables, description.read_back):
+    for declared in (
+        description.motion,
+        description.averaged_flows,
+        description.heat_variables,
+        description.term_variables,
+        description.read_back,
+    ):
         assert set(declared) <= variables, declared
     assert set(run.impact_columns) == set(description.impact_units)
     assert description.impact_target in description.impact_units
@@ -54,8 +59,10 @@ def test_no_key_an_engine_declares_unread_is_read_by_its_package(engine):
 
 @pytest.mark.parametrize(
     ("engine", "changes"),
-    [("1d", {"friction": 0.1, "gravity": False, "contact_step_fraction": 0.1, "vial_conductivity": 10.0}),
-     ("dem", {"rtol": 1e-3, "atol_temperature": 1e-3, "heat_model": "paper", "energy_projection": False})],
+    [
+        ("1d", {"friction": 0.1, "gravity": False, "contact_step_fraction": 0.1, "vial_conductivity": 10.0}),
+        ("dem", {"rtol": 1e-3, "atol_temperature": 1e-3, "heat_model": "paper", "energy_projection": False}),
+    ],
 )
 def test_a_key_an_engine_does_not_read_leaves_its_run_as_it_was(run, engine, changes):
     if run.params.engine != engine:

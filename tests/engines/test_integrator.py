@@ -68,7 +68,9 @@ def test_single_impact_restitution_equals_input(speed: float, restitution: float
 
 @pytest.mark.parametrize("restitution", [0.5, 0.7, 0.9])
 @pytest.mark.parametrize("speed", [0.1, 1.0, 5.0])
-def test_default_tolerance_gets_the_heat_and_rebound_of_one_impact(speed: float, restitution: float, single_impact) -> None:
+def test_default_tolerance_gets_the_heat_and_rebound_of_one_impact(
+    speed: float, restitution: float, single_impact
+) -> None:
     # The heat is what the model is for: at ode23's default rtol the contact used to lose 1-3 % of its
     # dissipated energy, which the energy projection then passed on to the rebound.
     params = single_impact(speed, restitution, rtol=DEFAULT_RTOL)
@@ -131,7 +133,9 @@ def test_elastic_collisions_make_no_heat_and_balance_the_vial_work() -> None:
     # Scale: the kinetic energy brought into the impacts, relative to the vial's frame.
     impact_energy = float((0.5 * params.ball_mass * result.impacts["impact_speed"] ** 2).sum())
     assert abs(audit.mechanical_residual) < 1e-4 * impact_energy
-    assert audit.work_by_vial == pytest.approx(audit.kinetic_energy_change + audit.elastic_energy_change, abs=1e-4 * impact_energy)
+    assert audit.work_by_vial == pytest.approx(
+        audit.kinetic_energy_change + audit.elastic_energy_change, abs=1e-4 * impact_energy
+    )
 
 
 def test_grazing_contact_is_not_stepped_over() -> None:
@@ -170,8 +174,15 @@ def test_contact_steps_respect_the_rayleigh_limit() -> None:
     k = model.constants_from(params)
     window = result.windows
     times = window["time"].values
-    limit = 0.9 * contact.rayleigh_time(params.ball_radius, params.ball_density, params.ball_youngs_modulus, params.ball_poisson_ratio)
-    gaps = np.array([min(model.gap(t, x, model.LEFT_WALL, k), model.gap(t, x, model.RIGHT_WALL, k)) for t, x in zip(times, window["x"].values)])
+    limit = 0.9 * contact.rayleigh_time(
+        params.ball_radius, params.ball_density, params.ball_youngs_modulus, params.ball_poisson_ratio
+    )
+    gaps = np.array(
+        [
+            min(model.gap(t, x, model.LEFT_WALL, k), model.gap(t, x, model.RIGHT_WALL, k))
+            for t, x in zip(times, window["x"].values)
+        ]
+    )
     # A step belongs to a contact when it starts overlapping; the landing step that ends at an onset does not.
     in_contact = gaps[:-1] < 0.0
     steps = np.diff(times)

@@ -26,9 +26,17 @@ def test_the_network_has_a_clamp_node_and_every_path_of_a_real_mill():
     network = DemEngine.network_for(mill_head(n_balls=2, drive_heat=7.0))
     assert [node.name for node in network.nodes] == ["ball 0", "ball 1", "vial", "air", "clamp"]
     assert [path.name for path in network.paths] == [
-        "ball 0 → air", "ball 1 → air", "vial → air", "vial → room, convection", "vial → room, radiation",
-        "ball 0 → vial, contacts", "ball 1 → vial, contacts", "ball 0 → other balls, contacts",
-        "ball 1 → other balls, contacts", "vial → clamp", "clamp → room",
+        "ball 0 → air",
+        "ball 1 → air",
+        "vial → air",
+        "vial → room, convection",
+        "vial → room, radiation",
+        "ball 0 → vial, contacts",
+        "ball 1 → vial, contacts",
+        "ball 0 → other balls, contacts",
+        "ball 1 → other balls, contacts",
+        "vial → clamp",
+        "clamp → room",
     ]
     assert list(network.arrays.fixed_heat) == [0.0, 0.0, 0.0, 0.0, 7.0]
     assert all(path.correlation and path.source and path.validity for path in network.paths)
@@ -49,7 +57,9 @@ def test_the_vials_speed_and_outer_convection_follow_from_its_motion():
 def test_each_ball_has_a_drive_for_its_contacts_with_the_vial_and_one_with_the_other_balls():
     """Issue 38: drives grow linearly with the balls (3 per ball), not with the pairs."""
     n = 5
-    indices = [kernel.contact_drive(i, -1, n) for i in range(n)] + [kernel.contact_drive(i, (i + 1) % n, n) for i in range(n)]
+    indices = [kernel.contact_drive(i, -1, n) for i in range(n)] + [
+        kernel.contact_drive(i, (i + 1) % n, n) for i in range(n)
+    ]
     assert sorted(indices) == list(range(n, kernel.drive_count(n))) and kernel.drive_count(n) == 3 * n
     assert kernel.contact_drive(3, 1, n) == kernel.contact_drive(3, 4, n) != kernel.contact_drive(1, 3, n)
 
@@ -83,7 +93,9 @@ def test_each_new_path_flows_as_its_correlation_says():
     flows = dict(zip((path.name for path in network.paths), network.flows(theta, drives)))
     ambient = params.ambient_temperature
     outer = vial_outer_convection(params)
-    assert flows["vial → room, convection"] == pytest.approx(outer.coefficient * outer.area * (310.0 - ambient), rel=1e-12)
+    assert flows["vial → room, convection"] == pytest.approx(
+        outer.coefficient * outer.area * (310.0 - ambient), rel=1e-12
+    )
     radiated = 0.3 * heat_paths.STEFAN_BOLTZMANN * outer.area * (310.0**4 - ambient**4)
     assert flows["vial → room, radiation"] == pytest.approx(radiated, rel=1e-12)
     assert flows["ball 0 → vial, contacts"] == pytest.approx(0.004 * 30.0)
@@ -103,7 +115,9 @@ def test_the_balance_books_the_drives_heat():
     capacity = network.arrays.capacity
     assert np.dot(capacity, rates) + lost == pytest.approx(heat.sum() + 12.0, rel=1e-12)
     stepped = theta.copy()
-    left = kernel.advance(stepped, np.append(heat, 0.0) * 0.01, drives, 0.01, network.arrays, np.empty(len(network.paths)), np.empty(5))
+    left = kernel.advance(
+        stepped, np.append(heat, 0.0) * 0.01, drives, 0.01, network.arrays, np.empty(len(network.paths)), np.empty(5)
+    )
     assert np.dot(capacity, stepped - theta) + left == pytest.approx((heat.sum() + 12.0) * 0.01, rel=1e-9)
 
 
@@ -133,11 +147,18 @@ def test_a_contact_records_what_it_conducted():
     for index in range(impacts["time"].size):
         radius = heat_paths.hertz_contact_radius(k.wall_radius[0, 0], impacts["max_overlap"][index])
         expected = heat_paths.contact_conduction(
-            radius, impacts["duration"][index], k.effusivity[0], k.vial_effusivity, k.conductivity[0], k.vial_conductivity
+            radius,
+            impacts["duration"][index],
+            k.effusivity[0],
+            k.vial_effusivity,
+            k.conductivity[0],
+            k.vial_conductivity,
         )
         assert impacts["conduction"][index] == pytest.approx(expected, rel=1e-12)
     n = params.n_balls
-    assert engine.state.drive_integrals[kernel.contact_drive(0, -1, n)] == pytest.approx(impacts["conduction"].sum(), rel=1e-12)
+    assert engine.state.drive_integrals[kernel.contact_drive(0, -1, n)] == pytest.approx(
+        impacts["conduction"].sum(), rel=1e-12
+    )
 
 
 @pytest.mark.parametrize(
@@ -161,8 +182,15 @@ def test_the_one_d_engine_takes_the_papers_network_only():
 @pytest.mark.slow
 def test_an_averaged_mill_head_run_reports_each_paths_heat_and_closes_its_balance():
     # The 3-D engine's 1-D limit settles in seconds; the paths are the mill-head's all the same.
-    params = mill_head(drive_heat=6.0, record_windows=(), duration=600.0, vial_diameter="19 mm", kinematics="axial",
-                       gravity=False, friction=0.0)
+    params = mill_head(
+        drive_heat=6.0,
+        record_windows=(),
+        duration=600.0,
+        vial_diameter="19 mm",
+        kinematics="axial",
+        gravity=False,
+        friction=0.0,
+    )
     result = sm.simulate(params)
     assert result.success, result.message
     paths = result.summary["heat_paths_W"]

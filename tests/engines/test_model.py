@@ -142,9 +142,7 @@ def test_constants_from_default_parameters(params: Parameters, hand: Hand) -> No
 
 
 def test_constants_follow_the_options(params: Parameters) -> None:
-    k = model.constants_from(
-        params.replace(no_tension=True, heat_model="paper", convection_velocity="relative")
-    )
+    k = model.constants_from(params.replace(no_tension=True, heat_model="paper", convection_velocity="relative"))
     assert (k.no_tension, k.paper_heat, k.relative_convection) == (True, True, True)
 
 
@@ -336,9 +334,7 @@ def test_paper_heat_model_is_non_negative_when_moving_away(params: Parameters, h
     overlap, speed = 2e-6, -1.0
     dydt = _rates(paper, 0.0, _right_contact(hand, 0.0, overlap, speed))
     rate = speed - 2.775  # −3.775 m/s
-    assert dydt[model.HEAT_GENERATED] == pytest.approx(
-        paper.eta * abs(hand.damping(overlap) * rate * speed), rel=1e-6
-    )
+    assert dydt[model.HEAT_GENERATED] == pytest.approx(paper.eta * abs(hand.damping(overlap) * rate * speed), rel=1e-6)
     assert dydt[model.HEAT_GENERATED] > 0.0
 
 
@@ -350,8 +346,11 @@ CASES = [
     ("right_later", dict(), lambda h: (0.004, _right_contact(h, 0.004, 4e-6, 3.0))),
     ("left", dict(), lambda h: (0.0, _left_contact(h, 0.0, 3e-6, -3.0))),
     ("clipped", dict(no_tension=True), lambda h: (0.0, _right_contact(h, 0.0, 1e-7, 0.775))),
-    ("paper_relative", dict(heat_model="paper", convection_velocity="relative"),
-     lambda h: (0.0, _right_contact(h, 0.0, 2e-6, 5.0))),
+    (
+        "paper_relative",
+        dict(heat_model="paper", convection_velocity="relative"),
+        lambda h: (0.0, _right_contact(h, 0.0, 2e-6, 5.0)),
+    ),
 ]
 
 

@@ -1,5 +1,6 @@
-"""The 'dem' engine's neighbour list (engines/dem/neighbours.py, issue 38): the same contacts as the search over every
-pair, its bound on the entries, the contacts it carries through a rebuild, and the packing that starts a large charge."""
+"""The 'dem' engine's neighbour list (engines/dem/neighbours.py, issue 38): the same contacts as the search over
+every pair, its bound on the entries, the contacts it carries through a rebuild, and the packing that starts a large
+charge."""
 
 from __future__ import annotations
 
@@ -122,7 +123,9 @@ def test_a_rebuild_carries_each_touching_contact_to_its_new_entry_whole(monkeypa
         nb = s.neighbours
         return {
             (int(nb.first_ball[e]), int(nb.second_ball[e])): (
-                *s.contacts.spring[walls + e], s.contacts.started[walls + e], *s.contacts.dissipated[walls + e],
+                *s.contacts.spring[walls + e],
+                s.contacts.started[walls + e],
+                *s.contacts.dissipated[walls + e],
                 s.contacts.peak_force[walls + e],
             )
             for e in range(int(nb.count[0]))
@@ -132,7 +135,10 @@ def test_a_rebuild_carries_each_touching_contact_to_its_new_entry_whole(monkeypa
     before = touching()
     assert rebuild_neighbours(k, s, engine.scratch.coordinates[:3])  # the list of the balls where they are now
     assert touching() == before
-    entries_before = s.neighbours.first_ball[: s.neighbours.count[0]].copy(), s.neighbours.second_ball[: s.neighbours.count[0]].copy()
+    entries_before = (
+        s.neighbours.first_ball[: s.neighbours.count[0]].copy(),
+        s.neighbours.second_ball[: s.neighbours.count[0]].copy(),
+    )
     # The grid moved by 0.4 of a cell: every ball in other cells, so the pairs are listed in another order.
     assert rebuild_neighbours(k, s, engine.scratch.coordinates[:3] + 0.4 * k.cell_size)
     entries_after = s.neighbours.first_ball[: s.neighbours.count[0]], s.neighbours.second_ball[: s.neighbours.count[0]]
@@ -158,8 +164,15 @@ def test_packing_a_thousand_balls_places_them_apart_and_inside_the_bowl():
 def test_a_bowl_filled_with_small_balls_runs_on_its_neighbour_list():
     """Issue 38: ``fill`` of a planetary bowl with Ø5-mm balls makes a charge of hundreds, which starts apart, runs,
     rebuilds its list and closes its energy audit."""
-    params = sm.default_parameters("pulverisette7", fill=0.3, ball_radius="2.5 mm", duration=0.002, record_windows=(),
-                                   output_interval=0.001, solver="full")
+    params = sm.default_parameters(
+        "pulverisette7",
+        fill=0.3,
+        ball_radius="2.5 mm",
+        duration=0.002,
+        record_windows=(),
+        output_interval=0.001,
+        solver="full",
+    )
     assert params.n_balls > 100  # hundreds of balls
     result = sm.simulate(params)
     assert result.success and result.counters["neighbour_builds"] > 0 and result.impact_count > 0

@@ -30,8 +30,9 @@ def jar_motion(params: sm.Parameters, t: float) -> tuple[np.ndarray, np.ndarray,
 @pytest.mark.parametrize("ratio, tilt", [(-2.0, 0.0), (-1.0, 0.0), (-2.5, 0.5), (0.7, 0.3)])
 @pytest.mark.parametrize("t", [0.0, 0.0123, 1.7, 3600.0])
 def test_the_jar_moves_as_the_closed_forms_of_a_planetary_mill(ratio, tilt, t):
-    params = sm.default_parameters(**PLANETARY, revolution_radius="75 mm", speed_ratio=ratio, jar_tilt=tilt,
-                                   omega="600 rpm", phase=0.4)
+    params = sm.default_parameters(
+        **PLANETARY, revolution_radius="75 mm", speed_ratio=ratio, jar_tilt=tilt, omega="600 rpm", phase=0.4
+    )
     radius, omega = params.revolution_radius, params.omega
     angle = omega * t + params.phase
     centre, velocity, orientation, turning = jar_motion(params, t)
@@ -46,21 +47,30 @@ def test_the_jar_moves_as_the_closed_forms_of_a_planetary_mill(ratio, tilt, t):
     assert turning == pytest.approx(omega * up + ratio * omega * axis, abs=1e-9)
     # The spin angle: a vial-frame direction across the axis turns by k·θ in the wheel's frame.
     across = orientation[:, 1]
-    wheel_frame_across = np.array([math.cos(angle) * across[0] + math.sin(angle) * across[1],
-                                   -math.sin(angle) * across[0] + math.cos(angle) * across[1], across[2]])
-    expected = np.array([-math.sin(ratio * angle) * math.cos(tilt), math.cos(ratio * angle), math.sin(ratio * angle) * math.sin(tilt)])
+    wheel_frame_across = np.array(
+        [
+            math.cos(angle) * across[0] + math.sin(angle) * across[1],
+            -math.sin(angle) * across[0] + math.cos(angle) * across[1],
+            across[2],
+        ]
+    )
+    expected = np.array(
+        [-math.sin(ratio * angle) * math.cos(tilt), math.cos(ratio * angle), math.sin(ratio * angle) * math.sin(tilt)]
+    )
     assert wheel_frame_across == pytest.approx(expected, abs=1e-9)
 
 
 def test_the_jar_accelerates_towards_the_sun_axis_and_turns_as_its_orientation_says():
     """Central differences of the engine's velocity and orientation against the closed forms: a = −R_p ω² r̂, and
     Q̇ Qᵀ = [Ω]× (the angular velocity the engine gives the walls)."""
-    params = sm.default_parameters(**PLANETARY, revolution_radius="70 mm", speed_ratio=-2.0, jar_tilt=0.3, omega="800 rpm")
+    params = sm.default_parameters(
+        **PLANETARY, revolution_radius="70 mm", speed_ratio=-2.0, jar_tilt=0.3, omega="800 rpm"
+    )
     t, h = 0.37, 1e-6
     centre, _, orientation, turning = jar_motion(params, t)
     (_, before, q_before, _), (_, after, q_after, _) = jar_motion(params, t - h), jar_motion(params, t + h)
     acceleration = (after - before) / (2 * h)
-    assert acceleration == pytest.approx(-params.omega**2 * centre, rel=1e-6, abs=1e-6)
+    assert acceleration == pytest.approx(-(params.omega**2) * centre, rel=1e-6, abs=1e-6)
     spin_matrix = (q_after - q_before) / (2 * h) @ orientation.T
     assert np.array([spin_matrix[2, 1], spin_matrix[0, 2], spin_matrix[1, 0]]) == pytest.approx(turning, rel=1e-7)
 
@@ -92,8 +102,9 @@ def test_a_ball_carried_on_the_wall_of_a_jar_that_does_not_spin_feels_the_centri
     assert s.force[0] == pytest.approx(centripetal, rel=1e-4, abs=2e-6 * k.mass[0] * params.omega**2 * distance)
     # It stays where it was put, sunk into the wall by the static Hertz overlap of that force (within a tenth of it:
     # the tangential spring keeps the few nanometres the first oscillations of the contact stretched it by).
-    modulus = contact.effective_modulus(params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus,
-                                        params.vial_poisson_ratio)
+    modulus = contact.effective_modulus(
+        params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus, params.vial_poisson_ratio
+    )
     concave = contact.concave_radius(params.ball_radius, bore)
     overlap = (3 * np.linalg.norm(centripetal) / (4 * modulus * math.sqrt(concave))) ** (2 / 3)
     where = orientation.T @ (s.position[0] - centre)
@@ -103,8 +114,16 @@ def test_a_ball_carried_on_the_wall_of_a_jar_that_does_not_spin_feels_the_centri
 def test_a_ball_carried_on_the_bore_of_a_spinning_jar_feels_the_centrifugal_force_of_the_spin():
     """A jar that only spins about its upright axis at ω (a user's motion of steady angles): the ball on its bore
     is pressed by m ω² (R_c − R)."""
-    params = sm.default_parameters(engine="dem", kinematics="fourier", motion="pitch:0:-1.5707963267948966:0, roll:0:0:1",
-                                   gravity=False, omega="200 rpm", duration=0.2, solver="full", record_windows=())
+    params = sm.default_parameters(
+        engine="dem",
+        kinematics="fourier",
+        motion="pitch:0:-1.5707963267948966:0, roll:0:0:1",
+        gravity=False,
+        omega="200 rpm",
+        duration=0.2,
+        solver="full",
+        record_windows=(),
+    )
     lever = params.vial_diameter / 2 - params.ball_radius
     engine = carried_ball(params, np.array([0.0, lever, 0.0]))
     engine.advance(params.duration)
@@ -131,8 +150,17 @@ def rotating_frame_energy(engine: DemEngine, omega: float) -> float:
 def rotating_frame_residual(**settings: object) -> tuple[float, float]:
     """Ten balls in a jar that keeps its place on the wheel (speed ratio 0) for 0.15 s: how far the Jacobi integral's
     fall misses what the contacts dissipated and store, relative to the dissipation, and the lab audit's residual."""
-    params = sm.default_parameters(**PLANETARY, speed_ratio=0.0, n_balls=10, ball_radius="5 mm", vial_diameter="50 mm",
-                                   vial_length="40 mm", omega="400 rpm", duration=0.15, **settings)
+    params = sm.default_parameters(
+        **PLANETARY,
+        speed_ratio=0.0,
+        n_balls=10,
+        ball_radius="5 mm",
+        vial_diameter="50 mm",
+        vial_length="40 mm",
+        omega="400 rpm",
+        duration=0.15,
+        **settings,
+    )
     engine = DemEngine(params)
     start = rotating_frame_energy(engine, params.omega)
     engine.advance(params.duration)
@@ -165,8 +193,16 @@ def test_with_friction_the_rotating_frame_balance_misses_by_the_overlap_over_the
 
 @pytest.mark.slow
 def test_the_audit_closes_in_a_spinning_tilted_planetary_jar():
-    params = sm.default_parameters(**PLANETARY, n_balls=10, ball_radius="5 mm", vial_diameter="50 mm", vial_length="40 mm",
-                                   jar_tilt=0.4, omega="500 rpm", duration=0.15)
+    params = sm.default_parameters(
+        **PLANETARY,
+        n_balls=10,
+        ball_radius="5 mm",
+        vial_diameter="50 mm",
+        vial_length="40 mm",
+        jar_tilt=0.4,
+        omega="500 rpm",
+        duration=0.15,
+    )
     result = sm.simulate(params)
     assert result.success, result.message
     assert result.energy.relative_residual < 1e-6
@@ -197,7 +233,12 @@ def rolling_ball(params: sm.Parameters, start: float) -> DemEngine:
     wheel's frame and spinning so that it rolls on the wall without slipping (the wall moves under it at k·ω)."""
     engine = DemEngine(params)
     centre, velocity, orientation, _ = jar_motion(params, 0.0)
-    rho, radius, omega, k = params.vial_diameter / 2 - params.ball_radius, params.ball_radius, params.omega, params.speed_ratio
+    rho, radius, omega, k = (
+        params.vial_diameter / 2 - params.ball_radius,
+        params.ball_radius,
+        params.omega,
+        params.speed_ratio,
+    )
     radial = centre / np.linalg.norm(centre)
     normal = math.cos(start) * radial + math.sin(start) * np.cross([0.0, 0.0, 1.0], radial)
     engine.state.position[0] = centre + rho * normal
@@ -214,8 +255,17 @@ def rolling_ball(params: sm.Parameters, start: float) -> DemEngine:
 def test_a_ball_rolling_on_the_wall_of_a_planetary_jar_swings_as_a_pendulum_whatever_the_jars_spin(ratio):
     """(7/5)·ρ·φ̈ = −ω²·R_p·sin φ: small swings of period 2π·√(7ρ / (5ω²R_p)), the same for every speed ratio k
     (MODEL.md §14.3), gravity off, friction enough to roll without slipping."""
-    params = sm.default_parameters("pulverisette7", **PLANETARY, n_balls=1, speed_ratio=ratio, gravity=False,
-                                   friction=1.0, rolling_friction=0.0, restitution=0.3, jar_tilt=0.0)
+    params = sm.default_parameters(
+        "pulverisette7",
+        **PLANETARY,
+        n_balls=1,
+        speed_ratio=ratio,
+        gravity=False,
+        friction=1.0,
+        rolling_friction=0.0,
+        restitution=0.3,
+        jar_tilt=0.0,
+    )
     rho = params.vial_diameter / 2 - params.ball_radius
     period = 2 * math.pi * math.sqrt(7 * rho / (5 * params.omega**2 * params.revolution_radius))
     engine = rolling_ball(params, 0.1)
@@ -228,7 +278,9 @@ def test_a_ball_rolling_on_the_wall_of_a_planetary_jar_swings_as_a_pendulum_what
     times, angles = np.array(times), np.array(angles)
     # Upward zero crossings of φ, interpolated: their spacing is the period.
     rising = np.flatnonzero((angles[:-1] < 0) & (angles[1:] >= 0))
-    crossings = times[rising] - angles[rising] * (times[rising + 1] - times[rising]) / (angles[rising + 1] - angles[rising])
+    crossings = times[rising] - angles[rising] * (times[rising + 1] - times[rising]) / (
+        angles[rising + 1] - angles[rising]
+    )
     assert len(crossings) >= 3
     measured = float(np.mean(np.diff(crossings)))
     # A swing of 0.1 rad lengthens the period by φ₀²/16 (0.0625 %): measured, 0.064 % for every k.
@@ -242,11 +294,21 @@ def test_a_ball_rolling_on_the_wall_of_a_planetary_jar_swings_as_a_pendulum_what
 @pytest.mark.parametrize("ratio", [-2.0, -1.0, 0.5, 1.0])
 def test_a_ball_carried_with_the_wall_of_a_planetary_jar_is_pressed_as_the_closed_form_says(ratio):
     """N = m·ω²·(R_p·cos φ + (1 + k)²·ρ) on a ball carried by the wall without slipping or rolling (MODEL.md §14.3),
-    gravity off, from 6° to 35° of its way round (past the settling of its start) from the outermost point: friction and rolling resistance of 1 hold
-    it there. (Farther round, what holds it carried, F_t/N = R_p·sin φ / (R_p·cos φ + (1 + k)²·ρ), outgrows any
-    friction before N reaches 0: it slips before cos φ = −(1 + k)²·ρ/R_p, the no-slip limit where it would leave.)"""
-    params = sm.default_parameters("pulverisette7", **PLANETARY, n_balls=1, speed_ratio=ratio, gravity=False,
-                                   friction=1.0, rolling_friction=1.0, restitution=0.3, jar_tilt=0.0)
+    gravity off, from 6° to 35° of its way round (past the settling of its start) from the outermost point: friction
+    and rolling resistance of 1 hold it there. (Farther round, what holds it carried,
+    F_t/N = R_p·sin φ / (R_p·cos φ + (1 + k)²·ρ), outgrows any friction before N reaches 0: it slips before
+    cos φ = −(1 + k)²·ρ/R_p, the no-slip limit where it would leave.)"""
+    params = sm.default_parameters(
+        "pulverisette7",
+        **PLANETARY,
+        n_balls=1,
+        speed_ratio=ratio,
+        gravity=False,
+        friction=1.0,
+        rolling_friction=1.0,
+        restitution=0.3,
+        jar_tilt=0.0,
+    )
     rho, omega, arm = params.vial_diameter / 2 - params.ball_radius, params.omega, params.revolution_radius
     centre, _, orientation, _ = jar_motion(params, 0.0)
     engine = carried_ball(params, orientation.T @ (rho * centre / np.linalg.norm(centre)))
@@ -259,7 +321,9 @@ def test_a_ball_carried_with_the_wall_of_a_planetary_jar_is_pressed_as_the_close
         phi = wheel_frame_angle(params, engine)
         if math.radians(6) <= abs(phi) <= math.radians(35):
             pressed = -float(engine.state.force[0] @ offset) / float(np.linalg.norm(offset))
-            compared.append((pressed, engine.constants.mass[0] * omega**2 * (arm * math.cos(phi) + (1 + ratio) ** 2 * rho)))
+            compared.append(
+                (pressed, engine.constants.mass[0] * omega**2 * (arm * math.cos(phi) + (1 + ratio) ** 2 * rho))
+            )
     pressed, expected = np.array(compared).T
     assert len(compared) >= 50
     # Within 0.5 %: the overlap puts the centre ~1e-4 beyond ρ, and the rolling torque's direction flips about a spin

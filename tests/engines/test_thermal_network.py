@@ -43,16 +43,22 @@ def test_each_path_flows_as_its_correlation_says():
     theta = np.array([330.0, 350.0, 310.0, 300.0])
     terms = np.array([12.0, 40.0])
     flows = network.flows(theta, terms)
-    prandtl = params.air_cp * thermal.sutherland_viscosity(
-        params.ambient_temperature, params.air_viscosity_ref, params.air_reference_temperature, params.sutherland
-    ) / params.air_conductivity
+    prandtl = (
+        params.air_cp
+        * thermal.sutherland_viscosity(
+            params.ambient_temperature, params.air_viscosity_ref, params.air_reference_temperature, params.sutherland
+        )
+        / params.air_conductivity
+    )
     for ball, radius in enumerate((5e-3, 6e-3)):
         mu = params.air_viscosity_ref * (theta[ball] / 273.15) ** 1.5 * (273.15 + 111.0) / (theta[ball] + 111.0)
         nusselt = 2.0 + terms[ball] * prandtl**0.4 * (mu / params.air_viscosity_ref) ** -0.25
         h = nusselt * params.air_conductivity / (2.0 * radius)
         assert flows[ball] == pytest.approx(4.0 * math.pi * radius**2 * 0.8 * h * (theta[ball] - theta[3]), rel=1e-12)
     assert flows[2] == pytest.approx(params.h_inner * params.inner_area * (theta[2] - theta[3]), rel=1e-14)
-    assert flows[3] == pytest.approx(params.h_outer * params.outer_area * (theta[2] - params.ambient_temperature), rel=1e-14)
+    assert flows[3] == pytest.approx(
+        params.h_outer * params.outer_area * (theta[2] - params.ambient_temperature), rel=1e-14
+    )
 
 
 def test_every_path_and_source_says_what_it_rests_on():
@@ -93,6 +99,10 @@ def test_node_conductances_are_the_paths_at_each_node():
     params = sm.default_parameters()
     network = OneDimensionalEngine.network_for(params)
     conductances = network.node_conductances(np.array([0.0]))
-    at_rest = 4.0 * math.pi * params.ball_radius**2 * params.beta * params.air_conductivity / (2.0 * params.ball_radius) * 2.0
+    at_rest = (
+        4.0 * math.pi * params.ball_radius**2 * params.beta * params.air_conductivity / (2.0 * params.ball_radius) * 2.0
+    )
     assert conductances[0] == pytest.approx(at_rest, rel=0.02)  # Nu = 2 at rest, Sutherland's factor aside
-    assert conductances[1] == pytest.approx(params.h_inner * params.inner_area + params.h_outer * params.outer_area, rel=1e-9)
+    assert conductances[1] == pytest.approx(
+        params.h_inner * params.inner_area + params.h_outer * params.outer_area, rel=1e-9
+    )

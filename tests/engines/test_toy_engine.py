@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Callable, ClassVar, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -30,12 +31,25 @@ from shakermill.parameters.keys import Parameters
 from shakermill.physics import thermal
 from shakermill.views.figures.run import temperature_figure
 
-IMPACT_UNITS = {"time": "s", "wall": "", "impact_speed": "m/s", "dissipated_energy": "J", "heat_generated": "J",
-                "peak_force": "N", "max_overlap": "m", "duration": "s"}
+IMPACT_UNITS = {
+    "time": "s",
+    "wall": "",
+    "impact_speed": "m/s",
+    "dissipated_energy": "J",
+    "heat_generated": "J",
+    "peak_force": "N",
+    "max_overlap": "m",
+    "duration": "s",
+}
 DESCRIPTION = EngineDescription(
     keys=EngineKeys(
-        name="toy", title="the toy engine", summary="a point ball bouncing rigidly between the end faces",
-        kinematics=("axial",), most_balls=1, thermal_models=("three_node",), networks=("paper",),
+        name="toy",
+        title="the toy engine",
+        summary="a point ball bouncing rigidly between the end faces",
+        kinematics=("axial",),
+        most_balls=1,
+        thermal_models=("three_node",),
+        networks=("paper",),
         air_moves_with_vial=False,
     ),
     channels=("normal",),
@@ -59,15 +73,22 @@ class ToyEngine:
 
     description: ClassVar[EngineDescription] = DESCRIPTION
 
-    def __init__(self, params: Parameters, budget: RunBudget | None = None, samples: Sequence[float] = (0.0,),
-                 horizon: float = 0.0) -> None:
+    def __init__(
+        self,
+        params: Parameters,
+        budget: RunBudget | None = None,
+        samples: Sequence[float] = (0.0,),
+        horizon: float = 0.0,
+    ) -> None:
         self.params = params
         self.budget = budget if budget is not None else RunBudget.of(params)
         self.network = self.network_for(params)
         self.speed = params.amplitude * params.omega
         self.gap = params.vial_length / 2.0 - params.ball_radius
         self.hit_heat = params.eta * 0.5 * params.ball_mass * self.speed**2 * (1.0 - params.restitution**2)
-        reynolds = thermal.reynolds_number(params.ball_radius, params.air_density, self.speed, air_constants(params)["viscosity_ambient"])
+        reynolds = thermal.reynolds_number(
+            params.ball_radius, params.air_density, self.speed, air_constants(params)["viscosity_ambient"]
+        )
         self.term = thermal.whitaker_velocity_term(reynolds)
         self.samples = np.asarray(samples, dtype=float)
         self.clock = 0.0
@@ -77,8 +98,13 @@ class ToyEngine:
 
     @classmethod
     def network_for(cls, params: Parameters) -> ThermalNetwork:
-        return build_network(params, [params.ball_radius], [params.ball_mass * params.ball_heat_capacity], ("ball",),
-                             "λ of each hit's heat")
+        return build_network(
+            params,
+            [params.ball_radius],
+            [params.ball_mass * params.ball_heat_capacity],
+            ("ball",),
+            "λ of each hit's heat",
+        )
 
     @property
     def heat_power(self) -> float:
@@ -99,8 +125,9 @@ class ToyEngine:
             return np.append(node_rates, lost)
 
         start = np.append(self.temperatures[-1], self.lost[-1])
-        solution = solve_ivp(rates, (self.clock, t_stop), start, method="LSODA", t_eval=np.union1d(grid, [t_stop]), rtol=1e-9,
-                             atol=1e-9)
+        solution = solve_ivp(
+            rates, (self.clock, t_stop), start, method="LSODA", t_eval=np.union1d(grid, [t_stop]), rtol=1e-9, atol=1e-9
+        )
         for time, state in zip(solution.t, solution.y.T):
             self.times.append(float(time))
             self.temperatures.append(state[:-1])
@@ -118,7 +145,10 @@ class ToyEngine:
         x = np.where(phase < 2.0 * self.gap, phase - self.gap, 3.0 * self.gap - phase)
         variables = {
             "x": (x, attributes("m", "ball centre position")),
-            "velocity": (np.where(phase < 2.0 * self.gap, self.speed, -self.speed), attributes("m s-1", "ball velocity")),
+            "velocity": (
+                np.where(phase < 2.0 * self.gap, self.speed, -self.speed),
+                attributes("m s-1", "ball velocity"),
+            ),
             "theta_ball": (theta[:, 0], attributes("K", "ball temperature")),
             "theta_vial": (theta[:, 1], attributes("K", "vial temperature")),
             "theta_air": (theta[:, 2], attributes("K", "inner air temperature")),
@@ -139,7 +169,9 @@ class ToyEngine:
 
     def impact_columns(self, since: float = -math.inf) -> dict[str, np.ndarray]:
         first = self.gap / self.speed
-        times = first + 2.0 * self.gap / self.speed * np.arange(int(max(self.clock - first, 0.0) * self.speed / (2.0 * self.gap)) + 1)
+        times = first + 2.0 * self.gap / self.speed * np.arange(
+            int(max(self.clock - first, 0.0) * self.speed / (2.0 * self.gap)) + 1
+        )
         times = times[(times <= self.clock) & (times >= since)]
         count = times.size
         return {
@@ -164,11 +196,19 @@ class ToyEngine:
         heat = self.heat_power * self.clock
         dissipated = heat / self.params.eta
         return EnergyAudit(
-            work_by_vial=dissipated, kinetic_energy_change=0.0, elastic_energy_change=0.0, dissipated=dissipated,
-            heat_generated=heat, heat_to_ball=self.params.lam * heat, heat_to_vial=(1.0 - self.params.lam) * heat,
-            not_converted_to_heat=dissipated - heat, stored_ball=float(capacity[0] * warming[0]),
-            stored_vial=float(capacity[1] * warming[1]), stored_air=float(capacity[2] * warming[2]),
-            heat_lost_to_surroundings=self.lost[-1], projection_correction=0.0,
+            work_by_vial=dissipated,
+            kinetic_energy_change=0.0,
+            elastic_energy_change=0.0,
+            dissipated=dissipated,
+            heat_generated=heat,
+            heat_to_ball=self.params.lam * heat,
+            heat_to_vial=(1.0 - self.params.lam) * heat,
+            not_converted_to_heat=dissipated - heat,
+            stored_ball=float(capacity[0] * warming[0]),
+            stored_vial=float(capacity[1] * warming[1]),
+            stored_air=float(capacity[2] * warming[2]),
+            heat_lost_to_surroundings=self.lost[-1],
+            projection_correction=0.0,
         )
 
     @property
@@ -179,20 +219,34 @@ class ToyEngine:
         return ""
 
     def measured(self) -> Measured:
-        return Measured(np.array([self.heat_power * self.clock]), np.array([self.term * self.clock]),
-                        self.heat_power / self.params.eta * self.clock)
+        return Measured(
+            np.array([self.heat_power * self.clock]),
+            np.array([self.term * self.clock]),
+            self.heat_power / self.params.eta * self.clock,
+        )
 
     def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
         power, lam = float(heat_rates[0]), self.params.lam
-        return NetworkLoad(np.array([lam * power, (1.0 - lam) * power, 0.0]), np.array(term_means, dtype=float), power,
-                           float(term_means[0]))
+        return NetworkLoad(
+            np.array([lam * power, (1.0 - lam) * power, 0.0]),
+            np.array(term_means, dtype=float),
+            power,
+            float(term_means[0]),
+        )
 
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
         count = len(impacts["time"])
         return np.array([count, count, 0])
 
-    def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray, load: NetworkLoad,
-                         dissipated_power: float, network: ThermalNetwork) -> StateHistory:
+    def averaged_history(
+        self,
+        times: np.ndarray,
+        temperatures: np.ndarray,
+        heat_lost: np.ndarray,
+        load: NetworkLoad,
+        dissipated_power: float,
+        network: ThermalNetwork,
+    ) -> StateHistory:
         return self._states(times, temperatures.T, heat_lost)
 
 
@@ -258,7 +312,9 @@ def test_the_averaged_solver_drives_a_registered_engine_too(toy, tmp_path):
     full = sm.simulate(toy)
     np.testing.assert_allclose(result.history["theta_ball"], full.history["theta_ball"], rtol=1e-6)
     # Its files say what the averaged run did not compute, and what it extended from the window, as it declares.
-    with xr.open_dataset(write_run(result, tmp_path / "averaged", preset="spex8000m") / "timeseries.nc", engine="h5netcdf") as series:
+    with xr.open_dataset(
+        write_run(result, tmp_path / "averaged", preset="spex8000m") / "timeseries.nc", engine="h5netcdf"
+    ) as series:
         assert "x, velocity are NaN" in series.attrs["coverage"]
         assert "heat_generated, velocity_term_integral are the averaging window's mean" in series.attrs["coverage"]
         assert "mean rate times time" in series["velocity_term_integral"].attrs["coverage"]

@@ -37,7 +37,10 @@ def test_the_guides_calibration_as_written_ends_with_a_fitted_preset_of_its_mill
     assert arguments == ["my-mill.toml", "--curve", "vial.csv", "--out", "my-mill-fitted.toml"]
     completed = subprocess.run(
         [sys.executable, "-m", "shakermill.cli", "calibrate", *arguments, "--no-posterior", "--json"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=1800,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=1800,
     )
     assert completed.returncode == 0, completed.stderr[-3000:]
     fit = json.loads(completed.stdout)

@@ -93,7 +93,15 @@ def test_run_writes_figures_and_prints_a_human_summary(tmp_path):
     ball_celsius = load_run(out).summary["ball_C"]
     units = ("°C", "min", "Hz", "m/s", "W")
     # Shorter than its slowest time constant: one row says why no exponential is fitted (issue 37).
-    expected = ("exponential fit", "none: the run is shorter than the slowest time constant", *units, "steps", "energy audit residual", f"{ball_celsius:.2f}", str(out))
+    expected = (
+        "exponential fit",
+        "none: the run is shorter than the slowest time constant",
+        *units,
+        "steps",
+        "energy audit residual",
+        f"{ball_celsius:.2f}",
+        str(out),
+    )
     for text in expected:
         assert text in result.stdout, text
     figures = sorted(path.name for path in (out / "figures").iterdir())
@@ -126,8 +134,17 @@ def test_config_file_and_set_overrides_end_up_in_the_stored_configuration(tmp_pa
         ("ball_radius=40 mm", ("ball_radius", "does not fit", "allowed ball_radius < vial_length/2 = 0.029 m")),
         ("vial_mass=-1", ("vial_mass", "allowed [0.001, 100] kg")),
         ("omega=0", ("omega", "allowed [1, 10000] rad/s")),
-        ("amplitude=3 kg", ("amplitude", "'3 kg' has the wrong dimension (read as kilogram); expected a length such as m or mm")),
-        ("omega=3 kg", ("omega: '3 kg' has the wrong dimension (read as kilogram); expected a frequency such as rad/s, Hz or rpm",)),
+        (
+            "amplitude=3 kg",
+            ("amplitude", "'3 kg' has the wrong dimension (read as kilogram); expected a length such as m or mm"),
+        ),
+        (
+            "omega=3 kg",
+            (
+                "omega: '3 kg' has the wrong dimension (read as kilogram); expected a frequency such as rad/s, Hz or "
+                "rpm",
+            ),
+        ),
         ("omega=1060 rmp", ("omega: cannot parse '1060 rmp': unknown unit 'rmp'; expected a frequency",)),
         ("ambient_temperature=25 kg", ("ambient_temperature", "expected a temperature such as K, degC or degF")),
         ("restitutoin=0.5", ("restitutoin", "did you mean 'restitution'")),
@@ -148,7 +165,15 @@ def test_bad_setting_exits_2_with_one_line_naming_the_key(tmp_path, setting, fra
 def test_temperatures_in_degrees_celsius_and_rates_in_rpm_of_any_case_are_read(tmp_path):
     out = tmp_path / "run"
     settings = ["ambient_temperature=25 C", "initial_temperature=68 °F", "omega=1060 RPM", "atol_temperature=1e-6 degC"]
-    result = invoke("run", *SHORT, *(part for setting in settings for part in ("--set", setting)), "--out", str(out), "--json", "--no-plots")
+    result = invoke(
+        "run",
+        *SHORT,
+        *(part for setting in settings for part in ("--set", setting)),
+        "--out",
+        str(out),
+        "--json",
+        "--no-plots",
+    )
     assert result.exit_code == 0, result.stderr
     params = load_config(out / "config.toml").params
     assert params.ambient_temperature == pytest.approx(298.15)  # 25 °C, not 25 coulombs
@@ -215,7 +240,9 @@ def test_interruption_writes_partial_results_and_exits_130(tmp_path, monkeypatch
         raise KeyboardInterrupt
 
     # The interruption arrives after the first chunk, inside the library, as a real Ctrl-C would.
-    monkeypatch.setattr(SIMULATE_MODULE, "simulate", lambda params, progress=None: real_simulate(params, progress=press_ctrl_c))
+    monkeypatch.setattr(
+        SIMULATE_MODULE, "simulate", lambda params, progress=None: real_simulate(params, progress=press_ctrl_c)
+    )
     out = tmp_path / "run"
     result = invoke("run", "--set", "duration=30", "--set", "record_windows=0:0.2", "--out", str(out), "--no-plots")
     assert result.exit_code == 130
@@ -243,7 +270,9 @@ def terminal_fixture(monkeypatch) -> io.StringIO:
 @pytest.mark.parametrize("solver", ["full", "averaged"])
 def test_progress_bar_is_drawn_on_a_terminal_once_a_run_takes_a_while(terminal, monkeypatch, solver):
     monkeypatch.setattr(cli_common, "PROGRESS_DELAY_S", 0.0)
-    result = cli_common.simulate_with_progress(sm.default_parameters(solver=solver, duration=60.0, attractor_starts=2, record_windows=()))
+    result = cli_common.simulate_with_progress(
+        sm.default_parameters(solver=solver, duration=60.0, attractor_starts=2, record_windows=())
+    )
     assert result.success
     assert "s simulated" in terminal.getvalue()
 
@@ -280,7 +309,13 @@ def test_presets_lists_and_shows_values_with_units_and_sources():
     assert "assumed inputs" not in shown.stdout
     planetary = invoke("presets", "pulverisette7")
     assert planetary.exit_code == 0
-    for text in ("assumed inputs, no source fixes them", "[0.1, 0.6]", "[1000, 4000] J/K", "log-uniform", "[0.368, 0.5]"):
+    for text in (
+        "assumed inputs, no source fixes them",
+        "[0.1, 0.6]",
+        "[1000, 4000] J/K",
+        "log-uniform",
+        "[0.368, 0.5]",
+    ):
         assert text in planetary.stdout, text
     assert "lateral_amplitude" not in planetary.stdout.split("assumed inputs")[1]
     listed = invoke("keys", "pair_friction")
@@ -351,7 +386,12 @@ def test_sweep_table_shows_swept_values_in_the_units_they_were_written_in(tmp_pa
     assert plan.units == (("amplitude", "mm"), ("omega", "RPM"))
     assert [point["amplitude"] for point in plan.points[::2]] == pytest.approx([0.005, 0.01])  # stored in SI
     table = pd.DataFrame(
-        {"amplitude": [0.005, 0.01], "omega": [1000 * np.pi / 30, 1100 * np.pi / 30], "n_balls": [1, 1], "error": [None, None]}
+        {
+            "amplitude": [0.005, 0.01],
+            "omega": [1000 * np.pi / 30, 1100 * np.pi / 30],
+            "n_balls": [1, 1],
+            "error": [None, None],
+        }
     )
     drawn = io.StringIO()
     Console(file=drawn, width=250).print(scans.sweep_preview(table, plan.keys, tmp_path, dict(plan.units)))
@@ -365,7 +405,9 @@ def test_a_run_folder_that_does_not_exist_is_named_so(tmp_path, command):
     (tmp_path / "default").mkdir()
     result = invoke(command, str(tmp_path / "defualt"))
     assert result.exit_code == 2
-    assert_one_error_line(result.stderr, f"{tmp_path / 'defualt'}: no such folder; did you mean {tmp_path / 'default'}?")
+    assert_one_error_line(
+        result.stderr, f"{tmp_path / 'defualt'}: no such folder; did you mean {tmp_path / 'default'}?"
+    )
     result = invoke(command, str(tmp_path / "default"))
     assert_one_error_line(result.stderr, f"{tmp_path / 'default'}: not a shakermill run folder (no summary.json)")
 
@@ -435,8 +477,15 @@ def test_validate_prints_table5_with_fitted_and_predicted_roles():
     assert "still rising at the hour" in study[("beta", "vial_mass")]["verdict"]
     # Issue 35: a quick validation without the 3-D studies said "full": true; it says what it ran.
     assert payload["full"] is False
-    assert payload["ran"] == {"table5": True, "free_set_study": True, "validation_matrix": False, "experiments": [],
-                              "structure_study": False, "held_out": False, "cross_prediction": False}
+    assert payload["ran"] == {
+        "table5": True,
+        "free_set_study": True,
+        "validation_matrix": False,
+        "experiments": [],
+        "structure_study": False,
+        "held_out": False,
+        "cross_prediction": False,
+    }
 
 
 @pytest.mark.slow
@@ -444,8 +493,18 @@ def test_calibrate_writes_a_preset_that_run_accepts_with_the_settings_it_was_fit
     preset_file = tmp_path / "fitted.toml"
     outcome = runner.invoke(
         cli.app,
-        ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--set", "omega=1200 rpm", "--out", str(preset_file),
-         "--json"],
+        [
+            "calibrate",
+            "--target",
+            "theta_inf_C=100",
+            "--free",
+            "beta",
+            "--set",
+            "omega=1200 rpm",
+            "--out",
+            str(preset_file),
+            "--json",
+        ],
     )
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
@@ -454,7 +513,10 @@ def test_calibrate_writes_a_preset_that_run_accepts_with_the_settings_it_was_fit
     assert params.beta == pytest.approx(payload["fitted"]["beta"])
     # The fit's --set is in the preset: without it the fitted beta would describe another drive.
     assert params.omega == pytest.approx(1200 * 2 * math.pi / 60)
-    run = runner.invoke(cli.app, ["run", str(preset_file), "--set", "solver=averaged", "--json", "--no-plots", "--out", str(tmp_path / "run")])
+    run = runner.invoke(
+        cli.app,
+        ["run", str(preset_file), "--set", "solver=averaged", "--json", "--no-plots", "--out", str(tmp_path / "run")],
+    )
     assert run.exit_code == 0, run.output
     assert json.loads(run.stdout)["theta_inf_C"] == pytest.approx(100.0, rel=0.005)
 
@@ -475,8 +537,16 @@ QUICK_BASE = ["--set", "duration=60", "--set", "record_windows="]
 def sweep_folder(tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("sweeps") / "omega_amplitude"
     outcome = invoke(
-        "sweep", *QUICK_BASE, "--grid", "omega=100:120:2", "--grid", "amplitude=24mm:26mm:2",
-        "--workers", "1", "--out", str(folder),
+        "sweep",
+        *QUICK_BASE,
+        "--grid",
+        "omega=100:120:2",
+        "--grid",
+        "amplitude=24mm:26mm:2",
+        "--workers",
+        "1",
+        "--out",
+        str(folder),
     )
     assert outcome.exit_code == 0, outcome.stderr
     return folder
@@ -489,9 +559,17 @@ def test_plot_of_a_sweep_folder_draws_maps_with_the_contour(sweep_folder, tmp_pa
     outcome = invoke("plot", str(sweep_folder), "--out", str(tmp_path / "maps"), "--contour", f"theta_inf_C={level}")
     assert outcome.exit_code == 0, outcome.stderr
     stems = {path.stem for path in (tmp_path / "maps").iterdir()}
-    assert stems == {"sweep_theta_inf_C", "sweep_tau_min", "sweep_impact_rate_hz", "sweep_heat_power_W",
-                     "sweep_mean_impact_speed_m_s", "sweep_ball_steady_C", "sweep_stress_energy_median_J",
-                     "sweep_stress_energy_p90_J", "sweep_regime"}
+    assert stems == {
+        "sweep_theta_inf_C",
+        "sweep_tau_min",
+        "sweep_impact_rate_hz",
+        "sweep_heat_power_W",
+        "sweep_mean_impact_speed_m_s",
+        "sweep_ball_steady_C",
+        "sweep_stress_energy_median_J",
+        "sweep_stress_energy_p90_J",
+        "sweep_regime",
+    }
     assert "18 files written" in outcome.stdout
     assert "not crossed" not in outcome.stderr
 
@@ -529,8 +607,21 @@ def test_plot_of_a_sweep_over_the_solver_draws_every_figure(tmp_path):
     points = tmp_path / "solvers.csv"
     points.write_text("solver\nfull\naveraged\n", encoding="utf-8")
     folder = tmp_path / "sweep"
-    swept = invoke("sweep", "--points", str(points), "--set", "duration=2", "--set", "record_windows=",
-                   "--set", "attractor_starts=1", "--workers", "1", "--out", str(folder))
+    swept = invoke(
+        "sweep",
+        "--points",
+        str(points),
+        "--set",
+        "duration=2",
+        "--set",
+        "record_windows=",
+        "--set",
+        "attractor_starts=1",
+        "--workers",
+        "1",
+        "--out",
+        str(folder),
+    )
     assert swept.exit_code == 0, swept.stderr
     outcome = invoke("plot", str(folder), "--out", str(tmp_path / "lines"))
     assert outcome.exit_code == 0, outcome.stderr
@@ -538,8 +629,18 @@ def test_plot_of_a_sweep_over_the_solver_draws_every_figure(tmp_path):
 
 
 # Three balls in a vial wide enough for them side by side, for 2 s: a few seconds with the figures.
-DEM = ["--set", "engine=dem", "--set", "n_balls=3", "--set", "vial_diameter=38 mm", "--set", "duration=2",
-       "--set", "record_windows=0:0.5,1.5:0.1"]
+DEM = [
+    "--set",
+    "engine=dem",
+    "--set",
+    "n_balls=3",
+    "--set",
+    "vial_diameter=38 mm",
+    "--set",
+    "duration=2",
+    "--set",
+    "record_windows=0:0.5,1.5:0.1",
+]
 # A run of several balls with impacts draws its stress-energy spectrum too (issue 37, point 3).
 DEM_FIGURES = ("ball_heating_zoom", "heat_by_channel", "stress_energy_spectrum", "temperatures", "trajectories")
 DEM_IMPACT_FIGURES = ("impact_energy_histogram", "impact_speed_histogram", "impacts_per_second")
@@ -570,8 +671,13 @@ def test_a_dem_run_draws_its_figures_and_its_table_tells_the_balls_apart(dem_run
     assert rows["engine; balls; fill of the vial"] == (f"dem; 3; {summary['fill_fraction']:.3f}", "")
     each = "; ".join(f"{value:.2f}" for value in summary["ball_temperatures_C"])
     assert rows["each ball at the end (ball 0; 1; …)"] == (each, "°C")
-    assert rows["impacts on the walls; between balls"] == (f"{summary['wall_impacts']}; {summary['ball_ball_impacts']}", "")
-    heat = "; ".join(f"{summary[f'heat_{channel}_W']:.3g}" for channel in ("normal", "tangential", "sliding", "rolling"))
+    assert rows["impacts on the walls; between balls"] == (
+        f"{summary['wall_impacts']}; {summary['ball_ball_impacts']}",
+        "",
+    )
+    heat = "; ".join(
+        f"{summary[f'heat_{channel}_W']:.3g}" for channel in ("normal", "tangential", "sliding", "rolling")
+    )
     assert rows["heat by channel: normal; tangential; sliding; rolling"] == (heat, "W")
     assert rows["balls' mean at the end"] == (f"{summary['ball_C']:.2f}", "°C")
     assert "ball at the end" not in rows
@@ -600,7 +706,9 @@ def test_report_of_a_dem_run_has_the_balls_and_their_figures(dem_run, tmp_path):
     document = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert "<h2>Balls</h2>" in document and document.count("<figure>") == len(DEM_FIGURES) + len(DEM_IMPACT_FIGURES)
     # Its configuration lists the keys of the 'dem' engine, not the tolerances of the 1-D integrator.
-    assert "<td>friction</td>" in document and "<td>n_balls</td>" in document and "<td>atol_position</td>" not in document
+    assert (
+        "<td>friction</td>" in document and "<td>n_balls</td>" in document and "<td>atol_position</td>" not in document
+    )
 
 
 @pytest.mark.slow
@@ -674,7 +782,9 @@ def start_up_s(tmp_path_factory) -> float:
     """Seconds a short run takes as a process here, with Numba's cache warm: how long to wait before a Ctrl-C."""
     out = tmp_path_factory.mktemp("warm") / "run"
     started = time.monotonic()
-    warm = subprocess.run([str(SHAKERMILL), "run", *SHORT, "--no-plots", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    warm = subprocess.run(
+        [str(SHAKERMILL), "run", *SHORT, "--no-plots", "--out", str(out)], capture_output=True, text=True, timeout=300
+    )
     assert warm.returncode == 0, warm.stderr
     return time.monotonic() - started
 
@@ -717,7 +827,9 @@ def test_real_ctrl_c_during_a_full_run_keeps_the_run_and_exits_130(tmp_path, sta
 )
 def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up_s, command):
     out = tmp_path / "out"
-    stderr = interrupt_after([*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0)
+    stderr = interrupt_after(
+        [*command, "--out", str(out if command[0] == "bifurcation" else out.with_suffix(".toml"))], start_up_s + 2.0
+    )
     assert stderr.startswith("error: interrupted; nothing was written")
     assert list(tmp_path.iterdir()) == []
 
@@ -744,24 +856,47 @@ def wait_for_cpu(process: subprocess.Popen, cpu_s: float, within_s: float = 180.
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads a process's CPU time from /proc (Linux)")
 @pytest.mark.parametrize(
     "settings",
-    [["--set", "solver=full", "--set", "duration=600 min"], ["--preset", "spex8000m-3d", "--set", "solver=full", "--set", "duration=60"]],
+    [
+        ["--set", "solver=full", "--set", "duration=600 min"],
+        ["--preset", "spex8000m-3d", "--set", "solver=full", "--set", "duration=60"],
+    ],
     ids=["1-D", "3-D"],
 )
 def test_real_ctrl_c_exits_within_a_second_with_the_data_written(tmp_path, settings):
     import resource  # POSIX only, like the /proc this test reads
+
     # Twice: the first warms Numba's cache (a compilation is no run to interrupt); the second is timed. All a short run
     # does but its steps: start-up, checks, writing. Past its CPU time by 1.5 s, the long run is stepping.
     for short_run in ("warm", "timed"):
         children_before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        done = subprocess.run([str(SHAKERMILL), "run", *settings, "--set", "duration=0.01", "--no-plots", "--out",
-                               str(tmp_path / short_run)], capture_output=True, text=True, timeout=300)
+        done = subprocess.run(
+            [
+                str(SHAKERMILL),
+                "run",
+                *settings,
+                "--set",
+                "duration=0.01",
+                "--no-plots",
+                "--out",
+                str(tmp_path / short_run),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert done.returncode == 0, done.stderr
         children_after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    short_run_cpu_s = sum(getattr(children_after, field) - getattr(children_before, field) for field in ("ru_utime", "ru_stime"))
+    short_run_cpu_s = sum(
+        getattr(children_after, field) - getattr(children_before, field) for field in ("ru_utime", "ru_stime")
+    )
     out = tmp_path / "run"
     # Figures asked for: they are what an interrupted run leaves to `plot`. --json: its summary all the same.
-    process = subprocess.Popen([str(SHAKERMILL), "run", *settings, "--json", "--out", str(out)], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [str(SHAKERMILL), "run", *settings, "--json", "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     wait_for_cpu(process, short_run_cpu_s + 1.5)
     used = cpu_seconds(process.pid)
     signalled = time.monotonic()
@@ -787,8 +922,9 @@ def test_real_ctrl_c_exits_within_a_second_with_the_data_written(tmp_path, setti
 
 @pytest.mark.slow
 def test_real_ctrl_c_in_validate_says_so_in_one_line(start_up_s):
-    process = subprocess.Popen([str(SHAKERMILL), "validate", "--no-three-d"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True)
+    process = subprocess.Popen(
+        [str(SHAKERMILL), "validate", "--no-three-d"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
     time.sleep(start_up_s + 2.0)
     assert process.poll() is None, "validate ended before it could be interrupted"
     process.send_signal(signal.SIGINT)
@@ -813,7 +949,10 @@ TINY_STEPS = [*(f"--set={key}={value}" for key, value in TIGHTEST_TOLERANCES.ite
         # Stopped in its mechanics or in the probe of its attractors (as the machine's load has it), the run is kept.
         (["run", "--set", "solver=averaged", "--no-plots", "--out", "{out}"], "interrupted: Interrupted by the user"),
         (["bifurcation", "--grid", "omega=100:120:2", "--out", "{out}"], "error: interrupted; nothing was written"),
-        (["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", "{out}.toml"], "error: interrupted; nothing was written"),
+        (
+            ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", "{out}.toml"],
+            "error: interrupted; nothing was written",
+        ),
     ],
     ids=["full run", "averaged run", "bifurcation", "calibrate"],
 )
@@ -936,7 +1075,8 @@ def test_a_run_without_figures_writes_its_files_without_the_heavy_libraries(tmp_
     script = (
         "import sys\n"
         "from shakermill import cli\n"
-        f"sys.argv = ['shakermill', 'run', '--set', 'solver=averaged', '--set', 'duration=120', '--no-plots', '--out', {str(tmp_path / 'run')!r}]\n"
+        "sys.argv = ['shakermill', 'run', '--set', 'solver=averaged', '--set', 'duration=120', '--no-plots', '--out', "
+        f"{str(tmp_path / 'run')!r}]\n"
         "try:\n"
         "    cli.app()\n"
         "except SystemExit as exit:\n"
@@ -973,8 +1113,17 @@ def test_a_run_of_a_calibrated_preset_reports_intervals_and_where_its_heat_goes(
 
 
 def test_a_short_averaged_run_says_before_it_starts_that_it_runs_at_full_resolution(tmp_path):
-    result = invoke("run", "--preset", "spex8000m-calibrated", *SHORT, "--set", "solver=averaged", "--no-plots",
-                    "--out", str(tmp_path / "short"))
+    result = invoke(
+        "run",
+        "--preset",
+        "spex8000m-calibrated",
+        *SHORT,
+        "--set",
+        "solver=averaged",
+        "--no-plots",
+        "--out",
+        str(tmp_path / "short"),
+    )
     assert result.exit_code == 0, result.stderr
     first = result.stderr.splitlines()[0]
     assert first.startswith("note: Full resolution instead of the averaged solver: duration = 2 s is no longer than")
@@ -1005,8 +1154,12 @@ def test_long_work_piped_into_a_log_says_how_far_it_is_at_most_every_interval(mo
         clock[0] = now
         update(evaluation)
     assert capsys.readouterr().err.splitlines() == [
-        "fitting: 3 model evaluations, 0 min 31 s", "fitting: 5 model evaluations, 1 min 02 s", "fitting: 6 model evaluations, 1 min 35 s",
+        "fitting: 3 model evaluations, 0 min 31 s",
+        "fitting: 5 model evaluations, 1 min 02 s",
+        "fitting: 6 model evaluations, 1 min 35 s",
     ]
-    sweep = cli_common.piped_lines("sweep", "{task.completed}/{task.total} points · {task.fields[failed]} failed", 0.0, 4, failed=0)
+    sweep = cli_common.piped_lines(
+        "sweep", "{task.completed}/{task.total} points · {task.fields[failed]} failed", 0.0, 4, failed=0
+    )
     sweep(1, failed=1)
     assert capsys.readouterr().err == "sweep: 1/4 points · 1 failed, 0 min 00 s\n"

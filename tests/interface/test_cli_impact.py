@@ -152,8 +152,16 @@ def test_installed_command_refuses_a_negative_speed_in_one_line():
 # The Chung & Ooi (2011) verification set through the command itself (inputs: docs/notes/dem-references.md §1;
 # the full set, with more angles and speeds, is in tests/solvers/test_impact.py).
 RIGID_WALL = ["--set", "vial_youngs_modulus=1.2e12"]
-ALUMINA = ["--set", "ball_radius=2.5mm", "--set", "ball_density=4000", "--set", "ball_youngs_modulus=3.8e11",
-           "--set", "ball_poisson_ratio=0.23"]
+ALUMINA = [
+    "--set",
+    "ball_radius=2.5mm",
+    "--set",
+    "ball_density=4000",
+    "--set",
+    "ball_youngs_modulus=3.8e11",
+    "--set",
+    "ball_poisson_ratio=0.23",
+]
 
 
 def impact_json(*args: str) -> dict:
@@ -164,18 +172,45 @@ def impact_json(*args: str) -> dict:
 
 def hertz(mass: float, radius: float, modulus: float, speed: float) -> tuple[float, float, float]:
     overlap = contact.hertz_max_overlap(mass, radius, modulus, speed)
-    return contact.hertz_contact_time(mass, radius, modulus, speed), overlap, contact.hertz_force(overlap, modulus, radius)
+    return (
+        contact.hertz_contact_time(mass, radius, modulus, speed),
+        overlap,
+        contact.hertz_force(overlap, modulus, radius),
+    )
 
 
 @pytest.mark.parametrize(
     "target, settings",
     [
         # Test 1: two glass balls (R = 10 mm, E = 48 GPa, ν = 0.2) meeting at 20 m/s, e = 1
-        ("ball", ["--set", "ball_radius=10mm", "--set", "ball_density=2800", "--set", "ball_youngs_modulus=4.8e10",
-                  "--set", "ball_poisson_ratio=0.2"]),
+        (
+            "ball",
+            [
+                "--set",
+                "ball_radius=10mm",
+                "--set",
+                "ball_density=2800",
+                "--set",
+                "ball_youngs_modulus=4.8e10",
+                "--set",
+                "ball_poisson_ratio=0.2",
+            ],
+        ),
         # Test 2: an aluminium ball (R = 0.1 m, E = 70 GPa, ν = 0.3) on a rigid plane at 0.2 m/s, e = 1
-        ("wall", ["--set", "ball_radius=0.1", "--set", "ball_density=2699", "--set", "ball_youngs_modulus=7e10",
-                  "--set", "ball_poisson_ratio=0.3", *RIGID_WALL]),
+        (
+            "wall",
+            [
+                "--set",
+                "ball_radius=0.1",
+                "--set",
+                "ball_density=2699",
+                "--set",
+                "ball_youngs_modulus=7e10",
+                "--set",
+                "ball_poisson_ratio=0.3",
+                *RIGID_WALL,
+            ],
+        ),
     ],
     ids=["test 1", "test 2"],
 )
@@ -184,7 +219,9 @@ def test_chung_ooi_elastic_normal_impacts_follow_hertz(target, settings):
     elastic = "pair_restitution=1" if target == "ball" else "restitution=1"
     outcome = impact_json("--speed", str(speed), "--target", target, "--set", elastic, *settings, *FINE)
     # The command makes the vial large enough for any ball; so does this, for the ball's mass and moduli.
-    params = sm.default_parameters(vial_length=1.0, vial_diameter=0.9, **dict(item.split("=", 1) for item in settings[1::2]))
+    params = sm.default_parameters(
+        vial_length=1.0, vial_diameter=0.9, **dict(item.split("=", 1) for item in settings[1::2])
+    )
     own = (params.ball_youngs_modulus, params.ball_poisson_ratio)
     if target == "ball":
         mass, radius, modulus = params.ball_mass / 2, params.ball_radius / 2, contact.effective_modulus(*own, *own)
@@ -200,17 +237,31 @@ def test_chung_ooi_elastic_normal_impacts_follow_hertz(target, settings):
 
 @pytest.mark.parametrize("restitution", ["0.2", "0.6", "1.0"])
 def test_chung_ooi_3_restitution_is_the_given_one(restitution):
-    outcome = impact_json("--speed", "3.9", "--set", f"restitution={restitution}", "--set", "friction=0", *ALUMINA,
-                          *RIGID_WALL, *FINE)
+    outcome = impact_json(
+        "--speed", "3.9", "--set", f"restitution={restitution}", "--set", "friction=0", *ALUMINA, *RIGID_WALL, *FINE
+    )
     assert outcome["normal_restitution"] == pytest.approx(float(restitution), abs=1e-3)
 
 
 def test_chung_ooi_4_gross_sliding_changes_velocity_and_spin_as_coulomb_says():
     """Alumina, e = 0.98, μ = 0.092, 3.9 m/s at 60° from the normal: sliding throughout."""
-    outcome = impact_json("--speed", "3.9", "--angle", "60", "--set", "restitution=0.98", "--set", "friction=0.092",
-                          *ALUMINA, *RIGID_WALL, *FINE)
+    outcome = impact_json(
+        "--speed",
+        "3.9",
+        "--angle",
+        "60",
+        "--set",
+        "restitution=0.98",
+        "--set",
+        "friction=0.092",
+        *ALUMINA,
+        *RIGID_WALL,
+        *FINE,
+    )
     normal = 3.9 * math.cos(math.radians(60.0))
     change = 0.092 * 1.98 * normal
-    assert 3.9 * math.sin(math.radians(60.0)) - outcome["tangential_velocity_out_m_s"] == pytest.approx(change, rel=0.02)
+    assert 3.9 * math.sin(math.radians(60.0)) - outcome["tangential_velocity_out_m_s"] == pytest.approx(
+        change, rel=0.02
+    )
     assert outcome["angular_velocity_rad_s"] == pytest.approx(2.5 * change / 2.5e-3, rel=0.02)
     assert outcome["dissipated_sliding_J"] > 0.0

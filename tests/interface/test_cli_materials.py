@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import pytest
-
 import json
 
+import pytest
 from conftest import assert_one_error_line
 from typer.testing import CliRunner
 
@@ -42,7 +41,11 @@ def test_json_holds_si_values_units_and_sources():
     everything = json.loads(invoke("materials", "--json").stdout)["materials"]
     assert [entry["name"] for entry in everything] == list(materials.names())
     one = json.loads(invoke("materials", "zirconia", "--json").stdout)
-    assert one["density"] == {"value": 6050.0, "unit": "kg/m^3", "source": materials.material("zirconia").density.source}
+    assert one["density"] == {
+        "value": 6050.0,
+        "unit": "kg/m^3",
+        "source": materials.material("zirconia").density.source,
+    }
     assert one["youngs_modulus"]["value"] == 205e9
     assert one["restitution"]["value"] == list(materials.material("zirconia").restitution.value)
     for key in materials.PROPERTIES:

@@ -14,8 +14,19 @@ from shakermill.studies.sweep_storage import load_sweep
 
 runner = CliRunner()
 # Twenty seconds of the paper's one ball at full resolution, with λ and β uncertain: eight members in seconds.
-CHEAP = ["--set", "duration=20", "--full-resolution", "--assume", "lam=0.3:0.5", "--assume", "beta=0.5:1.5:log-uniform",
-         "-n", "8", "--workers", "1"]
+CHEAP = [
+    "--set",
+    "duration=20",
+    "--full-resolution",
+    "--assume",
+    "lam=0.3:0.5",
+    "--assume",
+    "beta=0.5:1.5:log-uniform",
+    "-n",
+    "8",
+    "--workers",
+    "1",
+]
 
 
 def invoke(*args: str):
@@ -61,7 +72,10 @@ def test_an_ensemble_reports_quantiles_and_the_inputs_that_decide_them_and_resum
         (["-n", "6"], ("members: 6 is not allowed", "a power of two")),
         (["--preset", "pulverisette7", "--vary", "frction"], ("--vary frction: no range is stated", "friction")),
         (["--assume", "friction=0.5"], ("--assume 'friction=0.5'", "KEY=LOW:HIGH")),
-        (["--preset", "spex8000m-3d", "--assume", "swing_radius=0.05:0.1"], ("--assume swing_radius", "does not read it")),
+        (
+            ["--preset", "spex8000m-3d", "--assume", "swing_radius=0.05:0.1"],
+            ("--assume swing_radius", "does not read it"),
+        ),
         (["--preset", "spex8000m-3d", "--assume", "friction=0.2:7"], ("[assumed.friction]", "allowed range [0, 5]")),
         (["--preset", "spex8000m-3d", "--assume", "n_balls=1:3"], ("not a numeric key",)),
         # The paper's 1-D preset states no assumed inputs.

@@ -7,10 +7,9 @@ import functools
 import html
 import json
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
-
-import numpy as np
 
 from shakermill import cli
 from shakermill.parameters.assumed import AssumedInput
@@ -32,8 +31,8 @@ def quick_runs_fixture(monkeypatch):
     monkeypatch.setattr(validation_report, "validation_matrix", functools.partial(validation_matrix, overrides=QUICK))
     # Each structure's fit runs the one-ball hour: its study has tests of its own.
     monkeypatch.setattr(validation_report, "structure_study", lambda progress: ())
-    # Both directions run 64 averaged hours: emulators of made-up rises stand in (tests/studies/test_joint_calibration.py
-    # tests the method, its CLI test the runs).
+    # Both directions run 64 averaged hours: emulators of made-up rises stand in
+    # (tests/studies/test_joint_calibration.py tests the method, its CLI test the runs).
     monkeypatch.setattr(joint_calibration, "STEPS", 400)
     monkeypatch.setattr(validation_report, "cross_prediction", made_up_cross_prediction)
 
@@ -48,11 +47,16 @@ def made_up_cross_prediction(progress):
         rises = np.column_stack([point.rise_K * (1.0 + unit[:, 0]) for point in points])
         training = joint_calibration.Training(
             (AssumedInput("friction", 0.1, 0.6, "uniform", "a test's"),),
-            tuple(joint_calibration.Observable(point.node, point.time_s) for point in points), unit, rises, np.arange(16))
+            tuple(joint_calibration.Observable(point.node, point.time_s) for point in points),
+            unit,
+            rises,
+            np.arange(16),
+        )
         emulators[name] = joint_calibration.emulate(training)
     pair = (experiments[cross_prediction.ONE_BALL], experiments[cross_prediction.FIVE_BALLS])
-    directions = tuple(cross_prediction._direction(fitted_on, predicted, emulators)
-                       for fitted_on, predicted in (pair, pair[::-1]))
+    directions = tuple(
+        cross_prediction._direction(fitted_on, predicted, emulators) for fitted_on, predicted in (pair, pair[::-1])
+    )
     return cross_prediction.CrossPrediction("spex8000m-3d-mill-head", ("drive_heat",), emulators, directions)
 
 
@@ -75,7 +79,9 @@ def test_validate_prints_the_five_ball_prediction_the_engines_and_the_sensitivit
 @pytest.mark.slow
 def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_runs, tmp_path):
     page = tmp_path / "validation.html"
-    outcome = runner.invoke(cli.app, ["validate", "--full", "--solver", "averaged", "--no-study", "--json", "--report", str(page)])
+    outcome = runner.invoke(
+        cli.app, ["validate", "--full", "--solver", "averaged", "--no-study", "--json", "--report", str(page)]
+    )
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
     html = page.read_text(encoding="utf-8")
@@ -85,7 +91,9 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
     # Both directions of issue 36 point 4, each measured point plainly inside its interval or not.
     cross = payload["cross_prediction"]
     assert [(direction["fitted_on"], direction["predicted"]) for direction in cross["directions"]] == [
-        (cross_prediction.ONE_BALL, cross_prediction.FIVE_BALLS), (cross_prediction.FIVE_BALLS, cross_prediction.ONE_BALL)]
+        (cross_prediction.ONE_BALL, cross_prediction.FIVE_BALLS),
+        (cross_prediction.FIVE_BALLS, cross_prediction.ONE_BALL),
+    ]
     for direction in cross["directions"]:
         for point in direction["predictions"]:
             assert point["inside_90"] == (point["p5"] <= point["measured_K"] <= point["p95"])
@@ -94,7 +102,11 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
     five = payload["five_balls"]
     assert five["preset"] == "spex8000m-3d-calibrated" and five["fitted_parameters"]
     rows = five["rows"]
-    assert (rows["ball_rise_C"]["experiment"], rows["vial_rise_C"]["experiment"], rows["vial_ball_ratio"]["experiment"]) == (46.0, 21.0, 0.46)
+    assert (
+        rows["ball_rise_C"]["experiment"],
+        rows["vial_rise_C"]["experiment"],
+        rows["vial_ball_ratio"]["experiment"],
+    ) == (46.0, 21.0, 0.46)
     for row in rows.values():
         assert row["relative_error"] == pytest.approx(row["predicted"] / row["experiment"] - 1.0)
     cases = payload["engine_comparison"]["cases"]
@@ -102,7 +114,10 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
     assert payload["engine_comparison"]["units"]["heat_power_W"] == "W"
     sensitivity = payload["kinematic_sensitivity"]
     assert [(row["key"], row["factor"]) for row in sensitivity["rows"]] == [
-        ("lateral_amplitude", 0.5), ("lateral_amplitude", 1.5), ("yaw_amplitude", 0.5), ("yaw_amplitude", 1.5),
+        ("lateral_amplitude", 0.5),
+        ("lateral_amplitude", 1.5),
+        ("yaw_amplitude", 0.5),
+        ("yaw_amplitude", 1.5),
     ]
     assert set(sensitivity["baseline"]) == set(held_out.SENSITIVITY_MEASURES)
     matrix = payload["validation_matrix"]
@@ -134,7 +149,9 @@ def test_validate_is_quick_by_default_and_says_each_run_when_piped(quick_runs, t
     # Not a terminal: a plain line for each step (Table 5's runs, then each 3-D run), so a log shows the study moving.
     steps = len(VALIDATION_PRESETS) + len(quick) * len(THERMAL_MODEL_PRESETS)
     lines = [line for line in outcome.stderr.splitlines() if line.startswith("validation: ")]
-    assert [line.split(",")[0] for line in lines] == [f"validation: {done}/{steps} steps" for done in range(1, steps + 1)]
+    assert [line.split(",")[0] for line in lines] == [
+        f"validation: {done}/{steps} steps" for done in range(1, steps + 1)
+    ]
     assert outcome.stderr.startswith("validate: quick, ~45 s; --full for everything")
     # Its page says it is the quick one, and what --full adds.
     assert html.escape(QUICK_NOTE) in page.read_text(encoding="utf-8")

@@ -29,7 +29,19 @@ from shakermill.support.atomic import PARTIAL, create_exclusively, partial_path,
 
 # One simulated second without record windows: the run folder is ~50 kB, written in a second.
 RUN = ["run", "--set", "duration=1", "--set", "record_windows=", "--set", "attractor_starts=1", "--no-plots"]
-SWEEP = ["sweep", "--grid", "omega=100:110:2", "--set", "duration=1", "--set", "record_windows=", "--set", "attractor_starts=1", "--workers", "1"]
+SWEEP = [
+    "sweep",
+    "--grid",
+    "omega=100:110:2",
+    "--set",
+    "duration=1",
+    "--set",
+    "record_windows=",
+    "--set",
+    "attractor_starts=1",
+    "--workers",
+    "1",
+]
 NO_SPACE = os.strerror(errno.ENOSPC)
 SHAKERMILL_MAIN = [sys.executable, "-c", "from shakermill.cli import main; main()"]
 
@@ -210,7 +222,9 @@ def run_limited(args: list[str], file_size_limit: int, cwd: Path) -> subprocess.
 @pytest.mark.parametrize("limit", [4_000, 12_000])
 def test_a_child_whose_files_cannot_grow_exits_2_without_a_crash(tmp_path, limit):
     # Numba's cache must be warm: the child could not write it either.
-    warm = subprocess.run([*SHAKERMILL_MAIN, *RUN, "--out", str(tmp_path / "warm")], capture_output=True, text=True, timeout=300)
+    warm = subprocess.run(
+        [*SHAKERMILL_MAIN, *RUN, "--out", str(tmp_path / "warm")], capture_output=True, text=True, timeout=300
+    )
     assert warm.returncode == 0, warm.stderr
     limited = tmp_path / "limited"
     limited.mkdir()
@@ -226,7 +240,10 @@ def user_namespace_mounts() -> str | None:
     if shutil.which("unshare") is None:
         return "no unshare command"
     probe = subprocess.run(
-        ["unshare", "-rm", "sh", "-c", "mount -t tmpfs -o size=16k tmpfs /mnt"], capture_output=True, text=True, timeout=60
+        ["unshare", "-rm", "sh", "-c", "mount -t tmpfs -o size=16k tmpfs /mnt"],
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     if probe.returncode != 0:
         return f"cannot mount a tmpfs in a user namespace here: {probe.stderr.strip() or probe.returncode}"
@@ -249,7 +266,10 @@ def on_small_tmpfs(mount_options: str, args: list[str], mount_point: Path) -> tu
     )
     completed = subprocess.run(
         ["unshare", "-rm", "sh", "-c", script, "sh", mount_options, str(mount_point), *SHAKERMILL_MAIN, *args],
-        capture_output=True, text=True, timeout=300, env={**os.environ, "MOUNT_POINT": str(mount_point)},
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "MOUNT_POINT": str(mount_point)},
     )
     assert completed.returncode != 99, completed.stderr
     output = completed.stdout.splitlines()
@@ -278,14 +298,20 @@ def test_a_run_onto_a_full_tmpfs_exits_2_without_a_crash(tmpfs_point, size):
 
 @pytest.mark.slow
 def test_a_sweep_keeping_its_runs_onto_a_full_tmpfs_exits_2_without_a_crash(tmpfs_point):
-    code, stderr, left = on_small_tmpfs("size=40k", [*SWEEP, "--keep-runs", "--out", str(tmpfs_point / "sweep")], tmpfs_point)
+    code, stderr, left = on_small_tmpfs(
+        "size=40k", [*SWEEP, "--keep-runs", "--out", str(tmpfs_point / "sweep")], tmpfs_point
+    )
     assert code == 2, stderr
     assert_one_error_line(stderr, "cannot write the sweep", NO_SPACE)
     assert not [path for path in left if "/." in path]  # no hidden partial file or folder
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("command", [RUN, SWEEP, ["bifurcation", "--grid", "omega=100:110:2", *RUN[1:-1]]], ids=["run", "sweep", "bifurcation"])
+@pytest.mark.parametrize(
+    "command",
+    [RUN, SWEEP, ["bifurcation", "--grid", "omega=100:110:2", *RUN[1:-1]]],
+    ids=["run", "sweep", "bifurcation"],
+)
 def test_a_read_only_disk_is_refused_before_the_work(tmpfs_point, command):
     code, stderr, left = on_small_tmpfs("size=1m,ro", [*command, "--out", str(tmpfs_point / "out")], tmpfs_point)
     assert code == 2, stderr
@@ -364,6 +390,7 @@ def test_partial_names_record_the_machine_and_the_process(tmp_path):
 @pytest.mark.parametrize("hard_links", [True, False], ids=["hard links", "a file system without hard links"])
 def test_a_file_created_exclusively_is_created_once(tmp_path, monkeypatch, hard_links):
     if not hard_links:
+
         def no_links(*_args):
             raise PermissionError(errno.EPERM, os.strerror(errno.EPERM))
 
@@ -382,7 +409,9 @@ def test_a_place_that_refuses_files_is_found_before_the_work_even_as_root(tmp_pa
     nothing to root, so a file is made (and removed) where the output would go."""
     from shakermill.support.atomic import StorageError, check_writable_place
 
-    with pytest.raises(StorageError, match=r"^/proc/sys/report\.html: cannot write in /proc/sys \(.+\); choose another --report$"):
+    with pytest.raises(
+        StorageError, match=r"^/proc/sys/report\.html: cannot write in /proc/sys \(.+\); choose another --report$"
+    ):
         check_writable_place(Path("/proc/sys/report.html"), "--report")
     check_writable_place(tmp_path / "new" / "report.html", "--report")
     assert list(tmp_path.iterdir()) == []

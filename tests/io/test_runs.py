@@ -241,7 +241,9 @@ def test_averaged_run_files_say_what_covers_only_the_averaging_window(tmp_path):
 
 
 def test_full_run_files_cover_the_whole_run(tmp_path):
-    folder = write_run(sm.simulate(sm.default_parameters(solver="full", duration=2.0)), tmp_path / "full", preset=DEFAULT_PRESET)
+    folder = write_run(
+        sm.simulate(sm.default_parameters(solver="full", duration=2.0)), tmp_path / "full", preset=DEFAULT_PRESET
+    )
     with xr.open_dataset(folder / "timeseries.nc", engine="h5netcdf") as series:
         assert "coverage" not in series.attrs and "coverage" not in series["x"].attrs
     assert b"coverage" not in pq.read_schema(folder / "impacts.parquet").metadata

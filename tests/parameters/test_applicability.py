@@ -12,9 +12,16 @@ from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import WINDOW_INTERVAL, DemEngine
 from shakermill.engines.dem.stepper import RECORD_COLUMNS
 from shakermill.parameters.config import load_config, write_config_toml
-from shakermill.parameters.engine_keys import AVERAGED_ONLY, ENGINE_KEYS, MILL_HEAD_ONLY, MOTION_KEYS, NETWORK_ONLY, Reader
-from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
+from shakermill.parameters.engine_keys import (
+    AVERAGED_ONLY,
+    ENGINE_KEYS,
+    MILL_HEAD_ONLY,
+    MOTION_KEYS,
+    NETWORK_ONLY,
+    Reader,
+)
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.solvers import simulate as simulate_module
 from shakermill.studies.calibrate import LONGEST_FULL_RESOLUTION_FIT_S, check_full_resolution_work
 from shakermill.studies.sweep_plan import check_keys_read, plan_sweep
@@ -22,15 +29,28 @@ from shakermill.studies.sweep_plan import check_keys_read, plan_sweep
 
 def test_a_reader_names_where_a_key_applies():
     one_d = Reader("1d", "full", "paper", "axial")
-    assert one_d.not_read("ball_materials") == "the 1-D engine (engine = '1d') does not read it; it applies to engine = 'dem'"
-    assert one_d.not_read("averaging_max_time") == "the 'full' solver does not read it; it applies to solver = 'averaged'"
-    assert one_d.not_read("omega") is None and Reader("1d", "averaged", "paper", "axial").not_read("averaging_max_time") is None
+    assert (
+        one_d.not_read("ball_materials")
+        == "the 1-D engine (engine = '1d') does not read it; it applies to engine = 'dem'"
+    )
+    assert (
+        one_d.not_read("averaging_max_time") == "the 'full' solver does not read it; it applies to solver = 'averaged'"
+    )
+    assert (
+        one_d.not_read("omega") is None
+        and Reader("1d", "averaged", "paper", "axial").not_read("averaging_max_time") is None
+    )
     dem = Reader("dem", "averaged", "paper", "axial")
     assert "it applies to engine = '1d'" in dem.not_read("heat_model")
-    assert dem.not_read("drive_heat") == "the 'paper' network does not read it; it applies to thermal_model = 'mill-head'"
+    assert (
+        dem.not_read("drive_heat") == "the 'paper' network does not read it; it applies to thermal_model = 'mill-head'"
+    )
     assert Reader("dem", "averaged", "mill-head", "axial").not_read("drive_heat") is None
     # Every key of these sets is one some run reads: none is dead.
-    readers = [Reader("1d", "averaged", "paper", "axial"), *(Reader("dem", "averaged", "mill-head", motion) for motion in KINEMATIC_MODELS)]
+    readers = [
+        Reader("1d", "averaged", "paper", "axial"),
+        *(Reader("dem", "averaged", "mill-head", motion) for motion in KINEMATIC_MODELS),
+    ]
     for key in AVERAGED_ONLY | MILL_HEAD_ONLY | MOTION_KEYS | ENGINE_KEYS["1d"].unread | ENGINE_KEYS["dem"].unread:
         assert any(reader.not_read(key) is None for reader in readers), key
 
@@ -52,7 +72,7 @@ def test_a_key_set_where_the_run_does_not_read_it_is_refused(overrides, refused)
 
 def test_a_file_written_by_hand_is_explicit_a_runs_own_configuration_is_not(tmp_path):
     mine = tmp_path / "mine.toml"
-    mine.write_text('friction = 0.5\n', encoding="utf-8")
+    mine.write_text("friction = 0.5\n", encoding="utf-8")
     with pytest.raises(ParameterError, match="friction: set explicitly, but the 1-D engine"):
         load_config(mine)
     # What a run wrote holds every key, those its engine does not read included: it repeats the run.
@@ -66,7 +86,9 @@ def test_a_key_of_one_network_is_refused_on_a_run_of_the_other_both_ways(network
     """Issue 35: with thermal_model = 'mill-head', h_outer and outer_area changed nothing and were accepted."""
     reader = Reader("dem", "averaged", other, "spex8000m")
     for key in NETWORK_ONLY[network]:
-        assert reader.not_read(key) == f"the {other!r} network does not read it; it applies to thermal_model = {network!r}"
+        assert (
+            reader.not_read(key) == f"the {other!r} network does not read it; it applies to thermal_model = {network!r}"
+        )
         assert Reader("dem", "averaged", network, "spex8000m").not_read(key) is None
     key = sorted(NETWORK_ONLY[network])[0]
     preset = "spex8000m-3d-calibrated" if other == "mill-head" else "spex8000m-3d"
@@ -97,9 +119,13 @@ def test_the_keys_a_preset_sets_and_the_run_does_not_read_are_said_in_a_note():
 def test_a_key_of_the_vial_motion_is_read_only_by_the_kinematic_models_that_take_it():
     spex = Reader("dem", "full", "paper", "spex8000m")
     assert spex.not_read("lateral_amplitude") is None and spex.not_read("amplitude") is None
-    assert spex.not_read("swing_radius") == "kinematics = 'spex8000m' does not read it; it applies to kinematics = 'mixer-mill-arc'"
+    assert (
+        spex.not_read("swing_radius")
+        == "kinematics = 'spex8000m' does not read it; it applies to kinematics = 'mixer-mill-arc'"
+    )
     assert Reader("dem", "full", "paper", "fourier").not_read("amplitude") == (
-        "kinematics = 'fourier' does not read it; it applies to kinematics = 'axial' or 'spex8000m' or 'mixer-mill-arc'")
+        "kinematics = 'fourier' does not read it; it applies to kinematics = 'axial' or 'spex8000m' or 'mixer-mill-arc'"
+    )
     with pytest.raises(ParameterError, match="motion: set explicitly, but kinematics = 'spex8000m' does not read it"):
         load_config(preset="spex8000m-3d", overrides=["motion=x:1:0.001:0"])
 
@@ -129,11 +155,21 @@ def test_the_records_of_a_dem_run_are_counted_before_they_are_allocated(monkeypa
     contacts = model.contact_memory(model.constants_from(params), len(RECORD_COLUMNS))
     assert DemEngine.memory_needed(params, 3) == int(rows * model.row_width(params.n_balls, nodes) * 8 + contacts)
     # The contacts' memory grows linearly with the balls: 2000 balls hold well under 100 MB of it.
-    crowd = sm.default_parameters("pulverisette7", n_balls=2000, ball_radius=2.5e-3, vial_diameter=0.12, vial_length=0.07,
-                                  outer_diameter=0.13, outer_length=0.08, record_windows=())
+    crowd = sm.default_parameters(
+        "pulverisette7",
+        n_balls=2000,
+        ball_radius=2.5e-3,
+        vial_diameter=0.12,
+        vial_length=0.07,
+        outer_diameter=0.13,
+        outer_length=0.08,
+        record_windows=(),
+    )
     assert 20e6 < model.contact_memory(model.constants_from(crowd), len(RECORD_COLUMNS)) < 100e6
     monkeypatch.setattr("psutil.virtual_memory", lambda: SimpleNamespace(available=2**20))
-    with pytest.raises(ParameterError, match=r"record_windows: the run would keep .* GiB of records .*allowed shorter record_windows"):
+    with pytest.raises(
+        ParameterError, match=r"record_windows: the run would keep .* GiB of records .*allowed shorter record_windows"
+    ):
         sm.simulate(params)
     # The 1-D engine caps its windows itself: nothing to refuse.
     simulate_module.preflight(sm.default_parameters(duration=2.0))
@@ -143,8 +179,11 @@ def test_a_dem_run_that_needs_more_steps_than_its_budget_allows_is_refused_befor
     # No step of the 'dem' engine is longer than max_flight_step: 100 s take at least 1e6 steps at the default 1e-4 s.
     full = sm.default_parameters("spex8000m-3d", duration=100.0, solver="full", max_steps=999_999)
     assert DemEngine.least_steps(full, 100.0) == pytest.approx(1e6)
-    with pytest.raises(ParameterError, match=r"max_steps: 100 s of the run .* at least 1e\+06 steps .*allowed max_steps >= 1000000, "
-                                             "a shorter duration or solver = 'averaged'"):
+    with pytest.raises(
+        ParameterError,
+        match=r"max_steps: 100 s of the run .* at least 1e\+06 steps .*allowed max_steps >= 1000000, "
+        "a shorter duration or solver = 'averaged'",
+    ):
         simulate_module.preflight(full)
     simulate_module.preflight(full.model_copy(update={"max_steps": 1_000_000}))
     # An averaged run needs at least its least mechanics at full resolution, whatever its duration.
@@ -169,12 +208,29 @@ def test_the_fifty_balls_of_the_issue_are_refused_in_one_line_before_any_memory_
     # Issue 25: 50 balls with a 600-s record window asked for 27.7 GiB at start-up and ended in a traceback. The
     # machine here is told it has 8 GiB free, so that the case is the same on any machine.
     monkeypatch.setattr("psutil.virtual_memory", lambda: SimpleNamespace(available=8 * 2**30))
-    outcome = CliRunner().invoke(cli.app, [
-        "run", "--preset", "spex8000m-3d", "--set", "n_balls=50", "--set", "ball_radius=3mm", "--set", "solver=full",
-        "--set", "duration=600", "--set", "record_windows=0:600", "--no-plots", "--out", str(tmp_path / "run"),
-    ])
+    outcome = CliRunner().invoke(
+        cli.app,
+        [
+            "run",
+            "--preset",
+            "spex8000m-3d",
+            "--set",
+            "n_balls=50",
+            "--set",
+            "ball_radius=3mm",
+            "--set",
+            "solver=full",
+            "--set",
+            "duration=600",
+            "--set",
+            "record_windows=0:600",
+            "--no-plots",
+            "--out",
+            str(tmp_path / "run"),
+        ],
+    )
     assert outcome.exit_code == 2 and "Traceback" not in outcome.stderr
-    line, = outcome.stderr.strip().splitlines()
+    (line,) = outcome.stderr.strip().splitlines()
     assert line.startswith("error: record_windows: the run would keep ") and "of the 8 GiB free" in line
     assert "GiB of records and contacts (50 balls, 600 s of record windows" in line
     assert not (tmp_path / "run").exists()

@@ -12,9 +12,9 @@ from shakermill.parameters.assumed import (
     parse_assumption,
     with_derived,
 )
+from shakermill.parameters.config import load_config
 from shakermill.parameters.engine_keys import Reader
 from shakermill.parameters.errors import ParameterError
-from shakermill.parameters.config import load_config
 from shakermill.parameters.presets import PRESETS, default_parameters
 from shakermill.studies.ensemble import ensemble_inputs
 
@@ -35,7 +35,10 @@ SPEX_3D = Reader("dem", "averaged", "paper", "spex8000m")
         ("pm100", CONTACT | HEAD | BOWL),
         ("mm400", CONTACT | {"amplitude", "swing_radius"}),
         # What a calibration fitted has its posterior, not an assumed range.
-        ("spex8000m-3d-calibrated", CONTACT | {"emissivity", "clamp_conductance", "lateral_amplitude", "yaw_amplitude"}),
+        (
+            "spex8000m-3d-calibrated",
+            CONTACT | {"emissivity", "clamp_conductance", "lateral_amplitude", "yaw_amplitude"},
+        ),
     ],
 )
 def test_every_3d_preset_states_its_assumed_inputs(name, expected):
@@ -59,7 +62,12 @@ def test_lambda_spans_the_paper_and_the_effusivity_rule():
         ("friction", {**TABLE, "distribution": "normal"}, 0.3, "distribution must be one of uniform, log-uniform"),
         ("rolling_friction", {**TABLE, "low": 0.0, "distribution": "log-uniform"}, 0.0, "log-uniform needs low > 0"),
         ("friction", {**TABLE, "reason": " "}, 0.3, "give the reason"),
-        ("friction", {k: v for k, v in TABLE.items() if k != "reason"}, 0.3, "give exactly low, high, distribution, reason"),
+        (
+            "friction",
+            {k: v for k, v in TABLE.items() if k != "reason"},
+            0.3,
+            "give exactly low, high, distribution, reason",
+        ),
         ("friction", {**TABLE, "moves": ["vial_mass"]}, 0.3, "moves lists keys derived from the vial's dimensions"),
         ("vial_diameter", {**TABLE, "low": 0.01, "moves": ["omega"]}, 0.02, "(inner_area, vial_mass), only for"),
         ("friction", TABLE, 0.8, "the preset's friction = 0.8 lies outside its range [0.1, 0.6]"),
@@ -77,9 +85,13 @@ def test_a_bad_assumed_table_is_refused_in_one_line_naming_it(key, table, value,
 
 def test_a_preset_that_moves_an_inherited_input_outside_its_range_must_restate_it():
     base = {"friction": assumed_input("friction", TABLE, "base.toml")}
-    with pytest.raises(ParameterError, match=r"child.toml: \[assumed.friction\]: the preset's friction = 0.8 lies outside"):
+    with pytest.raises(
+        ParameterError, match=r"child.toml: \[assumed.friction\]: the preset's friction = 0.8 lies outside"
+    ):
         inherited_assumed(base, {}, {"friction": 0.8}, (), SPEX_3D, "child.toml")
-    restated = inherited_assumed(base, {"friction": {**TABLE, "high": 1.0}}, {"friction": 0.8}, (), SPEX_3D, "child.toml")
+    restated = inherited_assumed(
+        base, {"friction": {**TABLE, "high": 1.0}}, {"friction": 0.8}, (), SPEX_3D, "child.toml"
+    )
     assert restated["friction"].high == 1.0
     # Fitted, it is no longer assumed, wherever it ended.
     assert inherited_assumed(base, {}, {"friction": 0.8}, ("friction",), SPEX_3D, "child.toml") == {}
@@ -88,10 +100,18 @@ def test_a_preset_that_moves_an_inherited_input_outside_its_range_must_restate_i
 def test_a_users_range_from_the_command_line():
     narrowed = parse_assumption("friction=0.4:0.5", SPEX_3D)
     assert (narrowed.low, narrowed.high, narrowed.distribution) == (0.4, 0.5, "uniform")
-    assert parse_assumption("clamp_loss=1:10:log-uniform", Reader("dem", "averaged", "mill-head", "spex8000m")).distribution == "log-uniform"
-    for text, refused in (("friction=0.4", "write KEY=LOW:HIGH"), ("friction=a:b", "must be numbers"),
-                          ("swing_radius=0.05:0.1", "kinematics = 'spex8000m' does not read it"),
-                          ("friction=0.5:0.4", "low < high")):
+    assert (
+        parse_assumption(
+            "clamp_loss=1:10:log-uniform", Reader("dem", "averaged", "mill-head", "spex8000m")
+        ).distribution
+        == "log-uniform"
+    )
+    for text, refused in (
+        ("friction=0.4", "write KEY=LOW:HIGH"),
+        ("friction=a:b", "must be numbers"),
+        ("swing_radius=0.05:0.1", "kinematics = 'spex8000m' does not read it"),
+        ("friction=0.5:0.4", "low < high"),
+    ):
         with pytest.raises(ParameterError, match=None) as caught:
             parse_assumption(text, SPEX_3D)
         assert refused in str(caught.value), text
@@ -117,16 +137,25 @@ def test_a_planetary_bowls_dimensions_move_its_inner_area_and_wall_mass_with_the
 def test_a_bowl_whose_inner_area_is_not_its_bores_cannot_move_it(tmp_path):
     # A vial whose inner area was set apart from its bore (here by hand): a range of its diameter may not move it.
     config = tmp_path / "mine.toml"
-    config.write_text('preset = "spex8000m-3d"\ninner_area = 0.005\n[assumed.vial_diameter]\nlow = 0.035\nhigh = 0.041\n'
-                      'distribution = "uniform"\nreason = "ours"\nmoves = ["inner_area"]\n', encoding="utf-8")
-    with pytest.raises(ParameterError, match=r"mine.toml: \[assumed.vial_diameter\]: moves inner_area, but the preset's "
-                       r"inner_area = 0.005 is not the 0.00919\d* its vial's dimensions give"):
+    config.write_text(
+        'preset = "spex8000m-3d"\ninner_area = 0.005\n[assumed.vial_diameter]\nlow = 0.035\nhigh = 0.041\n'
+        'distribution = "uniform"\nreason = "ours"\nmoves = ["inner_area"]\n',
+        encoding="utf-8",
+    )
+    with pytest.raises(
+        ParameterError,
+        match=r"mine.toml: \[assumed.vial_diameter\]: moves inner_area, but the preset's "
+        r"inner_area = 0.005 is not the 0.00919\d* its vial's dimensions give",
+    ):
         load_config(config)
 
 
 def test_a_users_range_of_a_key_the_run_does_not_read_is_refused(tmp_path):
     config = tmp_path / "mine.toml"
-    config.write_text('preset = "spex8000m-3d"\n[assumed.swing_radius]\nlow = 0.05\nhigh = 0.1\n'
-                      'distribution = "uniform"\nreason = "ours"\n', encoding="utf-8")
+    config.write_text(
+        'preset = "spex8000m-3d"\n[assumed.swing_radius]\nlow = 0.05\nhigh = 0.1\n'
+        'distribution = "uniform"\nreason = "ours"\n',
+        encoding="utf-8",
+    )
     with pytest.raises(ParameterError, match=r"swing_radius.*kinematics = 'spex8000m' does not read it"):
         load_config(config)

@@ -15,11 +15,15 @@ from shakermill.parameters.presets import preset_values
 def test_a_documented_bound_written_with_a_unit_is_that_bound():
     # 25 um reaches SI as 2.4999999999999998e-05, one rounding step below the bound.
     assert build_parameters(preset_values("spex8000m"), {"ball_radius": "25um"}).ball_radius == 2.5e-05
-    assert build_parameters(preset_values("spex8000m"), {"ball_radius": "25 um"}).ball_radius == bounds("ball_radius").low
+    assert (
+        build_parameters(preset_values("spex8000m"), {"ball_radius": "25 um"}).ball_radius == bounds("ball_radius").low
+    )
 
 
 def test_a_value_beyond_the_tolerance_is_still_refused():
-    with pytest.raises(ParameterError, match=r"^ball_radius: 2\.4989999999999996e-05 is out of range; allowed \[2\.5e-05"):
+    with pytest.raises(
+        ParameterError, match=r"^ball_radius: 2\.4989999999999996e-05 is out of range; allowed \[2\.5e-05"
+    ):
         build_parameters(preset_values("spex8000m"), {"ball_radius": "24.99 um"})
 
 
@@ -47,7 +51,9 @@ def test_a_bound_is_printed_in_as_many_digits_as_tell_it_from_the_value():
     # A closed bound is printed in as many digits as are accepted as written: 6.28319 lies beyond 2π, 6.283185 inside.
     with pytest.raises(ParameterError, match=r"allowed \[-6\.283185, 6\.283185\] rad$"):
         build_parameters(preset_values("spex8000m"), {"phase": 6.2832})
-    with pytest.raises(ParameterError, match=r"^phase: 6\.28319 is out of range; allowed \[-6\.283185, 6\.283185\] rad$"):
+    with pytest.raises(
+        ParameterError, match=r"^phase: 6\.28319 is out of range; allowed \[-6\.283185, 6\.283185\] rad$"
+    ):
         build_parameters(preset_values("spex8000m"), {"phase": 6.28319})
 
 

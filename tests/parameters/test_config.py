@@ -97,7 +97,9 @@ def test_unknown_key_in_file_suggests_the_right_one(tmp_path):
 
 
 def test_window_with_wrong_unit_in_file_names_the_key(tmp_path):
-    with pytest.raises(ParameterError, match="record_windows: .*wrong dimension \\(read as .*\\); expected a time such as s"):
+    with pytest.raises(
+        ParameterError, match="record_windows: .*wrong dimension \\(read as .*\\); expected a time such as s"
+    ):
         load_config(write_toml(tmp_path, 'record_windows = [[0, "1 kg"]]\n'))
 
 
@@ -175,7 +177,9 @@ def test_a_byte_order_mark_is_read_as_utf8(tmp_path):
 def test_a_file_in_another_encoding_is_one_line_naming_it(tmp_path, encoding):
     path = tmp_path / "other.toml"
     path.write_text("# für die Mühle\neta = 0.7\n", encoding=encoding)
-    with pytest.raises(ParameterError, match=r"other.toml: not UTF-8 text \(byte 0x.. at offset \d+\); save it as UTF-8"):
+    with pytest.raises(
+        ParameterError, match=r"other.toml: not UTF-8 text \(byte 0x.. at offset \d+\); save it as UTF-8"
+    ):
         load_config(path)
 
 
@@ -190,7 +194,10 @@ def test_a_file_larger_than_any_configuration_is_refused_unread(tmp_path):
     [
         ("omega = inf\n", ("omega: inf is not a finite number", "allowed [1, 10000] rad/s")),
         ("phase = nan\n", ("phase: nan is not a finite number",)),
-        ("attractor_starts = true\n", ("attractor_starts: expected a whole number, got True", "allowed a whole number")),
+        (
+            "attractor_starts = true\n",
+            ("attractor_starts: expected a whole number, got True", "allowed a whole number"),
+        ),
         ("duration = false\n", ("duration: expected a number or a quantity with units, got False",)),
         ("no_tension = 1\n", ("no_tension: expected true or false, got 1",)),
         ("duration = " + "9" * 5000 + "\n", ("malformed TOML: a number too long to read",)),
@@ -214,19 +221,28 @@ def test_a_balls_diameter_is_taken_as_twice_its_radius_from_the_command_line_and
     from shakermill.parameters.config import load_config
     from shakermill.parameters.errors import ParameterError
 
-    assert load_config(preset="spex8000m-3d", overrides=['ball_diameter=10 mm']).params.ball_radius == pytest.approx(0.005)
-    assert load_config(preset="spex8000m-3d", overrides=["ball_diameter=0.0127"]).params.ball_radius == pytest.approx(0.00635)
+    assert load_config(preset="spex8000m-3d", overrides=["ball_diameter=10 mm"]).params.ball_radius == pytest.approx(
+        0.005
+    )
+    assert load_config(preset="spex8000m-3d", overrides=["ball_diameter=0.0127"]).params.ball_radius == pytest.approx(
+        0.00635
+    )
     mine = tmp_path / "mine.toml"
     mine.write_text('preset = "spex8000m-3d"\nball_diameter = "8 mm"\n', encoding="utf-8")
     assert load_config(mine).params.ball_radius == pytest.approx(0.004)
-    with pytest.raises(ParameterError, match=r"^ball_diameter: give ball_radius or ball_diameter \(twice ball_radius\), not both$"):
+    with pytest.raises(
+        ParameterError, match=r"^ball_diameter: give ball_radius or ball_diameter \(twice ball_radius\), not both$"
+    ):
         load_config(overrides=["ball_diameter=10 mm", "ball_radius=5 mm"])
-    with pytest.raises(ParameterError, match=r"^ball_diameter: .*allowed a length from 5e-05 to 0.2 m \(twice ball_radius\)$"):
+    with pytest.raises(
+        ParameterError, match=r"^ball_diameter: .*allowed a length from 5e-05 to 0.2 m \(twice ball_radius\)$"
+    ):
         load_config(overrides=["ball_diameter=10 kg"])
 
 
 def test_a_fitted_files_run_says_the_presets_caveat_is_of_the_preset_as_shipped():
-    """Issue 37, point 1: the guide's fitted file was told 'its thermal network is not calibrated' by its base preset."""
+    """Issue 37, point 1: the guide's fitted file was told 'its thermal network is not calibrated' by its base
+    preset."""
     from shakermill.parameters.presets import PRESETS
 
     preset = PRESETS["spex8000m-3d"]

@@ -42,7 +42,11 @@ def test_motion_terms_from_the_command_line_carry_units():
 
 def test_a_configuration_with_lists_and_motion_round_trips(tmp_path):
     params = sm.default_parameters(
-        engine="dem", n_balls=2, vial_diameter="38 mm", ball_radii="6 mm, 4 mm", kinematics="fourier",
+        engine="dem",
+        n_balls=2,
+        vial_diameter="38 mm",
+        ball_radii="6 mm, 4 mm",
+        kinematics="fourier",
         motion="x:1:0:25 mm, pitch:2:0.05:0",
     )
     path = tmp_path / "config.toml"

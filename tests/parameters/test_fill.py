@@ -60,7 +60,10 @@ def test_a_file_with_fill_round_trips_and_runs_with_another_ball(tmp_path):
     [
         ({"fill": 0.1, "n_balls": 3}, ("n_balls: 3 contradicts fill = 0.1", "allowed n_balls = 6", "fill = 0")),
         ({"fill": 0.5}, ("fill: 0.5 of the vial is 31 balls of radius 6.35 mm", "allowed fill < 0.334")),
-        ({"fill": 0.3, "ball_radius": "0.5 mm"}, ("fill: 0.3 of this vial is 37688 balls", "allowed fill <", "at most 2000 balls")),
+        (
+            {"fill": 0.3, "ball_radius": "0.5 mm"},
+            ("fill: 0.3 of this vial is 37688 balls", "allowed fill <", "at most 2000 balls"),
+        ),
         ({"fill": 0.8}, ("fill: 0.8 is out of range", "allowed [0, 0.74")),
         ({"fill": 0.1, "engine": "1d", "kinematics": "axial"}, ("fill:", "allowed fill = 0 with engine = '1d'")),
         ({"fill": 0.1, "ball_materials": "wc,wc"}, ("fill:", "ball_materials", "allowed fill = 0 with per-ball lists")),
@@ -76,7 +79,8 @@ def test_bad_fill_is_refused_in_one_line(overrides, fragments):
 
 def test_the_command_line_refuses_fill_beside_another_n_balls(tmp_path):
     outcome = CliRunner().invoke(
-        cli.app, ["run", "--preset", "spex8000m-3d", "--set", "fill=0.1", "--set", "n_balls=3", "--out", str(tmp_path / "r")]
+        cli.app,
+        ["run", "--preset", "spex8000m-3d", "--set", "fill=0.1", "--set", "n_balls=3", "--out", str(tmp_path / "r")],
     )
     assert outcome.exit_code == 2
     assert_one_error_line(outcome.stderr, "n_balls: 3 contradicts fill = 0.1", "allowed n_balls = 6")

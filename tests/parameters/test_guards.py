@@ -86,7 +86,19 @@ def test_cli_refuses_a_bare_temperature_with_exit_2_and_one_line(tmp_path):
 def test_cli_warns_once_and_echoes_what_was_understood(tmp_path):
     outcome = runner.invoke(
         cli.app,
-        ["run", "--set", "omega=1060", "--set", "duration=1", "--set", "record_windows=", "--no-plots", "--json", "--out", str(tmp_path / "run")],
+        [
+            "run",
+            "--set",
+            "omega=1060",
+            "--set",
+            "duration=1",
+            "--set",
+            "record_windows=",
+            "--no-plots",
+            "--json",
+            "--out",
+            str(tmp_path / "run"),
+        ],
     )
     slips = [line for line in outcome.stderr.splitlines() if "did you mean" in line]
     assert len(slips) == 1 and slips[0].startswith("warning: omega = 1060 rad/s")
@@ -101,8 +113,21 @@ def test_json_echo_of_rpm_and_millimetres(tmp_path):
     outcome = runner.invoke(
         cli.app,
         [
-            "run", "--set", "omega=1060 rpm", "--set", "amplitude=24 mm", "--set", "ambient_temperature=25 degC",
-            "--set", "duration=1", "--set", "record_windows=", "--no-plots", "--json", "--out", str(tmp_path / "run"),
+            "run",
+            "--set",
+            "omega=1060 rpm",
+            "--set",
+            "amplitude=24 mm",
+            "--set",
+            "ambient_temperature=25 degC",
+            "--set",
+            "duration=1",
+            "--set",
+            "record_windows=",
+            "--no-plots",
+            "--json",
+            "--out",
+            str(tmp_path / "run"),
         ],
     )
     summary = json.loads(outcome.stdout)
@@ -115,7 +140,19 @@ def test_json_echo_of_rpm_and_millimetres(tmp_path):
 
 def test_human_table_shows_omega_in_three_units(tmp_path):
     outcome = runner.invoke(
-        cli.app, ["run", "--set", "omega=1060 rpm", "--set", "duration=1", "--set", "record_windows=", "--no-plots", "--out", str(tmp_path / "run")]
+        cli.app,
+        [
+            "run",
+            "--set",
+            "omega=1060 rpm",
+            "--set",
+            "duration=1",
+            "--set",
+            "record_windows=",
+            "--no-plots",
+            "--out",
+            str(tmp_path / "run"),
+        ],
     )
     assert "111 rad/s = 17.67 Hz = 1060" in outcome.stdout
 

@@ -25,8 +25,16 @@ LIBRARY = list(materials.library().values())
 
 
 def test_the_library_holds_the_media_the_brief_names():
-    assert {"hardened-steel", "stainless-steel-440c", "stainless-steel-304", "tungsten-carbide", "zirconia", "alumina",
-            "silicon-nitride", "agate"} <= set(materials.names())
+    assert {
+        "hardened-steel",
+        "stainless-steel-440c",
+        "stainless-steel-304",
+        "tungsten-carbide",
+        "zirconia",
+        "alumina",
+        "silicon-nitride",
+        "agate",
+    } <= set(materials.names())
 
 
 @pytest.mark.parametrize("found", LIBRARY, ids=lambda found: found.name)
@@ -98,14 +106,22 @@ def test_a_short_dem_run_uses_each_balls_material():
 def test_vial_material_fills_the_vial_keys():
     params = sm.default_parameters(vial_material="stainless-steel-304")
     assert (params.vial_density, params.vial_youngs_modulus, params.vial_poisson_ratio, params.vial_heat_capacity) == (
-        7900.0, 200e9, 0.29, 500.0,
+        7900.0,
+        200e9,
+        0.29,
+        500.0,
     )
     assert params.ball_density == 7800.0
 
 
 def test_a_configuration_with_materials_round_trips(tmp_path):
-    params = sm.default_parameters(**TWO_BALLS, ball_material="wc", ball_materials="zirconia, alumina",
-                                   vial_material="aisi-440c", ball_density=14000.0)
+    params = sm.default_parameters(
+        **TWO_BALLS,
+        ball_material="wc",
+        ball_materials="zirconia, alumina",
+        vial_material="aisi-440c",
+        ball_density=14000.0,
+    )
     path = tmp_path / "config.toml"
     write_config_toml(params, path, preset="spex8000m")
     assert load_config(path).params == params

@@ -497,5 +497,7 @@ def test_direct_construction_refuses_non_finite_values(defaults: Parameters) -> 
 
 
 def test_replace_refuses_what_default_parameters_refuses(defaults: Parameters) -> None:
-    with pytest.raises(ParameterError, match=r"^phase: 'nan' is not a finite number; allowed \[-6.283185, 6.283185\] rad$"):
+    with pytest.raises(
+        ParameterError, match=r"^phase: 'nan' is not a finite number; allowed \[-6.283185, 6.283185\] rad$"
+    ):
         defaults.replace(phase="nan")

@@ -61,11 +61,23 @@ def test_dimensionless_quantities() -> None:
     [
         ("3 kg", "m", "'3 kg' has the wrong dimension (read as kilogram); expected a length such as m or mm"),
         ("3 kg", "", "wrong dimension (read as kilogram); expected a dimensionless number"),
-        ("1 m", "rad/s", "'1 m' has the wrong dimension (read as meter); expected a frequency such as rad/s, Hz or rpm"),
-        ("25 C", "rad/s", "wrong dimension (read as coulomb)"),  # °C only where a temperature is expected: here it is coulombs
+        (
+            "1 m",
+            "rad/s",
+            "'1 m' has the wrong dimension (read as meter); expected a frequency such as rad/s, Hz or rpm",
+        ),
+        (
+            "25 C",
+            "rad/s",
+            "wrong dimension (read as coulomb)",
+        ),  # °C only where a temperature is expected: here it is coulombs
         ("3 N", "J/(kg*K)", "wrong dimension (read as newton); expected a quantity in J/(kg*K)"),
         ("abc xyz", "m", "cannot parse 'abc xyz': unknown unit 'abc'; expected a length"),
-        ("1060 rmp", "rad/s", "cannot parse '1060 rmp': unknown unit 'rmp'; expected a frequency such as rad/s, Hz or rpm"),
+        (
+            "1060 rmp",
+            "rad/s",
+            "cannot parse '1060 rmp': unknown unit 'rmp'; expected a frequency such as rad/s, Hz or rpm",
+        ),
         (True, "m", "expected a number"),
         (None, "m", "expected a number"),
         ([1.0], "m", "expected a number"),
@@ -106,7 +118,12 @@ def test_arithmetic_in_a_quantity_is_refused_before_pint_sees_it(value: str) -> 
 
 @pytest.mark.parametrize(
     ("value", "unit", "expected"),
-    [("9.81 m/s^2", "m/s^2", 9.81), ("9.81 m/s**2", "m/s^2", 9.81), ("461 J/(kg*K)", "J/(kg*K)", 461.0), ("1 / min", "1/s", 1 / 60)],
+    [
+        ("9.81 m/s^2", "m/s^2", 9.81),
+        ("9.81 m/s**2", "m/s^2", 9.81),
+        ("461 J/(kg*K)", "J/(kg*K)", 461.0),
+        ("1 / min", "1/s", 1 / 60),
+    ],
 )
 def test_single_digit_powers_and_reciprocals_of_units_are_read(value: str, unit: str, expected: float) -> None:
     assert to_si(value, unit, key="k") == pytest.approx(expected, rel=1e-12)
@@ -126,7 +143,10 @@ def test_non_finite_values_are_refused(value: object) -> None:
         to_si(value, "m", key="k")
 
 
-@pytest.mark.parametrize("spelling", ["C", "c", "degC", "deg C", "°C", "° C", "ºC", "℃", "celsius", "Celsius", "degree_Celsius", "degrees celsius"])
+@pytest.mark.parametrize(
+    "spelling",
+    ["C", "c", "degC", "deg C", "°C", "° C", "ºC", "℃", "celsius", "Celsius", "degree_Celsius", "degrees celsius"],
+)
 def test_a_temperature_in_degrees_celsius_is_read_in_any_spelling(spelling: str) -> None:
     assert to_si(f"25 {spelling}", "K", key="ambient_temperature") == pytest.approx(298.15, rel=1e-15)
     assert to_si(f"25{spelling}", "K", key="initial_temperature") == pytest.approx(298.15, rel=1e-15)
@@ -135,7 +155,9 @@ def test_a_temperature_in_degrees_celsius_is_read_in_any_spelling(spelling: str)
 @pytest.mark.parametrize("spelling", ["F", "degF", "°F", "℉", "fahrenheit"])
 def test_a_temperature_in_degrees_fahrenheit_is_read(spelling: str) -> None:
     assert to_si(f"77 {spelling}", "K", key="ambient_temperature") == pytest.approx(298.15, rel=1e-12)
-    assert to_si(f"-40 {spelling}", "K", key="ambient_temperature") == pytest.approx(233.15, rel=1e-12)  # -40 °F = -40 °C
+    assert to_si(f"-40 {spelling}", "K", key="ambient_temperature") == pytest.approx(
+        233.15, rel=1e-12
+    )  # -40 °F = -40 °C
 
 
 def test_a_temperature_difference_in_degrees_takes_no_offset() -> None:
@@ -152,19 +174,40 @@ def test_every_key_in_kelvin_is_a_temperature_or_a_difference_of_temperatures() 
     assert not temperatures & TEMPERATURE_DIFFERENCE_KEYS
 
 
-@pytest.mark.parametrize("value", ["1060 rpm", "1060 RPM", "1060 Rpm", "1060rpm", "17.666666666666668 Hz", "17.666666666666668 hz", "17.666666666666668 HZ"])
+@pytest.mark.parametrize(
+    "value",
+    [
+        "1060 rpm",
+        "1060 RPM",
+        "1060 Rpm",
+        "1060rpm",
+        "17.666666666666668 Hz",
+        "17.666666666666668 hz",
+        "17.666666666666668 HZ",
+    ],
+)
 def test_rpm_and_hertz_are_read_in_any_case(value: str) -> None:
     assert to_si(value, "rad/s", key="omega") == pytest.approx(1060 * 2 * math.pi / 60, rel=1e-12)
 
 
 @pytest.mark.parametrize(
     ("written", "unit", "si_unit", "key"),
-    [("5 mm", "mm", "m", "amplitude"), ("25 C", "C", "K", "ambient_temperature"), ("77 degF", "degF", "K", "initial_temperature"),
-     ("1060 RPM", "RPM", "rad/s", "omega"), ("15 Hz", "Hz", "rad/s", "omega"), ("60 min", "min", "s", "duration")],
+    [
+        ("5 mm", "mm", "m", "amplitude"),
+        ("25 C", "C", "K", "ambient_temperature"),
+        ("77 degF", "degF", "K", "initial_temperature"),
+        ("1060 RPM", "RPM", "rad/s", "omega"),
+        ("15 Hz", "Hz", "rad/s", "omega"),
+        ("60 min", "min", "s", "duration"),
+    ],
 )
-def test_a_value_read_back_in_the_unit_it_was_written_in_is_the_number_written(written: str, unit: str, si_unit: str, key: str) -> None:
+def test_a_value_read_back_in_the_unit_it_was_written_in_is_the_number_written(
+    written: str, unit: str, si_unit: str, key: str
+) -> None:
     assert unit_written(written) == unit
-    assert from_si(to_si(written, si_unit, key=key), unit, si_unit, key=key) == pytest.approx(float(written.split()[0]), rel=1e-12)
+    assert from_si(to_si(written, si_unit, key=key), unit, si_unit, key=key) == pytest.approx(
+        float(written.split()[0]), rel=1e-12
+    )
 
 
 @pytest.mark.parametrize("value", ["0.005", 0.005, "steel", ""])

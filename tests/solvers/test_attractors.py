@@ -38,7 +38,9 @@ def test_two_attractors_at_110_rad_s_with_basins_summing_to_one(coexisting):
     params, scan = coexisting
     assert len(scan.attractors) == 2
     assert sum(attractor.basin_fraction for attractor in scan.attractors) == pytest.approx(1.0)
-    assert sorted(start for attractor in scan.attractors for start in attractor.starts) == list(range(params.attractor_starts))
+    assert sorted(start for attractor in scan.attractors for start in attractor.starts) == list(
+        range(params.attractor_starts)
+    )
     assert {attractor.regime for attractor in scan.attractors} == {"period-1", "period-2"}
     first, second = scan.attractors
     assert 0 in first.starts and scan.configured == first
@@ -108,7 +110,9 @@ OMEGA = 100.0
 DRIVE = 2 * math.pi / OMEGA
 
 
-def _motion(pattern: list[tuple[float, str]], every: int, periods: int = MEASURE_PERIODS, jitter: float = 0.0) -> pd.DataFrame:
+def _motion(
+    pattern: list[tuple[float, str]], every: int, periods: int = MEASURE_PERIODS, jitter: float = 0.0
+) -> pd.DataFrame:
     """Impacts at fractions of the drive period, the pattern repeating every ``every`` periods."""
     rng = np.random.default_rng(3)
     times, walls = [], []
@@ -119,8 +123,12 @@ def _motion(pattern: list[tuple[float, str]], every: int, periods: int = MEASURE
     return pd.DataFrame({"time": times, "wall": walls})
 
 
-def _settled(start: int, impacts: pd.DataFrame, regime: str, period: int | None, heat: float = 1.0, stderr: float = 0.0) -> SettledStart:
-    return SettledStart(start, 0.0, 0.0, regime, period, len(impacts) / (MEASURE_PERIODS * DRIVE), heat, stderr, impacts)
+def _settled(
+    start: int, impacts: pd.DataFrame, regime: str, period: int | None, heat: float = 1.0, stderr: float = 0.0
+) -> SettledStart:
+    return SettledStart(
+        start, 0.0, 0.0, regime, period, len(impacts) / (MEASURE_PERIODS * DRIVE), heat, stderr, impacts
+    )
 
 
 PERIOD_TWO = [(0.2, "left"), (0.7, "right"), (1.3, "left"), (1.75, "right")]
@@ -147,12 +155,17 @@ def test_a_start_jittering_on_a_cycle_joins_it_under_the_cycles_name():
     jittered = _settled(1, _motion(PERIOD_TWO, 2, jitter=0.9 * PHASE_TOLERANCE), IRREGULAR, None)
     far = _settled(2, _motion(PERIOD_TWO, 2, jitter=20 * PHASE_TOLERANCE), IRREGULAR, None, heat=0.8, stderr=0.001)
     attractors = group((jittered, cycle, far), OMEGA, 0.0)
-    assert [(attractor.regime, attractor.starts) for attractor in attractors] == [("period-2", (0, 1)), (IRREGULAR, (2,))]
+    assert [(attractor.regime, attractor.starts) for attractor in attractors] == [
+        ("period-2", (0, 1)),
+        (IRREGULAR, (2,)),
+    ]
 
 
 def test_irregular_motions_split_only_where_their_heat_powers_are_told_apart():
     def irregular(start: int, heat: float, stderr: float) -> SettledStart:
-        return _settled(start, _motion([(0.1 * start, "left")], 1, jitter=3.0), IRREGULAR, None, heat=heat, stderr=stderr)
+        return _settled(
+            start, _motion([(0.1 * start, "left")], 1, jitter=3.0), IRREGULAR, None, heat=heat, stderr=stderr
+        )
 
     # 1.00 and 1.03 differ by 3 %, within 3 combined standard errors of 1 %; 1.30 does not.
     starts = (irregular(0, 1.00, 0.01), irregular(1, 1.30, 0.01), irregular(2, 1.03, 0.01))
@@ -165,9 +178,23 @@ def test_irregular_motions_split_only_where_their_heat_powers_are_told_apart():
 def test_resting_starts_are_one_attractor_and_failed_starts_none():
     resting = [_settled(k, pd.DataFrame({"time": [], "wall": []}), NO_IMPACTS, None, heat=0.0) for k in (0, 2)]
     moving = _settled(1, _motion(PERIOD_TWO, 2), "period-2", 2)
-    failed = SettledStart(3, 0.0, 0.0, FAILED, None, math.nan, math.nan, math.nan, pd.DataFrame(columns=["time", "wall"]), "step too small")
+    failed = SettledStart(
+        3,
+        0.0,
+        0.0,
+        FAILED,
+        None,
+        math.nan,
+        math.nan,
+        math.nan,
+        pd.DataFrame(columns=["time", "wall"]),
+        "step too small",
+    )
     attractors = group((resting[0], moving, resting[1], failed), OMEGA, 0.0)
-    assert [(attractor.regime, attractor.starts) for attractor in attractors] == [(NO_IMPACTS, (0, 2)), ("period-2", (1,))]
+    assert [(attractor.regime, attractor.starts) for attractor in attractors] == [
+        (NO_IMPACTS, (0, 2)),
+        ("period-2", (1,)),
+    ]
     assert sum(attractor.basin_fraction for attractor in attractors) == 0.75
 
 
@@ -180,7 +207,18 @@ def test_a_start_that_fails_is_reported_not_grouped(monkeypatch):
         settled = real_settle(params, start, *budget_and_heartbeat)
         if start != 2:
             return settled
-        return SettledStart(start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan, {name: values[:0] for name, values in settled.impacts.items()}, "step size too small")
+        return SettledStart(
+            start,
+            params.ball_position,
+            params.ball_momentum,
+            FAILED,
+            None,
+            math.nan,
+            math.nan,
+            math.nan,
+            {name: values[:0] for name, values in settled.impacts.items()},
+            "step size too small",
+        )
 
     monkeypatch.setattr(module, "settle", third_fails)
     scan = find_attractors(sm.default_parameters(omega=110.0, attractor_starts=4))
@@ -248,6 +286,8 @@ def test_sweep_rows_count_the_attractors_and_their_heat_spread(tmp_path):
     for _, row in table.iterrows():
         assert row["n_attractors"] == len(expected.attractors)
         assert row["heat_power_spread_W"] == pytest.approx(expected.heat_power_spread_W)
-        assert row["heat_power_spread_relative"] == pytest.approx(expected.heat_power_spread_W / expected.configured.heat_power_W)
+        assert row["heat_power_spread_relative"] == pytest.approx(
+            expected.heat_power_spread_W / expected.configured.heat_power_W
+        )
         assert "coexisting attractor" in row["warnings"]
     assert str(table["n_attractors"].dtype) == "Int64"

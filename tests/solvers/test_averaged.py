@@ -51,7 +51,12 @@ def test_averaged_run_has_the_variables_of_a_full_run() -> None:
     assert averaged.timeseries["theta_ball"].attrs["units"] == "K"
     assert len(averaged.impacts) > 100 and len(averaged.windows["time"]) > 100
     assert averaged.energy.relative_residual < 1e-6
-    for key in ("averaged_heat_power_W", "averaged_velocity_term_stderr", "averaging_window_s", "averaging_transient_s"):
+    for key in (
+        "averaged_heat_power_W",
+        "averaged_velocity_term_stderr",
+        "averaging_window_s",
+        "averaging_transient_s",
+    ):
         assert np.isfinite(averaged.summary[key])
     assert averaged.summary["solver"] == "averaged"
 
@@ -84,12 +89,17 @@ def test_statistics_that_do_not_converge_are_refused() -> None:
     assert result.summary["averaging_converged"] is False
 
 
-
 def test_a_fall_back_that_could_not_end_within_the_budget_is_not_started() -> None:
     """Issue 37, point 1: a 3-D hour whose means missed their target fell back to full resolution and ran for 13 min
     into its step budget. Judged by the pace of the mechanics, it is refused at once instead."""
-    params = sm.default_parameters(solver="averaged", averaging_rel_error=1e-15, averaging_max_time=50.0,
-                                   record_windows=(), max_steps=300_000, attractor_starts=1)
+    params = sm.default_parameters(
+        solver="averaged",
+        averaging_rel_error=1e-15,
+        averaging_max_time=50.0,
+        record_windows=(),
+        max_steps=300_000,
+        attractor_starts=1,
+    )
     result = sm.simulate(params)
     assert result.status == AVERAGING_FAILED and result.solver == "averaged"
     assert "would take ~" in result.message and "not started" in result.message
@@ -102,7 +112,12 @@ def test_means_cut_short_by_averaging_max_time_say_how_long_would_reach_the_targ
     their uncorrelated batches miss 1 % by a little, and the run says how much mechanics would reach it. A
     full-resolution hour instead (~0.95e9 steps) would fit the default step budget, so a smaller one holds it back."""
     params = sm.default_parameters(
-        "spex8000m-3d", n_balls=2, ball_material="zirconia", omega=111.0, averaging_max_time=150.0, record_windows=(),
+        "spex8000m-3d",
+        n_balls=2,
+        ball_material="zirconia",
+        omega=111.0,
+        averaging_max_time=150.0,
+        record_windows=(),
         max_steps=100_000_000,
     )
     result = sm.simulate(params)
@@ -175,8 +190,14 @@ def test_a_planetary_charge_that_collapses_into_a_pack_is_averaged_after_the_cha
     # is chaotic, so any change of the stepping moves it: with issue 38's impact step, at the preset's friction 0.3 it
     # collapses within the start-up's own batches, at 0.38 and 0.4 not within 4 s; 0.32 to 0.36 pass.
     params = sm.default_parameters(
-        "pulverisette7", friction=0.35, duration=3600.0, solver="averaged", averaging_min_batches=4,
-        averaging_max_time=4.0, averaging_fallback="fail", record_windows=(),
+        "pulverisette7",
+        friction=0.35,
+        duration=3600.0,
+        solver="averaged",
+        averaging_min_batches=4,
+        averaging_max_time=4.0,
+        averaging_fallback="fail",
+        record_windows=(),
     )
     result = sm.simulate(params)
     averages = result.averages

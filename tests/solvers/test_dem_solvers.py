@@ -56,8 +56,13 @@ def test_both_solvers_give_each_ball_its_own_temperature_and_a_steady_state(pair
 def test_the_averaged_solver_falls_back_when_the_means_do_not_converge():
     # Batches of one period make the least mechanics (8 periods, 0.45 s) shorter than the run, so averaging is tried.
     params = sm.default_parameters(
-        **BALLS, duration=3.0, solver="averaged", dem_averaging_rel_error=1e-6, averaging_max_time=2.0,
-        averaging_batch_periods=1, averaging_min_batches=4,
+        **BALLS,
+        duration=3.0,
+        solver="averaged",
+        dem_averaging_rel_error=1e-6,
+        averaging_max_time=2.0,
+        averaging_batch_periods=1,
+        averaging_min_batches=4,
     )
     result = sm.simulate(params)
     assert result.success

@@ -27,7 +27,9 @@ def test_the_drive_alone_warms_an_empty_mill_and_its_heat_is_accounted_for(solve
     result = simulate(params)
     summary = result.summary
     assert result.success and summary["impacts"] == 0 and summary["heat_power_W"] == 0.0
-    assert math.isnan(summary["ball_C"]) and math.isnan(summary["ball_steady_C"]) and summary["ball_temperatures_C"] == []
+    assert (
+        math.isnan(summary["ball_C"]) and math.isnan(summary["ball_steady_C"]) and summary["ball_temperatures_C"] == []
+    )
     assert summary["drive_heat_W"] == pytest.approx(params.drive_heat)
     assert 20.0 < summary["vial_C"] < summary["clamp_C"] < summary["vial_steady_C"]
     # The drive's heat is the only flow of the balance, and all of it is accounted for.
@@ -50,27 +52,49 @@ def test_an_empty_mill_of_the_paper_network_stays_at_the_ambient():
 
 
 def test_the_one_dimensional_engine_refuses_an_empty_mill():
-    with pytest.raises(ParameterError, match=r"n_balls: the 1-D engine moves one ball; allowed n_balls = 1 .* engine = 'dem'"):
+    with pytest.raises(
+        ParameterError, match=r"n_balls: the 1-D engine moves one ball; allowed n_balls = 1 .* engine = 'dem'"
+    ):
         default_parameters("spex8000m", n_balls=0)
 
 
 def test_run_prints_and_stores_an_empty_mill(tmp_path):
     out = tmp_path / "empty"
-    outcome = runner.invoke(cli.app, ["run", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0",
-                                      "--set", "duration=600", "--out", str(out), "--no-plots"])
+    outcome = runner.invoke(
+        cli.app,
+        [
+            "run",
+            "--preset",
+            "spex8000m-3d-calibrated",
+            "--set",
+            "n_balls=0",
+            "--set",
+            "duration=600",
+            "--out",
+            str(out),
+            "--no-plots",
+        ],
+    )
     assert outcome.exit_code == 0, outcome.output
-    assert re.search(r"amplitude; ball radius\s*│\s*25; none", outcome.stdout) and "drive heat into the clamp" in outcome.stdout
+    assert (
+        re.search(r"amplitude; ball radius\s*│\s*25; none", outcome.stdout)
+        and "drive heat into the clamp" in outcome.stdout
+    )
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))["summary"]
     assert summary["n_balls"] == 0 and summary["ball_C"] is None and summary["vial_C"] > 20.0
 
 
 @pytest.mark.parametrize(
     ("option", "message"),
-    [(["--target", "theta_inf_C=40"], "target: the targets are the balls' temperatures"),
-     (["--free", "drive_heat"], "curve: experiment (Takacs & McHenry 2006")],
+    [
+        (["--target", "theta_inf_C=40"], "target: the targets are the balls' temperatures"),
+        (["--free", "drive_heat"], "curve: experiment (Takacs & McHenry 2006"),
+    ],
 )
 def test_a_fit_to_the_balls_of_an_empty_mill_is_refused(option, message):
-    outcome = runner.invoke(cli.app, ["calibrate", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0", *option])
+    outcome = runner.invoke(
+        cli.app, ["calibrate", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0", *option]
+    )
     assert outcome.exit_code == 2 and message in outcome.output and "vial_C" in outcome.output
 
 
@@ -80,8 +104,23 @@ def test_an_empty_mill_draws_its_temperatures_alone_and_refuses_an_animation(tmp
     from shakermill.views.report import render_report
 
     out = tmp_path / "empty"
-    outcome = runner.invoke(cli.app, ["run", "--preset", "spex8000m-3d-calibrated", "--set", "n_balls=0", "--set", "solver=full",
-                                      "--set", "duration=2", "--out", str(out), "--no-plots"])
+    outcome = runner.invoke(
+        cli.app,
+        [
+            "run",
+            "--preset",
+            "spex8000m-3d-calibrated",
+            "--set",
+            "n_balls=0",
+            "--set",
+            "solver=full",
+            "--set",
+            "duration=2",
+            "--out",
+            str(out),
+            "--no-plots",
+        ],
+    )
     assert outcome.exit_code == 0, outcome.output
     run = load_run(out)
     assert list(paper_figures(run)) == ["temperatures"]

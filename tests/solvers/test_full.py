@@ -76,7 +76,11 @@ def test_runs_are_deterministic() -> None:
 @pytest.mark.slow
 def test_without_motion_the_temperatures_relax_to_ambient() -> None:
     params = sm.default_parameters(
-        amplitude=RESTING_WALL_AMPLITUDE, initial_temperature=350.0, duration=24 * 3600.0, output_interval=60.0, rtol=1e-5,
+        amplitude=RESTING_WALL_AMPLITUDE,
+        initial_temperature=350.0,
+        duration=24 * 3600.0,
+        output_interval=60.0,
+        rtol=1e-5,
         record_windows=(),
     )
     result = sm.simulate(params)

@@ -10,13 +10,13 @@ import pytest
 
 import shakermill as sm
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.physics.contact import (
     effective_modulus,
     hertz_contact_time,
     hertz_force,
     hertz_max_overlap,
 )
-from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.solvers.impact import UNREAD_KEYS, check_keys_read, restitution_warning, single_impact
 
 # A contact step of 2 % of the Rayleigh time: an impact at 1/125 of its period, restitution within 6e-4 of e, contact

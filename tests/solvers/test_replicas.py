@@ -1,4 +1,5 @@
-"""Replicas of the averaged solver's mechanics (solvers/replicas.py): pooled, deterministic, on any number of threads."""
+"""Replicas of the averaged solver's mechanics (solvers/replicas.py): pooled, deterministic, on any number of
+threads."""
 
 from __future__ import annotations
 
@@ -11,18 +12,27 @@ import pytest
 import shakermill as sm
 from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import DemEngine
-from shakermill.solvers.averaged import full_resolution_instead, least_mechanics, settle_mechanics
-from shakermill.solvers.driver import least_rounds
 from shakermill.parameters.environment import THREADS_VARIABLE
 from shakermill.parameters.errors import ParameterError
+from shakermill.solvers.averaged import full_resolution_instead, least_mechanics, settle_mechanics
+from shakermill.solvers.driver import least_rounds
 from shakermill.solvers.replicas import ReplicaSet, replica_threads
 from shakermill.solvers.result import INTERRUPTED
 
 # Five balls knock each other about a wide bore (the cheapest chaotic case); batches of 4 periods and a loose target
 # keep the mechanics to a few simulated seconds.
-BALLS = {"engine": "dem", "n_balls": 5, "vial_diameter": "38 mm", "record_windows": (), "solver": "averaged",
-         "dem_averaging_rel_error": 0.05, "averaging_batch_periods": 4, "averaging_min_batches": 6, "duration": 600.0,
-         "averaging_fallback": "fail"}
+BALLS = {
+    "engine": "dem",
+    "n_balls": 5,
+    "vial_diameter": "38 mm",
+    "record_windows": (),
+    "solver": "averaged",
+    "dem_averaging_rel_error": 0.05,
+    "averaging_batch_periods": 4,
+    "averaging_min_batches": 6,
+    "duration": 600.0,
+    "averaging_fallback": "fail",
+}
 
 
 @pytest.fixture(name="params", scope="module")
@@ -40,7 +50,15 @@ def _pooled_run(params, monkeypatch, threads: int):
 def test_two_replicas_give_the_same_numbers_on_one_thread_and_on_two(params, monkeypatch):
     one, two = (_pooled_run(params, monkeypatch, threads) for threads in (1, 2))
     assert one.success and one.averages.converged and one.averages.replicas == 2
-    for name in ("heat_power", "heat_power_stderr", "velocity_term", "transient", "window", "batches", "impact_interval"):
+    for name in (
+        "heat_power",
+        "heat_power_stderr",
+        "velocity_term",
+        "transient",
+        "window",
+        "batches",
+        "impact_interval",
+    ):
         assert getattr(one.averages, name) == getattr(two.averages, name), name
     np.testing.assert_array_equal(one.history["theta_balls"], two.history["theta_balls"])
     assert one.counters == two.counters
@@ -54,7 +72,9 @@ def test_the_replicas_pool_independent_batches_and_the_first_is_the_run_without_
     # The first replica is the configured start: for as long as both ran, it moved as the run without replicas did.
     t = min(alone.engine.t, pooled.engine.t)
     alone_impacts, first_impacts = (m.engine.impact_columns() for m in (alone, pooled))
-    np.testing.assert_array_equal(alone_impacts["time"][alone_impacts["time"] <= t], first_impacts["time"][first_impacts["time"] <= t])
+    np.testing.assert_array_equal(
+        alone_impacts["time"][alone_impacts["time"] <= t], first_impacts["time"][first_impacts["time"] <= t]
+    )
     # Each replica ran at least its share of the least batches, and more batches were pooled than the first kept.
     batch = params.averaging_batch_periods * params.period
     assert pooled.engine.t >= least_rounds(params, 2) * batch * (1 - 1e-12)
@@ -65,7 +85,9 @@ def test_a_replica_starts_where_the_run_does_with_each_ball_kicked_by_its_own_se
     start = DemEngine(params).state
     kicked = [DemEngine(params, replica=number).state for number in (1, 1, 2)]
     np.testing.assert_array_equal(kicked[0].position, start.position)
-    np.testing.assert_allclose(np.linalg.norm(kicked[0].velocity - start.velocity, axis=1), model.REPLICA_KICK, rtol=1e-12)
+    np.testing.assert_allclose(
+        np.linalg.norm(kicked[0].velocity - start.velocity, axis=1), model.REPLICA_KICK, rtol=1e-12
+    )
     np.testing.assert_array_equal(kicked[0].velocity, kicked[1].velocity)  # the same number, the same start
     assert not np.allclose(kicked[0].velocity, kicked[2].velocity)
 

@@ -15,15 +15,22 @@ distributed = pytest.importorskip("distributed")
 
 # Two balls, three replicas, at most 12 s of mechanics in each: enough rounds that any difference would show.
 REPLICATED = {
-    "n_balls": 2, "dem_replicas": 3, "averaging_max_time": 12.0, "averaging_min_batches": 4,
-    "averaging_fallback": "fail", "record_windows": (), "duration": 600.0,
+    "n_balls": 2,
+    "dem_replicas": 3,
+    "averaging_max_time": 12.0,
+    "averaging_min_batches": 4,
+    "averaging_fallback": "fail",
+    "record_windows": (),
+    "duration": 600.0,
 }
 
 
 @pytest.fixture(scope="module")
 def client():
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
+    with (
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        distributed.Client(cluster) as client,
+    ):
         yield client
 
 
@@ -34,7 +41,9 @@ def test_replicas_on_a_two_worker_cluster_give_the_numbers_of_replicas_on_thread
     with replicas_on(client):
         on_the_cluster = sm.simulate(params)
     assert on_the_cluster.averages == on_threads.averages
-    assert on_the_cluster.averages.replicas == 3 and 0 < on_the_cluster.averages.impact_interval < 1.0  # impacts counted in every replica
+    assert (
+        on_the_cluster.averages.replicas == 3 and 0 < on_the_cluster.averages.impact_interval < 1.0
+    )  # impacts counted in every replica
     for key in ("heat_power_W", "impact_rate_per_s", "ball_steady_C"):
         assert on_the_cluster.summary.get(key) == on_threads.summary.get(key), key
     assert on_the_cluster.counters["steps"] == on_threads.counters["steps"]

@@ -1,4 +1,5 @@
-"""Runs that differ in the thermal network alone share the 'dem' engine's mechanics (solvers.simulate.thermal_variants)."""
+"""Runs that differ in the thermal network alone share the 'dem' engine's mechanics
+(solvers.simulate.thermal_variants)."""
 
 from __future__ import annotations
 
@@ -15,8 +16,15 @@ from shakermill.studies.calibrate import calibrate
 
 # Five balls knock each other off the bottom of a wide bore (the cheapest several-ball case) and their means
 # settle to ±3 % in a few seconds of mechanics.
-BALLS = {"engine": "dem", "n_balls": 5, "vial_diameter": "38 mm", "record_windows": (), "solver": "averaged",
-         "dem_averaging_rel_error": 0.03, "duration": 600.0}
+BALLS = {
+    "engine": "dem",
+    "n_balls": 5,
+    "vial_diameter": "38 mm",
+    "record_windows": (),
+    "solver": "averaged",
+    "dem_averaging_rel_error": 0.03,
+    "duration": 600.0,
+}
 VARIANT = {"h_outer": 20.0, "vial_mass": 0.3, "beta": 1.5, "outer_area": 0.01}
 
 
@@ -51,7 +59,9 @@ def test_mechanics_measured_for_other_mechanical_keys_are_refused(base):
 
 
 def test_a_dem_calibration_frees_only_thermal_keys(base):
-    with pytest.raises(ParameterError, match=r"^free: lam would change the dem engine's mechanics.*allowed for engine = 'dem': h_inner"):
+    with pytest.raises(
+        ParameterError, match=r"^free: lam would change the dem engine's mechanics.*allowed for engine = 'dem': h_inner"
+    ):
         calibrate(base, ("beta", "lam"))
 
 

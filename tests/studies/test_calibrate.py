@@ -7,9 +7,10 @@ import pytest
 
 import shakermill as sm
 from shakermill.parameters.config import load_config
+from shakermill.parameters.defaults import DEM_DEFAULT_FREE
+from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.presets import PRESETS
-from shakermill.parameters.defaults import DEM_DEFAULT_FREE
 from shakermill.studies.calibrate import (
     DEFAULT_FREE,
     DEFENSIBLE_RANGES,
@@ -20,9 +21,8 @@ from shakermill.studies.calibrate import (
     parse_free,
     parse_targets,
     unstarted_defaults,
-    write_preset,
 )
-from shakermill.parameters.engine_keys import reader_of
+from shakermill.studies.fitted_preset import write_preset
 from shakermill.studies.identifiability import (
     check_determinable,
     informative_points,
@@ -180,11 +180,19 @@ def test_calibrate_checks_its_targets_before_any_run() -> None:
 @pytest.mark.parametrize(
     ("times", "temperatures", "fragment"),
     [
-        ([0, 600, 1200], [20, float("nan"), 40], "point 2 has ball_C = nan °C; allowed a finite temperature above -273.15 °C"),
+        (
+            [0, 600, 1200],
+            [20, float("nan"), 40],
+            "point 2 has ball_C = nan °C; allowed a finite temperature above -273.15 °C",
+        ),
         ([0, 600, float("inf")], [20, 30, 40], "point 3 is at inf s; allowed times in [0, 1e+06] s"),
         ([0, 600, 1e308], [20, 30, 40], "point 3 is at 1e+308 s"),
         ([-60, 600], [20, 30], "point 1 is at -60 s"),
-        ([0, 600, 300], [20, 30, 35], "point 3 at 300 s does not come after the one before (600 s); times must increase"),
+        (
+            [0, 600, 300],
+            [20, 30, 35],
+            "point 3 at 300 s does not come after the one before (600 s); times must increase",
+        ),
         ([0, 600, 600], [20, 30, 31], "point 3 at 600 s does not come after"),
         ([0, 600], [20, -300], "point 2 has ball_C = -300"),
         ([], [], "0 times and 0 temperatures; allowed 1 to 100,000 of each"),
@@ -249,7 +257,11 @@ def test_the_default_free_set_of_a_mill_head_network_is_keys_it_reads(preset):
     """Issue 35: every 3-D preset's default free set held h_outer, which the mill-head network does not read."""
     params = sm.default_parameters(preset)
     free = default_free(params)
-    assert "h_outer" not in free and set(free) | set(unstarted_defaults(params)) == {"drive_heat", "clamp_heat_capacity", "clamp_loss"}
+    assert "h_outer" not in free and set(free) | set(unstarted_defaults(params)) == {
+        "drive_heat",
+        "clamp_heat_capacity",
+        "clamp_loss",
+    }
     assert all(reader_of(params).not_read(key) is None and getattr(params, key) > 0 for key in free)
     # The planetary presets start the drive's heat at 0: fitted in log space it needs a positive start.
     assert unstarted_defaults(params) == (("drive_heat",) if preset in ("pm100", "pulverisette7") else ())
@@ -280,21 +292,27 @@ def test_a_jacobian_that_leaves_keys_free_is_named_undetermined():
     assert undetermined_keys(good, ("a", "b", "c")) == ""
     dead = good.copy()
     dead[:, 1] = 0.0
-    assert undetermined_keys(dead, ("a", "b", "c")) == "undetermined: the fitted values do not depend on b (sensitivity 0)"
+    assert (
+        undetermined_keys(dead, ("a", "b", "c")) == "undetermined: the fitted values do not depend on b (sensitivity 0)"
+    )
     # h_outer and outer_area enter as their product: their columns are equal, one combination is all the data fix.
     collinear = good.copy()
     collinear[:, 2] = collinear[:, 0] * (1 + 1e-9)
     message = undetermined_keys(collinear, ("h_outer", "b", "outer_area"))
     assert message.startswith("undetermined: the data fix no more than a combination of h_outer, outer_area")
-    assert undetermined_keys(np.zeros((3, 2)), ("a", "b")) == "undetermined: the fitted values do not depend on a, b (sensitivity 0)"
+    assert (
+        undetermined_keys(np.zeros((3, 2)), ("a", "b"))
+        == "undetermined: the fitted values do not depend on a, b (sensitivity 0)"
+    )
 
 
 @pytest.mark.slow
 def test_a_fit_whose_run_does_not_depend_on_its_keys_is_undetermined_not_a_success():
     # An empty mill on the paper's network makes no heat: its vial stays at the room's temperature whatever β is.
     curve = Curve(np.array([0.0, 600.0, 1800.0, 3600.0]), np.array([20.0, 25.0, 30.0, 33.0]), "lab", node="vial")
-    fitted = calibrate(sm.default_parameters("spex8000m-3d", n_balls=0), ("beta", "vial_mass"), curve=curve,
-                       sample_posterior=False)
+    fitted = calibrate(
+        sm.default_parameters("spex8000m-3d", n_balls=0), ("beta", "vial_mass"), curve=curve, sample_posterior=False
+    )
     assert fitted.status == "undetermined" and not fitted.success
     assert fitted.message.startswith("undetermined: the fitted values do not depend on beta, vial_mass")
     assert fitted.as_dict()["status"] == "undetermined"
@@ -303,7 +321,11 @@ def test_a_fit_whose_run_does_not_depend_on_its_keys_is_undetermined_not_a_succe
 @pytest.mark.parametrize(
     ("text", "expected_C", "note"),
     [
-        ("time_min;vial_C\n0;20\n5;25,1\n", [20.0, 25.1], "read as ';'-separated columns, with decimal commas as points"),
+        (
+            "time_min;vial_C\n0;20\n5;25,1\n",
+            [20.0, 25.1],
+            "read as ';'-separated columns, with decimal commas as points",
+        ),
         ("time_min,vial_K\n0,293.15\n5,298.25\n", [0.0 + 20.0, 25.1], ""),
         ("time_min,vial_C,remark\n0,20,start\n5,25.1,\n", [20.0, 25.1], ""),
     ],
@@ -320,7 +342,10 @@ def test_a_curve_file_is_read_in_its_own_unit_and_separator(tmp_path, text, expe
 @pytest.mark.parametrize(
     ("text", "fragment"),
     [
-        ("time_min,vial_C\n0,20\n5,25,1\n", "line 3: 3 cells for the 2 columns of its header (time_min, vial_C); a decimal comma"),
+        (
+            "time_min,vial_C\n0,20\n5,25,1\n",
+            "line 3: 3 cells for the 2 columns of its header (time_min, vial_C); a decimal comma",
+        ),
         ("time_s,time_min,vial_C\n0,0,20\n", "has both time_s and time_min"),
         ("time_min,vial_C,vial_C\n0,20,20\n", "the column vial_C appears 2 times"),
         ("time_min,vial_C\n0,293.15\n60,320\n", "vial_C holds 293.15 to 320, which look like kelvin"),
@@ -368,8 +393,13 @@ def test_curves_of_two_nodes_under_two_conditions_recover_the_parameters_that_ma
     vial = sm.simulate(sm.default_parameters(**settings, **truth, omega=100.0)).timeseries
     curves = [
         Curve(ball["time"].values, ball["theta_ball"].values - 273.15, "ball at 111 rad/s"),
-        Curve(vial["time"].values, vial["theta_vial"].values - 273.15, "vial at 100 rad/s", node="vial",
-              conditions=("omega=100",)),
+        Curve(
+            vial["time"].values,
+            vial["theta_vial"].values - 273.15,
+            "vial at 100 rad/s",
+            node="vial",
+            conditions=("omega=100",),
+        ),
     ]
     fit = calibrate(sm.default_parameters(**settings, beta=0.3, vial_mass=0.05), ("beta", "vial_mass"), curve=curves)
     for key, value in truth.items():
@@ -398,8 +428,11 @@ def test_a_ctrl_c_while_the_posterior_is_sampled_is_raised_without_emcee_printin
 def test_a_fit_tells_its_progress_each_evaluation_with_its_rms_from_the_curve():
     """Issue 37, point 2: a long fit says how far it has got and how close it is, on a terminal and piped."""
     seen = []
-    calibration = calibrate(sm.default_parameters("spex8000m", record_windows=()), ("beta", "vial_mass"),
-                            progress=lambda done, rms: seen.append((done, rms)))
+    calibration = calibrate(
+        sm.default_parameters("spex8000m", record_windows=()),
+        ("beta", "vial_mass"),
+        progress=lambda done, rms: seen.append((done, rms)),
+    )
     assert [done for done, _ in seen] == list(range(1, calibration.evaluations + 1))
     # The start is far off the experiment's curve; the fit ends where its own RMS says, the last evaluations near it.
     assert seen[0][1] > 10 * calibration.curve_rms_K
@@ -415,8 +448,12 @@ def test_a_key_whose_standard_error_exceeds_its_value_is_named_loosely_determine
     assert loosely_determined(np.diag([0.01, 4.0]), ("h_outer", "lam"), on_bounds=("lam",)) == ""
 
 
-GUIDE_VIAL_CURVE = Curve(np.array([0.0, 5.0, 10.0, 20.0, 40.0, 60.0]) * 60.0,
-                         np.array([22.0, 25.1, 27.6, 31.0, 34.2, 35.3]), "vial.csv", node="vial")
+GUIDE_VIAL_CURVE = Curve(
+    np.array([0.0, 5.0, 10.0, 20.0, 40.0, 60.0]) * 60.0,
+    np.array([22.0, 25.1, 27.6, 31.0, 34.2, 35.3]),
+    "vial.csv",
+    node="vial",
+)
 
 
 @pytest.mark.slow

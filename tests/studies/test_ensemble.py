@@ -109,8 +109,12 @@ def test_a_charge_is_a_pack_when_lasting_contacts_dissipate_most_and_fast_impact
 def test_regimes_with_their_share_and_medians(tmp_path: Path):
     points = design([LINEAR], 8, seed=9)
     heat = np.linspace(18.0, 26.0, 8)
-    table = members_table(points, heat, charge_regime=np.array([PACK] * 4 + [ACTIVE] * 4),
-                          stress_energy_median_J=np.linspace(1e-4, 1e-3, 8))
+    table = members_table(
+        points,
+        heat,
+        charge_regime=np.array([PACK] * 4 + [ACTIVE] * 4),
+        stress_energy_median_J=np.linspace(1e-4, 1e-3, 8),
+    )
     regimes = analyse(table, [LINEAR], tmp_path).regimes
     assert regimes["pack"]["share"] == 0.5 and regimes["active"]["members"] == 4
     assert regimes["pack"]["medians"]["heat_power_W"] == pytest.approx(np.median(heat[:4]))

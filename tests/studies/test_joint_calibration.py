@@ -76,8 +76,10 @@ def test_two_configurations_fit_together_constrain_their_shared_input_more_than_
     alone = sample_posterior([(one, [Measured(Y, 4.0, 0.5)])])
     both = sample_posterior([(one, [Measured(Y, 4.0, 0.5)]), (two, [Measured(Y, 4.0, 0.5)])])
     assert both.keys == ["friction", "restitution"]
-    width = {name: found.quantiles()["friction"][2] - found.quantiles()["friction"][0]
-             for name, found in (("alone", alone), ("both", both))}
+    width = {
+        name: found.quantiles()["friction"][2] - found.quantiles()["friction"][0]
+        for name, found in (("alone", alone), ("both", both))
+    }
     # Two independent measurements of the same quantity: the spread shrinks by √2.
     assert width["both"] == pytest.approx(width["alone"] / math.sqrt(2), rel=0.2)
     # b is in no likelihood: its posterior is its prior.
@@ -106,7 +108,8 @@ def test_a_run_of_one_ball_frees_no_pair_key_and_the_network_keys_over_their_def
 
 @pytest.mark.slow
 def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mechanical_keys_a_run_does_not_carry(
-        tmp_path, monkeypatch):
+    tmp_path, monkeypatch
+):
     import json
 
     from typer.testing import CliRunner
@@ -117,8 +120,20 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
 
     monkeypatch.setattr(joint_calibration, "STEPS", 600)
     out = tmp_path / "fitted.toml"
-    outcome = CliRunner().invoke(cli.app, ["calibrate", "--preset", "spex8000m-3d-mill-head", "--with-assumed",
-                                           "--members", "8", "--json", "--out", str(out)])
+    outcome = CliRunner().invoke(
+        cli.app,
+        [
+            "calibrate",
+            "--preset",
+            "spex8000m-3d-mill-head",
+            "--with-assumed",
+            "--members",
+            "8",
+            "--json",
+            "--out",
+            str(out),
+        ],
+    )
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
     inputs = payload["posterior"]["inputs"]
@@ -148,15 +163,21 @@ def test_a_users_configuration_narrows_an_assumed_range_and_a_wrong_table_is_ref
     from shakermill.parameters.errors import ParameterError
 
     narrowed = tmp_path / "mine.toml"
-    narrowed.write_text('preset = "spex8000m-3d"\n[assumed.friction]\nlow = 0.25\nhigh = 0.35\n'
-                        'distribution = "uniform"\nreason = "measured on our vial, ±0.05"\n', encoding="utf-8")
+    narrowed.write_text(
+        'preset = "spex8000m-3d"\n[assumed.friction]\nlow = 0.25\nhigh = 0.35\n'
+        'distribution = "uniform"\nreason = "measured on our vial, ±0.05"\n',
+        encoding="utf-8",
+    )
     assumed = config_preset(load_config(narrowed)).assumed
     assert (assumed["friction"].low, assumed["friction"].high) == (0.25, 0.35)
     assert assumed["friction"].reason == "measured on our vial, ±0.05"
     assert assumed["restitution"] == PRESETS["spex8000m-3d"].assumed["restitution"]
     wrong = tmp_path / "wrong.toml"
-    wrong.write_text('preset = "spex8000m-3d"\n[assumed.friction]\nlow = 0.5\nhigh = 0.4\n'
-                     'distribution = "uniform"\nreason = "typo"\n', encoding="utf-8")
+    wrong.write_text(
+        'preset = "spex8000m-3d"\n[assumed.friction]\nlow = 0.5\nhigh = 0.4\n'
+        'distribution = "uniform"\nreason = "typo"\n',
+        encoding="utf-8",
+    )
     with pytest.raises(ParameterError, match=r"wrong.toml: \[assumed.friction\]: low and high"):
         load_config(wrong)
 
@@ -168,8 +189,10 @@ def test_a_free_key_the_run_does_not_read_or_that_moves_the_mechanics_is_refused
     preset = PRESETS["spex8000m-3d-mill-head"]
     params = default_parameters(preset.name)
     started = []
-    for free, refused in ((("h_outer",), r"^free: h_outer: fitted, but the 'mill-head' network does not read it"),
-                          (("friction",), r"^free: friction would change the dem engine's mechanics.*--with-assumed")):
+    for free, refused in (
+        (("h_outer",), r"^free: h_outer: fitted, but the 'mill-head' network does not read it"),
+        (("friction",), r"^free: friction would change the dem engine's mechanics.*--with-assumed"),
+    ):
         with pytest.raises(ParameterError, match=refused):
             calibrate_jointly(preset, params, free, [], 8, on_start=lambda: started.append(True))
     assert started == []

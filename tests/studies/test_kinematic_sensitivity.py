@@ -25,13 +25,18 @@ def spex():
 def test_each_assumed_amplitude_is_halved_and_raised_by_half(spex):
     params, study, calls = spex
     assert [(row.key, row.factor) for row in study.rows] == [
-        ("lateral_amplitude", 0.5), ("lateral_amplitude", 1.5), ("yaw_amplitude", 0.5), ("yaw_amplitude", 1.5),
+        ("lateral_amplitude", 0.5),
+        ("lateral_amplitude", 1.5),
+        ("yaw_amplitude", 0.5),
+        ("yaw_amplitude", 1.5),
     ]
     assert study.rows[1].value == pytest.approx(1.5 * params.lateral_amplitude, rel=1e-12)
     assert calls == [(done, 5) for done in range(1, 6)]
     for row in study.rows:
         for name in MEASURES:
-            assert row.relative_change[name] == pytest.approx(row.measures[name] / study.baseline[name] - 1.0, rel=1e-12)
+            assert row.relative_change[name] == pytest.approx(
+                row.measures[name] / study.baseline[name] - 1.0, rel=1e-12
+            )
 
 
 @pytest.mark.slow
@@ -63,5 +68,7 @@ def test_other_summary_keys_can_be_measured(spex):
     params, study, _ = spex
     again = kinematic_sensitivity(params, keys=("yaw_amplitude",), factors=(1.5,), measures=("ball_C", "heat_power_W"))
     assert again.baseline["heat_power_W"] == study.baseline["heat_power_W"]
-    assert again.rows[0].relative_change["ball_C"] == pytest.approx(again.rows[0].measures["ball_C"] / again.baseline["ball_C"] - 1.0)
+    assert again.rows[0].relative_change["ball_C"] == pytest.approx(
+        again.rows[0].measures["ball_C"] / again.baseline["ball_C"] - 1.0
+    )
     assert again.as_dict()["rows"][0]["key"] == "yaw_amplitude" and again.as_dict()["solver"] == "full"

@@ -15,8 +15,9 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -260,8 +261,11 @@ def test_a_grid_times_a_points_file_is_capped_as_a_product(tmp_path):
 
 def test_the_python_api_caps_the_points_it_is_given(tmp_path):
     with pytest.raises(ParameterError, match="sweep: 1,000,000 points"):
-        sweep(default_parameters(), {"omega": np.linspace(90, 130, 1000), "amplitude": np.linspace(0.02, 0.03, 1000)},
-              tmp_path / "sweep")
+        sweep(
+            default_parameters(),
+            {"omega": np.linspace(90, 130, 1000), "amplitude": np.linspace(0.02, 0.03, 1000)},
+            tmp_path / "sweep",
+        )
     assert not (tmp_path / "sweep").exists()
 
 
@@ -324,10 +328,14 @@ def assert_csv_matches_parquet(folder: Path) -> None:
         left, right = csv[column], parquet[column]
         if pd.api.types.is_bool_dtype(right) or pd.api.types.is_numeric_dtype(right):
             np.testing.assert_array_equal(
-                left.to_numpy(dtype=float, na_value=np.nan), right.to_numpy(dtype=float, na_value=np.nan), err_msg=column
+                left.to_numpy(dtype=float, na_value=np.nan),
+                right.to_numpy(dtype=float, na_value=np.nan),
+                err_msg=column,
             )
         else:
-            assert [None if pd.isna(v) else str(v) for v in left] == [None if pd.isna(v) else str(v) for v in right], column
+            assert [None if pd.isna(v) else str(v) for v in left] == [None if pd.isna(v) else str(v) for v in right], (
+                column
+            )
 
 
 @pytest.mark.slow
@@ -377,7 +385,9 @@ def test_dask_cluster_matches_local_pool(base, in_process, local_cluster, tmp_pa
     plan, _, _ = in_process
     pool = sweep(base, plan, tmp_path / "pool", workers=2)
     reports = []
-    cluster = sweep(base, plan, tmp_path / "cluster", scheduler=local_cluster.scheduler_address, progress=reports.append)
+    cluster = sweep(
+        base, plan, tmp_path / "cluster", scheduler=local_cluster.scheduler_address, progress=reports.append
+    )
     assert_frame_equal(comparable(cluster), comparable(pool))
     assert len(point_files(tmp_path / "cluster")) == len(plan.points)
     assert reports[-1].done == len(plan.points) and reports[-1].failed == 0
@@ -625,7 +635,10 @@ def test_cli_sweep_writes_matching_csv_and_parquet(base, tmp_path):
     assert_csv_matches_parquet(folder)
     # The command line's base: the default preset, the averaged solver, --set applied.
     expected = sweep(
-        base.replace(restitution=0.8), plan_sweep(["omega=100:120:2", "amplitude=23mm:29mm:2"]), tmp_path / "api", workers=1
+        base.replace(restitution=0.8),
+        plan_sweep(["omega=100:120:2", "amplitude=23mm:29mm:2"]),
+        tmp_path / "api",
+        workers=1,
     )
     assert_frame_equal(comparable(table), comparable(expected))
 
@@ -633,7 +646,9 @@ def test_cli_sweep_writes_matching_csv_and_parquet(base, tmp_path):
 @pytest.mark.slow
 def test_cli_some_points_failed_exits_1(tmp_path):
     folder = tmp_path / "cli"
-    completed = run_cli("sweep", "--grid", "restitution=0.9:1.1:2", "--set", "duration=60", "--out", str(folder), "--workers", "1")
+    completed = run_cli(
+        "sweep", "--grid", "restitution=0.9:1.1:2", "--set", "duration=60", "--out", str(folder), "--workers", "1"
+    )
     assert completed.returncode == 1, completed.stderr
     assert "Traceback" not in completed.stderr
     table = load_sweep(folder).table
@@ -665,7 +680,16 @@ def test_sigkill_mid_sweep_then_resume(tmp_path):
     grid = ["omega=90:130:8", "amplitude=23mm:30mm:8"]
     settings = ["--set", "duration=60"]
     folder = tmp_path / "killed"
-    command = [str(SHAKERMILL), "sweep", *(arg for spec in grid for arg in ("--grid", spec)), *settings, "--out", str(folder), "--workers", "2"]
+    command = [
+        str(SHAKERMILL),
+        "sweep",
+        *(arg for spec in grid for arg in ("--grid", spec)),
+        *settings,
+        "--out",
+        str(folder),
+        "--workers",
+        "2",
+    ]
     total = 64
 
     process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -677,7 +701,10 @@ def test_sigkill_mid_sweep_then_resume(tmp_path):
                 os.killpg(process.pid, signal.SIGKILL)
                 break
             if process.poll() is not None or time.monotonic() > deadline:
-                pytest.fail(f"the sweep ended or stalled before it could be killed (rc {process.poll()}): {process.stderr.read()!r}")
+                pytest.fail(
+                    f"the sweep ended or stalled before it could be killed (rc {process.poll()}): "
+                    f"{process.stderr.read()!r}"
+                )
             time.sleep(0.002)
     finally:
         if process.poll() is None:
@@ -725,7 +752,9 @@ def test_ctrl_c_keeps_the_finished_points_in_the_table_and_exits_130(tmp_path):
     folder = tmp_path / "interrupted"
     command = [str(SHAKERMILL), "sweep", "--grid", "omega=90:130:8", "--grid", "amplitude=23mm:30mm:8",
                "--set", "duration=60", "--out", str(folder), "--workers", "2"]  # fmt: skip
-    process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        command, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
     deadline = time.monotonic() + 120
     while not ((folder / POINTS_FOLDER).is_dir() and len(point_files(folder)) >= 3):
         if process.poll() is not None or time.monotonic() > deadline:
@@ -738,7 +767,13 @@ def test_ctrl_c_keeps_the_finished_points_in_the_table_and_exits_130(tmp_path):
     assert process.returncode == 130, stderr
     table = pd.read_parquet(folder / TABLE_PARQUET)
     finished = table["error"].isna()
-    assert_one_error_line(stderr, "interrupted", f"kept {finished.sum()} of 64 points", f"--out {folder}", f"the other {64 - finished.sum()}")
+    assert_one_error_line(
+        stderr,
+        "interrupted",
+        f"kept {finished.sum()} of 64 points",
+        f"--out {folder}",
+        f"the other {64 - finished.sum()}",
+    )
     assert finished.sum() == len(point_files(folder)) and 3 <= finished.sum() < 64
     assert table.loc[~finished, "error"].str.startswith("not finished").all()
     assert table["point_id"].is_unique and len(table) == 64
@@ -769,7 +804,9 @@ def test_ctrl_c_stops_a_3d_sweeps_workers_within_2_s_and_the_resume_computes_onl
     # the 0.7-s and 1.2-s points run, and those would run for seconds more.
     command = [str(SHAKERMILL), "sweep", "--preset", "spex8000m-3d", "--set", "solver=full", "--set", "record_windows=",
                "--grid", "duration=0.2:1.2:3", "--out", str(folder), "--workers", "2"]  # fmt: skip
-    process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+    )
     descendants = []
     try:
         wait_for_a_stored_point(process, folder, 180, "Ctrl-C")
@@ -780,7 +817,9 @@ def test_ctrl_c_stops_a_3d_sweeps_workers_within_2_s_and_the_resume_computes_onl
         while (process.poll() is None or _alive(descendants)) and time.monotonic() - signalled < 10:
             time.sleep(0.01)
         gone_after = time.monotonic() - signalled
-        assert process.poll() is not None and _alive(descendants) == [], f"still running {gone_after:.1f} s after Ctrl-C"
+        assert process.poll() is not None and _alive(descendants) == [], (
+            f"still running {gone_after:.1f} s after Ctrl-C"
+        )
         print(f"the sweep and its {len(descendants)} helper processes gone {gone_after:.2f} s after Ctrl-C")
         assert gone_after < 2.0
     finally:
@@ -796,7 +835,9 @@ def test_ctrl_c_stops_a_3d_sweeps_workers_within_2_s_and_the_resume_computes_onl
     not_done = table.loc[table["error"].notna(), "point_id"].tolist()
     assert 1 <= len(kept) < 3 and sorted(kept) == sorted(table.loc[table["error"].isna(), "point_id"])
     assert table.set_index("point_id").loc[not_done, "error"].str.startswith("not finished").all()
-    assert_one_error_line(stderr, f"kept {len(kept)} of 3 points in {folder}", f"--out {folder} to compute the other {len(not_done)}")
+    assert_one_error_line(
+        stderr, f"kept {len(kept)} of 3 points in {folder}", f"--out {folder} to compute the other {len(not_done)}"
+    )
 
     resumed = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert resumed.returncode == 0, resumed.stderr
@@ -826,8 +867,13 @@ def test_ctrl_c_on_a_dask_sweep_cancels_the_points_not_finished(base, local_clus
     plan = plan_sweep(GRID)
     with pytest.raises(SweepInterrupted) as interrupted:
         # Full runs of ten simulated minutes: the other points still run when the first one is stored.
-        sweep(base.replace(solver="full", duration=600.0), plan, tmp_path / "dask", scheduler=local_cluster.scheduler_address,
-              progress=ctrl_c_after_the_first_point)
+        sweep(
+            base.replace(solver="full", duration=600.0),
+            plan,
+            tmp_path / "dask",
+            scheduler=local_cluster.scheduler_address,
+            progress=ctrl_c_after_the_first_point,
+        )
     table = interrupted.value.table
     assert interrupted.value.kept == 1 == table["error"].isna().sum() == len(point_files(tmp_path / "dask"))
     # Every point not stored was cancelled, unless it finished between Ctrl-C and the cancel.
@@ -847,13 +893,13 @@ print(json.dumps(table.pivot(index="amplitude", columns="omega", values="theta_i
 @pytest.mark.slow
 @pytest.mark.parametrize("guarded", [False, True], ids=["plain script", "guarded script"])
 def test_the_readme_sweep_runs_from_a_script_with_or_without_a_main_guard(tmp_path, guarded):
-    source = README_SWEEP if not guarded else "if __name__ == '__main__':\n" + "".join(
-        f"    {line}\n" for line in README_SWEEP.splitlines()
+    source = (
+        README_SWEEP
+        if not guarded
+        else "if __name__ == '__main__':\n" + "".join(f"    {line}\n" for line in README_SWEEP.splitlines())
     )
     (tmp_path / "script.py").write_text(source)
-    completed = subprocess.run(
-        [sys.executable, "script.py"], cwd=tmp_path, capture_output=True, text=True, timeout=300
-    )
+    completed = subprocess.run([sys.executable, "script.py"], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert completed.returncode == 0, completed.stderr
     assert "BrokenProcessPool" not in completed.stderr and "Error" not in completed.stderr
     pivot = json.loads(completed.stdout)
@@ -871,7 +917,18 @@ def test_a_sweep_where_every_point_fails_raises_naming_the_first_failure(base, t
 @pytest.mark.slow
 def test_cli_sweep_where_every_point_fails_exits_1_with_one_line(tmp_path):
     folder = tmp_path / "failed"
-    command = [str(SHAKERMILL), "sweep", "--grid", "omega=-2:-1:2", "--set", "duration=60", "--out", str(folder), "--workers", "1"]
+    command = [
+        str(SHAKERMILL),
+        "sweep",
+        "--grid",
+        "omega=-2:-1:2",
+        "--set",
+        "duration=60",
+        "--out",
+        str(folder),
+        "--workers",
+        "1",
+    ]
     completed = subprocess.run(command, capture_output=True, text=True, timeout=120)
     assert completed.returncode == 1
     assert_one_error_line(completed.stderr, "2 of 2 points failed", "omega")
@@ -964,8 +1021,21 @@ def test_two_sweep_processes_started_at_once_into_one_new_folder(tmp_path):
     grids = ["omega=100:105:2", "omega=110:115:2"]
     processes = [
         subprocess.Popen(
-            [str(SHAKERMILL), "sweep", "--grid", grid, "--set", f"duration={DURATION}", "--workers", "1", "--out", str(folder)],
-            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+            [
+                str(SHAKERMILL),
+                "sweep",
+                "--grid",
+                grid,
+                "--set",
+                f"duration={DURATION}",
+                "--workers",
+                "1",
+                "--out",
+                str(folder),
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
         )
         for grid in grids
     ]
@@ -982,7 +1052,9 @@ def test_two_sweep_processes_started_at_once_into_one_new_folder(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("crafted", ["../../outside", "/etc/hostname", "0123456789abcdef/../../../outside", "0123456789ABCDEF", 17])
+@pytest.mark.parametrize(
+    "crafted", ["../../outside", "/etc/hostname", "0123456789abcdef/../../../outside", "0123456789ABCDEF", 17]
+)
 def test_a_crafted_point_id_in_the_manifest_is_refused_and_nothing_outside_is_read(base, tmp_path, crafted):
     folder = tmp_path / "crafted"
     sweep(base, {"omega": [100.0, 110.0]}, folder, workers=1)
@@ -1019,7 +1091,9 @@ def _interrupted_second_point(how: str, simulate: Callable[..., Any]) -> Callabl
             ctrl_c()
         except KeyboardInterrupt as interrupt:
             # What Python makes of a KeyboardInterrupt raised inside a Numba call.
-            raise SystemError("CPUDispatcher(<function _advance>) returned a result with an exception set") from interrupt
+            raise SystemError(
+                "CPUDispatcher(<function _advance>) returned a result with an exception set"
+            ) from interrupt
 
     return interrupted
 
@@ -1059,7 +1133,18 @@ def test_workers_stop_when_the_sweep_is_killed_and_not_yet_reaped(tmp_path):
     import psutil
 
     folder = tmp_path / "orphans"
-    command = [str(SHAKERMILL), "sweep", "--grid", "omega=90:130:40", "--set", "duration=600", "--workers", "2", "--out", str(folder)]
+    command = [
+        str(SHAKERMILL),
+        "sweep",
+        "--grid",
+        "omega=90:130:40",
+        "--set",
+        "duration=600",
+        "--workers",
+        "2",
+        "--out",
+        str(folder),
+    ]
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     descendants = []
     try:
@@ -1093,7 +1178,8 @@ def tls_certificates(tmp_path_factory) -> dict[str, str]:
     files = {"ca": folder / "ca.pem", "cert": folder / "node.pem", "key": folder / "node.key"}
     (folder / "extensions.cnf").write_text("subjectAltName=DNS:localhost,IP:127.0.0.1\n", encoding="ascii")
     commands = [
-        ["req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", "ca.key", "-out", "ca.pem", "-days", "2", "-subj", "/CN=shakermill test CA"],
+        ["req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", "ca.key", "-out", "ca.pem", "-days", "2",
+         "-subj", "/CN=shakermill test CA"],
         ["req", "-newkey", "rsa:2048", "-nodes", "-keyout", "node.key", "-out", "node.csr", "-subj", "/CN=localhost"],
         ["x509", "-req", "-in", "node.csr", "-CA", "ca.pem", "-CAkey", "ca.key", "-CAcreateserial", "-out", "node.pem",
          "-days", "2", "-extfile", "extensions.cnf"],
@@ -1112,12 +1198,23 @@ def tls_scheduler(tls_certificates):
 
     ca, cert, key = tls_certificates["ca"], tls_certificates["cert"], tls_certificates["key"]
     security = Security(
-        tls_ca_file=ca, tls_scheduler_cert=cert, tls_scheduler_key=key, tls_worker_cert=cert, tls_worker_key=key,
-        tls_client_cert=cert, tls_client_key=key, require_encryption=True,
+        tls_ca_file=ca,
+        tls_scheduler_cert=cert,
+        tls_scheduler_key=key,
+        tls_worker_cert=cert,
+        tls_worker_key=key,
+        tls_client_cert=cert,
+        tls_client_key=key,
+        require_encryption=True,
     )
     cluster = distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=False, protocol="tls://", host="127.0.0.1",
-        security=security, dashboard_address=None,
+        n_workers=1,
+        threads_per_worker=1,
+        processes=False,
+        protocol="tls://",
+        host="127.0.0.1",
+        security=security,
+        dashboard_address=None,
     )
     try:
         yield cluster.scheduler_address
@@ -1130,7 +1227,9 @@ def environment_without_dask_tls() -> dict[str, str]:
 
 
 @pytest.mark.slow
-def test_a_tls_scheduler_runs_the_sweep_with_the_environments_tls_settings(in_process, tls_certificates, tls_scheduler, tmp_path):
+def test_a_tls_scheduler_runs_the_sweep_with_the_environments_tls_settings(
+    in_process, tls_certificates, tls_scheduler, tmp_path
+):
     assert tls_scheduler.startswith("tls://127.0.0.1:")
     _, reference, _ = in_process
     environment = {
@@ -1152,7 +1251,18 @@ def test_a_tls_scheduler_runs_the_sweep_with_the_environments_tls_settings(in_pr
 @pytest.mark.slow
 def test_a_tls_scheduler_without_tls_settings_is_one_line(tls_scheduler, tmp_path):
     folder = tmp_path / "no-tls"
-    command = [str(SHAKERMILL), "sweep", "--grid", SMALL[0], "--scheduler", tls_scheduler, "--scheduler-timeout", "5", "--out", str(folder)]
+    command = [
+        str(SHAKERMILL),
+        "sweep",
+        "--grid",
+        SMALL[0],
+        "--scheduler",
+        tls_scheduler,
+        "--scheduler-timeout",
+        "5",
+        "--out",
+        str(folder),
+    ]
     completed = subprocess.run(command, capture_output=True, text=True, timeout=120, env=environment_without_dask_tls())
     assert completed.returncode == 2
     assert_one_error_line(completed.stderr, tls_scheduler, "TLS")

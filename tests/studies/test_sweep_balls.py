@@ -20,9 +20,7 @@ GRIDS = ("n_balls=1,5", "ball_radius=3mm,6.35mm")
 
 @pytest.fixture(name="base", scope="module")
 def base_fixture():
-    return sm.default_parameters(
-        engine="dem", solver="full", duration=0.005, output_interval=0.001, record_windows=()
-    )
+    return sm.default_parameters(engine="dem", solver="full", duration=0.005, output_interval=0.001, record_windows=())
 
 
 def test_a_plan_over_number_and_size_of_balls():

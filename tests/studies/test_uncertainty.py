@@ -5,11 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.stats import norm
 
 import shakermill as sm
-from scipy.stats import norm
 from shakermill.studies.uncertainty import HEADLINE, Uncertainty, intervals
-
 
 Z90 = norm.ppf(0.95)
 

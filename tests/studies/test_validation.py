@@ -63,7 +63,11 @@ def test_validation_of_published_and_calibrated_presets() -> None:
 def test_fitted_quantities_of_a_curve_fit_are_the_exponentials_numbers() -> None:
     assert fitted_quantities({"curve": "x"}) == CURVE_QUANTITIES
     assert fitted_quantities({"targets": {"tau_min": 16.7}}) == ("tau_min",)
-    assert fitted_quantities({"targets": {"tau_min": 16.7}, "curve": "x"}) == ("tau_min", "theta_inf_C", "rate0_C_per_min")
+    assert fitted_quantities({"targets": {"tau_min": 16.7}, "curve": "x"}) == (
+        "tau_min",
+        "theta_inf_C",
+        "rate0_C_per_min",
+    )
     assert fitted_quantities({}) == ()
 
 

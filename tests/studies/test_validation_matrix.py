@@ -28,7 +28,10 @@ def test_every_experiment_says_where_it_comes_from_and_what_it_measured():
     for experiment in EXPERIMENTS.values():
         assert experiment.title and experiment.source and experiment.how_measured and experiment.points
     five = EXPERIMENTS["takacs-mchenry-five-balls"]
-    assert five.conditions["n_balls"] == 5 and [(point.node, point.rise_K) for point in five.points] == [("ball", 46.0), ("vial", 21.0)]
+    assert five.conditions["n_balls"] == 5 and [(point.node, point.rise_K) for point in five.points] == [
+        ("ball", 46.0),
+        ("vial", 21.0),
+    ]
     # The one-ball points are the summary's exponential 28·(1 − exp(−t/16.7 min)).
     for point in EXPERIMENTS["takacs-mchenry-one-ball"].points:
         assert point.rise_K == pytest.approx(28.0 * (1.0 - math.exp(-point.time_s / 60.0 / 16.7)), abs=1e-4)
@@ -37,8 +40,12 @@ def test_every_experiment_says_where_it_comes_from_and_what_it_measured():
 @pytest.mark.parametrize("preset", THERMAL_MODEL_PRESETS)
 def test_the_one_ball_curve_is_fitted_the_rest_held_out_or_predicted(preset):
     roles = {name: experiment.role(preset) for name, experiment in EXPERIMENTS.items()}
-    assert roles == {"takacs-mchenry-one-ball": "fitted", "takacs-mchenry-five-balls": "held out",
-                     "empty-mill": "prediction", "one-ball-vial": "prediction"}
+    assert roles == {
+        "takacs-mchenry-one-ball": "fitted",
+        "takacs-mchenry-five-balls": "held out",
+        "empty-mill": "prediction",
+        "one-ball-vial": "prediction",
+    }
     assert EXPERIMENTS["takacs-mchenry-one-ball"].role("spex8000m-3d") == "held out"  # no calibration fitted it there
 
 

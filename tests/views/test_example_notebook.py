@@ -41,7 +41,7 @@ def test_the_notebook_runs_without_errors(executed):
 
 def test_the_notebook_shows_the_html_views_and_the_steady_state(executed):
     parameters, result, printed = executed[0], executed[1], executed[2]
-    assert "<td>drive frequency</td><td class=\"num\">1060</td><td>rpm</td>" in outputs_of(parameters, "text/html")[0]
+    assert '<td>drive frequency</td><td class="num">1060</td><td>rpm</td>' in outputs_of(parameters, "text/html")[0]
     text = "".join(output.get("text", "") for output in printed.outputs)
     steady = re.search(r"ball steady state: (\d+\.\d) °C", text)
     assert steady is not None, text
@@ -51,7 +51,7 @@ def test_the_notebook_shows_the_html_views_and_the_steady_state(executed):
 
 def test_the_notebook_draws_the_figures_and_the_celsius_series(executed):
     figures = outputs_of(executed[3], "text/html")[0]
-    assert figures.count("src=\"data:image/png;base64,") == 2
+    assert figures.count('src="data:image/png;base64,') == 2
     assert outputs_of(executed[4], "image/png"), "theta_ball_C.plot() drew nothing"
 
 

@@ -41,7 +41,11 @@ from shakermill.views.figures.sweeps import (
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 ALL_FIGURES = ("ball_heating_zoom", "ball_motion", "temperatures")
 IMPACT_FIGURE_NAMES = (
-    "impact_energy_histogram", "impact_phase_histogram", "impact_speed_histogram", "impacts_per_second", "stress_energy_spectrum"
+    "impact_energy_histogram",
+    "impact_phase_histogram",
+    "impact_speed_histogram",
+    "impacts_per_second",
+    "stress_energy_spectrum",
 )
 # "quantity (unit)": every axis label ends with its unit in parentheses.
 LABEL_WITH_UNIT = re.compile(r"^\S.* \([^()]+\)$")
@@ -241,7 +245,9 @@ def test_the_stress_spectrum_counts_every_impact_and_its_power_at_the_lowest_ene
     window = result.summary["stress_window_s"]
     # One ball on the axis: the total and its normal part, which is all of it; no tangential part, no ball hit.
     assert [line.get_label() for line in events.get_lines() if not line.get_label().startswith("_")] == [
-        "all impacts, normal + tangential", "normal part"]
+        "all impacts, normal + tangential",
+        "normal part",
+    ]
     total_events, total_power = events.get_lines()[0], power.get_lines()[0]
     assert total_events.get_ydata()[0] == pytest.approx(len(result.impacts) / window)
     assert total_power.get_ydata()[0] == pytest.approx(result.impacts["dissipated_energy"].sum() / window)
@@ -249,7 +255,8 @@ def test_the_stress_spectrum_counts_every_impact_and_its_power_at_the_lowest_ene
     assert events.get_xscale() == "log" and events.get_xlabel() == "stress energy E, dissipated per impact (J)"
     # The thresholds of the run, dash-dot.
     assert sorted(line.get_xdata()[0] for line in power.get_lines() if line.get_linestyle() == "-.") == sorted(
-        result.params.stress_energy_thresholds)
+        result.params.stress_energy_thresholds
+    )
 
 
 def test_rate_bins_span_the_impacts_in_bins_of_at_least_a_second_and_at_most_120():
@@ -261,7 +268,9 @@ def test_rate_bins_span_the_impacts_in_bins_of_at_least_a_second_and_at_most_120
 
 
 def test_no_impacts_no_impact_figures(result):
-    run = dataclasses.replace(result, impact_columns={name: values[:0] for name, values in result.impact_columns.items()})
+    run = dataclasses.replace(
+        result, impact_columns={name: values[:0] for name, values in result.impact_columns.items()}
+    )
     assert impact_figures(run) == {}
 
 
@@ -463,7 +472,10 @@ def test_one_key_sweep_is_a_line_with_the_contour_crossing_marked():
     assert crossing.get_xdata()[0] == pytest.approx(100.0)  # linear between (90, 50) and (110, 70)
     assert level.get_ydata()[0] == pytest.approx(60.0)
     assert axis.get_legend().get_texts()[0].get_text() == "ball θ∞ = 60 °C"
-    assert axis.get_xlabel() == "omega (rad/s)" and axis.get_ylabel() == "ball θ∞ of the exponential fitted over the run (°C)"
+    assert (
+        axis.get_xlabel() == "omega (rad/s)"
+        and axis.get_ylabel() == "ball θ∞ of the exponential fitted over the run (°C)"
+    )
 
 
 @pytest.mark.slow
@@ -490,7 +502,11 @@ def test_sweeps_over_three_keys_are_refused_with_one_line():
 
 @pytest.mark.parametrize(
     ("spec", "message"),
-    [("theta_inf_C", "expected COLUMN=VALUE"), ("nope=3", "nope is not a numeric column"), ("theta_inf_C=hot", "not a number")],
+    [
+        ("theta_inf_C", "expected COLUMN=VALUE"),
+        ("nope=3", "nope is not a numeric column"),
+        ("theta_inf_C=hot", "not a number"),
+    ],
 )
 def test_bad_contours_name_the_problem(spec, message):
     with pytest.raises(sm.ParameterError, match=message):
@@ -600,9 +616,9 @@ def test_omega_axes_also_read_in_rpm():
     assert secondary.yaxis.get_transform().inverted().transform(111.0) == pytest.approx(111.0 * 60 / (2 * np.pi))
     line = sweep_figures(synthetic_sweep().iloc[[0, 2, 4]].drop(columns="amplitude"), ("omega",))
     assert [child.get_xlabel() for child in line["sweep_regime"].axes[0].child_axes] == ["drive frequency (rpm)"]
-    assert sweep_figures(synthetic_sweep(), ("omega", "amplitude"))["sweep_tau_min"].axes[0].child_axes[0].get_xlabel() == (
-        "drive frequency (rpm)"
-    )
+    assert sweep_figures(synthetic_sweep(), ("omega", "amplitude"))["sweep_tau_min"].axes[0].child_axes[
+        0
+    ].get_xlabel() == ("drive frequency (rpm)")
 
 
 def test_sweep_titles_carry_the_preset_and_duration():

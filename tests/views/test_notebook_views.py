@@ -23,9 +23,9 @@ def test_result_html_repr_gives_status_answer_and_inputs_escaped(default_run_20s
     document = result._repr_html_()
     assert "<b onmouseover" not in document and "&lt;b onmouseover=&quot;x()&quot;&gt;" in document
     summary = result.summary
-    assert f"<td class=\"num\">{summary['ball_steady_C']:.1f}</td><td>°C</td>" in document
+    assert f'<td class="num">{summary["ball_steady_C"]:.1f}</td><td>°C</td>' in document
     assert f"After {summary['simulated_s'] / 60:.3g} min the ball is at {summary['ball_C']:.1f} °C" in document
-    assert "<td>drive frequency</td><td class=\"num\">1060</td><td>rpm</td>" in document
+    assert '<td>drive frequency</td><td class="num">1060</td><td>rpm</td>' in document
     # Small: the key inputs only, not all the keys the plain repr prints.
     assert document.count("<tr>") < 25
     assert "<script" not in document
@@ -34,8 +34,8 @@ def test_result_html_repr_gives_status_answer_and_inputs_escaped(default_run_20s
 def test_parameters_html_repr_has_the_key_inputs_and_every_key_folded_away():
     params = sm.default_parameters(omega=100.0)
     document = params._repr_html_()
-    assert "<td>drive frequency ω</td><td class=\"num\">100</td><td>rad/s</td>" in document
-    assert "<td>amplitude</td><td class=\"num\">25</td><td>mm</td>" in document
+    assert '<td>drive frequency ω</td><td class="num">100</td><td>rad/s</td>' in document
+    assert '<td>amplitude</td><td class="num">25</td><td>mm</td>' in document
     keys = params.model_dump()
     assert f"<summary>all {len(keys)} keys (SI units)</summary>" in document
     details = document[document.index("<details>") :]
@@ -81,7 +81,7 @@ def test_the_answer_says_when_an_uncalibrated_steady_state_is_far_above_the_expe
 
 def test_a_3d_run_far_above_the_experiment_is_pointed_to_the_3d_calibrated_preset():
     summary = {"ball_steady_C": 124.6, "initial_temperature_C": 20.0, "engine": "dem"}
-    far_above, = (sentence for sentence in answer_sentences(summary, "spex8000m-3d") if "far above" in sentence)
+    (far_above,) = (sentence for sentence in answer_sentences(summary, "spex8000m-3d") if "far above" in sentence)
     assert "Preset spex8000m-3d-calibrated is fitted to that experiment" in far_above
 
 

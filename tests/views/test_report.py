@@ -84,8 +84,12 @@ def test_report_lists_every_configuration_key_its_engine_reads_with_its_source(r
     rows = rows_of_table_after(report_html, "Configuration")
     listed = [re.search(r"<td>(\w+)</td>", row).group(1) for row in rows[1:]]
     assert listed == [key for key in FIELD_NAMES if reads("1d", key)]
-    assert "friction" not in listed and "n_balls" not in listed and "omega" in listed  # the 'dem' engine's keys are left out
-    assert f"The {len(FIELD_NAMES) - len(listed)} keys the engine of this run does not read are left out." in report_html
+    assert (
+        "friction" not in listed and "n_balls" not in listed and "omega" in listed
+    )  # the 'dem' engine's keys are left out
+    assert (
+        f"The {len(FIELD_NAMES) - len(listed)} keys the engine of this run does not read are left out." in report_html
+    )
     assert html.escape(PRESETS[DEFAULT_PRESET].values["omega"].source) in report_html
     # duration and record_windows were changed for this short run: marked as differing from the preset.
     marked = [row for row in rows_of_table_after(report_html, "Configuration") if 'class="differs"' in row]
@@ -174,10 +178,10 @@ def test_report_shows_impact_statistics_and_numerics(run_folder, report_html):
     assert f">{run.summary['impacts']}<" in impacts
     for wall in ("left", "right"):
         count = int((run.impacts["wall"] == wall).sum())
-        assert f"impacts at the {wall} end face</td><td class=\"num\">{count} (" in impacts
+        assert f'impacts at the {wall} end face</td><td class="num">{count} (' in impacts
     assert "contact duration: mean / min / max" in impacts and "µs" in impacts
     regime, _ = classify_impacts(settled_run_impacts(run), run.params.omega, run.params.phase)
-    assert f"regime of the settled motion</td><td class=\"num\">{regime}<" in impacts
+    assert f'regime of the settled motion</td><td class="num">{regime}<' in impacts
     assert "Drive phase ωt + φ (mod 2π) at the impacts of the settled motion" in report_html
     numerics = "\n".join(rows_of_table_after(report_html, "Numerics"))
     for label in ("accepted steps", "rejected steps", "right-hand-side evaluations", "wall time"):
@@ -364,5 +368,9 @@ def test_report_numbers_its_figures_in_order(report_html, run_folder, ball_only_
 def test_report_ends_with_what_to_cite(report_html):
     last = report_html[report_html.rindex("<section>") :]
     assert "<h2>What to cite</h2>" in last
-    for source in ("shakermill ", "Son 2025, Mathematics 13, 446", "Takacs &amp; McHenry 2006, J. Mater. Sci. 41, 5246"):
+    for source in (
+        "shakermill ",
+        "Son 2025, Mathematics 13, 446",
+        "Takacs &amp; McHenry 2006, J. Mater. Sci. 41, 5246",
+    ):
         assert source in last, source

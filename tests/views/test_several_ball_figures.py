@@ -41,7 +41,12 @@ LABEL_WITH_UNIT = re.compile(r"^\S.* \([^()]+\)$")
 @pytest.fixture(scope="module")
 def result() -> sm.Result:
     params = sm.default_parameters(
-        engine="dem", n_balls=3, vial_diameter=0.038, duration=2.0, kinematics="fourier", motion=ROTATING_MOTION,
+        engine="dem",
+        n_balls=3,
+        vial_diameter=0.038,
+        duration=2.0,
+        kinematics="fourier",
+        motion=ROTATING_MOTION,
         record_windows="0:0.5,1.5:0.1",
     )
     return sm.simulate(params)
@@ -128,7 +133,9 @@ def test_heat_by_channel_adds_up_to_the_runs_heat(stored):
     expected = [stored.params.eta * impacts[f"dissipated_{channel}"].sum() / span for channel in CHANNELS]
     np.testing.assert_allclose(heights, expected, rtol=1e-9)
     # The impact table misses only the contacts still open at the end: within a percent of the energy audit.
-    np.testing.assert_allclose(heights, [stored.summary[f"heat_{channel}_W"] for channel in CHANNELS], rtol=0.01, atol=1e-3)
+    np.testing.assert_allclose(
+        heights, [stored.summary[f"heat_{channel}_W"] for channel in CHANNELS], rtol=0.01, atol=1e-3
+    )
     assert heights[CHANNELS.index("sliding")] > 0.0  # friction is on: the channels are not all normal damping
     powers = [bar.get_height() for bar in received.patches]
     assert [tick.get_text() for tick in received.get_xticklabels()] == ["0", "1", "2", "vial"]
@@ -139,7 +146,12 @@ def test_heat_by_channel_adds_up_to_the_runs_heat(stored):
 
 def test_figures_of_one_ball_on_the_axis_are_left_out(stored):
     names = set(run_figures(stored, impacts=True))
-    assert names == set(SEVERAL_BALL_FIGURES) | {"impact_speed_histogram", "impact_energy_histogram", "impacts_per_second", "stress_energy_spectrum"}
+    assert names == set(SEVERAL_BALL_FIGURES) | {
+        "impact_speed_histogram",
+        "impact_energy_histogram",
+        "impacts_per_second",
+        "stress_energy_spectrum",
+    }
     assert "ball_motion" not in names and "impact_phase_histogram" not in names
 
 
@@ -178,7 +190,7 @@ def test_the_report_has_a_table_per_ball_and_leaves_out_what_is_one_dimensional(
     assert "<h2>Balls</h2>" in document
     temperatures = stored.summary["ball_temperatures_C"]
     for ball, value in enumerate(temperatures):
-        assert f"<td>{ball}</td><td class=\"num\">6.35</td><td class=\"num\">{value:.2f}</td>" in document
+        assert f'<td>{ball}</td><td class="num">6.35</td><td class="num">{value:.2f}</td>' in document
     assert "regime of the settled motion" not in document
     assert "n_balls = 3 (experiment: one ball)" in document
     assert document.count("<figure>") == 4 + 4  # temperatures, paths, heat, heating zoom; four impact figures
@@ -188,7 +200,13 @@ def test_the_report_has_a_table_per_ball_and_leaves_out_what_is_one_dimensional(
 def test_result_plot_and_html_of_a_dem_result(result):
     figures = result.plot()
     # The spectrum a run of several balls with impacts promises (issue 37, point 3), after the main figures.
-    assert list(figures) == ["temperatures", "trajectories", "heat_by_channel", "ball_heating_zoom", "stress_energy_spectrum"]
+    assert list(figures) == [
+        "temperatures",
+        "trajectories",
+        "heat_by_channel",
+        "ball_heating_zoom",
+        "stress_energy_spectrum",
+    ]
     assert figures._repr_html_().count("data:image/png;base64,") == 5
     assert "the 3 balls are at" in result._repr_html_()
 
@@ -198,5 +216,8 @@ def test_a_planetary_jar_is_seen_from_the_side_along_its_upright_axis_and_from_t
 
     planetary = sm.default_parameters("pulverisette7")
     shaker = sm.default_parameters("spex8000m-3d")
-    assert (view_name(planetary, "end view"), axis_label(planetary, "x")) == ("top view", "x, along the jar's axis, up (mm)")
+    assert (view_name(planetary, "end view"), axis_label(planetary, "x")) == (
+        "top view",
+        "x, along the jar's axis, up (mm)",
+    )
     assert (view_name(shaker, "end view"), axis_label(shaker, "z")) == ("end view", "z, up at rest (mm)")

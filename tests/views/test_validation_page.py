@@ -20,19 +20,46 @@ from shakermill.studies.validation_report import ValidationReport
 from shakermill.views import validation_page
 from shakermill.views.validation_page import matrix_rows, render_validation_page, save_validation_page, structure_rows
 
-FIVE = Experiment("five", "Five balls", "a paper", "a calorimeter", False, {"n_balls": 5},
-                  (Point("ball", 3600.0, 46.0), Point("vial", 3600.0, 21.0)))
-EMPTY = Experiment("empty", "An empty mill", "none yet", "a thermocouple", False, {"n_balls": 0},
-                   (Point("vial", 3600.0, None),), falsifies="the drive's heat")
-MATRIX = ValidationMatrix((FIVE, EMPTY), (
-    MatrixRow("a-preset", "mill-head", FIVE, FIVE.points[0], "held out", 105.0, 102.0, 106.0),
-    MatrixRow("a-preset", "mill-head", FIVE, FIVE.points[1], "held out", 25.9, 20.0, 27.0),
-    MatrixRow("a-preset", "mill-head", EMPTY, EMPTY.points[0], "prediction", 15.2, 14.0, 16.0),
-    MatrixRow("b-preset", "paper", FIVE, FIVE.points[0], "held out", 225.0, math.nan, math.nan),
-))
+FIVE = Experiment(
+    "five",
+    "Five balls",
+    "a paper",
+    "a calorimeter",
+    False,
+    {"n_balls": 5},
+    (Point("ball", 3600.0, 46.0), Point("vial", 3600.0, 21.0)),
+)
+EMPTY = Experiment(
+    "empty",
+    "An empty mill",
+    "none yet",
+    "a thermocouple",
+    False,
+    {"n_balls": 0},
+    (Point("vial", 3600.0, None),),
+    falsifies="the drive's heat",
+)
+MATRIX = ValidationMatrix(
+    (FIVE, EMPTY),
+    (
+        MatrixRow("a-preset", "mill-head", FIVE, FIVE.points[0], "held out", 105.0, 102.0, 106.0),
+        MatrixRow("a-preset", "mill-head", FIVE, FIVE.points[1], "held out", 25.9, 20.0, 27.0),
+        MatrixRow("a-preset", "mill-head", EMPTY, EMPTY.points[0], "prediction", 15.2, 14.0, 16.0),
+        MatrixRow("b-preset", "paper", FIVE, FIVE.points[0], "held out", 225.0, math.nan, math.nan),
+    ),
+)
 STRUCTURES = (
-    StructureOutcome(Structure("physical", "spex8000m-3d-mill-head", ("drive_heat",)), {"drive_heat": 23.2}, 1.8, (), 60.0, 25.0),
-    StructureOutcome(Structure("on an edge", "spex8000m-3d-mill-head", ("drive_heat",)), {"drive_heat": 30.0}, 1.5, ("drive_heat",), 92.0, 14.0),
+    StructureOutcome(
+        Structure("physical", "spex8000m-3d-mill-head", ("drive_heat",)), {"drive_heat": 23.2}, 1.8, (), 60.0, 25.0
+    ),
+    StructureOutcome(
+        Structure("on an edge", "spex8000m-3d-mill-head", ("drive_heat",)),
+        {"drive_heat": 30.0},
+        1.5,
+        ("drive_heat",),
+        92.0,
+        14.0,
+    ),
 )
 REPORT = ValidationReport("averaged", (), (), None, MATRIX, STRUCTURES)
 

@@ -155,7 +155,9 @@ class AttractorScan:
         for start in self.failed:
             failed_for.setdefault(start.message, []).append(str(start.start))
         for message, starts in failed_for.items():
-            lines.append(f"attractor probe: start{'s' if len(starts) > 1 else ''} {', '.join(starts)} did not settle ({message})")
+            lines.append(
+                f"attractor probe: start{'s' if len(starts) > 1 else ''} {', '.join(starts)} did not settle ({message})"
+            )
         return lines
 
     def table(self) -> pd.DataFrame:
@@ -190,7 +192,12 @@ class AttractorScan:
                 angles = impact_phases(settled.impacts, omega, phase)
                 parts.append(
                     pd.DataFrame(
-                        {"start": settled.start, "attractor": label_of[settled.start], "phase": angles.phase, "wall": angles.wall}
+                        {
+                            "start": settled.start,
+                            "attractor": label_of[settled.start],
+                            "phase": angles.phase,
+                            "wall": angles.wall,
+                        }
                     )
                 )
         columns = ["start", "attractor", "phase", "wall"]
@@ -205,10 +212,13 @@ def _relative_difference(value: float, reference: float) -> float:
 
 def _difference_warning(attractor: Attractor, configured: Attractor, starts: int) -> str:
     change = (
-        f" ({100.0 * (attractor.heat_power_W / configured.heat_power_W - 1.0):+.1f} %)" if configured.heat_power_W > 0 else ""
+        f" ({100.0 * (attractor.heat_power_W / configured.heat_power_W - 1.0):+.1f} %)"
+        if configured.heat_power_W > 0
+        else ""
     )
     return (
-        f"coexisting attractor: {len(attractor.starts)} of {starts} starts (basin fraction {attractor.basin_fraction:.2f}) "
+        f"coexisting attractor: {len(attractor.starts)} of {starts} starts (basin fraction "
+        f"{attractor.basin_fraction:.2f}) "
         f"settle on {attractor.regime} with heat power {attractor.heat_power_W:.4g} W{change}, the configured "
         f"start on {configured.regime} with {configured.heat_power_W:.4g} W; this run follows the configured start"
     )
@@ -235,7 +245,8 @@ def initial_states(params: Parameters, count: int) -> list[tuple[float, float]]:
 
 
 def settle_span(params: Parameters) -> float:
-    """Simulated seconds :func:`shakermill.solvers.attractors.settle` integrates: SETTLE_PERIODS and MEASURE_PERIODS drive periods."""
+    """Simulated seconds :func:`shakermill.solvers.attractors.settle` integrates: SETTLE_PERIODS and MEASURE_PERIODS
+    drive periods."""
     return (SETTLE_PERIODS + MEASURE_PERIODS) * params.period
 
 

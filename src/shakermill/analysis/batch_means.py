@@ -14,8 +14,8 @@ correlation: such columns (a periodic motion's, equal up to round-off) are not t
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 

@@ -10,8 +10,9 @@ period and finds the smallest n for which every period matches the one n later.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -52,7 +53,9 @@ def _walls(impacts: ImpactColumns) -> np.ndarray:
     """What was hit at each impact: the wall, or for several balls which ball hit what ("0:left", "1:ball")."""
     if "wall" in impacts:
         return np.asarray(impacts["wall"])
-    return np.char.add(np.char.add(np.asarray(impacts["ball"]).astype(str), ":"), np.asarray(impacts["target"]).astype(str))
+    return np.char.add(
+        np.char.add(np.asarray(impacts["ball"]).astype(str), ":"), np.asarray(impacts["target"]).astype(str)
+    )
 
 
 def settled_run_impacts(run: Any) -> dict[str, np.ndarray]:
@@ -81,10 +84,7 @@ def period_signatures(phases: ImpactPhases) -> list[Signature]:
     """
     first, last = phases.period_index.min() + 1, phases.period_index.max() - 1
     bounds = np.searchsorted(phases.period_index, np.arange(first, last + 2))
-    return [
-        (tuple(phases.wall[start:end]), phases.phase[start:end])
-        for start, end in zip(bounds[:-1], bounds[1:])
-    ]
+    return [(tuple(phases.wall[start:end]), phases.phase[start:end]) for start, end in zip(bounds[:-1], bounds[1:])]
 
 
 def signatures_match(a: Signature, b: Signature, tolerance: float = PHASE_TOLERANCE) -> bool:

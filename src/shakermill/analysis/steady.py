@@ -14,8 +14,8 @@ depend on the run's length at all.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 from scipy.differentiate import jacobian
@@ -81,9 +81,18 @@ def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:
     temperatures = network.with_free(theta)
     balls = tuple(float(value) for value in temperatures[: network.n_balls])
     return SteadyState(
-        float(network.mean_ball(temperatures)), float(temperatures[network.vial]), float(temperatures[network.air]), time_constants,
-        load.heat_power, load.velocity_term, True, "solved", balls,
-        tuple((node.name, float(temperatures[index])) for index, node in enumerate(network.nodes) if index > network.air),
+        float(network.mean_ball(temperatures)),
+        float(temperatures[network.vial]),
+        float(temperatures[network.air]),
+        time_constants,
+        load.heat_power,
+        load.velocity_term,
+        True,
+        "solved",
+        balls,
+        tuple(
+            (node.name, float(temperatures[index])) for index, node in enumerate(network.nodes) if index > network.air
+        ),
     )
 
 
@@ -143,9 +152,11 @@ def run_length_note(duration: float, steady: SteadyState) -> str | None:
     if not math.isfinite(slowest) or duration >= SETTLED_TIME_CONSTANTS * slowest:
         return None
     if fits_no_exponential(duration, steady):
-        return (f"The run ({duration / 60:.3g} min) is shorter than the slowest time constant ({slowest / 60:.3g} min): "
-                "no exponential describes it, so theta_inf_C, tau_min and rate0_C_per_min are not shown; the steady "
-                "state is the answer to read.")
+        return (
+            f"The run ({duration / 60:.3g} min) is shorter than the slowest time constant ({slowest / 60:.3g} min): "
+            "no exponential describes it, so theta_inf_C, tau_min and rate0_C_per_min are not shown; the steady "
+            "state is the answer to read."
+        )
     # An empty mill fits no exponential.
     what = "its end and the exponential fitted over it (theta_inf_C) are" if steady.balls else "its end is"
     return (
@@ -157,4 +168,6 @@ def run_length_note(duration: float, steady: SteadyState) -> str | None:
 def fits_no_exponential(duration: float, steady: SteadyState) -> bool:
     """Whether a run of balls ends before one slowest time constant of its network: an exponential fitted to it
     describes the start of the heating, not where it goes (an empty mill fits none at all)."""
-    return bool(steady.balls) and math.isfinite(steady.slowest_time_constant) and duration < steady.slowest_time_constant
+    return (
+        bool(steady.balls) and math.isfinite(steady.slowest_time_constant) and duration < steady.slowest_time_constant
+    )

@@ -24,8 +24,8 @@ power less that of its impacts, so that a contact still running when the records
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -106,9 +106,12 @@ class StressSpectrum:
     def as_summary(self) -> dict[str, float]:
         """The summary's keys: the median and 90th percentile of the total, of each part and for each target, and
         per threshold the events per second and their power."""
-        summary: dict[str, float] = {"stress_window_s": self.window, "stress_lasting_power_W": self.lasting_power(),
-                                     "stress_lasting_share": self.lasting_share(),
-                                     "stress_lasting_contacts_hz": self.lasting_per_second()}
+        summary: dict[str, float] = {
+            "stress_window_s": self.window,
+            "stress_lasting_power_W": self.lasting_power(),
+            "stress_lasting_share": self.lasting_share(),
+            "stress_lasting_contacts_hz": self.lasting_per_second(),
+        }
         for name, q in PERCENTILES:
             summary[f"stress_energy_{name}_J"] = self.percentile(q)
             for part in COMPONENTS[1:]:
@@ -135,20 +138,28 @@ def collision_energy(impacts: Mapping[str, Sequence], masses: Sequence[float]) -
     return 0.5 * reduced * speed**2
 
 
-def stress_spectrum(impacts: Mapping[str, Sequence], window: float, thresholds: Sequence[float] = (),
-                    dissipated_power: float = math.nan, masses: Sequence[float] | None = None) -> StressSpectrum:
+def stress_spectrum(
+    impacts: Mapping[str, Sequence],
+    window: float,
+    thresholds: Sequence[float] = (),
+    dissipated_power: float = math.nan,
+    masses: Sequence[float] | None = None,
+) -> StressSpectrum:
     """The spectrum of the impact records ``impacts`` (an engine's impact columns) resolved over ``window`` s, in
     which the contacts dissipated ``dissipated_power`` (W) in all; with the balls' ``masses`` (kg) also Kwade's stress
     energy of each impact (:func:`collision_energy`; NaN without them)."""
     total = np.asarray(impacts["dissipated_energy"], dtype=float)
     if "dissipated_normal" in impacts:
         normal = np.asarray(impacts["dissipated_normal"], dtype=float)
-        tangential = sum((np.asarray(impacts[channel], dtype=float) for channel in TANGENTIAL_CHANNELS), np.zeros_like(total))
+        tangential = sum(
+            (np.asarray(impacts[channel], dtype=float) for channel in TANGENTIAL_CHANNELS), np.zeros_like(total)
+        )
     else:
         normal, tangential = total, np.zeros_like(total)
     hit_ball = np.asarray(impacts["target"]) == "ball" if "target" in impacts else np.zeros(total.size, dtype=bool)
     lasting = np.asarray(impacts["duration"], dtype=float) > LASTING_CONTACT_S
     kinetic = collision_energy(impacts, masses) if masses is not None else np.full(total.size, math.nan)
     energies = {"total": total, "normal": normal, "tangential": tangential, "kinetic": kinetic}
-    return StressSpectrum(energies, hit_ball, lasting, float(window),
-                          tuple(sorted(thresholds)), float(dissipated_power))
+    return StressSpectrum(
+        energies, hit_ball, lasting, float(window), tuple(sorted(thresholds)), float(dissipated_power)
+    )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from shakermill.cli import ensembles, fits, listing, plots, run, scans
+from shakermill.cli import ensembles, fits, listing, plots, run, scans, validating
 from shakermill.cli.common import app
 
 # The commands, in the order `shakermill --help` lists them, with the line it shows for each.
@@ -18,7 +18,7 @@ COMMANDS = (
     ("sweep", scans.sweep, "Run one simulation per point of a grid or a list."),
     ("uncertainty", ensembles.uncertainty, "An answer over its assumed inputs: 5/50/95 %, Sobol' indices, regimes."),
     ("bifurcation", scans.bifurcation, "Scan one key: regimes, impact phases, attractors."),
-    ("validate", fits.validate, "This model against the experiment and the paper."),
+    ("validate", validating.validate, "This model against the experiment and the paper."),
     ("calibrate", fits.calibrate, "Fit free keys to a measured curve or targets."),
 )
 for name, command, short_help in COMMANDS:

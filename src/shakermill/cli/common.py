@@ -10,11 +10,12 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
 from types import SimpleNamespace
-from typing import TYPE_CHECKING, Annotated, Any, Callable, Iterator, NoReturn, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn
 
 import typer
 from rich.console import Console
@@ -30,7 +31,6 @@ from shakermill.support.atomic import StorageError
 from shakermill.support.version import __version__
 
 if TYPE_CHECKING:
-
     from shakermill.parameters.keys import Parameters
     from shakermill.solvers.result import Result
 
@@ -214,13 +214,20 @@ OverwriteOption = Annotated[
 
 
 SchedulerOption = Annotated[
-    str | None, typer.Option("--scheduler", metavar="ADDRESS", help="Run on this Dask distributed scheduler (tcp://host:8786).")
+    str | None,
+    typer.Option("--scheduler", metavar="ADDRESS", help="Run on this Dask distributed scheduler (tcp://host:8786)."),
 ]
 
 
 SchedulerTimeoutOption = Annotated[
     float,
-    typer.Option("--scheduler-timeout", min=0.1, max=86400.0, metavar="SECONDS", help="Give up connecting to the scheduler after this long."),
+    typer.Option(
+        "--scheduler-timeout",
+        min=0.1,
+        max=86400.0,
+        metavar="SECONDS",
+        help="Give up connecting to the scheduler after this long.",
+    ),
 ]
 
 
@@ -236,7 +243,8 @@ def echo_warnings(warnings: Sequence[str]) -> None:
 
 
 def echo_notes(notes: Sequence[str]) -> None:
-    """One ``note: ...`` line on stderr each: what a user should know that is not a problem (how a solver was chosen)."""
+    """One ``note: ...`` line on stderr each: what a user should know that is not a problem (how a solver was
+    chosen)."""
     for note in notes:
         typer.echo(f"note: {' '.join(note.splitlines())}", err=True)
 
@@ -316,7 +324,9 @@ def progress_bar(
             bar.stop()
 
 
-def piped_lines(verb: str, counter: str, interval_s: float = 0.0, total: float | None = None, **fields: Any) -> Callable[..., None]:
+def piped_lines(
+    verb: str, counter: str, interval_s: float = 0.0, total: float | None = None, **fields: Any
+) -> Callable[..., None]:
     """``update(completed, total=..., **fields)`` printing one plain line on stderr when ``completed`` has changed and
     ``interval_s`` has passed since the last line (or the start): the ``counter`` of a progress bar
     (``{task.completed}``, ``{task.total}``, ``{task.fields[NAME]}``) and the time elapsed."""
@@ -332,7 +342,9 @@ def piped_lines(verb: str, counter: str, interval_s: float = 0.0, total: float |
             return
         said.append(completed)
         last[0] = now
-        task = SimpleNamespace(completed=completed, total=known["total"], fields={k: v for k, v in known.items() if k != "total"})
+        task = SimpleNamespace(
+            completed=completed, total=known["total"], fields={k: v for k, v in known.items() if k != "total"}
+        )
         minutes, seconds = divmod(round(now - started), 60)
         typer.echo(f"{verb}: {counter.format(task=task)}, {minutes} min {seconds:02d} s", err=True)
 
@@ -348,6 +360,7 @@ def number(value: Any, spec: str) -> str:
 def format_value(key: str, value: Any) -> str:
     """A preset value with its unit, e.g. '0.00635 m', 'true', '[0, 1], [600, 0.1] s'."""
     from shakermill.parameters.keys import field_unit
+
     unit = field_unit(key)
     if isinstance(value, bool):
         return str(value).lower()

@@ -39,9 +39,12 @@ def uncertainty(
     settings: SettingsOption = None,
     assume: Annotated[
         list[str] | None,
-        typer.Option("--assume", metavar="KEY=LOW:HIGH[:DIST]",
-                     help="Your own range of an input (SI units; DIST uniform or log-uniform), replacing the preset's "
-                          "or adding one."),
+        typer.Option(
+            "--assume",
+            metavar="KEY=LOW:HIGH[:DIST]",
+            help="Your own range of an input (SI units; DIST uniform or log-uniform), replacing the preset's "
+            "or adding one.",
+        ),
     ] = None,
     vary: Annotated[
         list[str] | None,
@@ -49,9 +52,17 @@ def uncertainty(
     ] = None,
     members: Annotated[int, typer.Option("--members", "-n", help="Members of the design, a power of two.")] = 64,
     out: Annotated[
-        Path | None, typer.Option("--out", "-o", show_default="results/uncertainty-<timestamp>", help="Ensemble folder; re-run into it to resume.")
+        Path | None,
+        typer.Option(
+            "--out",
+            "-o",
+            show_default="results/uncertainty-<timestamp>",
+            help="Ensemble folder; re-run into it to resume.",
+        ),
     ] = None,
-    workers: Annotated[int | None, typer.Option("--workers", "-w", show_default="one per core", help="Local worker processes.")] = None,
+    workers: Annotated[
+        int | None, typer.Option("--workers", "-w", show_default="one per core", help="Local worker processes.")
+    ] = None,
     scheduler: SchedulerOption = None,
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
@@ -71,21 +82,35 @@ def uncertainty(
         inputs, posterior = ensemble_inputs(config_preset(run_config), run_config.params, assume or [], vary or [])
     target = out if out is not None else timestamped_folder("uncertainty")
     try:
-        counter = "{task.completed}/{task.total} members · {task.fields[running]} running · {task.fields[failed]} failed"
+        counter = (
+            "{task.completed}/{task.total} members · {task.fields[running]} running · {task.fields[failed]} failed"
+        )
         # A member takes seconds to minutes: piped, each one finished is a line.
-        with user_errors(), warnings_as_lines(), progress_bar(
-            "uncertainty", counter, members, lines_when_piped=True, running=0, failed=0
-        ) as update:
+        with (
+            user_errors(),
+            warnings_as_lines(),
+            progress_bar("uncertainty", counter, members, lines_when_piped=True, running=0, failed=0) as update,
+        ):
             ensemble = run_ensemble(
-                run_config.params, inputs, target, members, workers=workers, scheduler=scheduler, preset=run_config.preset,
-                posterior=posterior, announce=lambda line: typer.echo(f"uncertainty: {line}", err=True),
+                run_config.params,
+                inputs,
+                target,
+                members,
+                workers=workers,
+                scheduler=scheduler,
+                preset=run_config.preset,
+                posterior=posterior,
+                announce=lambda line: typer.echo(f"uncertainty: {line}", err=True),
                 progress=lambda state: update(state.done, running=state.running, failed=state.failed),
             )
     except SweepFailed as exc:
         fail(f"every member failed (first: {exc.table['error'].dropna().iloc[0]}); see {target}", 1)
     except (SweepInterrupted, KeyboardInterrupt):
-        fail(f"interrupted; the members finished are kept in {target}; re-run the same command with --out {target} "
-             "to compute the others", EXIT_INTERRUPTED)
+        fail(
+            f"interrupted; the members finished are kept in {target}; re-run the same command with --out {target} "
+            "to compute the others",
+            EXIT_INTERRUPTED,
+        )
     title = f"{run_config.preset}: what the answer hangs on"
     payload = {"preset": run_config.preset, "output_dir": str(target.absolute()), **ensemble.as_dict()}
     write_text_atomically(target / SUMMARY, json.dumps(payload, indent=1, allow_nan=False) + "\n")

@@ -1,16 +1,15 @@
-"""``shakermill validate`` and ``calibrate``: this model against the experiment and the paper, and free keys fitted to
-a measured curve or targets."""
+"""``shakermill calibrate``: free keys fitted to a measured curve or targets (``validate`` is in :mod:`validating`)."""
 
 from __future__ import annotations
 
 import json
 import math
 import sys
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
@@ -23,7 +22,6 @@ from shakermill.cli.common import (
     PresetOption,
     SettingsOption,
     add_plain_row,
-    fail,
     nothing_written_when_a_run_is_stopped,
     nothing_written_when_interrupted,
     number,
@@ -37,240 +35,30 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.support.atomic import check_writable_place
 
 if TYPE_CHECKING:
-
     from shakermill.studies.calibrate import Calibration
-
-
-def validate(
-    full: Annotated[
-        bool,
-        typer.Option("--full", help="Everything (~30 min on two cores): Table 5 at full resolution, the matrix's "
-                     "experiments of one ball, the structure study, the engines' one-ball comparison and the "
-                     "sensitivity to the assumed SPEX kinematics, and both SPEX experiments fitted over every uncertain input, "
-                     "each predicting the other. Without it, a quick validation (~45 s on two cores)."),
-    ] = False,
-    solver: Annotated[
-        str | None,
-        typer.Option("--solver", show_default="averaged; full with --full",
-                     help="Solver of the Table 5 runs: 'full' (as the paper) or 'averaged' (seconds instead of a minute)."),
-    ] = None,
-    study: Annotated[
-        bool, typer.Option(help="Also fit several free sets to the experiment's curve and say which follow it (~15 s).")
-    ] = True,
-    three_d: Annotated[
-        bool,
-        typer.Option(
-            "--three-d/--no-three-d",
-            help="Also the held-out five-ball prediction of the calibrated 3-D preset, the one-ball comparison of "
-            "the engines and the sensitivity to the assumed SPEX kinematics (averaged solver, a few minutes).",
-        ),
-    ] = True,
-    json_output: JsonOption = False,
-    html: Annotated[
-        Path | None,
-        typer.Option("--report", metavar="FILE", help="Also write the validation matrix, its figure, the structure study "
-                     "and the held-out prediction as one self-contained HTML page."),
-    ] = None,
-    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the --report file if it exists.")] = False,
-) -> None:
-    """Paper Table 5 and the experiment's curve side by side: the paper's model, this model with published and
-    calibrated parameters, which free sets of a calibration can follow the curve, and (3-D) the validation matrix of
-    the thermal models against the five-ball experiment no fit has seen and the empty mill; with --full also the
-    one-ball experiments, the structures that follow the one-ball curve, the held-out studies, and each SPEX
-    experiment fitted over every uncertain input predicting the other."""
-    from shakermill.io.runs import to_jsonable
-    from shakermill.studies.validation_report import SOLVERS, validation_report
-
-    solver = solver if solver is not None else "full" if full else "averaged"
-    if solver not in SOLVERS:
-        fail(f"--solver: {solver!r} is not allowed; allowed: one of {', '.join(map(repr, SOLVERS))}")
-    if html is not None:
-        if not three_d:
-            fail("report: the page holds the three-dimensional studies; allowed --report with --three-d (the default)")
-        check_report_target(html, overwrite)
-    typer.echo(f"validate: {'everything (--full), ~30 min' if full else 'quick, ~45 s; --full for everything (~30 min)'}; "
-               f"Table 5 with the {solver} solver" + (", then the 3-D validation matrix" if three_d else ""), err=True)
-    with (nothing_written_when_interrupted("validate prints and writes once every run has ended"),
-          nothing_written_when_a_run_is_stopped("validate"),
-          progress_bar("validation", "{task.completed}/{task.total} steps", None, lines_when_piped=True) as update):
-        report = validation_report(solver, study, three_d, progress=lambda done, total: update(done, total=total), everything=full)
-    # Printed before the page is written: a page that cannot be written loses nothing the study found.
-    if json_output:
-        typer.echo(json.dumps(to_jsonable(report.as_dict()), sort_keys=True, allow_nan=False))
-    else:
-        print_report(report)
-        if three_d and not full:
-            from shakermill.views.validation_page import QUICK_NOTE
-
-            stdout_console().print(Text(QUICK_NOTE))
-    if html is not None:
-        from shakermill.views.validation_page import save_validation_page
-
-        with writing(html, "the validation report"):
-            save_validation_page(report, html)
-        typer.echo(f"validation report written to {html}", err=True)
-
-
-def print_report(report: Any) -> None:
-    """The tables of ``validate`` on the terminal."""
-    from shakermill.studies.validation import TABLE5
-
-    console = stdout_console()
-    console.print(validation_table(report.runs))
-    for run in report.runs:
-        console.print(Text(run.statement))
-    console.print(Text(f"The experiment's ratio is for five balls: {TABLE5[-1].experiment_note}."))
-    if report.outcomes:
-        console.print(free_set_table(report.outcomes))
-    if report.matrix is not None:
-        print_matrix(console, report.matrix)
-    if report.structures:
-        print_structures(console, report.structures)
-    if report.held_out is not None:
-        print_held_out(console, report.held_out)
-    if report.cross is not None:
-        print_cross(console, report.cross)
-
-
-def print_cross(console: Console, cross: Any) -> None:
-    """Both directions of the SPEX experiments, each fitted over every uncertain input, plainly inside or not."""
-    from shakermill.views.validation_page import CROSS_HEADERS, CROSS_TITLE, cross_rows, cross_statement
-
-    table = Table(*CROSS_HEADERS, title=CROSS_TITLE)
-    for row in cross_rows(cross):
-        add_plain_row(table, *row)
-    console.print(table)
-    console.print(Text(cross_statement(cross)))
-
-
-def print_matrix(console: Console, matrix: Any) -> None:
-    """Each thermal model's calibrated preset against each experiment: the rise measured and predicted (K), with the
-    prediction's 90 % interval, its error and whether the measurement lies inside; then what each experiment is and
-    what each prediction would falsify."""
-    from shakermill.views.validation_page import MATRIX_HEADERS, matrix_rows
-
-    table = Table(*MATRIX_HEADERS, title="Validation matrix: rises above the start")
-    for row in matrix_rows(matrix):
-        add_plain_row(table, *row)
-    console.print(table)
-    for experiment in matrix.experiments:
-        console.print(Text(f"{experiment.name}: {experiment.title}. Source: {experiment.source}. Measured: {experiment.how_measured}."))
-        if experiment.falsifies:
-            console.print(Text(f"  It falsifies: {experiment.falsifies}."))
-
-
-def print_structures(console: Console, outcomes: Sequence[Any]) -> None:
-    """Each network structure fitted to the one-ball curve, whether it meets the bar of a physical fit, and what it
-    predicts for five balls, nothing refitted."""
-    from shakermill.views.validation_page import structure_headers, structure_rows, structure_verdict
-
-    table = Table(*structure_headers(),
-                  title="Which structure follows the one-ball curve with physical couplings, and what it then predicts")
-    for row in structure_rows(outcomes):
-        add_plain_row(table, *row)
-    console.print(table)
-    console.print(Text(structure_verdict(outcomes)))
-
-
-def check_report_target(target: Path, overwrite: bool) -> None:
-    """Before a long study: a --report that names a folder, or a file without --overwrite, is refused now."""
-    if target.is_dir():
-        fail(f"{target}: a folder; give the report a file name")
-    if target.exists() and not overwrite:
-        fail(f"{target}: exists; choose another --report, or add --overwrite to replace it")
-    with user_errors():
-        check_writable_place(target, "--report")
-
-
-def print_held_out(console: Console, held_out: Any) -> None:
-    from shakermill.studies.held_out import COMPARED_KEYS, FIVE_BALL_SOURCE
-    from shakermill.views.validation_page import HELD_OUT_HEADERS, held_out_rows
-
-    prediction, comparison, sensitivity = held_out.prediction, held_out.comparison, held_out.sensitivity
-    table = Table(*HELD_OUT_HEADERS, title=f"Held out: five balls ({FIVE_BALL_SOURCE})")
-    for row in held_out_rows(prediction):
-        add_plain_row(table, *row)
-    console.print(table)
-    console.print(Text(prediction.statement))
-    table = Table("one ball", *(f"{label} [{unit}]" for _, label, unit in COMPARED_KEYS), title="One ball: what the third dimension, gravity and friction change")
-    for index, case in enumerate(comparison.cases):
-        cells = [
-            f"{values:.3g}" + ("" if index == 0 else f" ({100 * comparison.change(key, index):+.0f} %)")
-            for key, values in ((key, comparison.values[index][key]) for key, _, _ in COMPARED_KEYS)
-        ]
-        add_plain_row(table, case.label, *cells)
-    console.print(table)
-    console.print(sensitivity_table(sensitivity))
-
-
-def sensitivity_table(sensitivity: Any) -> Table:
-    """Each assumed amplitude halved and raised by half: the measures' relative changes against the baseline."""
-    measures = list(sensitivity.baseline)
-    table = Table("assumed key × factor", "value (SI)", *measures, title=f"Sensitivity to the assumed {sensitivity.kinematics} motion (five balls)")
-    add_plain_row(table, "baseline", "", *(f"{sensitivity.baseline[name]:.4g}" for name in measures))
-    for row in sensitivity.rows:
-        # A temperature's relative change depends on where its scale starts: in kelvin it says more.
-        changes = (
-            f"{row.measures[name] - sensitivity.baseline[name]:+.1f} K" if name.endswith("_C") else f"{100 * row.relative_change[name]:+.1f} %"
-            for name in measures
-        )
-        add_plain_row(table, f"{row.key} × {row.factor:g}", f"{row.value:.4g}", *changes)
-    return table
-
-
-def validation_table(runs: Sequence[Any]) -> Table:
-    from shakermill.studies.validation import EXPERIMENT, TABLE5
-
-    table = Table("quantity", "unit", "experiment", "paper's model", title=f"Table 5 ({EXPERIMENT})")
-    for run in runs:
-        table.add_column(f"{run.preset}", justify="right")
-        table.add_column("vs exp.", justify="right")
-    for index, entry in enumerate(TABLE5):
-        cells = [entry.label, entry.unit, f"{entry.experiment:g}", f"{entry.paper_model:g}"]
-        for run in runs:
-            row = run.rows[index]
-            cells += [f"{row.value:.4g} ({row.role})", f"{100 * row.error_vs_experiment:+.2f} %"]
-        add_plain_row(table, *cells)
-    # The experiment's exponential plateau is its own estimate of the steady state; the paper gives none.
-    steady = ["ball steady state (MODEL.md §11)", "°C", f"{TABLE5[0].experiment:g}", "n/a"]
-    for run in runs:
-        value = run.summary["ball_steady_C"]
-        steady += [f"{value:.4g} (predicted)", f"{100 * (value - TABLE5[0].experiment) / TABLE5[0].experiment:+.2f} %"]
-    add_plain_row(table, *steady)
-    deviation = ["RMS deviation from the experiment's curve, 0–60 min", "K", "0", "n/a"]
-    for run in runs:
-        deviation += [f"{run.curve_rms_K:.3g}", ""]
-    add_plain_row(table, *deviation)
-    return table
-
-
-def free_set_table(outcomes: Sequence[Any]) -> Table:
-    table = Table(
-        "free keys", "fitted values", "RMS K", "vial/ball ratio (exp. 0.46)", "verdict",
-        title="Which free sets can follow the experiment's curve (fits within physically defensible ranges)",
-    )
-    for outcome in outcomes:
-        calibration = outcome.calibration
-        fitted = ", ".join(f"{key} {value:.3g}" for key, value in calibration.fitted.items())
-        ratio = calibration.predictions.get("vial_ball_ratio", math.nan)
-        add_plain_row(table, ", ".join(outcome.free), fitted, number(calibration.curve_rms_K, ".2f"), number(ratio, ".3f"), outcome.verdict)
-    return table
 
 
 WithAssumedOption = Annotated[
     bool,
-    typer.Option("--with-assumed", help="Also free the preset's assumed inputs that move the mechanics (friction, "
-                 "restitution, λ, the clamp's motion, ...), their stated ranges as priors: a Bayesian fit on emulators "
-                 "of the runs, with posterior-predictive intervals (MODEL.md §14.1; minutes)."),
+    typer.Option(
+        "--with-assumed",
+        help="Also free the preset's assumed inputs that move the mechanics (friction, "
+        "restitution, λ, the clamp's motion, ...), their stated ranges as priors: a Bayesian fit on emulators "
+        "of the runs, with posterior-predictive intervals (MODEL.md §14.1; minutes).",
+    ),
 ]
 MembersOption = Annotated[
-    int, typer.Option("--members", "-n", help="With --with-assumed: mechanical runs per set of conditions, a power of two.")
+    int,
+    typer.Option("--members", "-n", help="With --with-assumed: mechanical runs per set of conditions, a power of two."),
 ]
 PosteriorOption = Annotated[
     bool,
-    typer.Option("--posterior/--no-posterior", help="Sample the posterior of the fitted keys where an evaluation is "
-                 "the thermal network alone (engine 'dem': ~2400 evaluations, a few minutes); without it, the "
-                 "standard errors are linear."),
+    typer.Option(
+        "--posterior/--no-posterior",
+        help="Sample the posterior of the fitted keys where an evaluation is "
+        "the thermal network alone (engine 'dem': ~2400 evaluations, a few minutes); without it, the "
+        "standard errors are linear.",
+    ),
 ]
 
 
@@ -294,8 +82,15 @@ def calibrate(
     ] = None,
     free: Annotated[
         list[str] | None,
-        typer.Option("--free", "-f", metavar="KEY[,KEY]", help=f"Keys to fit (default: those of the run's network that it reads: 'paper' {','.join(DEFAULT_FREE)}, with "
-                     f"engine = 'dem' {','.join(DEM_DEFAULT_FREE)}; 'mill-head' {','.join(DEFAULT_FREE_BY_NETWORK['mill-head'])})."),
+        typer.Option(
+            "--free",
+            "-f",
+            metavar="KEY[,KEY]",
+            help="Keys to fit (default: those of the run's network that it reads: 'paper' "
+            f"{','.join(DEFAULT_FREE)}, with "
+            f"engine = 'dem' {','.join(DEM_DEFAULT_FREE)}; 'mill-head' "
+            f"{','.join(DEFAULT_FREE_BY_NETWORK['mill-head'])}).",
+        ),
     ] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the fitted preset TOML here.")] = None,
     full_resolution: FullResolutionOption = False,
@@ -326,13 +121,24 @@ def calibrate(
         if with_assumed:
             calibrate_over_assumed(run_config, free_keys, targets, measured, members, full_resolution, out, json_output)
             return
-        with nothing_written_when_interrupted("the fit starts again from the beginning"), nothing_written_when_a_run_is_stopped(
-            "the fit"
-        ), progress_bar("calibrate", "{task.fields[doing]}", None, delay_s=PROGRESS_DELAY_S, doing="starting") as update:
+        with (
+            nothing_written_when_interrupted("the fit starts again from the beginning"),
+            nothing_written_when_a_run_is_stopped("the fit"),
+            progress_bar(
+                "calibrate", "{task.fields[doing]}", None, delay_s=PROGRESS_DELAY_S, doing="starting"
+            ) as update,
+        ):
             calibration = fit_parameters(
-                run_config.params, free_keys, targets, measured, full_resolution=full_resolution, sample_posterior=posterior,
+                run_config.params,
+                free_keys,
+                targets,
+                measured,
+                full_resolution=full_resolution,
+                sample_posterior=posterior,
                 **fit_progress(update),
-                on_start=lambda: announce(run_config.params, free_keys, bool(free), [item.note for item in measured if item.note]),
+                on_start=lambda: announce(
+                    run_config.params, free_keys, bool(free), [item.note for item in measured if item.note]
+                ),
             )
     # A fit that leaves its keys undetermined has values that any others would match as well: no preset of them.
     written = out if out is not None and calibration.status != "undetermined" else None
@@ -340,7 +146,13 @@ def calibrate(
         settings = values_beyond_preset(run_config.params, run_config.preset)
         write_fitted_preset(calibration, written, run_config.preset, free_keys, targets, settings)
     if json_output:
-        typer.echo(json.dumps(to_jsonable({**calibration.as_dict(), "output": str(written) if written else None}), sort_keys=True, allow_nan=False))
+        typer.echo(
+            json.dumps(
+                to_jsonable({**calibration.as_dict(), "output": str(written) if written else None}),
+                sort_keys=True,
+                allow_nan=False,
+            )
+        )
     else:
         print_calibration(calibration, free_keys, targets, written)
     if not calibration.success:
@@ -360,14 +172,19 @@ def fit_progress(update: Callable[..., None]) -> dict[str, Callable[..., None]]:
     def evaluated(done: int, rms: float | None) -> None:
         count["done"] = done
         if count["posterior_from"] >= 0:
-            doing = f"sampling the posterior: {done - count['posterior_from']} of ~{count['posterior']} model evaluations"
+            doing = (
+                f"sampling the posterior: {done - count['posterior_from']} of ~{count['posterior']} model evaluations"
+            )
         else:
             doing = f"{done} model evaluations, the last {number(rms, '.3g')} K RMS from the curves"
         update(done, doing=doing)
 
     def measuring(done: float, total: float) -> None:
-        update(done, doing=f"measuring the mechanics once for every evaluation: {done:.4g} s simulated (converged "
-                           f"means end it, at most {total:.4g} s)")
+        update(
+            done,
+            doing=f"measuring the mechanics once for every evaluation: {done:.4g} s simulated (converged "
+            f"means end it, at most {total:.4g} s)",
+        )
 
     return {
         "progress": evaluated,
@@ -376,9 +193,16 @@ def fit_progress(update: Callable[..., None]) -> dict[str, Callable[..., None]]:
     }
 
 
-def calibrate_over_assumed(run_config: Any, free_keys: Sequence[str], targets: Mapping[str, float],
-                           curves: Sequence[Any], members: int, full_resolution: bool, out: Path | None,
-                           json_output: bool) -> None:
+def calibrate_over_assumed(
+    run_config: Any,
+    free_keys: Sequence[str],
+    targets: Mapping[str, float],
+    curves: Sequence[Any],
+    members: int,
+    full_resolution: bool,
+    out: Path | None,
+    json_output: bool,
+) -> None:
     """``calibrate --with-assumed``: the posterior of the network's free keys and the preset's assumed inputs given the
     curves, printed, and the preset of its medians written."""
     from shakermill.io.runs import to_jsonable
@@ -388,31 +212,53 @@ def calibrate_over_assumed(run_config: Any, free_keys: Sequence[str], targets: M
     from shakermill.studies.validation import experiment_curve
 
     if targets:
-        raise ParameterError("target: a calibration --with-assumed fits measured rises; allowed --curve (a Table 5 "
-                             "target is a summary of a curve, not a measurement)")
+        raise ParameterError(
+            "target: a calibration --with-assumed fits measured rises; allowed --curve (a Table 5 "
+            "target is a summary of a curve, not a measurement)"
+        )
     if full_resolution:
-        raise ParameterError("full-resolution: a calibration --with-assumed runs the averaged solver on a design of "
-                             "runs; allowed without --full-resolution")
+        raise ParameterError(
+            "full-resolution: a calibration --with-assumed runs the averaged solver on a design of "
+            "runs; allowed without --full-resolution"
+        )
     check_members(members)
     params = run_config.params.replace(solver="averaged", attractor_starts=1)
     curves = list(curves) or [experiment_curve()]
     sets = len({tuple(item.conditions) for item in curves} | {()})
-    said = (f"calibrate: fitting {', '.join(free_keys)} and the assumed inputs of {run_config.preset} over {members} "
-            f"mechanical runs per set of conditions ({sets}), then emcee on their emulators")
-    with nothing_written_when_interrupted("the fit starts again from the beginning"), \
-            nothing_written_when_a_run_is_stopped("the fit"), \
-            progress_bar("fitting", "{task.completed}/{task.total} runs", members * sets, lines_when_piped=True) as update:
-        joint = calibrate_jointly(config_preset(run_config), params, free_keys, curves, members,
-                                  progress=lambda done, total: update(done, total=total),
-                                  on_start=lambda: typer.echo(said, err=True))
+    said = (
+        f"calibrate: fitting {', '.join(free_keys)} and the assumed inputs of {run_config.preset} over {members} "
+        f"mechanical runs per set of conditions ({sets}), then emcee on their emulators"
+    )
+    with (
+        nothing_written_when_interrupted("the fit starts again from the beginning"),
+        nothing_written_when_a_run_is_stopped("the fit"),
+        progress_bar("fitting", "{task.completed}/{task.total} runs", members * sets, lines_when_piped=True) as update,
+    ):
+        joint = calibrate_jointly(
+            config_preset(run_config),
+            params,
+            free_keys,
+            curves,
+            members,
+            progress=lambda done, total: update(done, total=total),
+            on_start=lambda: typer.echo(said, err=True),
+        )
     if out is not None:
         command = "shakermill calibrate " + " ".join(sys.argv[2:])
         with writing(out, "the preset"):
-            write_joint_preset(joint, out, base_preset=run_config.preset, command=command,
-                               settings=values_beyond_preset(run_config.params, run_config.preset))
+            write_joint_preset(
+                joint,
+                out,
+                base_preset=run_config.preset,
+                command=command,
+                settings=values_beyond_preset(run_config.params, run_config.preset),
+            )
     if json_output:
-        typer.echo(json.dumps(to_jsonable({**joint.as_dict(), "output": str(out) if out else None}), sort_keys=True,
-                              allow_nan=False))
+        typer.echo(
+            json.dumps(
+                to_jsonable({**joint.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False
+            )
+        )
     else:
         print_joint(joint, out)
 
@@ -425,20 +271,32 @@ def print_joint(joint: Any, out: Path | None) -> None:
     quantiles = joint.posterior.quantiles()
     for item in joint.posterior.inputs:
         low, middle, high = quantiles[item.key]
-        add_plain_row(table, item.key, f"{item.shown_range()} {item.distribution}", f"{low:.3g}", f"{middle:.3g}",
-                      f"{high:.3g}")
+        add_plain_row(
+            table, item.key, f"{item.shown_range()} {item.distribution}", f"{low:.3g}", f"{middle:.3g}", f"{high:.3g}"
+        )
     console.print(table)
     points = Table("measured", "rise [K]", "posterior-predictive 90 % [K]", "inside?", title="the fitted points")
     for item in joint.fitted:
-        add_plain_row(points, item.observable.label, f"{item.measured_K:.3g}",
-                      f"{item.quantiles[0]:.3g} to {item.quantiles[2]:.3g}", "yes" if item.inside else "no")
+        add_plain_row(
+            points,
+            item.observable.label,
+            f"{item.measured_K:.3g}",
+            f"{item.quantiles[0]:.3g} to {item.quantiles[2]:.3g}",
+            "yes" if item.inside else "no",
+        )
     console.print(points)
     for item in joint.predictions:
-        console.print(Text(f"predicted: {item.observable.label} {item.quantiles[1]:.3g} K "
-                           f"(90 %: {item.quantiles[0]:.3g} to {item.quantiles[2]:.3g} K)"))
+        console.print(
+            Text(
+                f"predicted: {item.observable.label} {item.quantiles[1]:.3g} K "
+                f"(90 %: {item.quantiles[0]:.3g} to {item.quantiles[2]:.3g} K)"
+            )
+        )
     console.print(Text(f"{joint.status}: {joint.message}"))
     if out is not None:
-        console.print(Text(f"preset written to {out}; `shakermill uncertainty {out}` carries its posterior into any run"))
+        console.print(
+            Text(f"preset written to {out}; `shakermill uncertainty {out}` carries its posterior into any run")
+        )
 
 
 def announce(params: Any, free_keys: Sequence[str], chosen: bool, notes: Sequence[str]) -> None:
@@ -452,8 +310,10 @@ def announce(params: Any, free_keys: Sequence[str], chosen: bool, notes: Sequenc
         unstarted = unstarted_defaults(params)
         if unstarted:
             one = len(unstarted) == 1
-            line += (f"; {', '.join(unstarted)} start{'s' if one else ''} at 0 and {'is' if one else 'are'} left out: "
-                     f"set a positive start (--set KEY=VALUE) to fit {'it' if one else 'them'}")
+            line += (
+                f"; {', '.join(unstarted)} start{'s' if one else ''} at 0 and {'is' if one else 'are'} left out: "
+                f"set a positive start (--set KEY=VALUE) to fit {'it' if one else 'them'}"
+            )
     for said in (line, *(f"note: {note}" for note in notes)):
         typer.echo(said, err=True)
 
@@ -468,11 +328,15 @@ def check_preset_target(out: Path, overwrite: bool) -> None:
 
 
 def write_fitted_preset(
-    calibration: Calibration, out: Path, base_preset: str, free_keys: Sequence[str], targets: Mapping[str, float],
+    calibration: Calibration,
+    out: Path,
+    base_preset: str,
+    free_keys: Sequence[str],
+    targets: Mapping[str, float],
     settings: Mapping[str, Any],
 ) -> None:
     """Write the fitted preset TOML, saying in it which command fitted which keys to what, under which settings."""
-    from shakermill.studies.calibrate import write_preset
+    from shakermill.studies.fitted_preset import write_preset
 
     command = "shakermill calibrate " + " ".join(sys.argv[2:])
     fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]
@@ -481,7 +345,9 @@ def write_fitted_preset(
         f"{', '.join(calibration.predictions)} are predictions"
     )
     with writing(out, "the preset"):
-        write_preset(calibration, out, base_preset=base_preset, command=command, description=description, settings=settings)
+        write_preset(
+            calibration, out, base_preset=base_preset, command=command, description=description, settings=settings
+        )
 
 
 # A prediction whose standard error exceeds this share of its size (a temperature's rise from the start) is one
@@ -515,23 +381,38 @@ def print_calibration(
     console = stdout_console()
     ranges = calibration.posterior_ranges
     posterior_column = ["90 % of the posterior"] if ranges else []
-    table = Table("parameter", "start", "fitted", "std. error", *posterior_column, "physically defensible?", title="calibration")
+    table = Table(
+        "parameter", "start", "fitted", "std. error", *posterior_column, "physically defensible?", title="calibration"
+    )
     for key in free_keys:
         posterior = [f"{ranges[key][0]:.3g} to {ranges[key][1]:.3g}"] if ranges else []
         stderr = calibration.parameter_stderr[key]
         # A linear error beyond the value itself says the data leave the key undetermined, not how far it may move.
         shown = "undetermined" if stderr > LOOSE_LOG_ERROR * calibration.fitted[key] else number(stderr, ".3g")
         add_plain_row(
-            table, key, f"{calibration.start[key]:.6g}", f"{calibration.fitted[key]:.6g}", shown, *posterior,
+            table,
+            key,
+            f"{calibration.start[key]:.6g}",
+            f"{calibration.fitted[key]:.6g}",
+            shown,
+            *posterior,
             calibration.defensible[key],
         )
     console.print(table)
     if not ranges:
-        console.print(Text("no posterior sampled (--no-posterior, or each of its thousands of evaluations would rerun "
-                           "the engine's mechanics): the standard errors are linear"))
+        console.print(
+            Text(
+                "no posterior sampled (--no-posterior, or each of its thousands of evaluations would rerun "
+                "the engine's mechanics): the standard errors are linear"
+            )
+        )
     if calibration.status == "undetermined":
-        console.print(Text("no predictions: the data do not determine the fitted keys, so they do not support what the "
-                           "model would say of anything else"))
+        console.print(
+            Text(
+                "no predictions: the data do not determine the fitted keys, so they do not support what the "
+                "model would say of anything else"
+            )
+        )
     else:
         console.print(prediction_table(calibration))
     if targets:
@@ -539,15 +420,26 @@ def print_calibration(
         for key, wanted in targets.items():
             sensitivities = [f"{calibration.sensitivities[key][name]:+.3f}" for name in free_keys]
             add_plain_row(
-                residuals, key, f"{wanted:g}", f"{calibration.achieved[key]:.6g}",
-                f"{100 * calibration.relative_residuals[key]:+.3f} %", *sensitivities,
+                residuals,
+                key,
+                f"{wanted:g}",
+                f"{calibration.achieved[key]:.6g}",
+                f"{100 * calibration.relative_residuals[key]:+.3f} %",
+                *sensitivities,
             )
         console.print(residuals)
     if calibration.curve_rms_K is not None:
         console.print(Text(f"curve ({calibration.curve_source}): RMS residual {calibration.curve_rms_K:.3g} K"))
         for label, values in calibration.sensitivities.items():
             if label not in targets:
-                console.print(Text(f"d {label} / d ln(key), K: " + ", ".join(f"{key} {value:+.3g}" for key, value in values.items())))
-    console.print(Text(f"{calibration.evaluations} model evaluations ({calibration.solver} solver): {calibration.message}"))
+                console.print(
+                    Text(
+                        f"d {label} / d ln(key), K: "
+                        + ", ".join(f"{key} {value:+.3g}" for key, value in values.items())
+                    )
+                )
+    console.print(
+        Text(f"{calibration.evaluations} model evaluations ({calibration.solver} solver): {calibration.message}")
+    )
     if out is not None:
         console.print(Text(f"preset written to {out}; use it with `shakermill run {out}`"))

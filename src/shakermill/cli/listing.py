@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import fnmatch
 import json
-from typing import Annotated, Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Annotated, Any
 
 import typer
 from rich.table import Table
@@ -19,6 +20,7 @@ def presets(
 ) -> None:
     """List the presets, or show one preset's values, units and sources."""
     from shakermill.parameters.presets import PRESETS, preset_values
+
     console = stdout_console()
     if name is None:
         table = Table("preset", "description", title="presets")
@@ -35,12 +37,23 @@ def presets(
         add_plain_row(table, key, format_value(key, cited.value), cited.source)
     console.print(table)
     if preset.assumed:
-        assumed = Table("key", "value", "range", "distribution", "reason",
-                        title=f"{preset.name}: assumed inputs, no source fixes them (MODEL.md §14.1)")
+        assumed = Table(
+            "key",
+            "value",
+            "range",
+            "distribution",
+            "reason",
+            title=f"{preset.name}: assumed inputs, no source fixes them (MODEL.md §14.1)",
+        )
         for key, stated in preset.assumed.items():
-            add_plain_row(assumed, key, format_value(key, preset.values[key].value), stated.shown_range(),
-                          stated.distribution,
-                          stated.reason + (f" (moves {', '.join(stated.moves)} with it)" if stated.moves else ""))
+            add_plain_row(
+                assumed,
+                key,
+                format_value(key, preset.values[key].value),
+                stated.shown_range(),
+                stated.distribution,
+                stated.reason + (f" (moves {', '.join(stated.moves)} with it)" if stated.moves else ""),
+            )
         console.print(assumed)
     if preset.caveat:
         console.print(Text(f"Caveat ({preset.name}): {preset.caveat}"))
@@ -59,7 +72,9 @@ MATERIAL_COLUMNS = (
 
 
 def materials_command(
-    name: Annotated[str | None, typer.Argument(help="Show every value of this material with its unit and source.")] = None,
+    name: Annotated[
+        str | None, typer.Argument(help="Show every value of this material with its unit and source.")
+    ] = None,
     json_output: JsonOption = False,
 ) -> None:
     """List the materials library, or show one material's values, units and sources. Select one with
@@ -85,7 +100,11 @@ def _material_value(value: float | tuple[float, float], scale: float = 1.0) -> s
 def materials_table(chosen: Sequence[Any]) -> Table:
     table = Table("material", *(header for _, header, _ in MATERIAL_COLUMNS), title="materials (room temperature)")
     for found in chosen:
-        add_plain_row(table, found.name, *(_material_value(getattr(found, key).value, scale) for key, _, scale in MATERIAL_COLUMNS))
+        add_plain_row(
+            table,
+            found.name,
+            *(_material_value(getattr(found, key).value, scale) for key, _, scale in MATERIAL_COLUMNS),
+        )
     table.caption = "`shakermill materials NAME`: every value's source; restitution and friction are shown, not applied"
     return table
 
@@ -106,7 +125,10 @@ def keys(
         str | None,
         typer.Argument(
             metavar="PATTERN",
-            help="Only the keys whose name or description contains this, case ignored, or matches it as a glob ('ball_*').",
+            help=(
+                "Only the keys whose name or description contains this, case ignored, or matches it as a glob "
+                "('ball_*')."
+            ),
         ),
     ] = None,
     engine: Annotated[
@@ -121,8 +143,10 @@ def keys(
     if engine is not None and engine not in ENGINE_KEYS:
         fail(f"--engine: {engine!r} is no engine; allowed {', '.join(map(repr, ENGINE_KEYS))}")
     chosen = [
-        key for key in FIELD_NAMES
-        if (engine is None or reads(engine, key)) and (pattern is None or _matches(pattern, key, field_description(key)))
+        key
+        for key in FIELD_NAMES
+        if (engine is None or reads(engine, key))
+        and (pattern is None or _matches(pattern, key, field_description(key)))
     ]
     narrowed = [f"matching {pattern!r}"] if pattern is not None else []
     if engine is not None:

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Sequence
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -18,7 +19,6 @@ from shakermill.parameters.defaults import (
 )
 
 if TYPE_CHECKING:
-
     from shakermill.io.runs import RunData
 
 
@@ -32,7 +32,10 @@ def load_run_or_fail(folder: Path) -> RunData:
 
 def plot(
     folder: Annotated[
-        Path, typer.Argument(metavar="RUN_DIR|SWEEP_DIR", help="A run folder (`shakermill run`) or a sweep folder (`shakermill sweep`).")
+        Path,
+        typer.Argument(
+            metavar="RUN_DIR|SWEEP_DIR", help="A run folder (`shakermill run`) or a sweep folder (`shakermill sweep`)."
+        ),
     ],
     out: Annotated[
         Path | None, typer.Option("--out", "-o", show_default="DIR/figures", help="Folder for the figures.")
@@ -42,15 +45,32 @@ def plot(
     ] = False,
     contour: Annotated[
         list[str] | None,
-        typer.Option("--contour", metavar="COLUMN=VALUE", help="Sweep folder: draw this level on every map, e.g. theta_inf_C=60."),
+        typer.Option(
+            "--contour", metavar="COLUMN=VALUE", help="Sweep folder: draw this level on every map, e.g. theta_inf_C=60."
+        ),
     ] = None,
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG files.")] = PNG_DPI,
     window: Annotated[
         int | None,
-        typer.Option("--window", min=0, show_default="0", help="Run folder: the record window (index in record_windows, from 0) of the ball's motion, the balls' paths and the animation."),
+        typer.Option(
+            "--window",
+            min=0,
+            show_default="0",
+            help=(
+                "Run folder: the record window (index in record_windows, from 0) of the ball's motion, the balls' "
+                "paths and the animation."
+            ),
+        ),
     ] = None,
     animate: Annotated[
-        bool, typer.Option("--animate", help=f"Run folder of the dem engine: also write {ANIMATION_FILE}, the balls over --window in the vial's side view.")
+        bool,
+        typer.Option(
+            "--animate",
+            help=(
+                f"Run folder of the dem engine: also write {ANIMATION_FILE}, the balls over --window in the vial's "
+                "side view."
+            ),
+        ),
     ] = False,
     frames: Annotated[
         int, typer.Option("--frames", min=2, max=MOST_ANIMATION_FRAMES, help="Frames of the animation (24 a second).")
@@ -65,14 +85,19 @@ def plot(
     if is_sweep_folder(folder):
         for given, option in ((impacts, "--impacts"), (animate, "--animate"), (window is not None, "--window")):
             if given:
-                fail(f"{option}: a sweep folder has no impacts or motion of its own; plot one run (sweep --keep-runs writes them)")
+                fail(
+                    f"{option}: a sweep folder has no impacts or motion of its own; plot one run (sweep --keep-runs "
+                    "writes them)"
+                )
         figures = _sweep_figures(folder, contour or [])
         with writing(target, "the figures"):
             paths = plot_figures(figures, target, dpi=dpi)
     else:
         if contour:
             fail("--contour: contours are drawn on the maps of a sweep folder, not on a run")
-        paths = _plot_run_folder(folder, target, dpi, impacts=impacts, window=window, frames=frames if animate else None)
+        paths = _plot_run_folder(
+            folder, target, dpi, impacts=impacts, window=window, frames=frames if animate else None
+        )
     typer.echo(f"{len(paths)} files written to {target}")
 
 

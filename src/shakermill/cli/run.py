@@ -6,9 +6,10 @@ from __future__ import annotations
 import json
 import re
 import shutil
-from contextlib import contextmanager
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, ContextManager, Iterator, Mapping, NoReturn, Sequence
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn
 
 import typer
 from rich.table import Table
@@ -38,7 +39,6 @@ from shakermill.engines.budget import interrupts_held
 from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S, HIT_SPEED
 
 if TYPE_CHECKING:
-
     from shakermill.parameters.keys import Parameters
     from shakermill.solvers.result import Result
 
@@ -58,8 +58,11 @@ def run(
     overwrite: OverwriteOption = False,
     scheduler: Annotated[
         str | None,
-        typer.Option("--scheduler", metavar="ADDRESS",
-                     help="Advance an averaged run's replicas after the first on this Dask scheduler (tcp://host:8786)."),
+        typer.Option(
+            "--scheduler",
+            metavar="ADDRESS",
+            help="Advance an averaged run's replicas after the first on this Dask scheduler (tcp://host:8786).",
+        ),
     ] = None,
     scheduler_timeout: SchedulerTimeoutOption = DEFAULT_SCHEDULER_TIMEOUT_S,
 ) -> None:
@@ -99,7 +102,9 @@ def run(
         # After a Ctrl-C the figures are left to `plot`, so that it exits within a second.
         finished = no_plots or _draw_figures(result, target)
     if json_output:
-        typer.echo(json.dumps(to_jsonable({**result.summary, "output_dir": str(target)}), sort_keys=True, allow_nan=False))
+        typer.echo(
+            json.dumps(to_jsonable({**result.summary, "output_dir": str(target)}), sort_keys=True, allow_nan=False)
+        )
     elif finished:
         console = stdout_console()
         console.print(summary_table(result, target))
@@ -109,7 +114,7 @@ def run(
     _exit_for_status(result, target)
 
 
-def cluster_for_replicas(params: Parameters, scheduler: str | None, timeout: float) -> ContextManager[None]:
+def cluster_for_replicas(params: Parameters, scheduler: str | None, timeout: float) -> AbstractContextManager[None]:
     """Where the replicas of an averaged run after its first advance: on the Dask scheduler at ``scheduler``
     (solvers/replicas.py), or here. A scheduler a run would not use is refused in one line."""
     from contextlib import nullcontext
@@ -127,7 +132,8 @@ def cluster_for_replicas(params: Parameters, scheduler: str | None, timeout: flo
         key = description.replicas_key
         wanted = f"{key} >= 2" if key else "an engine with replicas (engine = 'dem', dem_replicas >= 2)"
         raise ParameterError(
-            f"--scheduler: this run sends nothing to a cluster (solver = {params.solver!r}, {replicas} replica); allowed "
+            f"--scheduler: this run sends nothing to a cluster (solver = {params.solver!r}, {replicas} "
+            "replica); allowed "
             f"with solver = 'averaged' and {wanted}"
         )
     return _sending_replicas(connect(scheduler, timeout))
@@ -160,8 +166,9 @@ def preset_findings_added(result: Result, preset: str | None, refitted: Sequence
 
 def with_preset_findings(result: Result, preset: str | None, refitted: Sequence[str] = ()) -> None:
     """Add to the summary of any preset's run what its validation found where it failed or is missing
-    (``validation_caveat``, said of the preset as shipped where the configuration ``refitted`` keys), and of a calibrated preset's run the 90 % intervals of its headline temperatures
-    (``studies.uncertainty``), which carry the calibration's uncertainty and the averaging error."""
+    (``validation_caveat``, said of the preset as shipped where the configuration ``refitted`` keys), and of a
+    calibrated preset's run the 90 % intervals of its headline temperatures (``studies.uncertainty``), which carry
+    the calibration's uncertainty and the averaging error."""
     from shakermill.parameters.presets import PRESETS
     from shakermill.studies.uncertainty import intervals, uncertainty_of
 
@@ -220,8 +227,10 @@ def _exit_interrupted(result: Result, target: Path) -> NoReturn:
     from shakermill.solvers.result import INTERRUPTED
 
     what = result.message if result.status == INTERRUPTED else "Interrupted by the user after the run had finished."
-    typer.echo(f"interrupted: {what} Data and status written to {target}; draw its figures with: shakermill plot {target}",
-               err=True)
+    typer.echo(
+        f"interrupted: {what} Data and status written to {target}; draw its figures with: shakermill plot {target}",
+        err=True,
+    )
     raise typer.Exit(EXIT_INTERRUPTED)
 
 
@@ -253,9 +262,18 @@ def summary_table(result: Result, target: Path) -> Table:
     rows = [
         ("status", s["message"] if not result.success else "ok", ""),
         ("solver", s["solver"], ""),
-        ("drive ω", f"{number(s['omega_rad_s'], '.4g')} rad/s = {number(s['omega_hz'], '.4g')} Hz = {number(s['omega_rpm'], '.0f')}", "rpm"),
+        (
+            "drive ω",
+            f"{number(s['omega_rad_s'], '.4g')} rad/s = {number(s['omega_hz'], '.4g')} Hz = "
+            f"{number(s['omega_rpm'], '.0f')}",
+            "rpm",
+        ),
         _size_row(result),
-        ("ambient; initial temperature", f"{number(s['ambient_temperature_C'], '.4g')}; {number(s['initial_temperature_C'], '.4g')}", "°C"),
+        (
+            "ambient; initial temperature",
+            f"{number(s['ambient_temperature_C'], '.4g')}; {number(s['initial_temperature_C'], '.4g')}",
+            "°C",
+        ),
         ("simulated time", number(s["simulated_s"], ".6g"), "s"),
         (f"{ball} steady state", number(s["ball_steady_C"], ".2f"), "°C"),
         ("vial; air steady state", f"{number(s['vial_steady_C'], '.2f')}; {number(s['air_steady_C'], '.2f')}", "°C"),
@@ -271,7 +289,11 @@ def summary_table(result: Result, target: Path) -> Table:
         ("impacts", number(s["impacts"], "d"), ""),
         ("impact rate", number(s["impact_rate_hz"], ".2f"), "Hz"),
         ("mean impact speed", number(s["mean_impact_speed_m_s"], ".3f"), "m/s"),
-        (f"hits ≥ {HIT_SPEED:g} m/s: rate; mean speed", f"{number(s['hit_rate_hz'], '.2f')} Hz; {number(s['mean_hit_speed_m_s'], '.3f')}", "m/s"),
+        (
+            f"hits ≥ {HIT_SPEED:g} m/s: rate; mean speed",
+            f"{number(s['hit_rate_hz'], '.2f')} Hz; {number(s['mean_hit_speed_m_s'], '.3f')}",
+            "m/s",
+        ),
         ("heat generated", number(s["heat_power_W"], ".3f"), "W"),
         ("steps (rejected)", f"{s['steps']} ({s['rejected_steps']})", ""),
         ("wall time", number(s["wall_time_s"], ".2f"), "s"),
@@ -300,8 +322,14 @@ def _fit_rows(result: Result, ball: str, fit_window: str) -> list[tuple[str, str
 
     s = result.summary
     if shorter_than_its_network(result):
-        return [("exponential fit", f"none: the run is shorter than the slowest time constant "
-                 f"({number(s['slowest_time_constant_min'], '.1f')} min)", "")]
+        return [
+            (
+                "exponential fit",
+                f"none: the run is shorter than the slowest time constant "
+                f"({number(s['slowest_time_constant_min'], '.1f')} min)",
+                "",
+            )
+        ]
     return [
         (f"{ball} θ∞ of the exponential fitted over {fit_window}", number(s["theta_inf_C"], ".2f"), "°C"),
         ("τ of that fit", number(s["tau_min"], ".2f"), "min"),
@@ -313,16 +341,33 @@ def interval_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
     """The clamp's temperatures (thermal_model = 'mill-head') and the 90 % intervals of a calibrated preset's run."""
     rows = []
     if "clamp_C" in s:
-        rows.append(("clamp at the end; steady state", f"{number(s['clamp_C'], '.2f')}; {number(s.get('clamp_steady_C'), '.2f')}", "°C"))
-    for key, label in (("ball_C", "ball at the end"), ("vial_C", "vial at the end"), ("ball_steady_C", "ball steady state"),
-                       ("vial_steady_C", "vial steady state")):
+        rows.append(
+            (
+                "clamp at the end; steady state",
+                f"{number(s['clamp_C'], '.2f')}; {number(s.get('clamp_steady_C'), '.2f')}",
+                "°C",
+            )
+        )
+    for key, label in (
+        ("ball_C", "ball at the end"),
+        ("vial_C", "vial at the end"),
+        ("ball_steady_C", "ball steady state"),
+        ("vial_steady_C", "vial steady state"),
+    ):
         if f"{key}_low" in s:
-            rows.append((f"  90 % interval, {label}", f"{number(s[f'{key}_low'], '.1f')} to {number(s[f'{key}_high'], '.1f')}", "°C"))
+            rows.append(
+                (
+                    f"  90 % interval, {label}",
+                    f"{number(s[f'{key}_low'], '.1f')} to {number(s[f'{key}_high'], '.1f')}",
+                    "°C",
+                )
+            )
     return rows
 
 
 def heat_path_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
-    """Each heat path's mean flow over the run, the balls' like paths summed (``ball 2 → air`` counts in ``balls → air``)."""
+    """Each heat path's mean flow over the run, the balls' like paths summed (``ball 2 → air`` counts in
+    ``balls → air``)."""
     totals: dict[str, float] = {}
     for name, value in (s.get("heat_paths_W") or {}).items():
         general = re.sub(r"ball \d+", "balls", name) if s.get("n_balls", 1) > 1 else name
@@ -340,7 +385,13 @@ EACH_BALL_UP_TO = 6
 def several_ball_rows(s: Mapping[str, Any], channels: Sequence[str]) -> list[tuple[str, str, str]]:
     """The run table's rows of an engine of several balls: balls, their temperatures at the end and steady states,
     impacts on the walls and between balls, heat by dissipation channel (``channels``)."""
-    rows = [("engine; balls; fill of the vial", f"{s['engine']}; {s['n_balls']}; {number(s.get('fill_fraction'), '.3f')}", "")]
+    rows = [
+        (
+            "engine; balls; fill of the vial",
+            f"{s['engine']}; {s['n_balls']}; {number(s.get('fill_fraction'), '.3f')}",
+            "",
+        )
+    ]
     for key, what in (("ball_temperatures_C", "at the end"), ("balls_steady_C", "steady state")):
         values = [value for value in s.get(key) or () if value is not None]
         if not values:
@@ -348,19 +399,43 @@ def several_ball_rows(s: Mapping[str, Any], channels: Sequence[str]) -> list[tup
         if len(values) <= EACH_BALL_UP_TO:
             rows.append((f"each ball {what} (ball 0; 1; …)", "; ".join(number(value, ".2f") for value in values), "°C"))
         else:
-            rows.append((f"balls {what}: coolest; hottest", f"{number(min(values), '.2f')}; {number(max(values), '.2f')}", "°C"))
+            rows.append(
+                (f"balls {what}: coolest; hottest", f"{number(min(values), '.2f')}; {number(max(values), '.2f')}", "°C")
+            )
     rows.append(("impacts on the walls; between balls", f"{s['wall_impacts']}; {s['ball_ball_impacts']}", ""))
     if s.get("stress_energy_median_J") is not None:
         # Kwade's ½·m*·v_n² beside the energy dissipated, and how much of the dissipation neither describes.
-        rows.append(("stress energy dissipated per impact: median; p90",
-                     f"{number(s.get('stress_energy_median_J'), '.3g')}; {number(s.get('stress_energy_p90_J'), '.3g')}", "J"))
-        rows.append(("½·m*·v_n² at contact (Kwade): median; p90",
-                     f"{number(s.get('stress_energy_kinetic_median_J'), '.3g')}; {number(s.get('stress_energy_kinetic_p90_J'), '.3g')}", "J"))
+        rows.append(
+            (
+                "stress energy dissipated per impact: median; p90",
+                f"{number(s.get('stress_energy_median_J'), '.3g')}; {number(s.get('stress_energy_p90_J'), '.3g')}",
+                "J",
+            )
+        )
+        rows.append(
+            (
+                "½·m*·v_n² at contact (Kwade): median; p90",
+                f"{number(s.get('stress_energy_kinetic_median_J'), '.3g')}; "
+                f"{number(s.get('stress_energy_kinetic_p90_J'), '.3g')}",
+                "J",
+            )
+        )
         share = s.get("stress_lasting_share")
-        rows.append(("dissipation in lasting contacts (not in the medians)", number(None if share is None else 100 * share, ".3g"), "%"))
+        rows.append(
+            (
+                "dissipation in lasting contacts (not in the medians)",
+                number(None if share is None else 100 * share, ".3g"),
+                "%",
+            )
+        )
     if s.get("charge_regime") is not None:
-        rows.append(("motion (pack: lasting contacts, under one impact > 1 m/s a ball and turn; else active)",
-                     f"{s['charge_regime']}, {number(s.get('fast_impact_rate_hz'), '.4g')} impacts > 1 m/s a second", ""))
+        rows.append(
+            (
+                "motion (pack: lasting contacts, under one impact > 1 m/s a ball and turn; else active)",
+                f"{s['charge_regime']}, {number(s.get('fast_impact_rate_hz'), '.4g')} impacts > 1 m/s a second",
+                "",
+            )
+        )
     heat = [s.get(f"heat_{channel}_W") for channel in channels]
     if any(value is not None for value in heat):
         # The averaged solver has no split by channel: its heat comes from the thermal network's means.
@@ -374,7 +449,8 @@ def compare_solvers(
     settings: SettingsOption = None,
     json_output: JsonOption = False,
 ) -> None:
-    """Run the same configuration with the full and the averaged solver; print both, the differences and the speed ratio."""
+    """Run the same configuration with the full and the averaged solver; print both, the differences and the
+    speed ratio."""
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import load_config
     from shakermill.studies.compare import compare_solvers as compare
@@ -388,7 +464,9 @@ def compare_solvers(
     else:
         table = Table("quantity", "full", "averaged", "averaged − full", "unit", title="full vs averaged solver")
         for label, unit, full_value, averaged_value, difference in comparison.rows():
-            add_plain_row(table, label, number(full_value, ".4g"), number(averaged_value, ".4g"), number(difference, "+.3g"), unit)
+            add_plain_row(
+                table, label, number(full_value, ".4g"), number(averaged_value, ".4g"), number(difference, "+.3g"), unit
+            )
         console = stdout_console()
         console.print(table)
         console.print(Text(f"averaged solver: {comparison.averaged.message}"))

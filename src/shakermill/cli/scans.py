@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.table import Table
@@ -60,26 +61,37 @@ def sweep(
     grid: Annotated[
         list[str] | None,
         typer.Option(
-            "--grid", "-g", metavar="KEY=START:STOP:N",
+            "--grid",
+            "-g",
+            metavar="KEY=START:STOP:N",
             help="N equally spaced values of a numeric key, units allowed (amplitude=20mm:30mm:6), or names "
             "(ball_material=steel,zirconia); several grids combine as a product.",
         ),
     ] = None,
     points: Annotated[
         Path | None,
-        typer.Option("--points", metavar="FILE.csv", help="Explicit points: a header of keys, one point per row (combined with --grid as a product)."),
+        typer.Option(
+            "--points",
+            metavar="FILE.csv",
+            help="Explicit points: a header of keys, one point per row (combined with --grid as a product).",
+        ),
     ] = None,
     preset: PresetOption = None,
     settings: SettingsOption = None,
     out: Annotated[
-        Path | None, typer.Option("--out", "-o", show_default="results/sweep-<timestamp>", help="Sweep folder; re-run into it to resume.")
+        Path | None,
+        typer.Option(
+            "--out", "-o", show_default="results/sweep-<timestamp>", help="Sweep folder; re-run into it to resume."
+        ),
     ] = None,
     workers: Annotated[
         int | None, typer.Option("--workers", "-w", show_default="one per core", help="Local worker processes.")
     ] = None,
     scheduler: SchedulerOption = None,
     scheduler_timeout: SchedulerTimeoutOption = DEFAULT_SCHEDULER_TIMEOUT_S,
-    keep_runs: Annotated[bool, typer.Option("--keep-runs", help="Also write each point's run folder under DIR/runs.")] = False,
+    keep_runs: Annotated[
+        bool, typer.Option("--keep-runs", help="Also write each point's run folder under DIR/runs.")
+    ] = False,
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
 ) -> None:
@@ -96,11 +108,25 @@ def sweep(
     target = out if out is not None else timestamped_folder("sweep")
     try:
         counter = "{task.completed}/{task.total} points · {task.fields[running]} running · {task.fields[failed]} failed"
-        with user_errors(), warnings_as_lines(), progress_bar("sweep", counter, len(plan.points), running=0, failed=0) as update:
-            progress = lambda state: update(state.done, running=state.running, failed=state.failed)
+        with (
+            user_errors(),
+            warnings_as_lines(),
+            progress_bar("sweep", counter, len(plan.points), running=0, failed=0) as update,
+        ):
+
+            def progress(state: Any) -> None:
+                update(state.done, running=state.running, failed=state.failed)
+
             table = run_sweep(
-                run_config.params, plan, target, workers=workers, scheduler=scheduler,
-                keep_runs=keep_runs, progress=progress, preset=run_config.preset, scheduler_timeout=scheduler_timeout,
+                run_config.params,
+                plan,
+                target,
+                workers=workers,
+                scheduler=scheduler,
+                keep_runs=keep_runs,
+                progress=progress,
+                preset=run_config.preset,
+                scheduler_timeout=scheduler_timeout,
             )
     except SweepFailed as exc:
         # Said below like any failed point, after the table's preview.
@@ -153,7 +179,8 @@ def report_sweep(
 
 
 def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path, units: Mapping[str, str]) -> Table:
-    """The first rows of a sweep table: swept values (in ``units`` where given, else SI), regime and the main results."""
+    """The first rows of a sweep table: swept values (in ``units`` where given, else SI), regime and the main
+    results."""
     import pandas as pd
 
     from shakermill.studies.sweep_storage import TABLE_CSV, TABLE_PARQUET, failed_points
@@ -207,7 +234,10 @@ def bifurcation(
     preset: PresetOption = None,
     settings: SettingsOption = None,
     out: Annotated[
-        Path | None, typer.Option("--out", "-o", show_default="results/bifurcation-<timestamp>", help="Folder for tables and figure.")
+        Path | None,
+        typer.Option(
+            "--out", "-o", show_default="results/bifurcation-<timestamp>", help="Folder for tables and figure."
+        ),
     ] = None,
     full_resolution: Annotated[
         bool, typer.Option("--full-resolution", help="Settle with the full-resolution solver (default: averaged).")
@@ -215,7 +245,8 @@ def bifurcation(
     dpi: Annotated[int, typer.Option("--dpi", min=30, max=600, help="Resolution of the PNG file.")] = PNG_DPI,
     overwrite: OverwriteOption = False,
 ) -> None:
-    """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation diagram."""
+    """Scan one key, record the impact phases of the settled motion, classify each run and draw the bifurcation
+    diagram."""
     from shakermill.io.runs import check_target, write_folder
     from shakermill.parameters.engine_keys import reader_of
     from shakermill.studies.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
@@ -237,9 +268,11 @@ def bifurcation(
     target = out if out is not None else timestamped_folder("bifurcation")
     with user_errors():
         check_target(target, overwrite=overwrite, kind=BIFURCATION_FOLDER)
-    with nothing_written_when_interrupted("a scan is quick to repeat"), nothing_written_when_a_run_is_stopped(
-        "the scan"
-    ), progress_bar("scanning", "{task.completed}/{task.total} runs", len(values)) as update:
+    with (
+        nothing_written_when_interrupted("a scan is quick to repeat"),
+        nothing_written_when_a_run_is_stopped("the scan"),
+        progress_bar("scanning", "{task.completed}/{task.total} runs", len(values)) as update,
+    ):
         scan = regime_scan(run_config.params, values, key, progress=lambda done, _total: update(done))
 
     def fill(folder: Path) -> None:
@@ -269,7 +302,9 @@ def _require_attractor_starts(engine: str) -> None:
     if not describe(engine).attractor_starts:
         allowed = [repr(name) for name in engine_names() if describe(name).attractor_starts]
         named = f"= {allowed[0]}" if len(allowed) == 1 else f"one of {', '.join(allowed)}"
-        raise ParameterError(f"engine: bifurcation settles the one ball's attractors; allowed engine {named} here (got {engine!r})")
+        raise ParameterError(
+            f"engine: bifurcation settles the one ball's attractors; allowed engine {named} here (got {engine!r})"
+        )
 
 
 COEXISTING_PREVIEW_ROWS = 20
@@ -282,15 +317,30 @@ def coexisting_attractors_table(attractors: pd.DataFrame, key: str, starts: int,
     several = attractors[counts > 1]
     values = several[key].unique()
     if not len(values):
-        return Text(f"coexisting attractors: none; all {starts} starts reach one attractor at each of {attractors[key].nunique()} values")
+        return Text(
+            f"coexisting attractors: none; all {starts} starts reach one attractor at each of "
+            f"{attractors[key].nunique()} values"
+        )
     table = Table(
-        key_header(key, unit), "attractor", "regime", "basin fraction", "heat power (W)", "impact rate (Hz)",
-        title=f"coexisting attractors ({starts} starts per value): at {len(values)} of {attractors[key].nunique()} values",
+        key_header(key, unit),
+        "attractor",
+        "regime",
+        "basin fraction",
+        "heat power (W)",
+        "impact rate (Hz)",
+        title=(
+            f"coexisting attractors ({starts} starts per value): at {len(values)} of {attractors[key].nunique()} values"
+        ),
     )
     for _, row in several[several[key].isin(values[:COEXISTING_PREVIEW_ROWS])].iterrows():
         add_plain_row(
-            table, f"{in_unit(row[key], key, unit):.5g}", str(row["attractor"]), str(row["regime"]), f"{row['basin_fraction']:.2f}",
-            f"{row['heat_power_W']:.4g}", f"{row['impact_rate_hz']:.4g}",
+            table,
+            f"{in_unit(row[key], key, unit):.5g}",
+            str(row["attractor"]),
+            str(row["regime"]),
+            f"{row['basin_fraction']:.2f}",
+            f"{row['heat_power_W']:.4g}",
+            f"{row['impact_rate_hz']:.4g}",
         )
     more = len(values) - COEXISTING_PREVIEW_ROWS
     table.caption = (f"{more} more values; " if more > 0 else "") + "all attractors: bifurcation_attractors.csv"

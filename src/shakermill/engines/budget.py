@@ -14,9 +14,10 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Iterator, Mapping
+from typing import TYPE_CHECKING
 
 from shakermill.engines.status import BUDGET_EXCEEDED
 
@@ -94,7 +95,8 @@ class RunBudget:
         if needed <= PACE_MARGIN * self.max_wall_time:
             return False
         self.reason = (
-            f"The run was stopped early: at its pace so far ({simulated:.3g} s simulated in {wall:.3g} s) it would need "
+            f"The run was stopped early: at its pace so far ({simulated:.3g} s simulated in {wall:.3g} s) it would "
+            "need "
             f"~{_hours_or_minutes(needed)} of computing to reach t = {end:g} s, beyond its wall-clock budget "
             f"(max_wall_time = {self.max_wall_time:g} s). Ask for less work (a shorter duration, fewer balls, "
             f"solver = 'averaged') or allow it, e.g. --set max_wall_time={math.ceil(needed * PACE_MARGIN):d}."
@@ -112,7 +114,8 @@ class RunBudget:
         if elapsed > self.max_wall_time:
             return (
                 f"The run used up its wall-clock budget (max_wall_time = {self.max_wall_time:g} s, {elapsed:.3g} s "
-                f"elapsed). If the run is meant to take that long, raise it, e.g. --set max_wall_time={2 * self.max_wall_time:g}."
+                "elapsed). If the run is meant to take that long, raise it, e.g. --set "
+                f"max_wall_time={2 * self.max_wall_time:g}."
             )
         return None
 

@@ -10,7 +10,8 @@ each engine's loop resumes bit for bit where it paused.
 from __future__ import annotations
 
 import time
-from typing import Callable, ClassVar
+from collections.abc import Callable
+from typing import ClassVar
 
 from shakermill.engines.budget import RunBudget, interrupts_held
 from shakermill.engines.status import BUDGET_EXCEEDED
@@ -59,7 +60,9 @@ class CompiledRun:
             before = self.steps_taken()
             started = time.perf_counter()
             with interrupts_held():
-                status = self.compiled_call(t_stop, min(self._pace or self.first_steps_per_call, self.budget.steps_left))
+                status = self.compiled_call(
+                    t_stop, min(self._pace or self.first_steps_per_call, self.budget.steps_left)
+                )
             steps = self.steps_taken() - before
             self.budget.count_steps(steps)
             if status == CALL_AGAIN:

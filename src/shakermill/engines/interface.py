@@ -5,8 +5,9 @@ read an engine's description instead of asking which engine a run used (docs/ARC
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable, ClassVar, Mapping, NamedTuple, Protocol, Sequence
+from typing import TYPE_CHECKING, ClassVar, NamedTuple, Protocol
 
 from shakermill.parameters.engine_keys import EngineKeys
 
@@ -36,7 +37,9 @@ class EngineDescription:
     # over a run's second half, through ``Engine.load``, drive its steady state.
     heat_variables: tuple[str, ...]
     term_variables: tuple[str, ...]
-    status_messages: Mapping[int, str]  # every status code it reports (engines/status.py's and its own) and what it means
+    status_messages: Mapping[
+        int, str
+    ]  # every status code it reports (engines/status.py's and its own) and what it means
     averaging_error_key: str  # the key of its averaged solver's target relative standard error
     # Keys that enter its thermal network alone, never its mechanics: runs that differ in these share one
     # measured mechanics (solvers.simulate.thermal_variants). Empty where the temperatures share the mechanics'
@@ -69,7 +72,7 @@ class Measured(NamedTuple):
     heat: np.ndarray
     terms: np.ndarray
     dissipated: float
-    conduction: "np.ndarray" = ()
+    conduction: np.ndarray = ()
 
 
 ProgressCallback = Callable[[float, float], None]
@@ -83,8 +86,13 @@ class Engine(Protocol):
     budget: RunBudget
     network: ThermalNetwork
 
-    def __init__(self, params: Parameters, budget: RunBudget | None = None, samples: Sequence[float] = (0.0,),
-                 horizon: float = 0.0) -> None:
+    def __init__(
+        self,
+        params: Parameters,
+        budget: RunBudget | None = None,
+        samples: Sequence[float] = (0.0,),
+        horizon: float = 0.0,
+    ) -> None:
         """A run from ``params``' initial state, within ``budget`` (``params``' own if None); its history is sampled
         at ``samples`` (s, sorted) and its record windows (``params.record_windows``) are kept up to ``horizon`` (s)."""
 
@@ -136,7 +144,14 @@ class Engine(Protocol):
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
         """How many of ``impacts`` heated each node of the network."""
 
-    def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray,
-                         load: NetworkLoad, dissipated_power: float, network: ThermalNetwork) -> StateHistory:
+    def averaged_history(
+        self,
+        times: np.ndarray,
+        temperatures: np.ndarray,
+        heat_lost: np.ndarray,
+        load: NetworkLoad,
+        dissipated_power: float,
+        network: ThermalNetwork,
+    ) -> StateHistory:
         """The history of an averaged run: the network's ``temperatures`` (node, time) and the cumulative heat
         lost; the flows as the load's mean rates times time; the motion, not computed, NaN."""

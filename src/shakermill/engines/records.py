@@ -4,8 +4,9 @@ and where the supplied work went (:class:`EnergyAudit`). The solvers assemble a 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,7 +45,8 @@ class StateHistory:
     def with_attributes(self, extra: Mapping[str, Mapping[str, str]]) -> StateHistory:
         """The same history with ``extra[name]`` added to the attributes of variable ``name``."""
         variables = {
-            name: (values, {**attributes, **extra.get(name, {})}) for name, (values, attributes) in self.variables.items()
+            name: (values, {**attributes, **extra.get(name, {})})
+            for name, (values, attributes) in self.variables.items()
         }
         return StateHistory(self.times, variables, self.dimensions)
 

@@ -24,9 +24,10 @@ import json
 import math
 import os
 import shutil
+from collections.abc import Callable, Container, Iterable, Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Container, Iterable, Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -211,7 +212,8 @@ def _run_attributes(result: Result, preset: str) -> dict[str, Any]:
 
 
 def averaging_coverage(result: Result) -> dict[str, str]:
-    """What the files of an averaged run cover, in words (the motion only over the averaging window); empty for a full run."""
+    """What the files of an averaged run cover, in words (the motion only over the averaging window); empty for a full
+    run."""
     averages = result.averages
     if result.impact_window is None or averages is None:
         return {}
@@ -241,9 +243,12 @@ def _covers(coverage: Mapping[str, str], part: str) -> dict[str, str]:
     return {COVERAGE_KEY: coverage[part]} if coverage else {}
 
 
-def _mark_averaged_variables(history: StateHistory, description: EngineDescription,
-                             coverage: Mapping[str, str]) -> StateHistory:
-    marks = {name: {COVERAGE_KEY: coverage["motion_variable"]} for name in description.motion if name in history.variables}
+def _mark_averaged_variables(
+    history: StateHistory, description: EngineDescription, coverage: Mapping[str, str]
+) -> StateHistory:
+    marks = {
+        name: {COVERAGE_KEY: coverage["motion_variable"]} for name in description.motion if name in history.variables
+    }
     marks.update({name: {COVERAGE_KEY: coverage["flow_variable"]} for name in description.averaged_flows})
     return history.with_attributes(marks)
 
@@ -272,13 +277,18 @@ def netcdf_bytes(history: StateHistory, *, title: str, **attributes: Any) -> byt
         for name, (values, _) in history.variables.items():
             sizes.update(zip(history.dims(name), np.shape(values)))
         file.dimensions = sizes
-        for name, (values, variable_attributes) in {"time": (history.times, TIME_ATTRIBUTES), **history.variables}.items():
+        for name, (values, variable_attributes) in {
+            "time": (history.times, TIME_ATTRIBUTES),
+            **history.variables,
+        }.items():
             variable = file.create_variable(name, history.dims(name), data=values)
             variable.attrs.update(variable_attributes)
     return buffer.getvalue()
 
 
-def impacts_parquet(columns: Mapping[str, np.ndarray], units: Mapping[str, str], *, coverage: str | None = None) -> memoryview:
+def impacts_parquet(
+    columns: Mapping[str, np.ndarray], units: Mapping[str, str], *, coverage: str | None = None
+) -> memoryview:
     """The impact columns as a Parquet file, with their ``units`` as JSON in the schema metadata, and what
     the table covers (``coverage``) where it is not the whole run."""
     import pyarrow as pa
@@ -312,7 +322,9 @@ def arrow_array(values: np.ndarray) -> Any:
         buffers = [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(encoded.tolist()))]
         return pa.Array.from_buffers(pa.string(), values.size, buffers)
     contiguous = np.ascontiguousarray(values)
-    return pa.Array.from_buffers(pa.from_numpy_dtype(contiguous.dtype), contiguous.size, [None, pa.py_buffer(contiguous)])
+    return pa.Array.from_buffers(
+        pa.from_numpy_dtype(contiguous.dtype), contiguous.size, [None, pa.py_buffer(contiguous)]
+    )
 
 
 def summary_document(result: Result, preset: str) -> dict[str, Any]:
@@ -367,7 +379,9 @@ def load_run(path: Path | str) -> RunData:
         raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
     document = _read_part(summary_path, _summary_document)
     config = _read_part(folder / CONFIG_FILE, load_config)
-    impacts, impact_units = _read_part(folder / IMPACTS_FILE, lambda path: _read_impact_table(path, config.params.engine))
+    impacts, impact_units = _read_part(
+        folder / IMPACTS_FILE, lambda path: _read_impact_table(path, config.params.engine)
+    )
     return RunData(
         path=folder,
         params=config.params,
@@ -432,7 +446,8 @@ def _read_impact_table(path: Path, engine: str) -> tuple[pd.DataFrame, dict[str,
 
 
 def _require(names: Iterable[str], present: Container[str], kind: str) -> None:
-    """A file of the right format but not written by a run (another tool's, an empty one) lacks what plot and report read."""
+    """A file of the right format but not written by a run (another tool's, an empty one) lacks what plot and report
+    read."""
     missing = [name for name in names if name not in present]
     if missing:
         raise ValueError(f"no {kind} {missing[0]!r}; not written by shakermill run")
@@ -445,7 +460,8 @@ def _read_part(path: Path, read: Callable[[Path], Any]) -> Any:
             raise FileNotFoundError(errno.ENOENT, "missing")
         return read(path)
     except (OSError, ValueError, KeyError, TypeError) as exc:
-        # ValueError covers malformed JSON, TOML and Parquet (ArrowInvalid) and a configuration that no longer validates.
+        # ValueError covers malformed JSON, TOML and Parquet (ArrowInvalid) and a configuration that no longer
+        # validates.
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else in_one_line(exc)
         # A configuration error names the file already.
         reason = reason.removeprefix(f"{path}: ") or type(exc).__name__

@@ -8,8 +8,9 @@ posterior says what it is) nor a key its own run does not read (a planetary jar 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 from shakermill.parameters.engine_keys import Reader
 from shakermill.parameters.errors import ParameterError
@@ -61,15 +62,19 @@ def assumed_input(key: str, table: Any, where: str) -> AssumedInput:
     low, high, distribution, reason = (table[field] for field in TABLE_FIELDS)
     moves = table.get(MOVES_FIELD, [])
     if key not in BOWL_KEYS and moves or not isinstance(moves, list) or not set(moves) <= set(DERIVED_KEYS):
-        raise ParameterError(f"{name}: {MOVES_FIELD} lists keys derived from the vial's dimensions "
-                             f"({', '.join(DERIVED_KEYS)}), only for {', '.join(BOWL_KEYS)}")
+        raise ParameterError(
+            f"{name}: {MOVES_FIELD} lists keys derived from the vial's dimensions "
+            f"({', '.join(DERIVED_KEYS)}), only for {', '.join(BOWL_KEYS)}"
+        )
     if not all(isinstance(bound, (int, float)) and math.isfinite(bound) for bound in (low, high)) or not low < high:
         raise ParameterError(f"{name}: low and high must be finite numbers with low < high, not {low!r}, {high!r}")
     allowed = bounds(key)
     if not (allowed.contains(low) and allowed.contains(high)):
         raise ParameterError(f"{name}: [{low:g}, {high:g}] leaves {key}'s allowed range {allowed}")
     if distribution not in DISTRIBUTIONS or (distribution == "log-uniform" and low <= 0):
-        raise ParameterError(f"{name}: distribution must be one of {', '.join(DISTRIBUTIONS)} (log-uniform needs low > 0)")
+        raise ParameterError(
+            f"{name}: distribution must be one of {', '.join(DISTRIBUTIONS)} (log-uniform needs low > 0)"
+        )
     if not isinstance(reason, str) or not reason.strip():
         raise ParameterError(f"{name}: give the reason for the range")
     return AssumedInput(key, float(low), float(high), str(distribution), reason, tuple(moves))
@@ -78,8 +83,10 @@ def assumed_input(key: str, table: Any, where: str) -> AssumedInput:
 def check_holds(assumed: AssumedInput, value: float, where: str) -> None:
     """A preset's own value of an assumed input lies in the range it states."""
     if not assumed.contains(float(value)):
-        raise ParameterError(f"{where}: [assumed.{assumed.key}]: the preset's {assumed.key} = {value:g} lies outside "
-                             f"its range {assumed.shown_range()}; state its own [assumed.{assumed.key}]")
+        raise ParameterError(
+            f"{where}: [assumed.{assumed.key}]: the preset's {assumed.key} = {value:g} lies outside "
+            f"its range {assumed.shown_range()}; state its own [assumed.{assumed.key}]"
+        )
 
 
 def check_derived(assumed: AssumedInput, values: Mapping[str, Any], where: str) -> None:
@@ -87,15 +94,20 @@ def check_derived(assumed: AssumedInput, values: Mapping[str, Any], where: str) 
     change the bowl in two ways at once (the bore's area; the wall's mass sets the density it moves with)."""
     for key, expected in derived_values(assumed.moves, values, values).items():
         if abs(float(values[key]) - expected) > 1e-6 * abs(expected):
-            raise ParameterError(f"{where}: [assumed.{assumed.key}]: moves {key}, but the preset's {key} = "
-                                 f"{float(values[key]):g} is not the {expected:g} its vial's dimensions give")
+            raise ParameterError(
+                f"{where}: [assumed.{assumed.key}]: moves {key}, but the preset's {key} = "
+                f"{float(values[key]):g} is not the {expected:g} its vial's dimensions give"
+            )
 
 
 def derived_values(keys: Sequence[str], values: Mapping[str, Any], base: Mapping[str, Any]) -> dict[str, float]:
     """``keys`` (of DERIVED_KEYS) for the vial dimensions of ``values``: the bore's area, and the mass of the wall
     at the density ``base``'s mass and dimensions imply (a preset states no density of its vial)."""
+
     def wall(of: Mapping[str, Any]) -> float:
-        return wall_volume(*(float(of[key]) for key in ("outer_diameter", "outer_length", "vial_diameter", "vial_length")))
+        return wall_volume(
+            *(float(of[key]) for key in ("outer_diameter", "outer_length", "vial_diameter", "vial_length"))
+        )
 
     found = {}
     if "inner_area" in keys:
@@ -119,12 +131,20 @@ def keeping_moves(user: AssumedInput, stated: Mapping[str, AssumedInput]) -> Ass
     return replace(user, moves=stated[user.key].moves) if user.key in stated else user
 
 
-def inherited_assumed(base: Mapping[str, AssumedInput], tables: Mapping[str, Any], values: Mapping[str, Any],
-                      fitted: tuple[str, ...], reader: Reader, where: str) -> dict[str, AssumedInput]:
+def inherited_assumed(
+    base: Mapping[str, AssumedInput],
+    tables: Mapping[str, Any],
+    values: Mapping[str, Any],
+    fitted: tuple[str, ...],
+    reader: Reader,
+    where: str,
+) -> dict[str, AssumedInput]:
     """A preset's assumed inputs: those of its ``base`` and its own ``tables`` (which replace the base's), less the
     keys it ``fitted`` and those its run (``reader``) does not read; each checked against the preset's ``values``."""
     own = {key: assumed_input(key, table, where) for key, table in tables.items()}
-    kept = {key: assumed for key, assumed in {**base, **own}.items() if key not in fitted and reader.not_read(key) is None}
+    kept = {
+        key: assumed for key, assumed in {**base, **own}.items() if key not in fitted and reader.not_read(key) is None
+    }
     for key, assumed in kept.items():
         check_holds(assumed, values[key], where)
         check_derived(assumed, values, where)
@@ -145,6 +165,10 @@ def parse_assumption(text: str, reader: Reader) -> AssumedInput:
     why = reader.not_read(key) if key in Parameters.model_fields else None
     if why is not None:
         raise ParameterError(f"--assume {key}: the run does not read it: {why}")
-    table = {"low": low, "high": high, "distribution": parts[2] if len(parts) == 3 else "uniform",
-             "reason": "the user's range (--assume)"}
+    table = {
+        "low": low,
+        "high": high,
+        "distribution": parts[2] if len(parts) == 3 else "uniform",
+        "reason": "the user's range (--assume)",
+    }
     return assumed_input(key, table, "--assume")

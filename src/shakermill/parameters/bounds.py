@@ -8,8 +8,8 @@ beside it (2.4999999999999998e-05): a value within :data:`RELATIVE_TOLERANCE` of
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 # Far above the rounding of a unit conversion (~1e-16), far below any difference a user means.
 RELATIVE_TOLERANCE = 1e-9

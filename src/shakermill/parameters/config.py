@@ -14,10 +14,11 @@ from __future__ import annotations
 import dataclasses
 import platform
 import tomllib
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import tomli_w
 
@@ -108,8 +109,9 @@ def load_config(
     notes = [run.ignored_note(inherited, defaults, preset_reader)]
     if file_preset is not None and chosen_preset != file_preset:
         notes.append(f"The preset is {chosen_preset!r} (--preset), not the {file_preset!r} that {source} names.")
-    config = RunConfig(params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note),
-                       **tables)
+    config = RunConfig(
+        params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note), **tables
+    )
     if config.assumed_tables:
         config_preset(config)  # its [assumed.KEY] tables checked now, with one line for the first that is wrong
     return config
@@ -125,8 +127,9 @@ def config_preset(config: RunConfig) -> Preset:
         fitted = tuple(config.provenance["fitted"])
         note = f"fitted by calibration ({config.source.name}, [provenance])"
         values = {**base.values, **{key: Cited(getattr(config.params, key), note) for key in fitted}}
-        base = dataclasses.replace(base, name=config.source.stem, values=values, fitted=fitted,
-                                   provenance=config.provenance)
+        base = dataclasses.replace(
+            base, name=config.source.stem, values=values, fitted=fitted, provenance=config.provenance
+        )
     tables = config.assumed_tables
     if not isinstance(tables, Mapping):
         raise ParameterError(f"{config.source}: [assumed] must hold tables [assumed.KEY]")
@@ -134,8 +137,9 @@ def config_preset(config: RunConfig) -> Preset:
     problem = reader.unread_problem([key for key in tables if key in Parameters.model_fields], how="given a range")
     if problem is not None:
         raise ParameterError(f"{config.source}: [assumed]: {problem}")
-    assumed = inherited_assumed(base.assumed, tables, config.params.model_dump(), base.fitted, reader,
-                                config.source.name)
+    assumed = inherited_assumed(
+        base.assumed, tables, config.params.model_dump(), base.fitted, reader, config.source.name
+    )
     return dataclasses.replace(base, assumed=assumed)
 
 
@@ -178,7 +182,9 @@ def _config_text(path: Path) -> str:
         # -sig: editors on Windows start UTF-8 files with a byte-order mark, which TOML itself does not allow.
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise ParameterError(f"{path}: not UTF-8 text (byte {data[exc.start]:#04x} at offset {exc.start}); save it as UTF-8") from None
+        raise ParameterError(
+            f"{path}: not UTF-8 text (byte {data[exc.start]:#04x} at offset {exc.start}); save it as UTF-8"
+        ) from None
 
 
 def _file_preset(values: dict[str, Any], path: Path) -> str | None:
@@ -247,15 +253,16 @@ def values_beyond_preset(params: Parameters, preset: str) -> dict[str, Any]:
     """The values of ``params`` that differ from those of ``preset``, as a configuration file writes them (SI);
     ``n_balls`` is left out where ``fill`` sets it."""
     ours, theirs = params.model_dump(), default_parameters(preset).model_dump()
-    return {key: value for key, value in ours.items()
-            if value != theirs[key] and not (key == "n_balls" and params.fill > 0)}
+    return {
+        key: value for key, value in ours.items() if value != theirs[key] and not (key == "n_balls" and params.fill > 0)
+    }
 
 
 def _provenance(preset: str, extra: Mapping[str, Any]) -> dict[str, Any]:
     provenance: dict[str, Any] = {
         "shakermill_version": __version__,
         "preset": preset,
-        "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "python": platform.python_version(),
         "units": SI_NOTE,
     }

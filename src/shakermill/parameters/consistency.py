@@ -7,7 +7,8 @@ derived values alone."""
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 from shakermill.parameters.engine_keys import ENGINE_KEYS, MAX_BALLS, engine_problem
 from shakermill.parameters.geometry import ball_volume, balls_for_fill
@@ -36,11 +37,14 @@ def ball_fits_vial(params: Any) -> None:
     if diameter > params.vial_diameter:
         raise ValueError(
             f"ball_radius: a ball of diameter {diameter * 1e3:g} mm does not fit a vial of diameter "
-            f"{params.vial_diameter * 1e3:g} mm; allowed ball_radius <= vial_diameter/2 = {params.vial_diameter / 2:g} m"
+            f"{params.vial_diameter * 1e3:g} mm; allowed ball_radius <= vial_diameter/2 = {params.vial_diameter / 2:g} "
+            "m"
         )
     half_gap = params.vial_length / 2.0 - params.ball_radius
     if abs(params.ball_position) >= half_gap:
-        raise ValueError(f"ball_position: the ball must start inside the vial, allowed |ball_position| < {half_gap:g} m")
+        raise ValueError(
+            f"ball_position: the ball must start inside the vial, allowed |ball_position| < {half_gap:g} m"
+        )
 
 
 def outside_holds_the_bore(params: Any) -> None:
@@ -55,7 +59,9 @@ def outside_holds_the_bore(params: Any) -> None:
                 f"{getattr(params, inner):g} m"
             )
     if params.model != "three_node":
-        raise ValueError("model: thermal_model = 'mill-head' has a vial and a clamp of their own; allowed model = 'three_node'")
+        raise ValueError(
+            "model: thermal_model = 'mill-head' has a vial and a clamp of their own; allowed model = 'three_node'"
+        )
 
 
 def fill_sets_the_balls(params: Any, per_ball_keys: Sequence[str]) -> None:
@@ -73,17 +79,21 @@ def fill_sets_the_balls(params: Any, per_ball_keys: Sequence[str]) -> None:
         raise ValueError(problem)
     listed = next((key for key in ("ball_materials", *per_ball_keys) if getattr(params, key)), None)
     if listed is not None:
-        raise ValueError(f"fill: makes equal balls, and {listed} gives each ball its own value; allowed fill = 0 with per-ball lists")
+        raise ValueError(
+            f"fill: makes equal balls, and {listed} gives each ball its own value; allowed fill = 0 with per-ball lists"
+        )
     wanted = balls_for_fill(params.fill, params.ball_radius, params.vial_length, params.vial_diameter)
     if wanted > MAX_BALLS:
         raise ValueError(
-            f"fill: {params.fill:g} of this vial is {wanted} balls of radius {params.ball_radius * 1e3:g} mm; allowed fill "
+            f"fill: {params.fill:g} of this vial is {wanted} balls of radius {params.ball_radius * 1e3:g} mm; allowed "
+            "fill "
             f"< {_fill_below(params, MAX_BALLS):.3g} here (at most {MAX_BALLS} balls)"
         )
     if params.n_balls != wanted:
         raise ValueError(
             f"n_balls: {params.n_balls} contradicts fill = {params.fill:g}, which makes {wanted} balls of radius "
-            f"{params.ball_radius * 1e3:g} mm in this vial; allowed n_balls = {wanted}, or fill = 0 to give n_balls alone"
+            f"{params.ball_radius * 1e3:g} mm in this vial; allowed n_balls = {wanted}, or fill = 0 to give n_balls "
+            "alone"
         )
 
 
@@ -110,7 +120,9 @@ def motion_is_well_formed(params: Any) -> None:
     """A Fourier motion has terms, no coordinate moves too far, and a mixer mill's arc turns the jar at most a
     quarter turn."""
     if params.kinematics == "fourier" and not params.motion:
-        raise ValueError("motion: kinematics = 'fourier' needs at least one harmonic; allowed (coordinate, k, cos, sin) terms")
+        raise ValueError(
+            "motion: kinematics = 'fourier' needs at least one harmonic; allowed (coordinate, k, cos, sin) terms"
+        )
     _check_motion(params.motion)
     if params.kinematics == "mixer-mill-arc" and arc_angle(params.amplitude, params.swing_radius) > MAX_SWING_ANGLE:
         raise ValueError(
@@ -139,7 +151,8 @@ def _check_motion(motion: tuple[tuple[str, int, float, float], ...]) -> None:
         limit, unit = (math.pi, "rad") if coordinate in ("roll", "pitch", "yaw") else (MAX_MOTION_TRANSLATION, "m")
         if amplitude > limit:
             raise ValueError(
-                f"motion: the harmonics of {coordinate} add up to {amplitude:g} {unit}; allowed at most {limit:g} {unit}"
+                f"motion: the harmonics of {coordinate} add up to {amplitude:g} {unit}; allowed at most {limit:g} "
+                f"{unit}"
             )
 
 
@@ -152,7 +165,8 @@ def balls_fit_side_by_side(params: Any) -> None:
     if 2.0 * largest >= params.vial_diameter:
         key = "ball_radii" if params.ball_radii else "ball_radius"
         raise ValueError(
-            f"{key}: a ball of diameter {2e3 * largest:g} mm does not move in a bore of {params.vial_diameter * 1e3:g} mm; "
+            f"{key}: a ball of diameter {2e3 * largest:g} mm does not move in a bore of {params.vial_diameter * 1e3:g} "
+            "mm; "
             f"allowed radii < vial_diameter/2 = {params.vial_diameter / 2:g} m"
         )
     if params.n_balls > 1 and params.initial_positions() is None:
@@ -160,7 +174,8 @@ def balls_fit_side_by_side(params: Any) -> None:
             _refuse_fill_that_does_not_fit(params)
         raise ValueError(
             f"n_balls: {params.n_balls} balls (radius up to {largest * 1e3:g} mm) do not fit side by side in a vial of "
-            f"{params.vial_diameter * 1e3:g} mm x {params.vial_length * 1e3:g} mm; allowed fewer balls, smaller ones or a "
+            f"{params.vial_diameter * 1e3:g} mm x {params.vial_length * 1e3:g} mm; allowed fewer balls, smaller ones "
+            "or a "
             "larger vial_diameter"
         )
 
@@ -173,7 +188,8 @@ def _refuse_fill_that_does_not_fit(params: Any) -> None:
     fitting = len(packed(np.full(params.n_balls, params.ball_radius), params.vial_length, params.vial_diameter))
     raise ValueError(
         f"fill: {params.fill:g} of the vial is {params.n_balls} balls of radius {params.ball_radius * 1e3:g} mm, and "
-        f"{fitting} fit side by side in {params.vial_diameter * 1e3:g} mm x {params.vial_length * 1e3:g} mm; allowed fill "
+        f"{fitting} fit side by side in {params.vial_diameter * 1e3:g} mm x {params.vial_length * 1e3:g} mm; allowed "
+        "fill "
         f"< {_fill_below(params, fitting):.3g} for these balls and this vial"
     )
 
@@ -196,7 +212,8 @@ def stored_data_fit_in_memory(params: Any) -> None:
     if params.solver == "full" and periods > MAX_FULL_RESOLUTION_PERIODS:
         longest = MAX_FULL_RESOLUTION_PERIODS * params.period
         raise ValueError(
-            f"duration: {params.duration:g} s at omega = {params.omega:g} rad/s is {periods:.3g} drive periods, and the "
+            f"duration: {params.duration:g} s at omega = {params.omega:g} rad/s is {periods:.3g} drive periods, and "
+            "the "
             f"full solver keeps every impact; allowed duration <= {longest:.4g} s here "
             f"({MAX_FULL_RESOLUTION_PERIODS:,} periods), or solver = 'averaged' for longer runs"
         )

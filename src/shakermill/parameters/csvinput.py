@@ -26,7 +26,9 @@ def read_csv_rows(path: Path, what: str, most_rows: int, delimiter: str = ",") -
                 _check_cells(row, what, reader.line_num)
                 rows.append(row)
                 if len(rows) > most_rows + 1:
-                    raise ParameterError(f"{what}: more than {most_rows:,} rows after the header; allowed at most {most_rows:,}")
+                    raise ParameterError(
+                        f"{what}: more than {most_rows:,} rows after the header; allowed at most {most_rows:,}"
+                    )
     except UnicodeDecodeError:
         raise ParameterError(f"{what}: not UTF-8 text; save it as UTF-8 (with or without a byte-order mark)") from None
     except csv.Error as exc:
@@ -52,7 +54,8 @@ def check_rectangular(rows: list[list[str]], header: list[str], what: str) -> No
             continue
         hint = (
             "; a decimal comma splits a number in two: write 25.1, not 25,1 (or separate the columns with ';')"
-            if len(row) > len(header) else ""
+            if len(row) > len(header)
+            else ""
         )
         raise ParameterError(
             f"{what} line {line}: {len(row)} cell{'s' * (len(row) != 1)} for the {len(header)} columns of its header "

@@ -7,8 +7,9 @@ in this layer, below the engines; each engine carries its own as part of its des
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any
 
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 
@@ -52,13 +53,43 @@ ONE_DIMENSIONAL = EngineKeys(
     air_moves_with_vial=False,
     unread=frozenset(
         {
-            "n_balls", "fill", "ball_radii", "ball_densities", "ball_youngs_moduli", "ball_poisson_ratios",
-            "ball_heat_capacities", "ball_conductivities", "ball_materials", "ball_conductivity", "gravity", "friction",
-            "pair_friction", "pair_restitution", "rolling_friction", "kinematics", "lateral_amplitude", "yaw_amplitude",
-            "swing_radius", "motion", "revolution_radius", "speed_ratio", "jar_tilt",
-            "contact_step_fraction", "enduring_step_fraction", "max_flight_step", "dem_averaging_rel_error",
-            "dem_replicas", "thermal_model", "outer_diameter", "outer_length", "emissivity", "vial_conductivity", "clamp_heat_capacity",
-            "clamp_conductance", "clamp_loss", "drive_heat",
+            "n_balls",
+            "fill",
+            "ball_radii",
+            "ball_densities",
+            "ball_youngs_moduli",
+            "ball_poisson_ratios",
+            "ball_heat_capacities",
+            "ball_conductivities",
+            "ball_materials",
+            "ball_conductivity",
+            "gravity",
+            "friction",
+            "pair_friction",
+            "pair_restitution",
+            "rolling_friction",
+            "kinematics",
+            "lateral_amplitude",
+            "yaw_amplitude",
+            "swing_radius",
+            "motion",
+            "revolution_radius",
+            "speed_ratio",
+            "jar_tilt",
+            "contact_step_fraction",
+            "enduring_step_fraction",
+            "max_flight_step",
+            "dem_averaging_rel_error",
+            "dem_replicas",
+            "thermal_model",
+            "outer_diameter",
+            "outer_length",
+            "emissivity",
+            "vial_conductivity",
+            "clamp_heat_capacity",
+            "clamp_conductance",
+            "clamp_loss",
+            "drive_heat",
         }
     ),
 )
@@ -73,7 +104,15 @@ THREE_DIMENSIONAL = EngineKeys(
     air_moves_with_vial=True,
     # It steps by velocity Verlet at its own contact step, and its heat is η times what each contact dissipates.
     unread=frozenset(
-        {"rtol", "atol_position", "atol_momentum", "atol_temperature", "energy_projection", "heat_model", "averaging_rel_error"}
+        {
+            "rtol",
+            "atol_position",
+            "atol_momentum",
+            "atol_temperature",
+            "energy_projection",
+            "heat_model",
+            "averaging_rel_error",
+        }
     ),
 )
 
@@ -89,8 +128,15 @@ def reads(engine: str, key: str) -> bool:
 # Keys only the averaged solver reads: a full-resolution run integrates every impact. (``attractor_starts`` too, but
 # its 1, "no probe", is what a full run does anyway, and scripts set it for either solver.)
 AVERAGED_ONLY = frozenset(
-    {"averaging_rel_error", "dem_averaging_rel_error", "dem_replicas", "averaging_batch_periods", "averaging_min_batches",
-     "averaging_max_time", "averaging_fallback"}
+    {
+        "averaging_rel_error",
+        "dem_averaging_rel_error",
+        "dem_replicas",
+        "averaging_batch_periods",
+        "averaging_min_batches",
+        "averaging_max_time",
+        "averaging_fallback",
+    }
 )
 # Keys only one thermal network reads (engines/thermal/network.py), stated once for both directions: 'paper' loses
 # the vial's heat to the room through a constant h_outer·outer_area; 'mill-head' computes that loss from the vial's
@@ -98,8 +144,15 @@ AVERAGED_ONLY = frozenset(
 NETWORK_ONLY: dict[str, frozenset[str]] = {
     "paper": frozenset({"h_outer", "outer_area"}),
     "mill-head": frozenset(
-        {"outer_diameter", "outer_length", "emissivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss",
-         "drive_heat"}
+        {
+            "outer_diameter",
+            "outer_length",
+            "emissivity",
+            "clamp_heat_capacity",
+            "clamp_conductance",
+            "clamp_loss",
+            "drive_heat",
+        }
     ),
 }
 MILL_HEAD_ONLY = NETWORK_ONLY["mill-head"]
@@ -124,7 +177,9 @@ class Reader:
         if not reads(self.engine, key):
             readers = [name for name in ENGINE_KEYS if reads(name, key)]
             where = f"engine = {readers[0]!r}" if len(readers) == 1 else "another engine"
-            return f"{ENGINE_KEYS[self.engine].title} (engine = {self.engine!r}) does not read it; it applies to {where}"
+            return (
+                f"{ENGINE_KEYS[self.engine].title} (engine = {self.engine!r}) does not read it; it applies to {where}"
+            )
         if self.solver != "averaged" and key in AVERAGED_ONLY:
             return f"the {self.solver!r} solver does not read it; it applies to solver = 'averaged'"
         for network, keys in NETWORK_ONLY.items():
@@ -144,15 +199,23 @@ class Reader:
                 return f"{key}: {how}, but {why}"
         return None
 
-    def ignored_note(self, values: Mapping[str, Any], defaults: Mapping[str, Any], preset: Reader | None = None) -> str | None:
+    def ignored_note(
+        self, values: Mapping[str, Any], defaults: Mapping[str, Any], preset: Reader | None = None
+    ) -> str | None:
         """A sentence naming the keys of a preset (``values``) that differ from ``defaults``, that a run of the preset
         itself reads (``preset``, its own reader) and that this run does not, or None: inherited, not asked for, so
         ignored, but said. (A key the preset's own run does not read either, inherited from a preset it builds on,
         was never part of its answer.)"""
         # A solver's own numerical settings say nothing of the answer of a run that chose another solver: not said.
-        ignored = [key for key, value in values.items()
-                   if key in defaults and value != defaults[key] and self.not_read(key) is not None
-                   and (preset is None or preset.not_read(key) is None) and key not in AVERAGED_ONLY]
+        ignored = [
+            key
+            for key, value in values.items()
+            if key in defaults
+            and value != defaults[key]
+            and self.not_read(key) is not None
+            and (preset is None or preset.not_read(key) is None)
+            and key not in AVERAGED_ONLY
+        ]
         if not ignored:
             return None
         return f"Ignored, as this run does not read them: the preset's {', '.join(ignored)}."
@@ -179,7 +242,7 @@ def undeclare(name: str) -> None:
 
 
 def engines_taking(accepts: Callable[[EngineKeys], bool]) -> str:
-    """"engine = 'dem'" (or "engine one of 'a', 'b'"): the engines whose keys satisfy ``accepts``, for a message."""
+    """ "engine = 'dem'" (or "engine one of 'a', 'b'"): the engines whose keys satisfy ``accepts``, for a message."""
     names = [repr(keys.name) for keys in ENGINE_KEYS.values() if accepts(keys)]
     return f"engine = {names[0]}" if len(names) == 1 else f"engine one of {', '.join(names)}"
 
@@ -197,19 +260,22 @@ def engine_problem(params: Any, fill: bool = False) -> str | None:
         )
     if params.n_balls == 0 and not keys.several_balls:
         return (
-            f"n_balls: {keys.title} moves one ball; allowed n_balls = 1 with {engine}; an empty mill (n_balls = 0) needs "
+            f"n_balls: {keys.title} moves one ball; allowed n_balls = 1 with {engine}; an empty mill (n_balls = 0) "
+            "needs "
             f"{engines_taking(lambda other: other.several_balls)}"
         )
     if params.n_balls > keys.most_balls:
         moves = "one ball" if keys.most_balls == 1 else f"at most {keys.most_balls} balls"
         return (
             f"n_balls: {keys.title} moves {moves}; allowed n_balls {'=' if keys.most_balls == 1 else '<='} "
-            f"{keys.most_balls} with {engine}, or set {engines_taking(lambda other: other.most_balls >= params.n_balls)}"
+            f"{keys.most_balls} with {engine}, or set "
+            f"{engines_taking(lambda other: other.most_balls >= params.n_balls)}"
         )
     if params.kinematics not in keys.kinematics:
         allowed = ", ".join(map(repr, keys.kinematics))
         return (
-            f"kinematics: {keys.title} does not move the vial as {params.kinematics!r}; allowed {allowed} with {engine}, "
+            f"kinematics: {keys.title} does not move the vial as {params.kinematics!r}; allowed {allowed} with "
+            f"{engine}, "
             f"or set {engines_taking(lambda other: params.kinematics in other.kinematics)}"
         )
     if params.model not in keys.thermal_models:
@@ -218,7 +284,8 @@ def engine_problem(params: Any, fill: bool = False) -> str | None:
     if params.thermal_model not in keys.networks:
         allowed = ", ".join(map(repr, keys.networks))
         return (
-            f"thermal_model: {keys.title} has no {params.thermal_model!r} network; allowed {allowed} with {engine}, or set "
+            f"thermal_model: {keys.title} has no {params.thermal_model!r} network; allowed {allowed} with {engine}, or "
+            "set "
             f"{engines_taking(lambda other: params.thermal_model in other.networks)}"
         )
     return None

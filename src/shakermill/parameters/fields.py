@@ -40,7 +40,11 @@ def choice(description: str) -> Any:
 def per_ball(scalar_key: str) -> Any:
     return Field(
         max_length=MAX_BALLS,
-        json_schema_extra={"unit": "", "per_ball": scalar_key, "description": f"per-ball {scalar_key} (engine = 'dem')"},
+        json_schema_extra={
+            "unit": "",
+            "per_ball": scalar_key,
+            "description": f"per-ball {scalar_key} (engine = 'dem')",
+        },
     )
 
 

@@ -42,7 +42,8 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
 
 
 def unit_slip(key: str, value: float, unit: str) -> str | None:
-    """Why ``value`` (SI, in ``unit``) of ``key`` looks like a unit slip, naming the unit likely meant; None if plausible."""
+    """Why ``value`` (SI, in ``unit``) of ``key`` looks like a unit slip, naming the unit likely meant; None if
+    plausible."""
     plausible = PLAUSIBLE_RANGES.get(key)
     if plausible is None or plausible.low <= value <= plausible.high:
         return None
@@ -55,7 +56,8 @@ def unit_slip(key: str, value: float, unit: str) -> str | None:
 
 
 def _plausible_in(alternative: str, value: float, key: str, unit: str) -> bool:
-    """Whether ``value`` read in ``alternative`` is plausible for ``key`` (SI ``unit``; 1e308 Hz is no frequency at all)."""
+    """Whether ``value`` read in ``alternative`` is plausible for ``key`` (SI ``unit``; 1e308 Hz is no frequency at
+    all)."""
     plausible = PLAUSIBLE_RANGES[key]
     try:
         return plausible.low <= to_si(f"{value:g} {alternative}", unit, key=key) <= plausible.high
@@ -156,7 +158,8 @@ def motion(value: Any) -> tuple[tuple[str, int, float, float], ...]:
 def _harmonic(term: Any) -> tuple[str, int, float, float]:
     if not isinstance(term, (list, tuple)) or len(term) != 4 or str(term[0]).strip() not in MOTION_COORDINATES:
         raise UnitError(
-            f"motion: expected COORDINATE:K:COS:SIN with a coordinate of {', '.join(MOTION_COORDINATES)}, got {quoted(term)}"
+            f"motion: expected COORDINATE:K:COS:SIN with a coordinate of {', '.join(MOTION_COORDINATES)}, got "
+            f"{quoted(term)}"
         )
     coordinate = str(term[0]).strip()
     unit = "rad" if coordinate in ("roll", "pitch", "yaw") else "m"

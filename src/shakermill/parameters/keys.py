@@ -11,7 +11,8 @@ from __future__ import annotations
 import difflib
 import math
 import typing
-from typing import TYPE_CHECKING, Any, Literal, Mapping
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, Literal
 
 import annotated_types
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -19,6 +20,7 @@ from pydantic_core import PydanticCustomError
 
 from shakermill.parameters import consistency, guards, materials
 from shakermill.parameters.bounds import Bounds
+from shakermill.parameters.derived import DerivedQuantities
 from shakermill.parameters.engine_keys import ENGINE_KEYS, MAX_BALLS
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.fields import (
@@ -34,7 +36,7 @@ from shakermill.parameters.fields import (
     per_ball,
     quantity,
 )
-from shakermill.parameters.geometry import DENSEST_PACKING, ball_volume, balls_for_fill, end_faces_area, vial_volume
+from shakermill.parameters.geometry import DENSEST_PACKING, balls_for_fill
 from shakermill.parameters.kinematic_models import MAX_MOTION_HARMONIC, MAX_MOTION_TRANSLATION, MOTION_COORDINATES
 from shakermill.parameters.units import UnitError
 from shakermill.support.limits import MAX_RECORD_WINDOWS, MAX_RECORDED_SECONDS, QUOTED_LENGTH, quoted
@@ -49,7 +51,7 @@ if TYPE_CHECKING:
 # and tight enough that the model and its integrator stay meaningful and finish; the comment above each
 # field says why its bounds are where they are. Lower bounds of 0 that stay open are physical (no
 # negative length), except where a small value makes the run misbehave.
-class Parameters(BaseModel):
+class Parameters(DerivedQuantities, BaseModel):
     """One run of the one-ball shaker-mill model (MODEL.md sections 1–9)."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True, allow_inf_nan=False)
@@ -63,11 +65,16 @@ class Parameters(BaseModel):
     # Open at 0: a vanishing stroke is a resting wall, the analytic test of a single impact. 0.5 m: five
     # times the longest stroke of a shaker mill.
     amplitude: float = quantity(
-        "m", "vial oscillation amplitude X_v (kinematics = 'mixer-mill-arc': along the arc, at the jar's centre)", gt=0, le=0.5
+        "m",
+        "vial oscillation amplitude X_v (kinematics = 'mixer-mill-arc': along the arc, at the jar's centre)",
+        gt=0,
+        le=0.5,
     )
     # 1 rad/s (0.16 Hz): thirty times slower than any mill. 1e4 rad/s (1.6 kHz): beyond acoustic mixers
     # (60 Hz), high enough that 1060 typed for rpm is warned about, not refused; the step count grows with ω.
-    omega: float = quantity("rad/s", "vial angular frequency ω (kinematics = 'planetary': the sun wheel's speed)", ge=1.0, le=1e4)
+    omega: float = quantity(
+        "rad/s", "vial angular frequency ω (kinematics = 'planetary': the sun wheel's speed)", ge=1.0, le=1e4
+    )
     # One turn either way: every phase has an equal one inside, and larger ones only cost precision in sin(ωt + φ).
     phase: float = quantity("rad", "vial phase φ at t = 0", ge=-2 * math.pi, le=2 * math.pi)
     # Materials (Table 2). A named material fills in the keys below (with_materials); '' leaves them as they are.
@@ -123,10 +130,13 @@ class Parameters(BaseModel):
     # The thermal network of a real mill (MODEL.md section 13): its structure and the paths beyond the paper's.
     thermal_model: Literal["paper", "mill-head"] = choice(
         "'paper': ball, vial and air, the vial losing h_outer·outer_area to the room (MODEL.md §5); 'mill-head': the "
-        "vial's outer convection and radiation at its own speed, conduction through contacts, a clamp warmed by the drive (§13)"
+        "vial's outer convection and radiation at its own speed, conduction through contacts, a clamp warmed "
+        "by the drive (§13)"
     )
     # 1 mm to 1 m as the bore; the outside must hold the bore (checked below).
-    outer_diameter: float = quantity("m", "outer diameter of the vial D_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0)
+    outer_diameter: float = quantity(
+        "m", "outer diameter of the vial D_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0
+    )
     outer_length: float = quantity("m", "outer length of the vial L_o (thermal_model = 'mill-head')", ge=1e-3, le=1.0)
     # Polished metal ~0.05, oxidised steel ~0.8, black paint ~0.95.
     emissivity: float = quantity("", "emissivity ε of the vial's outside (thermal_model = 'mill-head')", ge=0, le=1)
@@ -134,10 +144,14 @@ class Parameters(BaseModel):
     vial_conductivity: float = quantity("W/(m*K)", "vial thermal conductivity k_v", ge=0.01, le=2000.0)
     # Up to ~50 kg of steel in a clamp and mill head; 0 is refused: the node needs a heat capacity. The joint and the
     # loss up to a soldered joint over 10 cm² (0 decouples); the drive's heat up to a mill's whole motor (~0.1-1 kW).
-    clamp_heat_capacity: float = quantity("J/K", "heat capacity C_k of the clamp and mill head ('mill-head')", gt=0, le=1e5)
+    clamp_heat_capacity: float = quantity(
+        "J/K", "heat capacity C_k of the clamp and mill head ('mill-head')", gt=0, le=1e5
+    )
     clamp_conductance: float = quantity("W/K", "vial-to-clamp contact conductance G_vk ('mill-head')", ge=0, le=1e3)
     clamp_loss: float = quantity("W/K", "clamp-to-room conductance G_k (thermal_model = 'mill-head')", ge=0, le=1e3)
-    drive_heat: float = quantity("W", "heat Q_m the drive puts into the clamp whatever the balls do ('mill-head')", ge=0, le=1e3)
+    drive_heat: float = quantity(
+        "W", "heat Q_m the drive puts into the clamp whatever the balls do ('mill-head')", ge=0, le=1e3
+    )
     # Collision and heat generation (Table 4)
     # A perfectly plastic contact (0) has no damping ratio. Towards 0 the ball chatters on the face and a
     # run takes more steps (20 times at 0.05, 40 at 1e-6), but it stays correct and finishes.
@@ -183,20 +197,28 @@ class Parameters(BaseModel):
     )
     # Budget of one run (shakermill.budget): beyond either limit it stops with a non-ok status, keeping its results
     max_wall_time: float = quantity(
-        "s", "wall-clock budget of one run, its mechanics phase, fall-back and attractor probe included", gt=0,
+        "s",
+        "wall-clock budget of one run, its mechanics phase, fall-back and attractor probe included",
+        gt=0,
         le=LONGEST_RUN_S,  # a budget beyond the longest simulated run is no budget
     )
     max_steps: int = Field(
         gt=0,
         le=10**12,  # at ~0.5 µs a step, about a week of computing
-        json_schema_extra={"unit": "", "description": "step budget of one run: accepted integrator steps, all its integrations together"},
+        json_schema_extra={
+            "unit": "",
+            "description": "step budget of one run: accepted integrator steps, all its integrations together",
+        },
     )
     # Solver choice (full resolution, or the multiscale averaged solver)
     solver: Literal["full", "averaged"] = choice(
-        "'full': every impact for the whole run; 'averaged': mechanics until its statistics converge, then the slow network"
+        "'full': every impact for the whole run; 'averaged': mechanics until its statistics converge, then "
+        "the slow network"
     )
     # Any target is safe: one that is never reached ends at averaging_max_time, and the run falls back.
-    averaging_rel_error: float = quantity("", "averaged solver: target relative standard error of the averages", gt=0, lt=1)
+    averaging_rel_error: float = quantity(
+        "", "averaged solver: target relative standard error of the averages", gt=0, lt=1
+    )
     # The several balls' motion is chaotic: its means converge as 1/√T, and 1e-3 would take ~15 min of mechanics.
     dem_averaging_rel_error: float = quantity(
         "",
@@ -206,12 +228,18 @@ class Parameters(BaseModel):
         lt=1,
     )
     # Each replica pays its own start-up transient, so more replicas than cores cost more than they save.
-    dem_replicas: int = count("averaged solver of the 'dem' engine: independent replicas of the mechanics, pooled", ge=1, le=64)
+    dem_replicas: int = count(
+        "averaged solver of the 'dem' engine: independent replicas of the mechanics, pooled", ge=1, le=64
+    )
     # 10 000 periods (~10 min) per batch: already past any averaging_max_time worth waiting for.
-    averaging_batch_periods: int = count("averaged solver: drive periods per batch of the batch-means estimate", ge=1, le=10_000)
+    averaging_batch_periods: int = count(
+        "averaged solver: drive periods per batch of the batch-means estimate", ge=1, le=10_000
+    )
     averaging_min_batches: int = count("averaged solver: fewest batches after the transient", ge=4, le=10_000)
     # An hour of mechanics costs what a full-resolution hour does; averaging converges in ~20 s.
-    averaging_max_time: float = quantity("s", "averaged solver: longest mechanics window before giving up", gt=0, le=3600.0)
+    averaging_max_time: float = quantity(
+        "s", "averaged solver: longest mechanics window before giving up", gt=0, le=3600.0
+    )
     averaging_fallback: Literal["full", "fail"] = choice("averaged solver: what to do when averaging is not valid")
     # Each start costs a settled run at every point of a scan; 100 cover the gap far more densely than
     # the basins found so far need (the default 8 finds them).
@@ -226,7 +254,9 @@ class Parameters(BaseModel):
         "'three_node': ball, vial and air (this paper); 'ball_only': air held at ambient and no vial "
         "reservoir, the author's 2023 predecessor"
     )
-    no_tension: bool = Field(strict=True, json_schema_extra={"description": "clip the contact force at zero (no adhesion)"})
+    no_tension: bool = Field(
+        strict=True, json_schema_extra={"description": "clip the contact force at zero (no adhesion)"}
+    )
     heat_model: Literal["relative", "paper"] = choice("'relative': η·c·ζ̇² (default); 'paper': η·|F_d·v| as printed")
     convection_velocity: Literal["auto", "ball", "relative"] = choice(
         "velocity in Re: the ball's ('ball', as the paper) or relative to the vial, which carries "
@@ -238,7 +268,9 @@ class Parameters(BaseModel):
         "dimensions with friction and rotation (section 12)"
     )
     # 50 balls of the smallest radius still fit any vial the bounds allow; the pair search is O(N²).
-    n_balls: int = count("number of balls (engine = 'dem', 0: an empty mill; the 1-D engine has one)", ge=0, le=MAX_BALLS)
+    n_balls: int = count(
+        "number of balls (engine = 'dem', 0: an empty mill; the 1-D engine has one)", ge=0, le=MAX_BALLS
+    )
     fill: float = quantity(
         "",
         "fraction of the vial's inner volume the balls take (engine = 'dem'): > 0 sets n_balls = max(1, "
@@ -265,10 +297,13 @@ class Parameters(BaseModel):
     # from aerogel-like 0.01 to diamond's 2000 W/(m·K).
     ball_conductivity: float = quantity("W/(m*K)", "ball thermal conductivity k_b", ge=0.01, le=2000.0)
     gravity: bool = Field(
-        strict=True, json_schema_extra={"description": "gravity 9.81 m/s² downward, the vial axis horizontal (engine = 'dem')"}
+        strict=True,
+        json_schema_extra={"description": "gravity 9.81 m/s² downward, the vial axis horizontal (engine = 'dem')"},
     )
     # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
-    friction: float = quantity("", "Coulomb friction coefficient μ of a ball on the vial (engine = 'dem')", ge=0, le=5.0)
+    friction: float = quantity(
+        "", "Coulomb friction coefficient μ of a ball on the vial (engine = 'dem')", ge=0, le=5.0
+    )
     pair_friction: float = quantity("", "Coulomb friction coefficient μ of two balls (engine = 'dem')", ge=0, le=5.0)
     rolling_friction: float = quantity("", "rolling resistance coefficient μ_r (engine = 'dem')", ge=0, le=1.0)
     kinematics: Literal["axial", "fourier", "spex8000m", "mixer-mill-arc", "planetary"] = choice(
@@ -281,7 +316,10 @@ class Parameters(BaseModel):
     # The SPEX clamp's lateral motion and yaw (kinematics = 'spex8000m'); 0 leaves either out. Half a metre,
     # as any translation of a vial; a quarter turn, far beyond the few degrees a clamp turns.
     lateral_amplitude: float = quantity(
-        "m", "kinematics = 'spex8000m': lateral amplitude Y of the vial's centre, y = Y sin 2θ", ge=0, le=MAX_MOTION_TRANSLATION
+        "m",
+        "kinematics = 'spex8000m': lateral amplitude Y of the vial's centre, y = Y sin 2θ",
+        ge=0,
+        le=MAX_MOTION_TRANSLATION,
     )
     yaw_amplitude: float = quantity(
         "rad", "kinematics = 'spex8000m': yaw amplitude Ψ about the vertical, yaw = Ψ sin θ", ge=0, le=0.5 * math.pi
@@ -295,9 +333,13 @@ class Parameters(BaseModel):
         "m", "kinematics = 'planetary': radius R_p of the jar centre's circle about the sun axis", ge=1e-2, le=1.0
     )
     # The jar's speed relative to the sun wheel: mills are built from −3 to −1 (Retsch, Fritsch); ±5 covers any gear.
-    speed_ratio: float = quantity("", "kinematics = 'planetary': the jar's spin relative to the sun wheel, k of 1 : k", ge=-5.0, le=5.0)
+    speed_ratio: float = quantity(
+        "", "kinematics = 'planetary': the jar's spin relative to the sun wheel, k of 1 : k", ge=-5.0, le=5.0
+    )
     # Jars stand upright in most mills; tilted ones lean by tens of degrees. Past 60° a jar would lie nearly flat.
-    jar_tilt: float = quantity("rad", "kinematics = 'planetary': lean of the jar's top away from the sun axis", ge=0.0, le=math.pi / 3)
+    jar_tilt: float = quantity(
+        "rad", "kinematics = 'planetary': lean of the jar's top away from the sun axis", ge=0.0, le=math.pi / 3
+    )
     motion: tuple[Harmonic, ...] = Field(
         max_length=MAX_HARMONICS,
         json_schema_extra={
@@ -316,7 +358,10 @@ class Parameters(BaseModel):
     # An enduring contact (rolling, sliding or resting, not an impact) steps at this fraction of its own period,
     # within the same 0.9 t_R bound; Verlet is stable below 1/π of a period (engines/dem/model.py, ENDURING_AFTER).
     enduring_step_fraction: float = quantity(
-        "", "step of the 'dem' engine inside an enduring contact as a fraction of its oscillation period", ge=1e-3, le=0.1
+        "",
+        "step of the 'dem' engine inside an enduring contact as a fraction of its oscillation period",
+        ge=1e-3,
+        le=0.1,
     )
     # A free-flight step never lets a contact begin inside it; this caps it further (1 s: no cap in practice).
     max_flight_step: float = quantity("s", "longest step of the 'dem' engine in free flight", ge=1e-7, le=1.0)
@@ -324,7 +369,9 @@ class Parameters(BaseModel):
         max_length=MAX_STRESS_THRESHOLDS,
         json_schema_extra={
             "unit": "J",
-            "description": "stress energies above which each run reports the impacts' power (analysis/stress_energy.py)",
+            "description": (
+                "stress energies above which each run reports the impacts' power (analysis/stress_energy.py)"
+            ),
         },
     )
     record_windows: tuple[Window, ...] = Field(
@@ -337,11 +384,13 @@ class Parameters(BaseModel):
     def _known_engine(cls, name: str) -> str:
         if name not in ENGINE_KEYS:
             # Worded as pydantic words a value outside a Literal's choices, as the other options are.
-            raise PydanticCustomError("literal_error", "Input should be {expected}", {"expected": " or ".join(map(repr, ENGINE_KEYS))})
+            raise PydanticCustomError(
+                "literal_error", "Input should be {expected}", {"expected": " or ".join(map(repr, ENGINE_KEYS))}
+            )
         return name
 
     @model_validator(mode="after")
-    def _consistent(self) -> "Parameters":
+    def _consistent(self) -> Parameters:
         """The checks across keys (:mod:`consistency`) and of the per-ball values' bounds, in this order: the first
         problem is the one reported."""
         consistency.ball_fits_vial(self)
@@ -370,7 +419,7 @@ class Parameters(BaseModel):
         values = getattr(self, PER_BALL_KEY_OF[scalar_key])
         return tuple(values) if values else (getattr(self, scalar_key),) * self.n_balls
 
-    def initial_positions(self) -> "numpy.ndarray | None":
+    def initial_positions(self) -> numpy.ndarray | None:
         """Ball centres (n_balls, 3) in the vial frame at t = 0 (m): one ball at ``ball_position`` on the axis,
         several (or none) filled in from the bottom (:mod:`shakermill.parameters.packing`); None if they do not fit."""
         import numpy as np
@@ -381,59 +430,6 @@ class Parameters(BaseModel):
             return np.array([[self.ball_position, 0.0, 0.0]])
         return placement(np.array(self.ball_values("ball_radius")), self.vial_length, self.vial_diameter)
 
-    # Derived quantities used by more than one module (MODEL.md sections 1 and 6)
-    @property
-    def period(self) -> float:
-        """2π/ω: one drive period (s)."""
-        return 2.0 * math.pi / self.omega
-
-    @property
-    def frequency(self) -> float:
-        """ω/2π: drive cycles per second (Hz)."""
-        return self.omega / (2.0 * math.pi)
-
-    @property
-    def ball_mass(self) -> float:
-        """m_b = ρ_b·4/3·π R³ (kg)."""
-        return self.ball_density * 4.0 / 3.0 * math.pi * self.ball_radius**3
-
-    def ball_masses(self) -> tuple[float, ...]:
-        """Each ball's mass ρ·4/3·π R³ (kg), from its per-ball values or the scalar ones."""
-        radii, densities = self.ball_values("ball_radius"), self.ball_values("ball_density")
-        return tuple(density * 4.0 / 3.0 * math.pi * radius**3 for radius, density in zip(radii, densities))
-
-    @property
-    def end_face_area(self) -> float:
-        """2·π·d_v²/4: both circular end faces (m²), MODEL.md section 1; the paper's A_i = A_o."""
-        return end_faces_area(self.vial_diameter)
-
-    @property
-    def vial_volume(self) -> float:
-        """π d_v²/4·l_v: the vial's inner volume (m³)."""
-        return vial_volume(self.vial_length, self.vial_diameter)
-
-    @property
-    def balls_volume(self) -> float:
-        """Σ 4/3·π R³ over every ball of the 'dem' engine, or the one ball of the 1-D engine (m³)."""
-        radii = self.ball_values("ball_radius") if ENGINE_KEYS[self.engine].several_balls else (self.ball_radius,)
-        return sum(ball_volume(radius) for radius in radii)
-
-    @property
-    def fill_fraction(self) -> float:
-        """The fraction of the vial's inner volume the balls take (dimensionless): what ``fill`` asks, as achieved
-        by a whole number of balls."""
-        return self.balls_volume / self.vial_volume
-
-    @property
-    def air_mass(self) -> float:
-        """m_a = ρ_a·(π d_v²/4·l_v − Σ 4/3·π R³) (kg), MODEL.md section 6 (every ball of the 'dem' engine)."""
-        return self.air_density * (self.vial_volume - self.balls_volume)
-
-    @property
-    def air_heat_capacity(self) -> float:
-        """c_a = c_p,a/γ: the trapped air is heated at constant volume (J/(kg·K))."""
-        return self.air_cp / self.air_heat_capacity_ratio
-
     @property
     def thermal_time_constants_at_rest(self) -> dict[str, tuple[float, tuple[str, ...]]]:
         """Heat capacity over conductance of each node that evolves (s), and the keys that set it
@@ -443,7 +439,7 @@ class Parameters(BaseModel):
     def _repr_html_(self) -> str:
         return present("parameters html", self)
 
-    def replace(self, **changes: Any) -> "Parameters":
+    def replace(self, **changes: Any) -> Parameters:
         """A new validated ``Parameters`` with ``changes`` applied (values may carry units)."""
         current = self.model_dump()
         if self.fill > 0 and "fill" not in changes:
@@ -523,7 +519,8 @@ def allowed_range(key: str, refused: Any = None) -> str:
         return materials.allowed_for(key)
     if key == "motion":
         return (
-            f"at most {MAX_HARMONICS} (coordinate, k, cos, sin) terms: coordinate one of {', '.join(MOTION_COORDINATES)}, "
+            f"at most {MAX_HARMONICS} (coordinate, k, cos, sin) terms: coordinate one of "
+            f"{', '.join(MOTION_COORDINATES)}, "
             f"k in [0, {MAX_MOTION_HARMONIC}], translations in m, angles in rad"
         )
     shown = bounds(key).shown(refused if isinstance(refused, float) else None)
@@ -659,7 +656,11 @@ def _one_line(error: ValidationError) -> str:
         return str(first["msg"]).removeprefix("Value error, ")
     value = _shown_value(first.get("input"))
     message = str(first["msg"])
-    problem = f"{value} is out of range" if first.get("type") in RANGE_ERRORS else f"{message[:1].lower()}{message[1:]} (got {value})"
+    problem = (
+        f"{value} is out of range"
+        if first.get("type") in RANGE_ERRORS
+        else f"{message[:1].lower()}{message[1:]} (got {value})"
+    )
     return f"{key}: {problem}; allowed {allowed_range(key, first.get('input'))}"
 
 

@@ -17,8 +17,8 @@ are stated assumptions, each a key of its own so that it can be swept
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 Term = tuple[str, int, float, float]
 
@@ -146,7 +146,8 @@ KINEMATIC_MODELS: dict[str, KinematicModel] = {
 
 
 def motion_terms(kinematics: str, values: object) -> tuple[Term, ...]:
-    """The Fourier terms of the model ``kinematics``, its keys read (SI) as attributes of ``values`` (a ``Parameters``)."""
+    """The Fourier terms of the model ``kinematics``, its keys read (SI) as attributes of ``values`` (a
+    ``Parameters``)."""
     model = KINEMATIC_MODELS[kinematics]
     return model.terms(*(getattr(values, key) for key in model.keys))
 
@@ -157,13 +158,15 @@ ASSUMED_DEFAULTS: dict[str, tuple[float, str]] = {
     # A figure of eight visibly narrower than long: 2Y = 10 mm across a 2X_v = 50 mm stroke (1:5).
     "lateral_amplitude": (
         5e-3,
-        f"assumption: ±5 mm at twice the drive frequency, a figure of eight 10 mm wide across the 50 mm stroke; {NO_SOURCE}",
+        "assumption: ±5 mm at twice the drive frequency, a figure of eight 10 mm wide across the 50 mm stroke; "
+        f"{NO_SOURCE}",
     ),
     # A clamp carried on a curved path of radius ρ turns by X_v/ρ: ρ ≈ 0.3 m, the size of the mill's
     # housing, gives 25 mm/0.3 m = 0.083 rad.
     "yaw_amplitude": (
         math.radians(5.0),
-        f"assumption: ±5° (0.0873 rad) in phase with the stroke, X_v/ρ for a curved path of radius ρ ≈ 0.3 m; {NO_SOURCE}",
+        "assumption: ±5° (0.0873 rad) in phase with the stroke, X_v/ρ for a curved path of radius ρ ≈ 0.3 m; "
+        f"{NO_SOURCE}",
     ),
     # Mixer mills carry their jars on arms of the order of a decimetre (the mill is ~0.4 m wide).
     "swing_radius": (

@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import functools
 import tomllib
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 from shakermill.parameters.errors import ParameterError
 from shakermill.support.limits import quoted
@@ -68,7 +69,11 @@ class Material:
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready: name, description, aliases and every property as {value, unit, source} (SI)."""
-        described: dict[str, object] = {"name": self.name, "description": self.description, "aliases": list(self.aliases)}
+        described: dict[str, object] = {
+            "name": self.name,
+            "description": self.description,
+            "aliases": list(self.aliases),
+        }
         for key, sourced in self.properties().items():
             value = list(sourced.value) if isinstance(sourced.value, tuple) else sourced.value
             described[key] = {"value": value, "unit": sourced.unit, "source": sourced.source}
@@ -131,8 +136,13 @@ def allowed_names() -> str:
 
 
 def allowed_for(key: str) -> str:
-    """The values ``key`` takes: one name (``ball_material``, ``vial_material``) or a list of them (``ball_materials``)."""
-    return f"an empty list or n_balls names, each {allowed_names()}" if key == "ball_materials" else f"'' (none) or {allowed_names()}"
+    """The values ``key`` takes: one name (``ball_material``, ``vial_material``) or a list of them
+    (``ball_materials``)."""
+    return (
+        f"an empty list or n_balls names, each {allowed_names()}"
+        if key == "ball_materials"
+        else f"'' (none) or {allowed_names()}"
+    )
 
 
 def names_in(key: str, value: Any) -> str | tuple[str, ...]:
@@ -155,7 +165,9 @@ def _named(key: str, name: Any) -> str:
         raise ParameterError(f"{key}: {exc}") from None
 
 
-def filled_keys(layer: Mapping[str, Any], keys: Sequence[str], per_ball_key_of: Mapping[str, str]) -> dict[str, tuple[Any, str]]:
+def filled_keys(
+    layer: Mapping[str, Any], keys: Sequence[str], per_ball_key_of: Mapping[str, str]
+) -> dict[str, tuple[Any, str]]:
     """The ``keys`` that the materials named in ``layer`` fill in, each with the material's value and source: a ball's
     or the vial's properties (``ball_material``, ``vial_material``), each ball's per-ball list (``ball_materials``,
     its list key by ``per_ball_key_of``)."""

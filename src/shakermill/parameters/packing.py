@@ -67,8 +67,10 @@ def packed(radii: np.ndarray, vial_length: float, vial_diameter: float) -> np.nd
 
 def _box(centre: np.ndarray, reach: float, grids: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
     """Flat indices (in meshgrid 'ij' order) of the grid points within ``reach`` of ``centre`` along every axis."""
-    ranges = [np.arange(np.searchsorted(grid, c - reach), np.searchsorted(grid, c + reach, side="right"))
-              for grid, c in zip(grids, centre, strict=True)]
+    ranges = [
+        np.arange(np.searchsorted(grid, c - reach), np.searchsorted(grid, c + reach, side="right"))
+        for grid, c in zip(grids, centre, strict=True)
+    ]
     sizes = [grid.size for grid in grids]
     i, j, k = np.meshgrid(*ranges, indexing="ij")
     return (i * sizes[1] + j) * sizes[2] + k

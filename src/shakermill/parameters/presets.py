@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import dataclasses
 import tomllib
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 from shakermill.parameters.assumed import AssumedInput, inherited_assumed
 from shakermill.parameters.defaults import DEFAULT_PRESET
@@ -62,12 +63,16 @@ class Preset:
             return None
         changed = [key for key in self.fitted if key in values and values[key] != self.values[key].value]
         if refitted:
-            return (f"{self.caveat} (This run's configuration refits {', '.join(refitted)} to its own measurement "
-                    "(calibrate): what was found is of the preset as shipped; read the fit's own errors.)")
+            return (
+                f"{self.caveat} (This run's configuration refits {', '.join(refitted)} to its own measurement "
+                "(calibrate): what was found is of the preset as shipped; read the fit's own errors.)"
+            )
         if not changed:
             return self.caveat
-        return (f"{self.caveat} (This run changes {', '.join(changed)}, which the calibration fitted: what was found "
-                "is of the preset as shipped.)")
+        return (
+            f"{self.caveat} (This run changes {', '.join(changed)}, which the calibration fitted: what was found "
+            "is of the preset as shipped.)"
+        )
 
     @property
     def posterior(self) -> list[list[float]] | None:
@@ -83,7 +88,9 @@ SPEX_8000M = Preset(
         "vial_length": Cited(58e-3, f"{PAPER}, Table 1"),
         "vial_diameter": Cited(19e-3, f"{PAPER}, Table 1 (A_i = A_o = 567.06 mm² = 2·π·d_v²/4)"),
         "amplitude": Cited(25e-3, f"{PAPER}, Table 1 (X_v)"),
-        "omega": Cited(111.0, "assumption: not stated (range 90-130 rad/s); ~1060 cycles/min, the SPEX 8000M on 60 Hz mains"),
+        "omega": Cited(
+            111.0, "assumption: not stated (range 90-130 rad/s); ~1060 cycles/min, the SPEX 8000M on 60 Hz mains"
+        ),
         "phase": Cited(0.0, "assumption"),
         "ball_density": Cited(7800.0, f"{PAPER}, Table 2"),
         "vial_density": Cited(7800.0, f"{PAPER}, Table 2"),
@@ -107,7 +114,9 @@ SPEX_8000M = Preset(
         "sutherland": Cited(111.0, f"{PAPER}, Table 3"),
         "h_inner": Cited(200.0, f"{PAPER}, Table 3"),
         "h_outer": Cited(45.0, f"{PAPER}, Table 3"),
-        "inner_area": Cited(end_faces_area(19e-3), f"{PAPER}, Table 1 (A_i = 567.06 mm²: the two end faces, MODEL.md §1)"),
+        "inner_area": Cited(
+            end_faces_area(19e-3), f"{PAPER}, Table 1 (A_i = 567.06 mm²: the two end faces, MODEL.md §1)"
+        ),
         "outer_area": Cited(
             end_faces_area(19e-3),
             f"{PAPER}, Table 1 (A_o = 567.06 mm²: the two end faces only; a real vial also loses heat through its "
@@ -119,7 +128,9 @@ SPEX_8000M = Preset(
             "estimate: walls ~6 mm round a Ø38 mm bore (the SPEX 8001 vial's outside is not published, "
             "docs/notes/dem-references.md §2.3); thermal_model = 'mill-head' only",
         ),
-        "outer_length": Cited(70e-3, "estimate: ends ~6 mm beyond a 58 mm bore, as outer_diameter; thermal_model = 'mill-head' only"),
+        "outer_length": Cited(
+            70e-3, "estimate: ends ~6 mm beyond a 58 mm bore, as outer_diameter; thermal_model = 'mill-head' only"
+        ),
         "emissivity": Cited(
             0.2,
             "assumption: machined, lightly oxidised steel, 0.1-0.3 (Incropera & DeWitt, Table A.11: stainless steel "
@@ -150,7 +161,8 @@ SPEX_8000M = Preset(
         "ambient_temperature": Cited(293.15, f"{PAPER}, Table 3 footnote (ambient 20 °C)"),
         "initial_temperature": Cited(293.15, f"assumption: θ̇_0 of {PAPER} Table 5 implies θ_0 = 20 °C"),
         "ball_temperature_limit": Cited(
-            1673.15, "assumption: carbon and bearing steels begin to melt near 1400 °C; above it the model does not hold"
+            1673.15,
+            "assumption: carbon and bearing steels begin to melt near 1400 °C; above it the model does not hold",
         ),
         "ball_position": Cited(0.0, "assumption: ball starts at the vial centre"),
         "ball_momentum": Cited(0.0, "assumption: ball starts at rest"),
@@ -200,7 +212,10 @@ SPEX_8000M = Preset(
         "engine": Cited("1d", f"{PAPER}: one ball on the vial's axis"),
         "n_balls": Cited(1, f"{PAPER}: one ball"),
         "fill": Cited(0.0, "unused: n_balls gives the number of balls"),
-        **{key: Cited("", "no material: the keys' own values (the paper's steel)") for key in ("ball_material", "vial_material")},
+        **{
+            key: Cited("", "no material: the keys' own values (the paper's steel)")
+            for key in ("ball_material", "vial_material")
+        },
         "ball_materials": Cited((), "every ball takes ball_material, or the scalar keys' values"),
         **{key: Cited((), "every ball takes the scalar key's value") for key in PER_BALL_KEYS},
         "ball_conductivity": Cited(
@@ -215,14 +230,20 @@ SPEX_8000M = Preset(
         "pair_friction": Cited(
             0.3, "assumption: the ball-on-vial friction's common choice for steel on steel, no source of its own"
         ),
-        "pair_restitution": Cited(0.7, f"{PAPER}, Table 4 (e): the paper's one e, for two balls too (no source of its own)"),
+        "pair_restitution": Cited(
+            0.7, f"{PAPER}, Table 4 (e): the paper's one e, for two balls too (no source of its own)"
+        ),
         "rolling_friction": Cited(0.0, "MODEL.md section 12.3: no rolling resistance by default"),
         "kinematics": Cited("axial", f"{PAPER}: the vial moves along its axis (MODEL.md section 12.2)"),
         "motion": Cited((), "used only with kinematics = 'fourier'"),
         "revolution_radius": Cited(
-            0.07, "Fritsch Pulverisette 7 premium line: effective sun-disc diameter 140 mm (used only by kinematics = 'planetary')"
+            0.07,
+            "Fritsch Pulverisette 7 premium line: effective sun-disc diameter 140 mm (used only by kinematics = "
+            "'planetary')",
         ),
-        "speed_ratio": Cited(-2.0, "Retsch PM 100 and Fritsch Pulverisette 7: jar to sun wheel 1 : −2 (kinematics = 'planetary')"),
+        "speed_ratio": Cited(
+            -2.0, "Retsch PM 100 and Fritsch Pulverisette 7: jar to sun wheel 1 : −2 (kinematics = 'planetary')"
+        ),
         "jar_tilt": Cited(0.0, "upright jars, as in the Pulverisette 7 and PM 100 (kinematics = 'planetary')"),
         **{key: Cited(value, source) for key, (value, source) in ASSUMED_DEFAULTS.items()},
         "contact_step_fraction": Cited(
@@ -239,7 +260,8 @@ SPEX_8000M = Preset(
         "max_flight_step": Cited(1e-4, "numerical choice: ~1/60 of a drive period, so the wall's motion is resolved"),
         "stress_energy_thresholds": Cited(
             (1e-3, 1e-2),
-            "numerical choice: 1 mJ and 10 mJ, about the median and the upper tail of the energy a steel ball dissipates "
+            "numerical choice: 1 mJ and 10 mJ, about the median and the upper tail of the energy a steel ball "
+            "dissipates "
             "per impact in the SPEX 8000M and the planetary presets (benchmarks/README.md, stress energies)",
         ),
         "record_windows": Cited(
@@ -290,7 +312,9 @@ def load_presets(folder: Path, built_in: Preset) -> dict[str, Preset]:
     while waiting:
         ready = [name for name in waiting if bases[name] in presets]
         if not ready:
-            raise ValueError(f"presets {', '.join(sorted(waiting))} build on presets that do not exist or on each other")
+            raise ValueError(
+                f"presets {', '.join(sorted(waiting))} build on presets that do not exist or on each other"
+            )
         for name in ready:
             presets[name] = load_preset_file(waiting.pop(name), presets)
     return presets

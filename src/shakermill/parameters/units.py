@@ -44,9 +44,12 @@ _ARITHMETIC = re.compile(r"\d|\*\*|\^")
 # t is (t + zero)·scale K, a difference d is d·scale K. pint alone reads "25 C" as coulombs and "25 F" as farads.
 _CELSIUS, _FAHRENHEIT, _KELVIN = (1.0, 273.15), (5.0 / 9.0, 459.67), (1.0, 0.0)
 TEMPERATURE_SPELLINGS = {
-    **dict.fromkeys(("c", "°c", "ºc", "℃", "degc", "degreec", "degreesc", "celsius", "degreecelsius", "degreescelsius"), _CELSIUS),
     **dict.fromkeys(
-        ("f", "°f", "ºf", "℉", "degf", "degreef", "degreesf", "fahrenheit", "degreefahrenheit", "degreesfahrenheit"), _FAHRENHEIT
+        ("c", "°c", "ºc", "℃", "degc", "degreec", "degreesc", "celsius", "degreecelsius", "degreescelsius"), _CELSIUS
+    ),
+    **dict.fromkeys(
+        ("f", "°f", "ºf", "℉", "degf", "degreef", "degreesf", "fahrenheit", "degreefahrenheit", "degreesfahrenheit"),
+        _FAHRENHEIT,
     ),
     **dict.fromkeys(("k", "kelvin", "kelvins"), _KELVIN),
 }
@@ -135,7 +138,7 @@ def _temperature_in_kelvin(text: str, key: str) -> float | None:
     """A number and a spelling of °C, °F or K (:data:`TEMPERATURE_SPELLINGS`) in kelvin, as a temperature or, for
     :data:`TEMPERATURE_DIFFERENCE_KEYS`, as a difference; None for any other unit."""
     number = _LEADING_NUMBER.match(text)
-    scale_and_zero = TEMPERATURE_SPELLINGS.get(re.sub(r"[\s_]", "", text[number.end():]).lower()) if number else None
+    scale_and_zero = TEMPERATURE_SPELLINGS.get(re.sub(r"[\s_]", "", text[number.end() :]).lower()) if number else None
     if number is None or scale_and_zero is None:
         return None
     scale, zero = scale_and_zero
@@ -148,7 +151,7 @@ def unit_written(value: object) -> str:
     if not isinstance(value, str):
         return ""
     number = _LEADING_NUMBER.match(value)
-    return value[number.end():].strip() if number else ""
+    return value[number.end() :].strip() if number else ""
 
 
 def from_si(number: float, unit: str, si_unit: str, *, key: str) -> float:
@@ -165,7 +168,9 @@ def _quantity_to_si(text: str, value: str, unit: str, key: str) -> float:
         quantity = registry.Quantity(text)
     except pint.UndefinedUnitError as exc:
         unknown = ", ".join(map(repr, exc.unit_names))
-        raise UnitError(f"{key}: cannot parse {quoted(value)}: unknown unit {unknown}; expected {expected_quantity(unit)}") from None
+        raise UnitError(
+            f"{key}: cannot parse {quoted(value)}: unknown unit {unknown}; expected {expected_quantity(unit)}"
+        ) from None
     except Exception as exc:  # pint raises several unrelated exception types
         raise UnitError(f"{key}: cannot parse {quoted(value)} as a quantity ({type(exc).__name__})") from None
     if not isinstance(quantity, pint.Quantity):
@@ -177,5 +182,6 @@ def _quantity_to_si(text: str, value: str, unit: str, key: str) -> float:
         return float(quantity.to(target).magnitude)
     except pint.DimensionalityError:
         raise UnitError(
-            f"{key}: {quoted(value)} has the wrong dimension (read as {quantity.units}); expected {expected_quantity(unit)}"
+            f"{key}: {quoted(value)} has the wrong dimension (read as {quantity.units}); expected "
+            f"{expected_quantity(unit)}"
         ) from None

@@ -30,7 +30,14 @@ def churchill_bernstein_nusselt(reynolds: float, prandtl: float) -> float:
     cylinder across a uniform flow (Churchill & Bernstein, J. Heat Transfer 99 (1977) 300; Incropera & DeWitt,
     Eq. 7.54: Re_D·Pr > 0.2). A planetary jar's side, carried round the sun wheel across its axis."""
     correction = (1.0 + (reynolds / 282000.0) ** 0.625) ** 0.8
-    return 0.3 + 0.62 * math.sqrt(reynolds) * prandtl ** (1.0 / 3.0) / (1.0 + (0.4 / prandtl) ** (2.0 / 3.0)) ** 0.25 * correction
+    return (
+        0.3
+        + 0.62
+        * math.sqrt(reynolds)
+        * prandtl ** (1.0 / 3.0)
+        / (1.0 + (0.4 / prandtl) ** (2.0 / 3.0)) ** 0.25
+        * correction
+    )
 
 
 def churchill_chu_cylinder_nusselt(rayleigh: float, prandtl: float) -> float:
@@ -39,8 +46,15 @@ def churchill_chu_cylinder_nusselt(rayleigh: float, prandtl: float) -> float:
     return (0.60 + 0.387 * rayleigh ** (1.0 / 6.0) / (1.0 + (0.559 / prandtl) ** (9.0 / 16.0)) ** (8.0 / 27.0)) ** 2
 
 
-def rayleigh_number(length: float, temperature_difference: float, film_temperature: float, viscosity: float,
-                    density: float, conductivity: float, cp: float) -> float:
+def rayleigh_number(
+    length: float,
+    temperature_difference: float,
+    film_temperature: float,
+    viscosity: float,
+    density: float,
+    conductivity: float,
+    cp: float,
+) -> float:
     """Ra_L = g·β_T·ΔT·L³/(ν·α) of an ideal gas (β_T = 1/θ_film)."""
     kinematic = viscosity / density
     diffusivity = conductivity / (density * cp)
@@ -70,7 +84,14 @@ def impact_conduction(contact_radius: float, duration: float, effusivity_1: floa
     """Heat through one short impact per kelvin between the bodies (J/K): Q/ΔT = 0.87·π·a²·√t_c/(1/e₁ + 1/e₂)
     with each body's effusivity e = √(ρck) (Sun & Chen, Int. J. Heat Mass Transfer 31 (1988) 969, for
     Fourier numbers of the contact well below 1: both bodies semi-infinite for the impact's heat)."""
-    return 0.87 * math.pi * contact_radius * contact_radius * math.sqrt(duration) / (1.0 / effusivity_1 + 1.0 / effusivity_2)
+    return (
+        0.87
+        * math.pi
+        * contact_radius
+        * contact_radius
+        * math.sqrt(duration)
+        / (1.0 / effusivity_1 + 1.0 / effusivity_2)
+    )
 
 
 @njit(cache=True)
@@ -81,8 +102,14 @@ def constriction_conductance(contact_radius: float, conductivity_1: float, condu
 
 
 @njit(cache=True)
-def contact_conduction(contact_radius: float, duration: float, effusivity_1: float, effusivity_2: float,
-                       conductivity_1: float, conductivity_2: float) -> float:
+def contact_conduction(
+    contact_radius: float,
+    duration: float,
+    effusivity_1: float,
+    effusivity_2: float,
+    conductivity_1: float,
+    conductivity_2: float,
+) -> float:
     """Heat through one contact per kelvin (J/K): the larger of the impact's transient conduction (Sun & Chen,
     growing as √t_c) and the steady constriction conductance held for the contact's duration (growing as t_c).
     The first holds for impacts (tens of µs), the second for lasting contacts (a ball resting or rolling);

@@ -75,7 +75,9 @@ def rotation_matrix(roll: float, pitch: float, yaw: float, out: np.ndarray) -> N
 
 
 @njit(cache=True)
-def angular_velocity(pitch: float, yaw: float, roll_rate: float, pitch_rate: float, yaw_rate: float, out: np.ndarray) -> None:
+def angular_velocity(
+    pitch: float, yaw: float, roll_rate: float, pitch_rate: float, yaw_rate: float, out: np.ndarray
+) -> None:
     """Ω (rad/s, lab frame) of R_z(yaw)·R_y(pitch)·R_x(roll): ψ̇ ẑ + θ̇ R_z ŷ + φ̇ R_z R_y x̂, into ``out``."""
     cp, sp = math.cos(pitch), math.sin(pitch)
     cy, sy = math.cos(yaw), math.sin(yaw)

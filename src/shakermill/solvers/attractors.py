@@ -5,7 +5,7 @@ run's result. For engines whose runs start as one ball on the axis (``descriptio
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -48,8 +48,16 @@ def settle(
     status = engine.advance(boundaries[-1], heartbeat)
     if status != REACHED_STOP:
         return SettledStart(
-            start, params.ball_position, params.ball_momentum, FAILED, None, math.nan, math.nan, math.nan,
-            {"time": np.empty(0), "wall": np.empty(0, dtype=str)}, engine.explain(status),
+            start,
+            params.ball_position,
+            params.ball_momentum,
+            FAILED,
+            None,
+            math.nan,
+            math.nan,
+            math.nan,
+            {"time": np.empty(0), "wall": np.empty(0, dtype=str)},
+            engine.explain(status),
         )
     impacts = engine.impact_columns(since=settled_at)
     regime, cycle = classify_impacts(impacts, params.omega, params.phase)
@@ -59,8 +67,15 @@ def settle(
     span = measured * period
     count = int(np.count_nonzero(impacts["time"] < boundaries[measured]))
     return SettledStart(
-        start, params.ball_position, params.ball_momentum, regime, cycle, count / span,
-        (heat[measured] - heat[0]) / span, _batch_standard_error(heat, period), impacts,
+        start,
+        params.ball_position,
+        params.ball_momentum,
+        regime,
+        cycle,
+        count / span,
+        (heat[measured] - heat[0]) / span,
+        _batch_standard_error(heat, period),
+        impacts,
     )
 
 
@@ -98,8 +113,9 @@ def probe_attractors(result: Result, budget: RunBudget, progress: ProgressCallba
         scan = find_attractors(result.params, budget, progress)
     except KeyboardInterrupt:
         result.status = INTERRUPTED
-        result.message = ("Interrupted by the user while probing attractors; the run itself finished, its attractors "
-                          "were not probed.")
+        result.message = (
+            "Interrupted by the user while probing attractors; the run itself finished, its attractors were not probed."
+        )
         result.summary = summarize(result)
         return
     attach(result, scan)

@@ -70,8 +70,12 @@ class Mechanics:
         return params.replace(**{key: getattr(self.params, key) for key in keys}) == self.params
 
 
-def settle_mechanics(params: Parameters, engine_class: type[Engine], progress: ProgressCallback | None = None,
-                     budget: RunBudget | None = None) -> Mechanics:
+def settle_mechanics(
+    params: Parameters,
+    engine_class: type[Engine],
+    progress: ProgressCallback | None = None,
+    budget: RunBudget | None = None,
+) -> Mechanics:
     """Run the mechanics until its means converge; Ctrl-C ends it with the status INTERRUPTED and keeps the engine,
     so that what it integrated can still be returned. Only the start is sampled; the record windows are kept, by
     the first of the replicas that an engine with a ``replicas_key`` runs (solvers/replicas.py) alone."""
@@ -86,8 +90,13 @@ def settle_mechanics(params: Parameters, engine_class: type[Engine], progress: P
     return Mechanics(params, engine, means, status)
 
 
-def simulate_averaged(params: Parameters, engine_class: type[Engine], progress: ProgressCallback | None = None,
-                      budget: RunBudget | None = None, mechanics: Mechanics | None = None) -> Result:
+def simulate_averaged(
+    params: Parameters,
+    engine_class: type[Engine],
+    progress: ProgressCallback | None = None,
+    budget: RunBudget | None = None,
+    mechanics: Mechanics | None = None,
+) -> Result:
     """Run ``params`` with the multiscale solver (module docstring); the same :class:`Result` as a full run.
 
     ``mechanics`` measured before serves parameters that differ from its own in the engine's thermal-only keys.
@@ -111,7 +120,11 @@ def simulate_averaged(params: Parameters, engine_class: type[Engine], progress: 
         raise ValueError("mechanics: measured for parameters that differ in more than the engine's thermal-only keys")
     result = _from_mechanics(params, engine_class, mechanics, progress, budget, started)
     stopped_by_the_user_or_the_budget = result.status in (INTERRUPTED, BUDGET_EXCEEDED)
-    if engine_class.description.attractor_starts and params.attractor_starts > 1 and not stopped_by_the_user_or_the_budget:
+    if (
+        engine_class.description.attractor_starts
+        and params.attractor_starts > 1
+        and not stopped_by_the_user_or_the_budget
+    ):
         probe_attractors(result, budget, progress)
     return result
 
@@ -146,14 +159,22 @@ def full_resolution_instead(params: Parameters) -> str | None:
     )
 
 
-def _from_mechanics(params: Parameters, engine_class: type[Engine], mechanics: Mechanics,
-                    progress: ProgressCallback | None, budget: RunBudget, started: float) -> Result:
+def _from_mechanics(
+    params: Parameters,
+    engine_class: type[Engine],
+    mechanics: Mechanics,
+    progress: ProgressCallback | None,
+    budget: RunBudget,
+    started: float,
+) -> Result:
     if mechanics.status != REACHED_STOP or mechanics.means is None:
         return _stopped(mechanics, mechanics.status, mechanics.explanation, started)
     means = mechanics.means
     # The mechanics may have been measured for parameters that differ in thermal-only keys: the network is params'.
     network = engine_class.network_for(params)
-    problem = means.averages.message if not means.averages.converged else time_scale_problem(mechanics.engine, network, means)
+    problem = (
+        means.averages.message if not means.averages.converged else time_scale_problem(mechanics.engine, network, means)
+    )
     if problem is not None:
         return _refuse(params, engine_class, mechanics, _not_valid(means.averages, problem), progress, budget, started)
     thermal = integrate_network(network, means.load, params)
@@ -165,13 +186,16 @@ def _from_mechanics(params: Parameters, engine_class: type[Engine], mechanics: M
     return _averaged_result(params, network, mechanics, thermal, started)
 
 
-def _averaged_result(params: Parameters, network: ThermalNetwork, mechanics: Mechanics, thermal: Any,
-                     started: float) -> Result:
+def _averaged_result(
+    params: Parameters, network: ThermalNetwork, mechanics: Mechanics, thermal: Any, started: float
+) -> Result:
     """The result of a valid averaged run: the network's temperatures for the whole duration, the motion and
     impacts of the averaging window, the audit of the mean rates."""
     engine, means = mechanics.engine, mechanics.means
     averages, load = means.averages, means.load
-    history = engine.averaged_history(thermal.t, thermal.y[:-1], thermal.y[-1], load, averages.dissipated_power, network)
+    history = engine.averaged_history(
+        thermal.t, thermal.y[:-1], thermal.y[-1], load, averages.dissipated_power, network
+    )
     impacts = engine.impact_columns(since=averages.transient)
     note = "" if math.isfinite(averages.impact_interval) else engine.no_impact_note()
     result = Result(
@@ -207,7 +231,8 @@ def time_scale_problem(engine: Engine, network: ThermalNetwork, means: Means) ->
         if count and constant < TIME_SCALE_SEPARATION * window / count:
             return (
                 f"the {network.nodes[node].name}'s thermal time constant ({constant:.3g} s) is not well separated from "
-                f"the time between the impacts that heat it ({window / count:.3g} s): its temperature follows single impacts"
+                f"the time between the impacts that heat it ({window / count:.3g} s): its temperature follows single "
+                "impacts"
             )
     return None
 
@@ -222,13 +247,19 @@ def integrate_network(network: ThermalNetwork, load: NetworkLoad, params: Parame
 
     initial = np.append(network.initial_temperatures(params.initial_temperature), 0.0)
     return solve_ivp(
-        rates, (0.0, params.duration), initial, method="LSODA", t_eval=sample_times(params), rtol=THERMAL_RTOL,
+        rates,
+        (0.0, params.duration),
+        initial,
+        method="LSODA",
+        t_eval=sample_times(params),
+        rtol=THERMAL_RTOL,
         atol=THERMAL_ATOL,
     )
 
 
-def averaged_energy(engine: Engine, network: ThermalNetwork, means: Means, thermal: Any, impacts: dict[str, np.ndarray],
-                    duration: float) -> EnergyAudit:
+def averaged_energy(
+    engine: Engine, network: ThermalNetwork, means: Means, thermal: Any, impacts: dict[str, np.ndarray], duration: float
+) -> EnergyAudit:
     """The audit of an averaged run: mean rates times the duration; the split by channel is that of the contacts of
     the averaging window."""
     load = means.load
@@ -237,8 +268,11 @@ def averaged_energy(engine: Engine, network: ThermalNetwork, means: Means, therm
     heat = load.heat_power * duration
     dissipated = means.averages.dissipated_power * duration
     warming = thermal.y[:-1, -1] - thermal.y[:-1, 0]
-    by_channel = {name: float(np.sum(impacts[f"dissipated_{name}"])) for name in engine.description.channels
-                  if f"dissipated_{name}" in impacts}
+    by_channel = {
+        name: float(np.sum(impacts[f"dissipated_{name}"]))
+        for name in engine.description.channels
+        if f"dissipated_{name}" in impacts
+    }
     total = sum(by_channel.values())
     return EnergyAudit(
         work_by_vial=dissipated,
@@ -256,7 +290,9 @@ def averaged_energy(engine: Engine, network: ThermalNetwork, means: Means, therm
         drive_heat=network.fixed_heat * duration,
         heat_lost_to_surroundings=float(thermal.y[-1, -1]),
         projection_correction=engine.projection_correction,
-        dissipated_by_channel={name: value / total * dissipated if total > 0 else 0.0 for name, value in by_channel.items()},
+        dissipated_by_channel={
+            name: value / total * dissipated if total > 0 else 0.0 for name, value in by_channel.items()
+        },
     )
 
 
@@ -290,16 +326,26 @@ def _full_resolution_out_of_reach(params: Parameters, mechanics: Mechanics, star
     if steps <= params.max_steps and wall <= params.max_wall_time:
         return None
     return (
-        f"A full-resolution run instead (averaging_fallback = 'full') would take ~{steps:.2g} steps and ~{wall / 3600:.2g} h "
+        f"A full-resolution run instead (averaging_fallback = 'full') would take ~{steps:.2g} steps and "
+        f"~{wall / 3600:.2g} h "
         f"at the mechanics' pace, beyond max_steps = {params.max_steps} or max_wall_time = {params.max_wall_time:g} s: "
         "not started. Allow the averaging more time (averaging_max_time) or ask for a shorter duration."
     )
 
 
-def _refuse(params: Parameters, engine_class: type[Engine], mechanics: Mechanics, averages: MechanicsAverages,
-            progress: ProgressCallback | None, budget: RunBudget, started: float) -> Result:
+def _refuse(
+    params: Parameters,
+    engine_class: type[Engine],
+    mechanics: Mechanics,
+    averages: MechanicsAverages,
+    progress: ProgressCallback | None,
+    budget: RunBudget,
+    started: float,
+) -> Result:
     """Averaging is not valid: fall back to full resolution, or fail, as ``averaging_fallback`` says."""
-    out_of_reach = None if params.averaging_fallback == "fail" else _full_resolution_out_of_reach(params, mechanics, started)
+    out_of_reach = (
+        None if params.averaging_fallback == "fail" else _full_resolution_out_of_reach(params, mechanics, started)
+    )
     if params.averaging_fallback == "fail" or out_of_reach is not None:
         advice = out_of_reach or "Set averaging_fallback = 'full' to run at full resolution."
         reason = f"Averaging is not valid: {averages.message}. {advice}"

@@ -5,8 +5,8 @@ converge (:func:`measure_means`, the averaged solver's batch means: MSER truncat
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -90,8 +90,9 @@ def _flat(measured: Measured) -> np.ndarray:
     return np.concatenate([measured.heat, measured.terms, measured.conduction, [measured.dissipated]])
 
 
-def measure_means(params: Parameters, engines: Sequence[Engine], progress: ProgressCallback | None,
-                  threads: int = 1) -> tuple[Means, int]:
+def measure_means(
+    params: Parameters, engines: Sequence[Engine], progress: ProgressCallback | None, threads: int = 1
+) -> tuple[Means, int]:
     """Run the mechanics of ``engines`` (independent replicas of one run, solvers/replicas.py) batch by batch, side by
     side on ``threads`` threads, until their pooled means converge (or :func:`mechanics_limit`); returns the means and
     the last status. ``progress(t, mechanics_limit)`` is told how far the first replica has got.
@@ -127,12 +128,15 @@ def measure_means(params: Parameters, engines: Sequence[Engine], progress: Progr
                 settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target)
                 if settled.ready and all(relative_error(c) <= target for c in settled.checked.T):
                     converged = True
-                    message = (f"converged after {t:.3g} s of mechanics{_in_each(engines)} ({settled.grouping.groups} "
-                               f"uncorrelated batches of {settled.batch:.3g} s)")
+                    message = (
+                        f"converged after {t:.3g} s of mechanics{_in_each(engines)} ({settled.grouping.groups} "
+                        f"uncorrelated batches of {settled.batch:.3g} s)"
+                    )
                     break
             if t + batch > limit:
                 message = (
-                    f"the averages did not converge to a relative standard error of {target:g} ({key}) in uncorrelated, "
+                    f"the averages did not converge to a relative standard error of {target:g} ({key}) in "
+                    "uncorrelated, "
                     f"stationary batches within {limit_name} = {limit:g} s{_in_each(engines)} (irregular or slowly "
                     f"settling motion){_longer_window_hint(settled, t, target, limit_name)}"
                 )
@@ -167,8 +171,9 @@ class Settled:
         return self.grouping.uncorrelated and not self.drifting
 
 
-def _settled(cumulative: list[list[np.ndarray]], base: float, sources: int, balls: int, least: int,
-             target: float) -> Settled:
+def _settled(
+    cumulative: list[list[np.ndarray]], base: float, sources: int, balls: int, least: int, target: float
+) -> Settled:
     """Cut each replica's transient (MSER on its total heat power and its balls' mean velocity term, White 1997),
     group its batches until their means are uncorrelated, and test the totals for drift (MODEL.md §14.2); a
     spread or drift within the ``target`` relative error is no concern."""
@@ -204,9 +209,14 @@ def _longer_window_hint(settled: Settled | None, t: float, target: float, limit_
     needed = transient + (t - transient) * (worst / target) ** 2
     most = bounds(limit_name).high
     if needed > most:
-        return f"; its largest relative error was {worst:.3g}, so about {needed:.3g} s would reach it, more than {limit_name} allows ({most:g} s)"
-    return (f"; its largest relative error was {worst:.3g}, so about {needed:.3g} s would reach it: allowed "
-            f"{limit_name} >= {math.ceil(min(1.2 * needed, most))}")
+        return (
+            f"; its largest relative error was {worst:.3g}, so about {needed:.3g} s would reach it, more than "
+            f"{limit_name} allows ({most:g} s)"
+        )
+    return (
+        f"; its largest relative error was {worst:.3g}, so about {needed:.3g} s would reach it: allowed "
+        f"{limit_name} >= {math.ceil(min(1.2 * needed, most))}"
+    )
 
 
 def _in_each(engines: Sequence[Engine]) -> str:
@@ -242,8 +252,9 @@ def mechanics_limit(params: Parameters) -> tuple[float, str]:
     return params.averaging_max_time, "averaging_max_time"
 
 
-def _means(engines: Sequence[Engine], settled: Settled, sources: int, balls: int, rounds: int, converged: bool,
-           message: str) -> Means:
+def _means(
+    engines: Sequence[Engine], settled: Settled, sources: int, balls: int, rounds: int, converged: bool, message: str
+) -> Means:
     """The means of the settled, grouped batch rates of every replica (columns: each source's heat, each ball's
     term, each contact conductance, the dissipation). The conductances are averaged but not held to the target
     error: a pair of balls that rarely touch has a noisy one, and a small one. ``rounds``: the batches each replica
@@ -251,8 +262,9 @@ def _means(engines: Sequence[Engine], settled: Settled, sources: int, balls: int
     rates = settled.rates
     heat, terms, conductances = rates[:, :sources], rates[:, sources : sources + balls], rates[:, sources + balls : -1]
     total_heat, mean_terms = heat.sum(axis=1), terms.mean(axis=1)
-    impacts = sum(len(engine.impact_columns(since=cut * settled.base)["time"])
-                  for engine, cut in zip(engines, settled.cuts))
+    impacts = sum(
+        len(engine.impact_columns(since=cut * settled.base)["time"]) for engine, cut in zip(engines, settled.cuts)
+    )
     pooled_window = sum(rounds - cut for cut in settled.cuts) * settled.base
     averages = MechanicsAverages(
         heat_power=_mean(total_heat),
@@ -284,8 +296,10 @@ def _change(settled: Settled, heat_power: float, error: float) -> str:
         return ""
     if abs(before - heat_power) <= max(CHANGE_SHARE * abs(heat_power), DRIFT_SIGMAS * error):
         return ""
-    return (f"; the motion changed at t = {cut * settled.base:.3g} s (heat power {before:.3g} W before, "
-            f"{heat_power:.3g} W after): the averages are of the motion after the change")
+    return (
+        f"; the motion changed at t = {cut * settled.base:.3g} s (heat power {before:.3g} W before, "
+        f"{heat_power:.3g} W after): the averages are of the motion after the change"
+    )
 
 
 # A transient whose heat power differs from the settled motion's by more than this share is reported as a change.
@@ -295,8 +309,16 @@ CHANGE_SHARE = 0.1
 def _nothing_moves(engine: Engine, first: Measured) -> Means:
     """The means of an empty mill (n_balls = 0): no contact heats anything, so there is nothing to average."""
     averages = MechanicsAverages(
-        heat_power=0.0, heat_power_stderr=0.0, dissipated_power=0.0, velocity_term=math.nan, velocity_term_stderr=0.0,
-        transient=0.0, window=0.0, batches=0, impact_interval=math.inf, converged=True,
+        heat_power=0.0,
+        heat_power_stderr=0.0,
+        dissipated_power=0.0,
+        velocity_term=math.nan,
+        velocity_term_stderr=0.0,
+        transient=0.0,
+        window=0.0,
+        batches=0,
+        impact_interval=math.inf,
+        converged=True,
         message="no balls: no mechanics to average",
     )
     return Means(engine.load(np.zeros_like(first.heat), np.zeros(0), np.zeros_like(first.conduction)), averages)

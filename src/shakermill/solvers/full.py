@@ -18,8 +18,12 @@ from shakermill.solvers.driver import run_until, sample_times, stop_message
 from shakermill.solvers.result import Result, conclude
 
 
-def simulate_full(params: Parameters, engine_class: type[Engine], progress: ProgressCallback | None = None,
-                  budget: RunBudget | None = None) -> Result:
+def simulate_full(
+    params: Parameters,
+    engine_class: type[Engine],
+    progress: ProgressCallback | None = None,
+    budget: RunBudget | None = None,
+) -> Result:
     """Run ``params`` at full resolution for ``params.duration`` seconds, within ``budget`` (``params``' if None).
 
     ``progress(t, duration)`` is called after every chunk of simulated time, and more often when steps are tiny.
@@ -64,7 +68,13 @@ def settled_load(engine: Engine, history: StateHistory) -> NetworkLoad:
     description = engine.description
 
     def rates(names: tuple[str, ...]) -> np.ndarray:
-        return np.concatenate([np.atleast_1d(settled_rates(history.times, history[name])) for name in names] or [np.zeros(0)])
+        return np.concatenate(
+            [np.atleast_1d(settled_rates(history.times, history[name])) for name in names] or [np.zeros(0)]
+        )
 
-    return engine.load(*(rates(names) for names in (description.heat_variables, description.term_variables,
-                                                     description.conduction_variables)))
+    return engine.load(
+        *(
+            rates(names)
+            for names in (description.heat_variables, description.term_variables, description.conduction_variables)
+        )
+    )

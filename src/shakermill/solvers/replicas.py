@@ -14,9 +14,10 @@ from __future__ import annotations
 import contextvars
 import os
 import threading
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_EXCEPTION, Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager
-from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -158,7 +159,9 @@ class ReplicaSet:
         replica's time, from this thread. Ctrl-C, or an exception in any replica, stops them all within one compiled
         call each and is raised here, every engine whole at its last step."""
         if self._pool is None:
-            return [engine.advance(t_stop, heartbeat if index == 0 else None) for index, engine in enumerate(self.engines)]
+            return [
+                engine.advance(t_stop, heartbeat if index == 0 else None) for index, engine in enumerate(self.engines)
+            ]
         futures = [self._pool.submit(engine.advance, t_stop, self._check_stop) for engine in self.engines]
         try:
             while True:

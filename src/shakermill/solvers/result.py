@@ -5,9 +5,10 @@ warnings)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -91,8 +92,13 @@ class MechanicsAverages:
 
 
 # What ``repr(result)`` shows of its summary, and the longest message it prints whole.
-REPR_HEADLINES = {"ball_C": "ball °C", "vial_C": "vial °C", "air_C": "air °C", "heat_power_W": "heat W",
-                  "impact_rate_hz": "impacts/s"}
+REPR_HEADLINES = {
+    "ball_C": "ball °C",
+    "vial_C": "vial °C",
+    "air_C": "air °C",
+    "heat_power_W": "heat W",
+    "impact_rate_hz": "impacts/s",
+}
 REPR_MESSAGE = 160
 
 
@@ -134,17 +140,25 @@ class Result:
     def __repr__(self) -> str:
         """A few lines, as xarray and pandas objects print: what ran and how it ended, its headline numbers and the
         sizes of its data; the data themselves are ``timeseries``, ``impacts``, ``windows`` and ``summary``."""
-        shown = [f"{REPR_HEADLINES[key]} {self.summary[key]:.4g}" for key in REPR_HEADLINES
-                 if isinstance(self.summary.get(key), (int, float))]
+        shown = [
+            f"{REPR_HEADLINES[key]} {self.summary[key]:.4g}"
+            for key in REPR_HEADLINES
+            if isinstance(self.summary.get(key), (int, float))
+        ]
         impacts = next(iter(self.impact_columns.values()), np.zeros(0)).size
         lines = [
             f"<shakermill.Result: engine {self.params.engine!r}, solver {self.solver!r}, "
-            f"{'success' if self.success else f'status {self.status}'}, {self.t_end:g} s simulated in {self.wall_time:.3g} s>",
+            f"{'success' if self.success else f'status {self.status}'}, {self.t_end:g} s simulated in "
+            f"{self.wall_time:.3g} s>",
             f"  {self.message if len(self.message) <= REPR_MESSAGE else self.message[: REPR_MESSAGE - 1] + '…'}",
             *([f"  {', '.join(shown)}"] if shown else []),
             f"  data: {self.history.times.size} samples of {len(self.history.variables)} series, {impacts} impacts, "
             f"{self.window_history.times.size} window samples, {len(self.summary)} summary keys",
-            *([f"  {len(self.warnings)} warning{'s' if len(self.warnings) != 1 else ''} (.warnings)"] if self.warnings else []),
+            *(
+                [f"  {len(self.warnings)} warning{'s' if len(self.warnings) != 1 else ''} (.warnings)"]
+                if self.warnings
+                else []
+            ),
         ]
         return "\n".join(lines)
 
@@ -213,7 +227,9 @@ def conclude(result: Result, network: ThermalNetwork, load: NetworkLoad) -> Resu
 
 def node_temperatures(network: ThermalNetwork, history: StateHistory) -> np.ndarray:
     """Every node's temperature (K) at the samples of ``history``, over (node, time)."""
-    balls = history[BALL_TEMPERATURES].T if BALL_TEMPERATURES in history.variables else np.atleast_2d(history["theta_ball"])
+    balls = (
+        history[BALL_TEMPERATURES].T if BALL_TEMPERATURES in history.variables else np.atleast_2d(history["theta_ball"])
+    )
     others = [history[f"theta_{node.name}"] for node in network.nodes[network.n_balls :]]
     return np.vstack([balls, *others])
 
@@ -357,12 +373,19 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         ),
     }
     summary.update(understood_inputs(params))
-    summary.update(stress_spectrum(impacts, impact_window, params.stress_energy_thresholds,
-                                   summary["dissipated_power_W"], params.ball_masses()).as_summary())
+    summary.update(
+        stress_spectrum(
+            impacts, impact_window, params.stress_energy_thresholds, summary["dissipated_power_W"], params.ball_masses()
+        ).as_summary()
+    )
     summary.update(several_ball_summary(result))
     if describe(params.engine).several_balls and math.isfinite(summary["stress_lasting_share"]):
-        summary["charge_regime"] = charge_regime(summary["stress_lasting_share"], summary["fast_impact_rate_hz"],
-                                                 params.n_balls, params.omega / (2.0 * math.pi))
+        summary["charge_regime"] = charge_regime(
+            summary["stress_lasting_share"],
+            summary["fast_impact_rate_hz"],
+            params.n_balls,
+            params.omega / (2.0 * math.pi),
+        )
     if "theta_clamp" in series.variables:
         summary["clamp_C"] = kelvin_to_celsius(float(series["theta_clamp"][-1]))
     if result.steady is not None:

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 from shakermill.engines.budget import BudgetExceeded, RunBudget
 from shakermill.engines.interface import ProgressCallback
@@ -66,8 +66,11 @@ def _check_step_budget(params: Parameters, least_steps: Callable[[Parameters, fl
     simulated = params.duration if at_full_resolution else least_mechanics(params)
     steps = least_steps(params, simulated)
     if steps > params.max_steps:
-        what, or_less = ("the run", ", a shorter duration or solver = 'averaged'") if at_full_resolution else (
-            "the least mechanics of the averaged solver", "")
+        what, or_less = (
+            ("the run", ", a shorter duration or solver = 'averaged'")
+            if at_full_resolution
+            else ("the least mechanics of the averaged solver", "")
+        )
         raise ParameterError(
             f"max_steps: {simulated:.4g} s of {what} at full resolution take at least {steps:.3g} steps of engine = "
             f"{params.engine!r} (none is longer than max_flight_step = {params.max_flight_step:g} s), more than "
@@ -82,7 +85,8 @@ def _check_memory(params: Parameters, needed_by: Callable[[Parameters, int], int
     free = psutil.virtual_memory().available
     if needed > MEMORY_SHARE * free:
         raise ParameterError(
-            f"record_windows: the run would keep {needed / 2**30:.3g} GiB of records and contacts ({params.n_balls} balls, "
+            f"record_windows: the run would keep {needed / 2**30:.3g} GiB of records and contacts ({params.n_balls} "
+            "balls, "
             f"{sum(length for _, length in params.record_windows):g} s of record windows, a sample every "
             f"{params.output_interval:g} s), more than the {MEMORY_SHARE * free / 2**30:.3g} GiB it may take of the "
             f"{free / 2**30:.3g} GiB free; allowed shorter record_windows or a longer output_interval"
@@ -125,7 +129,9 @@ def thermal_variants(params: Parameters, progress: ProgressCallback | None = Non
         budget = RunBudget.of(params)
         mechanics = settle_mechanics(params, engine, progress, budget)
         if mechanics.status != REACHED_STOP:
-            _whole(simulate_averaged(params, engine, None, budget, mechanics), budget)  # raises for Ctrl-C and the budget
+            _whole(
+                simulate_averaged(params, engine, None, budget, mechanics), budget
+            )  # raises for Ctrl-C and the budget
         else:
             while len(_SETTLED) >= _SETTLED_KEPT:
                 _SETTLED.pop(next(iter(_SETTLED)))

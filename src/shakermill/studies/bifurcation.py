@@ -3,9 +3,10 @@ the folder a scan writes."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Sequence
+from typing import TYPE_CHECKING
 
 from shakermill.analysis.regime import classify
 from shakermill.io.runs import FolderKind
@@ -60,8 +61,14 @@ def bifurcation(
         scan = probed(result)
         label, period = classify(result)
         regimes.append(
-            {key: float(value), "regime": label, "period": period, "solver": result.solver, "message": result.message,
-             "n_attractors": len(scan.attractors)}
+            {
+                key: float(value),
+                "regime": label,
+                "period": period,
+                "solver": result.solver,
+                "message": result.message,
+                "n_attractors": len(scan.attractors),
+            }
         )
         attractors.append(_keyed(scan.table(), key, value))
         phases.append(_keyed(scan.phases(result.params.omega, result.params.phase), key, value))
@@ -84,7 +91,8 @@ BIFURCATION_FIGURE = "bifurcation"
 
 
 def write_bifurcation(scan: Bifurcation, folder: Path) -> list[Path]:
-    """``bifurcation_regimes``, ``bifurcation_attractors`` and ``bifurcation_phases`` tables (Parquet and CSV) in ``folder``."""
+    """``bifurcation_regimes``, ``bifurcation_attractors`` and ``bifurcation_phases`` tables (Parquet and CSV) in
+    ``folder``."""
     from shakermill.studies.sweep_storage import write_table
 
     folder.mkdir(parents=True, exist_ok=True)

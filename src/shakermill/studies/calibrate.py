@@ -21,13 +21,11 @@ makes each evaluation a few hundredths of a second.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
-from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
-import tomli_w
 from scipy.optimize import least_squares
 
 from shakermill.engines.interface import ProgressCallback
@@ -58,9 +56,7 @@ from shakermill.studies.validation import (
     experiment_curve,
     target_range,
 )
-from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
 from shakermill.support.limits import MAX_VALUE_LENGTH, quoted
-from shakermill.support.version import __version__
 
 # The free set of the shipped calibrated preset: the smallest set that follows the experiment's curve
 # within 1 K RMS with every value inside its defensible range (see README, "Against the experiment").
@@ -211,8 +207,10 @@ def _default_candidates(params: Parameters) -> tuple[str, ...]:
     reader = reader_of(params)
     thermal_only = describe(params.engine).thermal_only_keys
     return tuple(
-        key for key in DEFAULT_FREE_BY_NETWORK[params.thermal_model]
-        if reader.not_read(key) is None and (not thermal_only or key in thermal_only)
+        key
+        for key in DEFAULT_FREE_BY_NETWORK[params.thermal_model]
+        if reader.not_read(key) is None
+        and (not thermal_only or key in thermal_only)
         and not (params.n_balls == 0 and key in BALL_HEAT_KEYS)
     )
 
@@ -299,8 +297,12 @@ def calibrate(
     predicted = [key for key in PREDICTED_KEYS if key not in targets]
     prediction_stderr = {} if full_resolution else _prediction_stderr(evaluate, solution.x, covariance, predicted)
     # Sampled only where an evaluation is a network alone: thousands of them take minutes there, hours elsewhere.
-    sampled = sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution
-    posterior = _sampled_posterior(evaluate, solution.x, (lower, upper), residuals, curves, on_posterior) if sampled else None
+    sampled = (
+        sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution
+    )
+    posterior = (
+        _sampled_posterior(evaluate, solution.x, (lower, upper), residuals, curves, on_posterior) if sampled else None
+    )
     status, message = _verdict(solution, result.success, free, missed, at_bounds, curve_rms, covariance)
     return Calibration(
         params=result.params.replace(solver=base.solver, attractor_starts=base.attractor_starts),
@@ -333,21 +335,31 @@ def _fitting_parameters(base: Parameters, curves: Sequence[Curve], full_resoluti
     longest = max((float(measured.times.max()) for measured in curves), default=0.0)
     if full_resolution:
         check_full_resolution_work(base, max(base.duration, longest))
-    fitting = base.replace(solver="full" if full_resolution else "averaged", attractor_starts=1,
-                           duration=max(base.duration, longest))
+    fitting = base.replace(
+        solver="full" if full_resolution else "averaged", attractor_starts=1, duration=max(base.duration, longest)
+    )
     preflight(fitting)
     return fitting
 
 
-def _verdict(solution: Any, run_success: bool, free: Sequence[str], missed: Mapping[str, float], at_bounds: Sequence[str],
-             curve_rms: float | None, covariance: np.ndarray | None) -> tuple[str, str]:
+def _verdict(
+    solution: Any,
+    run_success: bool,
+    free: Sequence[str],
+    missed: Mapping[str, float],
+    at_bounds: Sequence[str],
+    curve_rms: float | None,
+    covariance: np.ndarray | None,
+) -> tuple[str, str]:
     """The fit's status ('fitted', 'undetermined' or 'not met') and its message: undetermined where a direction of
     the keys leaves the residuals unmoved, or a key's standard error exceeds its value."""
     off_curve = curve_rms is not None and curve_rms > CURVE_TOLERANCE_K
     stuck = [key for key in at_bounds if key not in DEFENSIBLE_RANGES]
     met = bool(solution.success) and not stuck and not missed and not off_curve and run_success
     # A fit that misses its data has large errors for that reason: its verdict is the miss, not its errors.
-    undetermined = undetermined_keys(solution.jac, free) or ("" if missed or off_curve else loosely_determined(covariance, free, at_bounds))
+    undetermined = undetermined_keys(solution.jac, free) or (
+        "" if missed or off_curve else loosely_determined(covariance, free, at_bounds)
+    )
     message = _outcome(str(solution.message), free, missed, at_bounds, curve_rms if off_curve else None)
     if undetermined:
         return "undetermined", f"{undetermined}; {message}"
@@ -361,14 +373,22 @@ Evaluation = tuple[np.ndarray, dict[tuple[str, ...], Result]]
 RUNS_KEPT = 8
 
 
-def _evaluator(fitting: Parameters, free: Sequence[str], targets: Mapping[str, float], curves: Sequence[Curve],
-               progress: Callable[[int, float | None], None] | None, mechanics_progress: ProgressCallback | None = None,
-               ) -> tuple[Callable[[np.ndarray], Evaluation], dict[tuple[float, ...], np.ndarray]]:
+def _evaluator(
+    fitting: Parameters,
+    free: Sequence[str],
+    targets: Mapping[str, float],
+    curves: Sequence[Curve],
+    progress: Callable[[int, float | None], None] | None,
+    mechanics_progress: ProgressCallback | None = None,
+) -> tuple[Callable[[np.ndarray], Evaluation], dict[tuple[float, ...], np.ndarray]]:
     """The model a fit evaluates at the logarithms ``x`` of its free keys: the residuals and the run of each set of
     conditions (the fitted parameters' own, ``()``, always: the targets and the predictions are of it). The
     residuals of every evaluation are kept (the cache it returns), the runs of the latest RUNS_KEPT: an older one
     asked for again is run again (the runs are deterministic), uncounted. Every set measures its mechanics once."""
-    bases = {conditions: fitting.replace(**parse_overrides(conditions)) for conditions in ((), *(c.conditions for c in curves))}
+    bases = {
+        conditions: fitting.replace(**parse_overrides(conditions))
+        for conditions in ((), *(c.conditions for c in curves))
+    }
     models = {conditions: thermal_variants(params, mechanics_progress) for conditions, params in bases.items()}
     cache: dict[tuple[float, ...], np.ndarray] = {}
     runs: dict[tuple[float, ...], dict[tuple[str, ...], Result]] = {}
@@ -377,7 +397,9 @@ def _evaluator(fitting: Parameters, free: Sequence[str], targets: Mapping[str, f
         key = tuple(np.round(x, 14))
         if key not in runs:
             values = {name: float(math.exp(v)) for name, v in zip(free, x)}
-            runs[key] = {conditions: models[conditions](params.replace(**values)) for conditions, params in bases.items()}
+            runs[key] = {
+                conditions: models[conditions](params.replace(**values)) for conditions, params in bases.items()
+            }
             while len(runs) > RUNS_KEPT:
                 runs.pop(next(iter(runs)))
         if key not in cache:
@@ -408,8 +430,9 @@ def check_full_resolution_work(base: Parameters, duration: float) -> None:
     )
 
 
-def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float] | None,
-             curve: Curve | Sequence[Curve] | None) -> tuple[dict[str, float], tuple[Curve, ...], tuple[str, ...]]:
+def _checked(
+    base: Parameters, free: Sequence[str], targets: Mapping[str, float] | None, curve: Curve | Sequence[Curve] | None
+) -> tuple[dict[str, float], tuple[Curve, ...], tuple[str, ...]]:
     """The targets, the curves (the experiment's when neither is given) and the free keys of a fit, checked: every
     target in its range, no curve's conditions setting a fitted key, every free key one the engine's fits may move,
     starting positive (fitted in log space)."""
@@ -420,16 +443,22 @@ def _checked(base: Parameters, free: Sequence[str], targets: Mapping[str, float]
         curves = (experiment_curve(),)
     free = tuple(free)
     if targets and base.n_balls == 0:
-        raise ParameterError("target: the targets are the balls' temperatures, and an empty mill (n_balls = 0) has no "
-                             "balls; allowed a vial_C curve (--curve) for it")
+        raise ParameterError(
+            "target: the targets are the balls' temperatures, and an empty mill (n_balls = 0) has no "
+            "balls; allowed a vial_C curve (--curve) for it"
+        )
     for measured in curves:
         conditions = parse_overrides(measured.conditions)
         clash = sorted(set(conditions) & set(free))
         if clash:
-            raise ParameterError(f"curve: the conditions of {measured.source} set {', '.join(clash)}, which the fit moves")
+            raise ParameterError(
+                f"curve: the conditions of {measured.source} set {', '.join(clash)}, which the fit moves"
+            )
         if measured.node == "ball" and str(conditions.get("n_balls", base.n_balls)).strip() == "0":
-            raise ParameterError(f"curve: {measured.source or 'the curve'} is of the balls, and its run has none "
-                                 "(n_balls = 0); allowed a vial_C curve for an empty mill")
+            raise ParameterError(
+                f"curve: {measured.source or 'the curve'} is of the balls, and its run has none "
+                "(n_balls = 0); allowed a vial_C curve for an empty mill"
+            )
     check_free_for_engine(base, free)
     check_determinable(free, targets, curves)
     for key in free:
@@ -449,14 +478,19 @@ def check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
     moving = [key for key in free if key not in thermal_only]
     if thermal_only and moving:
         raise ParameterError(
-            f"free: {', '.join(moving)} would change the {base.engine} engine's mechanics, which a calibration measures "
+            f"free: {', '.join(moving)} would change the {base.engine} engine's mechanics, which a calibration "
+            "measures "
             f"once (calibrate --with-assumed frees the preset's assumed inputs, over their stated ranges); allowed for "
             f"engine = {base.engine!r}: {', '.join(thermal_only)}"
         )
 
 
 def _outcome(
-    solver_message: str, free: Sequence[str], missed: Mapping[str, float], at_bounds: Sequence[str], curve_missed_by: float | None
+    solver_message: str,
+    free: Sequence[str],
+    missed: Mapping[str, float],
+    at_bounds: Sequence[str],
+    curve_missed_by: float | None,
 ) -> str:
     """What the fit achieved, in words: the optimiser's message, or why the targets were not met, and the
     keys that ended on the edge of their physically defensible range."""
@@ -483,7 +517,9 @@ def _outcome(
 def _described(measured: Curve) -> str:
     """A curve's source, its node and its conditions, for the record of a fit."""
     conditions = f", {', '.join(measured.conditions)}" if measured.conditions else ""
-    return f"{measured.source} ({measured.node}{conditions})" if measured.node != "ball" or conditions else measured.source
+    return (
+        f"{measured.source} ({measured.node}{conditions})" if measured.node != "ball" or conditions else measured.source
+    )
 
 
 def _curve_residuals_K(results: Mapping[tuple[str, ...], Result], measured: Curve) -> np.ndarray:
@@ -492,7 +528,9 @@ def _curve_residuals_K(results: Mapping[tuple[str, ...], Result], measured: Curv
     return measured.residuals_K(series["time"].values, series[measured.variable].values)
 
 
-def _residuals(results: Mapping[tuple[str, ...], Result], targets: Mapping[str, float], curves: Sequence[Curve]) -> np.ndarray:
+def _residuals(
+    results: Mapping[tuple[str, ...], Result], targets: Mapping[str, float], curves: Sequence[Curve]
+) -> np.ndarray:
     parts = [(float(results[()].summary[key]) - value) / value for key, value in targets.items()]
     for measured in curves:
         parts.extend(_curve_residuals_K(results, measured) / CURVE_SCALE_K)
@@ -509,9 +547,14 @@ def _curve_rms(results: Mapping[tuple[str, ...], Result], curves: Sequence[Curve
     return math.sqrt(float(np.mean(residuals**2)))
 
 
-def _sampled_posterior(evaluate: Callable[[np.ndarray], Evaluation], best: np.ndarray,
-                       limits: tuple[np.ndarray, np.ndarray], residuals: np.ndarray, curves: Sequence[Curve],
-                       on_posterior: Callable[[int], None] | None) -> list[list[float]]:
+def _sampled_posterior(
+    evaluate: Callable[[np.ndarray], Evaluation],
+    best: np.ndarray,
+    limits: tuple[np.ndarray, np.ndarray],
+    residuals: np.ndarray,
+    curves: Sequence[Curve],
+    on_posterior: Callable[[int], None] | None,
+) -> list[list[float]]:
     """The posterior samples of a fit's keys at the fit's residual variance, ``on_posterior`` told how many
     evaluations they take before they begin."""
     if on_posterior is not None:
@@ -520,69 +563,22 @@ def _sampled_posterior(evaluate: Callable[[np.ndarray], Evaluation], best: np.nd
     return posterior_samples(lambda x: evaluate(x)[0], best, *limits, variance).tolist()
 
 
-def _prediction_stderr(evaluate: Callable[[np.ndarray], Evaluation], best: np.ndarray,
-                       covariance: np.ndarray | None, keys: Sequence[str]) -> dict[str, float]:
+def _prediction_stderr(
+    evaluate: Callable[[np.ndarray], Evaluation], best: np.ndarray, covariance: np.ndarray | None, keys: Sequence[str]
+) -> dict[str, float]:
     """Each prediction's standard error (its own unit) by the delta method: its forward differences in the logarithms
     of the keys (one run each) through their covariance; NaN without a covariance."""
     if covariance is None:
         return {key: math.nan for key in keys}
     summary = evaluate(best)[1][()].summary
-    gradients = np.array([
-        [(evaluate(best + JACOBIAN_STEP * unit)[1][()].summary[key] - summary[key]) / JACOBIAN_STEP for key in keys]
-        for unit in np.eye(best.size)
-    ])
+    gradients = np.array(
+        [
+            [(evaluate(best + JACOBIAN_STEP * unit)[1][()].summary[key] - summary[key]) / JACOBIAN_STEP for key in keys]
+            for unit in np.eye(best.size)
+        ]
+    )
     variances = np.einsum("ik,ij,jk->k", gradients, covariance, gradients)
     return {key: float(math.sqrt(max(variance, 0.0))) for key, variance in zip(keys, variances)}
-
-
-def write_preset(calibration: Calibration, path: Path | str, *, base_preset: str, command: str, description: str,
-                 settings: Mapping[str, Any] | None = None) -> Path:
-    """Write a preset TOML usable with ``shakermill run FILE`` and as a shipped preset, with provenance: the fitted
-    values over ``base_preset`` and the ``settings`` (SI values) under which they were fitted, without which the
-    fitted values would describe another mill."""
-    values = {key: calibration.fitted[key] for key in calibration.free}
-    document = {
-        "preset": base_preset,
-        **{key: value for key, value in (settings or {}).items() if key not in values},
-        **values,
-        "provenance": {
-            "description": description,
-            "command": command,
-            "fitted": list(calibration.free),
-            "targets": calibration.targets,
-            "achieved": calibration.achieved,
-            "relative_residuals": calibration.relative_residuals,
-            "sensitivities": calibration.sensitivities,
-            "parameter_stderr": calibration.parameter_stderr,
-            "predictions": calibration.predictions,
-            "defensible": calibration.defensible,
-            "at_bounds": calibration.at_bounds,
-            "start": calibration.start,
-            "solver": calibration.solver,
-            "evaluations": calibration.evaluations,
-            "message": calibration.message,
-            "shakermill_version": __version__,
-            "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        },
-    }
-    # TOML has no null: a fit that does not determine its covariance or samples no posterior leaves the key out.
-    if calibration.covariance is not None:
-        document["provenance"]["covariance_log"] = calibration.covariance
-    if calibration.posterior is not None:
-        document["provenance"]["posterior_log"] = calibration.posterior
-    if calibration.curve_rms_K is not None:
-        document["provenance"]["curve_rms_K"] = calibration.curve_rms_K
-        document["provenance"]["curve"] = calibration.curve_source
-    return write_preset_file(path, f"# shakermill preset fitted by calibration; keys not listed come from {base_preset!r}.",
-                             document)
-
-
-def write_preset_file(path: Path | str, header: str, document: Mapping[str, Any]) -> Path:
-    """A fitted preset's TOML ``document`` under its comment ``header``, written atomically (its folder made)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    remove_abandoned_writes(path.parent)
-    return write_text_atomically(path, f"{header}\n" + tomli_w.dumps(document))
 
 
 # Free sets compared by `validate` and the README: which follow the experiment's curve and which cannot.
@@ -628,10 +624,13 @@ class FreeSetOutcome:
 
 
 def free_set_study(
-    base: Parameters, free_sets: Sequence[tuple[str, ...]] = FREE_SET_STUDY, curve: Curve | None = None,
+    base: Parameters,
+    free_sets: Sequence[tuple[str, ...]] = FREE_SET_STUDY,
+    curve: Curve | None = None,
     progress: Callable[[int], None] | None = None,
 ) -> list[FreeSetOutcome]:
-    """Fit each free set to ``curve`` (the experiment's by default) from ``base``; ``progress(fits done)`` after each."""
+    """Fit each free set to ``curve`` (the experiment's by default) from ``base``; ``progress(fits done)`` after
+    each."""
     curve = curve or experiment_curve()
     outcomes = []
     for free in free_sets:

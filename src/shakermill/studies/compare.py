@@ -4,8 +4,9 @@ the speed ratio (``shakermill compare-solvers``)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.result import INTERRUPTED, Result
@@ -43,7 +44,10 @@ class SolverComparison:
     def rows(self) -> list[tuple[str, str, Any, Any, Any]]:
         """(quantity, unit, full, averaged, averaged − full) of each compared quantity."""
         full, averaged = self.full.summary, self.averaged.summary
-        return [(label, unit, full[key], averaged[key], averaged[key] - full[key]) for key, label, unit in COMPARED_QUANTITIES]
+        return [
+            (label, unit, full[key], averaged[key], averaged[key] - full[key])
+            for key, label, unit in COMPARED_QUANTITIES
+        ]
 
     def as_dict(self) -> dict[str, Any]:
         return {

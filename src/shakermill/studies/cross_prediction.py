@@ -7,8 +7,9 @@ stated ranges as priors, and the network's own free keys over their defensible r
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any
 
 from shakermill.parameters.defaults import DEFAULT_FREE_BY_NETWORK
 from shakermill.parameters.presets import PRESETS, default_parameters
@@ -58,17 +59,23 @@ class Direction:
     def verdict(self) -> str:
         inside = [prediction.inside for prediction in self.predictions]
         own = [prediction.inside for prediction in self.fitted]
-        return (f"fitted on {self.fitted_on.name} ({sum(own)} of its {len(own)} points inside their own 90 % "
-                f"intervals): {sum(inside)} of the {len(inside)} measured points of {self.predicted.name} inside "
-                "their 90 % intervals")
+        return (
+            f"fitted on {self.fitted_on.name} ({sum(own)} of its {len(own)} points inside their own 90 % "
+            f"intervals): {sum(inside)} of the {len(inside)} measured points of {self.predicted.name} inside "
+            "their 90 % intervals"
+        )
 
     def as_dict(self) -> dict[str, Any]:
-        return {"fitted_on": self.fitted_on.name, "predicted": self.predicted.name, "verdict": self.verdict,
-                "unreliable": self.problems,
-                "posterior": posterior_as_dict(self.posterior),
-                "fitted_points": [prediction.as_dict() for prediction in self.fitted],
-                "predictions": [prediction.as_dict() for prediction in self.predictions],
-                "prior_predictions": [prediction.as_dict() for prediction in self.prior_predictions]}
+        return {
+            "fitted_on": self.fitted_on.name,
+            "predicted": self.predicted.name,
+            "verdict": self.verdict,
+            "unreliable": self.problems,
+            "posterior": posterior_as_dict(self.posterior),
+            "fitted_points": [prediction.as_dict() for prediction in self.fitted],
+            "predictions": [prediction.as_dict() for prediction in self.predictions],
+            "prior_predictions": [prediction.as_dict() for prediction in self.prior_predictions],
+        }
 
 
 @dataclass(frozen=True)
@@ -79,31 +86,47 @@ class CrossPrediction:
     directions: tuple[Direction, ...]
 
     def as_dict(self) -> dict[str, Any]:
-        return {"preset": self.preset, "network_free": list(self.free),
-                "measurement_sd_K": ASSUMED_MEASUREMENT_SD_K, "averaging_error": AVERAGING_ERROR,
-                "emulators": {name: emulator_as_dict(emulator) for name, emulator in self.emulators.items()},
-                "directions": [direction.as_dict() for direction in self.directions]}
+        return {
+            "preset": self.preset,
+            "network_free": list(self.free),
+            "measurement_sd_K": ASSUMED_MEASUREMENT_SD_K,
+            "averaging_error": AVERAGING_ERROR,
+            "emulators": {name: emulator_as_dict(emulator) for name, emulator in self.emulators.items()},
+            "directions": [direction.as_dict() for direction in self.directions],
+        }
 
 
-def cross_prediction(preset: str = BASE_PRESET, members: int = MEMBERS, thermal_draws: int = THERMAL_DRAWS,
-                     overrides: Mapping[str, Any] | None = None,
-                     progress: Callable[[int, int], None] | None = None) -> CrossPrediction:
+def cross_prediction(
+    preset: str = BASE_PRESET,
+    members: int = MEMBERS,
+    thermal_draws: int = THERMAL_DRAWS,
+    overrides: Mapping[str, Any] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> CrossPrediction:
     """Emulate both experiments over their uncertain inputs, fit each and predict the other (module docstring);
     ``progress(done, total)`` counts the mechanical members of both."""
     experiments = {experiment.name: experiment for experiment in load_experiments()}
     pair = (experiments[ONE_BALL], experiments[FIVE_BALLS])
-    settings = {"solver": "averaged", "record_windows": (), "attractor_starts": 1,
-                "dem_averaging_rel_error": AVERAGING_ERROR, **(overrides or {})}
+    settings = {
+        "solver": "averaged",
+        "record_windows": (),
+        "attractor_starts": 1,
+        "dem_averaging_rel_error": AVERAGING_ERROR,
+        **(overrides or {}),
+    }
     free = DEFAULT_FREE_BY_NETWORK[PRESETS[preset].values["thermal_model"].value]
     emulators = {}
     for index, experiment in enumerate(pair):
         params = default_parameters(preset, **{**settings, **experiment.conditions})
         observables = [Observable(point.node, point.time_s) for point in experiment.points]
-        shown = None if progress is None else (lambda done, total, before=index * members: progress(before + done, 2 * members))
+        shown = (
+            None
+            if progress is None
+            else (lambda done, total, before=index * members: progress(before + done, 2 * members))
+        )
         training = train(params, fit_inputs(PRESETS[preset], params, free), observables, members, thermal_draws, shown)
         emulators[experiment.name] = emulate(training)
-    directions = tuple(_direction(fitted_on, predicted, emulators)
-                       for fitted_on, predicted in (pair, pair[::-1]))
+    directions = tuple(_direction(fitted_on, predicted, emulators) for fitted_on, predicted in (pair, pair[::-1]))
     return CrossPrediction(preset, tuple(free), emulators, directions)
 
 
@@ -111,7 +134,12 @@ def _direction(fitted_on: Experiment, predicted: Experiment, emulators: Mapping[
     measured: list[Measured] = measured_of(fitted_on)
     source, target = emulators[fitted_on.name], emulators[predicted.name]
     posterior = sample_posterior([(source, measured)])
-    return Direction(fitted_on, predicted, posterior, tuple(predict(source, posterior, measured)),
-                     tuple(predict(target, posterior, measured_of(predicted))),
-                     tuple(predict(target, prior_sample(target.inputs), measured_of(predicted))),
-                     tuple(reliability_problems((source, target), posterior)))
+    return Direction(
+        fitted_on,
+        predicted,
+        posterior,
+        tuple(predict(source, posterior, measured)),
+        tuple(predict(target, posterior, measured_of(predicted))),
+        tuple(predict(target, prior_sample(target.inputs), measured_of(predicted))),
+        tuple(reliability_problems((source, target), posterior)),
+    )

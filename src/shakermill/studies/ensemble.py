@@ -24,9 +24,10 @@ import hashlib
 import json
 import math
 import warnings
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -54,8 +55,13 @@ HEADLINES: dict[str, tuple[str, str]] = {
     "stress_energy_p90_J": ("stress energy, 90th percentile", "J"),
     "stress_lasting_share": ("share of the dissipation in lasting contacts", ""),
 }
-RISES = {"ball_rise_K": "ball_C", "vial_rise_K": "vial_C", "air_rise_K": "air_C",
-         "ball_steady_rise_K": "ball_steady_C", "vial_steady_rise_K": "vial_steady_C"}
+RISES = {
+    "ball_rise_K": "ball_C",
+    "vial_rise_K": "vial_C",
+    "air_rise_K": "air_C",
+    "ball_steady_rise_K": "ball_steady_C",
+    "vial_steady_rise_K": "vial_steady_C",
+}
 POWER_ABOVE = "stress_power_above_"
 QUANTILES = (0.05, 0.5, 0.95)
 # The surrogate's cross-validated Q² below which its Sobol' indices are not reported, and its folds.
@@ -100,8 +106,10 @@ class FittedPosterior:
 
     def as_dict(self) -> dict[str, Any]:
         spread = np.sqrt(np.diag(self.factor @ self.factor.T))
-        return {key: {"median": float(np.exp(centre)), "log_sd": float(sd)}
-                for key, centre, sd in zip(self.keys, self.mean, spread)}
+        return {
+            key: {"median": float(np.exp(centre)), "log_sd": float(sd)}
+            for key, centre, sd in zip(self.keys, self.mean, spread)
+        }
 
 
 def fitted_posterior(keys: Sequence[str], samples: Sequence[Sequence[float]] | None) -> FittedPosterior | None:
@@ -110,7 +118,9 @@ def fitted_posterior(keys: Sequence[str], samples: Sequence[Sequence[float]] | N
     if not keys or samples is None or len(samples) <= len(keys):
         return None
     logs = np.asarray(samples, dtype=float)
-    return FittedPosterior(tuple(keys), logs.mean(axis=0), np.linalg.cholesky(np.atleast_2d(np.cov(logs, rowvar=False))))
+    return FittedPosterior(
+        tuple(keys), logs.mean(axis=0), np.linalg.cholesky(np.atleast_2d(np.cov(logs, rowvar=False)))
+    )
 
 
 @dataclass(frozen=True)
@@ -138,9 +148,17 @@ class HeadlineSpread:
         return sorted(self.total, key=lambda key: -self.total[key])
 
     def as_dict(self) -> dict[str, Any]:
-        return {"label": self.label, "unit": self.unit, **dict(zip(("p5", "p50", "p95"), self.quantiles)),
-                "surrogate_q2": self.surrogate_q2, "sobol_first": dict(self.first), "sobol_total": dict(self.total),
-                "deciding": self.deciding[:3], "varies": self.varies, "parts": dict(self.parts)}
+        return {
+            "label": self.label,
+            "unit": self.unit,
+            **dict(zip(("p5", "p50", "p95"), self.quantiles)),
+            "surrogate_q2": self.surrogate_q2,
+            "sobol_first": dict(self.first),
+            "sobol_total": dict(self.total),
+            "deciding": self.deciding[:3],
+            "varies": self.varies,
+            "parts": dict(self.parts),
+        }
 
 
 @dataclass(frozen=True)
@@ -161,15 +179,17 @@ class Ensemble:
 
     def as_dict(self) -> dict[str, Any]:
         """Everything as plain JSON: a number that is not finite (a quantile of no member, an unmeasured Q²) is null."""
-        return _finite({
-            "members": self.members,
-            "failed": self.failed,
-            "inputs": [{"key": item.key, **item.table()} for item in self.inputs],
-            "fitted": None if self.posterior is None else self.posterior.as_dict(),
-            "headlines": {spread.key: spread.as_dict() for spread in self.headlines},
-            "regimes": {name: dict(regime) for name, regime in self.regimes.items()},
-            "folder": str(self.folder),
-        })
+        return _finite(
+            {
+                "members": self.members,
+                "failed": self.failed,
+                "inputs": [{"key": item.key, **item.table()} for item in self.inputs],
+                "fitted": None if self.posterior is None else self.posterior.as_dict(),
+                "headlines": {spread.key: spread.as_dict() for spread in self.headlines},
+                "regimes": {name: dict(regime) for name, regime in self.regimes.items()},
+                "folder": str(self.folder),
+            }
+        )
 
 
 def _finite(value: Any) -> Any:
@@ -180,8 +200,9 @@ def _finite(value: Any) -> Any:
     return None if isinstance(value, float) and not math.isfinite(value) else value
 
 
-def ensemble_inputs(preset: Preset, params: Parameters, assume: Sequence[str], vary: Sequence[str]
-                    ) -> tuple[list[AssumedInput], FittedPosterior | None]:
+def ensemble_inputs(
+    preset: Preset, params: Parameters, assume: Sequence[str], vary: Sequence[str]
+) -> tuple[list[AssumedInput], FittedPosterior | None]:
     """What an ensemble of ``params`` varies: the assumed inputs ``preset`` states that the run reads, replaced or
     joined by the user's ranges (``assume``: ``KEY=LOW:HIGH[:DIST]``), only those named in ``vary`` where it names
     some; and, varying all, the posterior of the keys the preset's calibration fitted, where the run keeps their
@@ -192,16 +213,19 @@ def ensemble_inputs(preset: Preset, params: Parameters, assume: Sequence[str], v
     inputs = {**stated, **{item.key: item for item in users}}
     missing = [key for key in vary if key not in inputs]
     if missing:
-        raise ParameterError(f"--vary {missing[0]}: no range is stated for it; give one with --assume "
-                             f"{missing[0]}=LOW:HIGH (stated: {', '.join(inputs) or 'none'})")
+        raise ParameterError(
+            f"--vary {missing[0]}: no range is stated for it; give one with --assume "
+            f"{missing[0]}=LOW:HIGH (stated: {', '.join(inputs) or 'none'})"
+        )
     if vary:
         return [inputs[key] for key in dict.fromkeys(vary)], None
     keeps_fit = all(getattr(params, key) == preset.values[key].value for key in preset.fitted)
     return list(inputs.values()), fitted_posterior(preset.fitted, preset.posterior) if keeps_fit else None
 
 
-def design(inputs: Sequence[AssumedInput], members: int, seed: int,
-           posterior: FittedPosterior | None = None) -> list[dict[str, float]]:
+def design(
+    inputs: Sequence[AssumedInput], members: int, seed: int, posterior: FittedPosterior | None = None
+) -> list[dict[str, float]]:
     """``members`` points (a power of two) of a scrambled Sobol' design over ``inputs`` and the ``posterior``'s
     normals, each value drawn through its input's distribution."""
     from scipy.stats import qmc
@@ -240,8 +264,10 @@ def to_unit(inputs: Sequence[AssumedInput], values: np.ndarray) -> np.ndarray:
 
 def check_members(members: int) -> None:
     if members < LEAST_MEMBERS or members > MOST_MEMBERS or members & (members - 1):
-        raise ParameterError(f"members: {members} is not allowed; a power of two in [{LEAST_MEMBERS}, {MOST_MEMBERS}]"
-                             " (a Sobol' design is balanced at powers of two)")
+        raise ParameterError(
+            f"members: {members} is not allowed; a power of two in [{LEAST_MEMBERS}, {MOST_MEMBERS}]"
+            " (a Sobol' design is balanced at powers of two)"
+        )
 
 
 def design_seed(base: Parameters, inputs: Sequence[AssumedInput]) -> int:
@@ -253,18 +279,29 @@ def design_seed(base: Parameters, inputs: Sequence[AssumedInput]) -> int:
     return int.from_bytes(hashlib.sha256(text.encode()).digest()[:4], "big")
 
 
-def run_ensemble(base: Parameters, inputs: Sequence[AssumedInput], out_dir: Path | str, members: int,
-                 workers: int | None = None, scheduler: str | None = None,
-                 progress: ProgressCallback | None = None, *, preset: str,
-                 posterior: FittedPosterior | None = None, announce: Callable[[str], None] | None = None) -> Ensemble:
+def run_ensemble(
+    base: Parameters,
+    inputs: Sequence[AssumedInput],
+    out_dir: Path | str,
+    members: int,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: ProgressCallback | None = None,
+    *,
+    preset: str,
+    posterior: FittedPosterior | None = None,
+    announce: Callable[[str], None] | None = None,
+) -> Ensemble:
     """Run ``base`` at ``members`` points of a Sobol' design over ``inputs`` and the fitted keys' ``posterior`` (a
     sweep stored in ``out_dir``, resumed where an earlier run of the same ensemble stopped) and analyse the members
     (:func:`analyse`). ``announce`` is told what runs and when the members are being analysed, which takes a while
     (a surrogate cross-validated for each headline)."""
     check_members(members)
     if not inputs and posterior is None:
-        raise ParameterError("assumed inputs: none to vary; the preset states none that this run reads, give some "
-                             "with --assume KEY=LOW:HIGH")
+        raise ParameterError(
+            "assumed inputs: none to vary; the preset states none that this run reads, give some "
+            "with --assume KEY=LOW:HIGH"
+        )
     seed = design_seed(base, inputs) + (0 if posterior is None else 1)
     points = [with_derived(base, inputs, point) for point in design(inputs, members, seed, posterior)]
     say = announce or (lambda _: None)
@@ -275,8 +312,9 @@ def run_ensemble(base: Parameters, inputs: Sequence[AssumedInput], out_dir: Path
     return analyse(table, inputs, Path(out_dir), posterior)
 
 
-def analyse(table: pd.DataFrame, inputs: Sequence[AssumedInput], folder: Path,
-            posterior: FittedPosterior | None = None) -> Ensemble:
+def analyse(
+    table: pd.DataFrame, inputs: Sequence[AssumedInput], folder: Path, posterior: FittedPosterior | None = None
+) -> Ensemble:
     """The quantiles, Sobol' indices and regimes of an ensemble's members (the sweep ``table``)."""
     finished = table[table["error"].isna()].copy() if "error" in table else table.copy()
     for rise, end in RISES.items():
@@ -289,8 +327,16 @@ def analyse(table: pd.DataFrame, inputs: Sequence[AssumedInput], folder: Path,
         unit = np.column_stack([unit, posterior.unit(finished[list(posterior.keys)].to_numpy(dtype=float))])
         names += posterior.names
     headlines = tuple(_spread(key, finished[key].to_numpy(dtype=float), unit, names) for key in keys)
-    return Ensemble(tuple(inputs), posterior, len(table), len(table) - len(finished), headlines,
-                    _regimes(finished, keys), folder, finished)
+    return Ensemble(
+        tuple(inputs),
+        posterior,
+        len(table),
+        len(table) - len(finished),
+        headlines,
+        _regimes(finished, keys),
+        folder,
+        finished,
+    )
 
 
 def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]) -> HeadlineSpread:
@@ -311,8 +357,9 @@ def _power_label(key: str) -> str:
 ASSUMED_PART, POSTERIOR_PART, NOISE_PART = "assumed inputs", "fitted keys' posterior", "unexplained"
 
 
-def _sensitivity(unit: np.ndarray, values: np.ndarray, names: Sequence[str]
-                 ) -> tuple[float, dict[str, float], dict[str, float], dict[str, float]]:
+def _sensitivity(
+    unit: np.ndarray, values: np.ndarray, names: Sequence[str]
+) -> tuple[float, dict[str, float], dict[str, float], dict[str, float]]:
     """The surrogate's cross-validated Q² and, where it reaches LEAST_Q2, the first and total Sobol' indices of
     each input computed on it, and the interval's parts (:attr:`HeadlineSpread.parts`)."""
     if len(values) < FOLDS:
@@ -328,7 +375,9 @@ def _sensitivity(unit: np.ndarray, values: np.ndarray, names: Sequence[str]
     return q2, first, total, parts
 
 
-def _sobol(surrogate: Any, names: list[str], groups: list[str] | None = None) -> tuple[dict[str, float], dict[str, float]]:
+def _sobol(
+    surrogate: Any, names: list[str], groups: list[str] | None = None
+) -> tuple[dict[str, float], dict[str, float]]:
     """First and total Sobol' indices (SALib: Saltelli's design, Jansen's estimators) of the ``surrogate``'s mean over
     the unit cube of ``names``, of each input or, with ``groups``, of each group of them."""
     from SALib.analyze import sobol as sobol_analyse
@@ -350,8 +399,9 @@ def gaussian_process(unit: np.ndarray, values: np.ndarray) -> Any:
     from sklearn.gaussian_process import GaussianProcessRegressor
     from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
 
-    kernel = ConstantKernel(1.0) * Matern(length_scale=np.ones(unit.shape[1]), length_scale_bounds=(1e-2, 1e3),
-                                          nu=2.5) + WhiteKernel(1e-3, noise_level_bounds=(1e-8, 1.0))
+    kernel = ConstantKernel(1.0) * Matern(
+        length_scale=np.ones(unit.shape[1]), length_scale_bounds=(1e-2, 1e3), nu=2.5
+    ) + WhiteKernel(1e-3, noise_level_bounds=(1e-8, 1.0))
     regressor = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=2, random_state=0)
     # A length scale at its upper bound is an input the headline does not depend on: an answer, not a problem.
     with warnings.catch_warnings():
@@ -387,6 +437,9 @@ def _regimes(finished: pd.DataFrame, keys: Sequence[str]) -> dict[str, dict[str,
         members = named == name
         if members.any():
             chosen = finished[members]
-            regimes[name] = {"share": float(members.mean()), "members": int(members.sum()),
-                             "medians": {key: float(chosen[key].median()) for key in keys}}
+            regimes[name] = {
+                "share": float(members.mean()),
+                "members": int(members.sum()),
+                "medians": {key: float(chosen[key].median()) for key in keys},
+            }
     return regimes

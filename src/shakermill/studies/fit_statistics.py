@@ -4,7 +4,7 @@ key's standard error, the posterior sampled with emcee, and the sensitivities of
 from __future__ import annotations
 
 import math
-from typing import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -14,7 +14,9 @@ from shakermill.studies.validation import ASSUMED_CURVE_SD_K, Curve
 CURVE_SCALE_K = 100.0
 
 
-def log_covariance(jacobian: np.ndarray, residuals: np.ndarray, free_count: int, curves: Sequence[Curve]) -> np.ndarray | None:
+def log_covariance(
+    jacobian: np.ndarray, residuals: np.ndarray, free_count: int, curves: Sequence[Curve]
+) -> np.ndarray | None:
     """The covariance of the logarithms of the fitted keys, (JᵀJ)⁻¹·s² with s² the residual variance; meaningful
     only for curves of more points than parameters, None otherwise or where JᵀJ is singular.
 
@@ -52,8 +54,13 @@ def posterior_evaluations(keys: int) -> int:
     return POSTERIOR_STEPS * WALKERS_PER_KEY * keys
 
 
-def posterior_samples(residuals_of: Callable[[np.ndarray], np.ndarray], best: np.ndarray, lower: np.ndarray,
-                      upper: np.ndarray, variance: float) -> np.ndarray:
+def posterior_samples(
+    residuals_of: Callable[[np.ndarray], np.ndarray],
+    best: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    variance: float,
+) -> np.ndarray:
     """Samples (POSTERIOR_KEPT, keys) of the logarithms of the fitted keys: a Gaussian likelihood of the residuals with
     ``variance`` (the fit's), a prior uniform in the logarithms within [``lower``, ``upper``] (the defensible
     ranges). Where one curve leaves a direction of the keys undetermined, the ranges bound it, which the
@@ -86,7 +93,9 @@ def posterior_samples(residuals_of: Callable[[np.ndarray], np.ndarray], best: np
     return chain[np.linspace(0, len(chain) - 1, POSTERIOR_KEPT).astype(int)]
 
 
-def standard_errors(covariance: np.ndarray | None, free: Sequence[str], fitted: Mapping[str, float]) -> dict[str, float]:
+def standard_errors(
+    covariance: np.ndarray | None, free: Sequence[str], fitted: Mapping[str, float]
+) -> dict[str, float]:
     """Each fitted key's standard error in its own unit: in log space the standard error is relative."""
     if covariance is None:
         return {key: math.nan for key in free}
@@ -107,6 +116,8 @@ def sensitivities(
         conditions = f" ({', '.join(measured.conditions)})" if measured.conditions else ""
         for point in (measured.times.size // 2, measured.times.size - 1):
             label = f"{measured.node}_C at {measured.times[point] / 60.0:g} min{conditions}"
-            values[label] = {key: float(CURVE_SCALE_K * jacobian[offset + point, column]) for column, key in enumerate(free)}
+            values[label] = {
+                key: float(CURVE_SCALE_K * jacobian[offset + point, column]) for column, key in enumerate(free)
+            }
         offset += measured.times.size
     return values

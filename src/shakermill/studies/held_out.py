@@ -8,8 +8,9 @@ fit has seen: the ball's and the vial's temperature rise after one hour, and the
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping
+from typing import Any
 
 from shakermill.parameters.defaults import HIT_SPEED
 from shakermill.parameters.keys import Parameters
@@ -21,7 +22,9 @@ from shakermill.studies.validation import relative_error
 
 HELD_OUT_PRESET = "spex8000m-3d-calibrated"
 FIVE_BALLS = 5
-FIVE_BALL_SOURCE = "Takacs & McHenry 2006 (J. Mater. Sci. 41, 5246) as quoted by Son 2025, section 4: five balls, one hour"
+FIVE_BALL_SOURCE = (
+    "Takacs & McHenry 2006 (J. Mater. Sci. 41, 5246) as quoted by Son 2025, section 4: five balls, one hour"
+)
 # The experiment's rises after one hour (K) and their ratio, as that source gives them ("21 °C / 46 °C").
 FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K, FIVE_BALL_RATIO = 46.0, 21.0, 0.46
 
@@ -53,7 +56,8 @@ class HeldOutPrediction:
     def statement(self) -> str:
         errors = "; ".join(f"{row.label} off by {100 * row.relative_error:+.0f} %" for row in self.rows)
         return (
-            f"{self.preset}: {', '.join(self.fitted)} fitted to {self.fitted_to} (one ball) only; with {FIVE_BALLS} balls "
+            f"{self.preset}: {', '.join(self.fitted)} fitted to {self.fitted_to} (one ball) only; with {FIVE_BALLS} "
+            "balls "
             f"nothing was refitted, so every number here is a prediction: {errors}."
         )
 
@@ -62,15 +66,36 @@ def five_ball_rows(summary: Mapping[str, Any]) -> tuple[HeldOutRow, ...]:
     """The rises after one hour of the balls' mean and of the vial, and their ratio, beside the experiment."""
     start = float(summary["initial_temperature_C"])
     return (
-        HeldOutRow("ball_rise_C", "ball temperature rise after 1 h", "K", FIVE_BALL_BALL_RISE_K, float(summary["ball_C"]) - start),
-        HeldOutRow("vial_rise_C", "vial temperature rise after 1 h", "K", FIVE_BALL_VIAL_RISE_K, float(summary["vial_C"]) - start),
-        HeldOutRow("vial_ball_ratio", "vial/ball rise ratio after 1 h", "", FIVE_BALL_RATIO, float(summary["vial_ball_ratio"])),
+        HeldOutRow(
+            "ball_rise_C",
+            "ball temperature rise after 1 h",
+            "K",
+            FIVE_BALL_BALL_RISE_K,
+            float(summary["ball_C"]) - start,
+        ),
+        HeldOutRow(
+            "vial_rise_C",
+            "vial temperature rise after 1 h",
+            "K",
+            FIVE_BALL_VIAL_RISE_K,
+            float(summary["vial_C"]) - start,
+        ),
+        HeldOutRow(
+            "vial_ball_ratio", "vial/ball rise ratio after 1 h", "", FIVE_BALL_RATIO, float(summary["vial_ball_ratio"])
+        ),
     )
 
 
 def five_ball_parameters(overrides: Mapping[str, Any] | None = None) -> Parameters:
-    """:data:`HELD_OUT_PRESET` with five balls for the experiment's hour, averaged unless ``overrides`` say otherwise."""
-    settings = {"solver": "averaged", "record_windows": (), "duration": 3600.0, **(overrides or {}), "n_balls": FIVE_BALLS}
+    """:data:`HELD_OUT_PRESET` with five balls for the experiment's hour, averaged unless ``overrides`` say
+    otherwise."""
+    settings = {
+        "solver": "averaged",
+        "record_windows": (),
+        "duration": 3600.0,
+        **(overrides or {}),
+        "n_balls": FIVE_BALLS,
+    }
     return default_parameters(HELD_OUT_PRESET, **settings)
 
 
@@ -94,7 +119,11 @@ class EngineCase:
 
 ENGINE_CASES: tuple[EngineCase, ...] = (
     EngineCase("1-D (the paper's model)", "spex8000m"),
-    EngineCase("3-D, its 1-D limit (axial, no gravity, no friction, Ø19 mm)", "spex8000m", {"engine": "dem", "gravity": False, "friction": 0.0}),
+    EngineCase(
+        "3-D, its 1-D limit (axial, no gravity, no friction, Ø19 mm)",
+        "spex8000m",
+        {"engine": "dem", "gravity": False, "friction": 0.0},
+    ),
     EngineCase("3-D, axial, gravity and friction, Ø19 mm", "spex8000m", {"engine": "dem"}),
     EngineCase("3-D, axial, gravity and friction, Ø38 mm vial", "spex8000m-3d", {"kinematics": "axial"}),
     EngineCase("3-D, SPEX figure-eight, Ø38 mm vial", "spex8000m-3d"),
@@ -163,8 +192,13 @@ class HeldOutStudies:
                 "fitted_to": prediction.fitted_to,
                 "statement": prediction.statement,
                 "rows": {
-                    row.key: {"label": row.label, "unit": row.unit, "experiment": row.experiment, "predicted": row.predicted,
-                              "relative_error": row.relative_error}
+                    row.key: {
+                        "label": row.label,
+                        "unit": row.unit,
+                        "experiment": row.experiment,
+                        "predicted": row.predicted,
+                        "relative_error": row.relative_error,
+                    }
                     for row in prediction.rows
                 },
             },

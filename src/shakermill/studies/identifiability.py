@@ -3,7 +3,7 @@ that every direction of the keys moves. A fit that cannot is refused, or says "u
 
 from __future__ import annotations
 
-from typing import Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -43,15 +43,21 @@ def undetermined_keys(jacobian: np.ndarray, free: Sequence[str]) -> str:
     if jacobian.size == 0 or not np.all(np.isfinite(jacobian)):
         return ""
     scale = float(np.abs(jacobian).max())
-    dead = [key for column, key in enumerate(free) if scale == 0 or np.abs(jacobian[:, column]).max() <= SINGULAR_FRACTION * scale]
+    dead = [
+        key
+        for column, key in enumerate(free)
+        if scale == 0 or np.abs(jacobian[:, column]).max() <= SINGULAR_FRACTION * scale
+    ]
     if dead:
         return f"undetermined: the fitted values do not depend on {', '.join(dead)} (sensitivity 0)"
     _, singular, directions = np.linalg.svd(jacobian, full_matrices=False)
     if singular.size < len(free) or singular[-1] <= SINGULAR_FRACTION * singular[0]:
         weights = np.abs(directions[-1]) if singular.size == len(free) else np.ones(len(free))
         leaning = [key for key, weight in zip(free, weights) if weight >= 0.2 * weights.max()]
-        return (f"undetermined: the data fix no more than a combination of {', '.join(leaning)} (a singular "
-                "Jacobian); fix one of them or add a measurement that separates them")
+        return (
+            f"undetermined: the data fix no more than a combination of {', '.join(leaning)} (a singular "
+            "Jacobian); fix one of them or add a measurement that separates them"
+        )
     return ""
 
 
@@ -72,5 +78,7 @@ def loosely_determined(covariance: np.ndarray | None, free: Sequence[str], on_bo
         return ""
     determined = [key for key, error in zip(free, errors) if error <= LOOSE_LOG_ERROR]
     keep = f" (e.g. --free {','.join(determined)})" if determined else ""
-    return (f"undetermined: the data leave {', '.join(loose)} free (a standard error larger than the value: "
-            f"{len(free)} keys on too few or too similar points); free fewer keys{keep}")
+    return (
+        f"undetermined: the data leave {', '.join(loose)} free (a standard error larger than the value: "
+        f"{len(free)} keys on too few or too similar points); free fewer keys{keep}"
+    )

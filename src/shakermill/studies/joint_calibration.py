@@ -24,8 +24,10 @@ emulated, as Kennedy & O'Hagan (2001) calibrate a costly computer model:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Mapping, Sequence
+from datetime import UTC
+from typing import Any
 
 import numpy as np
 
@@ -36,9 +38,10 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.simulate import thermal_variants
-from shakermill.studies.calibrate import check_free_for_engine, log_bounds, write_preset_file
+from shakermill.studies.calibrate import check_free_for_engine, log_bounds
 from shakermill.studies.defensible import DEFENSIBLE_RANGES
-from shakermill.studies.ensemble import QUANTILES, LEAST_Q2, design_seed, from_unit, gaussian_process, q2_of
+from shakermill.studies.ensemble import LEAST_Q2, QUANTILES, design_seed, from_unit, gaussian_process, q2_of
+from shakermill.studies.fitted_preset import write_preset_file
 
 # A measured rise's standard deviation where its source states none (K): the one-ball curve is an exponential
 # fitted to intermittent calorimetric measurements, which a model following within 2 K follows within their likely
@@ -85,8 +88,11 @@ def fit_inputs(preset: Preset, params: Parameters, free: Sequence[str]) -> list[
     that the run reads and can feel (no pair key for one ball), and the thermal ``free`` keys, each log-uniform over
     its defensible range (the prior of the network's own fit, ``calibrate.log_bounds``)."""
     reader = reader_of(params)
-    assumed = [item for key, item in preset.assumed.items()
-               if reader.not_read(key) is None and key not in free and feels(params, key)]
+    assumed = [
+        item
+        for key, item in preset.assumed.items()
+        if reader.not_read(key) is None and key not in free and feels(params, key)
+    ]
     fitted = []
     for key in free:
         low, high = (math.exp(bound) for bound in log_bounds(key, float(getattr(params, key))))
@@ -113,8 +119,14 @@ class Training:
     failed: list[str] = field(default_factory=list)
 
 
-def train(params: Parameters, inputs: Sequence[AssumedInput], observables: Sequence[Observable], members: int,
-          thermal_draws: int, progress: Callable[[int, int], None] | None = None) -> Training:
+def train(
+    params: Parameters,
+    inputs: Sequence[AssumedInput],
+    observables: Sequence[Observable],
+    members: int,
+    thermal_draws: int,
+    progress: Callable[[int, int], None] | None = None,
+) -> Training:
     """Run ``params`` at ``members`` points of a Sobol' design over the inputs its mechanics reads, and its network
     at ``thermal_draws`` points each over the inputs only the network reads (module docstring); ``progress(done,
     members)`` after each member. A member whose run fails is left out and named in ``failed``."""
@@ -141,7 +153,9 @@ def train(params: Parameters, inputs: Sequence[AssumedInput], observables: Seque
     rise_of = _rises(observables)
     for member in range(members):
         rows = range(member * draws, (member + 1) * draws)
-        runs = [params.replace(**with_derived(params, inputs, dict(zip(keys, map(float, values[row]))))) for row in rows]
+        runs = [
+            params.replace(**with_derived(params, inputs, dict(zip(keys, map(float, values[row]))))) for row in rows
+        ]
         result = thermal_variants(runs[0])(runs[0])
         if not result.success or result.load is None:
             failed.append(f"member {member}: {result.message}")
@@ -151,8 +165,9 @@ def train(params: Parameters, inputs: Sequence[AssumedInput], observables: Seque
         if progress is not None:
             progress(member + 1, members)
     kept = np.isfinite(rises).all(axis=1)
-    return Training(tuple(inputs), tuple(observables), unit[kept], rises[kept],
-                    np.repeat(np.arange(members), draws)[kept], failed)
+    return Training(
+        tuple(inputs), tuple(observables), unit[kept], rises[kept], np.repeat(np.arange(members), draws)[kept], failed
+    )
 
 
 def _rises(observables: Sequence[Observable]) -> Callable[[Parameters, Any], np.ndarray]:
@@ -200,7 +215,9 @@ class Emulator:
         """Unit-cube points of this emulator's inputs from points over ``keys``: an input not among them drawn from
         its prior (uniform in the cube)."""
         position = {key: index for index, key in enumerate(keys)}
-        columns = [unit[:, position[item.key]] if item.key in position else rng.random(len(unit)) for item in self.inputs]
+        columns = [
+            unit[:, position[item.key]] if item.key in position else rng.random(len(unit)) for item in self.inputs
+        ]
         return np.column_stack(columns)
 
 
@@ -212,8 +229,9 @@ def emulate(training: Training) -> Emulator:
 
     members = np.unique(training.member)
     if members.size < FOLDS:
-        raise ParameterError(f"members: {members.size} runs succeeded, too few to check an emulator on held-out runs "
-                             f"(at least {FOLDS})")
+        raise ParameterError(
+            f"members: {members.size} runs succeeded, too few to check an emulator on held-out runs (at least {FOLDS})"
+        )
     logarithmic = bool(np.all(training.rises > 0))
     fitted = np.log(training.rises) if logarithmic else training.rises
     back = np.exp if logarithmic else (lambda values: values)
@@ -222,11 +240,21 @@ def emulate(training: Training) -> Emulator:
         values = training.rises[:, column]
         predicted = np.empty_like(values)
         for fit, held in GroupKFold(FOLDS).split(training.unit, values, training.member):
-            predicted[held] = back(gaussian_process(training.unit[fit], fitted[fit, column]).predict(training.unit[held]))
+            predicted[held] = back(
+                gaussian_process(training.unit[fit], fitted[fit, column]).predict(training.unit[held])
+            )
         q2[observable.name] = q2_of(values, predicted)
     models = [gaussian_process(training.unit, fitted[:, column]) for column in range(len(training.observables))]
-    return Emulator(training.inputs, training.observables, models, q2, len(training.unit), int(members.size),
-                    training.failed, logarithmic)
+    return Emulator(
+        training.inputs,
+        training.observables,
+        models,
+        q2,
+        len(training.unit),
+        int(members.size),
+        training.failed,
+        logarithmic,
+    )
 
 
 @dataclass(frozen=True)
@@ -278,8 +306,15 @@ def sample_posterior(data: Data) -> Posterior:
     for emulator, measured in data:
         columns = [emulator.observables.index(item.observable) for item in measured]
         positions = [keys.index(item.key) for item in emulator.inputs]
-        parts.append((emulator, positions, columns, np.array([item.rise_K for item in measured]),
-                      np.array([item.sd_K for item in measured]) ** 2))
+        parts.append(
+            (
+                emulator,
+                positions,
+                columns,
+                np.array([item.rise_K for item in measured]),
+                np.array([item.sd_K for item in measured]) ** 2,
+            )
+        )
 
     def log_probability(unit: np.ndarray) -> np.ndarray:
         inside = np.all((unit > 0) & (unit < 1), axis=1)
@@ -325,9 +360,13 @@ class Prediction:
         return None if self.measured_K is None else bool(self.quantiles[0] <= self.measured_K <= self.quantiles[2])
 
     def as_dict(self) -> dict[str, Any]:
-        return {"observable": self.observable.name, "label": self.observable.label,
-                **dict(zip(("p5", "p50", "p95"), self.quantiles)), "measured_K": self.measured_K,
-                "inside_90": self.inside}
+        return {
+            "observable": self.observable.name,
+            "label": self.observable.label,
+            **dict(zip(("p5", "p50", "p95"), self.quantiles)),
+            "measured_K": self.measured_K,
+            "inside_90": self.inside,
+        }
 
 
 def predict(emulator: Emulator, posterior: Posterior, measured: Sequence[Measured] = ()) -> list[Prediction]:
@@ -337,29 +376,42 @@ def predict(emulator: Emulator, posterior: Posterior, measured: Sequence[Measure
     draws = emulator.draw(emulator.at(posterior.keys, posterior.unit, rng), rng)
     table = np.quantile(draws, QUANTILES, axis=0)
     known = {item.observable: item.rise_K for item in measured}
-    return [Prediction(observable, tuple(float(v) for v in table[:, column]), known.get(observable))
-            for column, observable in enumerate(emulator.observables)]
+    return [
+        Prediction(observable, tuple(float(v) for v in table[:, column]), known.get(observable))
+        for column, observable in enumerate(emulator.observables)
+    ]
 
 
 def posterior_as_dict(posterior: Posterior) -> dict[str, Any]:
     quantiles = posterior.quantiles()
     return {
-        "inputs": {item.key: {**item.table(), **dict(zip(("p5", "p50", "p95"), quantiles[item.key]))}
-                   for item in posterior.inputs},
-        "samples": len(posterior.unit), "acceptance": posterior.acceptance,
-        "autocorrelation_steps": posterior.autocorrelation_steps, "converged": posterior.converged,
+        "inputs": {
+            item.key: {**item.table(), **dict(zip(("p5", "p50", "p95"), quantiles[item.key]))}
+            for item in posterior.inputs
+        },
+        "samples": len(posterior.unit),
+        "acceptance": posterior.acceptance,
+        "autocorrelation_steps": posterior.autocorrelation_steps,
+        "converged": posterior.converged,
     }
 
 
 def emulator_as_dict(emulator: Emulator) -> dict[str, Any]:
-    return {"members": emulator.members, "training_points": emulator.training_points, "held_out_q2": emulator.q2,
-            "failed": emulator.failed}
+    return {
+        "members": emulator.members,
+        "training_points": emulator.training_points,
+        "held_out_q2": emulator.q2,
+        "failed": emulator.failed,
+    }
 
 
 def measured_of(experiment: Any) -> list[Measured]:
     """The measured points of a validation experiment (``studies/validation_matrix.Experiment``)."""
-    return [Measured(Observable(point.node, point.time_s), point.rise_K)
-            for point in experiment.points if point.rise_K is not None]
+    return [
+        Measured(Observable(point.node, point.time_s), point.rise_K)
+        for point in experiment.points
+        if point.rise_K is not None
+    ]
 
 
 # A curve enters the fit at this many times, evenly spread over its points: its shape informs the fit, and an
@@ -399,29 +451,49 @@ class JointCalibration:
         return said + (f"; unreliable: {'; '.join(self.problems)}" if self.problems else "")
 
     def as_dict(self) -> dict[str, Any]:
-        return {"method": METHOD,
-                "network_free": list(self.free), "status": self.status, "message": self.message,
-                "posterior": posterior_as_dict(self.posterior),
-                "emulators": {", ".join(conditions) or "the run's own": emulator_as_dict(emulator)
-                              for conditions, emulator in self.emulators.items()},
-                "fitted_points": [item.as_dict() for item in self.fitted],
-                "predictions": [item.as_dict() for item in self.predictions], "curve": self.curve_source}
+        return {
+            "method": METHOD,
+            "network_free": list(self.free),
+            "status": self.status,
+            "message": self.message,
+            "posterior": posterior_as_dict(self.posterior),
+            "emulators": {
+                ", ".join(conditions) or "the run's own": emulator_as_dict(emulator)
+                for conditions, emulator in self.emulators.items()
+            },
+            "fitted_points": [item.as_dict() for item in self.fitted],
+            "predictions": [item.as_dict() for item in self.predictions],
+            "curve": self.curve_source,
+        }
 
 
 def reliability_problems(emulators: Iterable[Emulator], posterior: Posterior) -> list[str]:
     """Why a posterior and what it predicts cannot be relied on: an emulator that predicts runs it did not see with
     Q² below LEAST_Q2, or a chain shorter than 25 of its autocorrelation times after burn-in."""
-    found = [f"the emulator of {observable} predicts held-out runs with Q² {value:.2f} (< {LEAST_Q2:g})"
-             for emulator in emulators for observable, value in emulator.q2.items() if not value >= LEAST_Q2]
+    found = [
+        f"the emulator of {observable} predicts held-out runs with Q² {value:.2f} (< {LEAST_Q2:g})"
+        for emulator in emulators
+        for observable, value in emulator.q2.items()
+        if not value >= LEAST_Q2
+    ]
     if not posterior.converged:
-        found.append(f"the chain is {STEPS // 2} steps after burn-in, under 25 of its autocorrelation times "
-                     f"({posterior.autocorrelation_steps:.0f} steps)")
+        found.append(
+            f"the chain is {STEPS // 2} steps after burn-in, under 25 of its autocorrelation times "
+            f"({posterior.autocorrelation_steps:.0f} steps)"
+        )
     return found
 
 
-def calibrate_jointly(preset: Preset, base: Parameters, free: Sequence[str], curves: Sequence[Any], members: int,
-                      thermal_draws: int = 8, progress: Callable[[int, int], None] | None = None,
-                      on_start: Callable[[], None] | None = None) -> JointCalibration:
+def calibrate_jointly(
+    preset: Preset,
+    base: Parameters,
+    free: Sequence[str],
+    curves: Sequence[Any],
+    members: int,
+    thermal_draws: int = 8,
+    progress: Callable[[int, int], None] | None = None,
+    on_start: Callable[[], None] | None = None,
+) -> JointCalibration:
     """Fit ``curves`` (``studies/validation.Curve``) over the network's ``free`` keys and every assumed input of
     ``preset`` that a run of ``base`` can feel (module docstring). As for ``calibrate``: the ``free`` keys must be
     the network's and read by the run, ``on_start()`` is called once they are, before the first run; ``progress(done,
@@ -437,10 +509,15 @@ def calibrate_jointly(preset: Preset, base: Parameters, free: Sequence[str], cur
     data, emulators, total = [], {}, members * len(groups)
     for index, (conditions, chosen) in enumerate(groups.items()):
         params = base.replace(**parse_overrides(conditions))
-        measured = [Measured(Observable(curve.node, float(curve.times[point])),
-                             float(curve.temperature_C[point]) + 273.15 - params.initial_temperature,
-                             curve.sigma_K if curve.sigma_K is not None else ASSUMED_MEASUREMENT_SD_K)
-                    for curve in chosen for point in _spread_points(curve.times.size)]
+        measured = [
+            Measured(
+                Observable(curve.node, float(curve.times[point])),
+                float(curve.temperature_C[point]) + 273.15 - params.initial_temperature,
+                curve.sigma_K if curve.sigma_K is not None else ASSUMED_MEASUREMENT_SD_K,
+            )
+            for curve in chosen
+            for point in _spread_points(curve.times.size)
+        ]
         at_end = [Observable(node, params.duration) for node in ("ball", "vial")] if not conditions else []
         observables = list(dict.fromkeys([item.observable for item in measured] + at_end))
         shown = None if progress is None else (lambda done, _, before=index * members: progress(before + done, total))
@@ -448,8 +525,12 @@ def calibrate_jointly(preset: Preset, base: Parameters, free: Sequence[str], cur
         emulators[conditions] = emulator
         data.append((emulator, measured))
     posterior = sample_posterior(data)
-    fitted = tuple(item for emulator, measured in data for item in predict(emulator, posterior, measured)
-                   if item.measured_K is not None)
+    fitted = tuple(
+        item
+        for emulator, measured in data
+        for item in predict(emulator, posterior, measured)
+        if item.measured_K is not None
+    )
     ends = tuple(item for item in predict(emulators[()], posterior) if item.observable.time_s == base.duration)
     source = "; ".join(curve.source for curve in curves)
     return JointCalibration(tuple(free), posterior, emulators, fitted, ends, source)
@@ -463,12 +544,13 @@ def _spread_points(count: int) -> list[int]:
 PRESET_SAMPLES = 200
 
 
-def write_joint_preset(joint: JointCalibration, path: Any, *, base_preset: str, command: str,
-                       settings: Mapping[str, Any]) -> Any:
+def write_joint_preset(
+    joint: JointCalibration, path: Any, *, base_preset: str, command: str, settings: Mapping[str, Any]
+) -> Any:
     """A preset with every freed key at its posterior median, and the posterior's samples (their logarithms) in its
     provenance: ``shakermill uncertainty`` carries them into any run of it, a run's own interval those of the keys its
     network alone reads."""
-    from datetime import datetime, timezone
+    from datetime import datetime
 
     from shakermill.support.version import __version__
 
@@ -482,7 +564,7 @@ def write_joint_preset(joint: JointCalibration, path: Any, *, base_preset: str, 
         **medians,
         "provenance": {
             "description": f"{base_preset} with {', '.join(keys)} at the medians of their posterior given "
-                           f"{joint.curve_source} (MODEL.md §14.1)",
+            f"{joint.curve_source} (MODEL.md §14.1)",
             "command": command,
             "fitted": list(keys),
             "method": METHOD,
@@ -494,9 +576,11 @@ def write_joint_preset(joint: JointCalibration, path: Any, *, base_preset: str, 
             "predictions": {item.observable.name: list(item.quantiles) for item in joint.predictions},
             "curve": joint.curve_source,
             "shakermill_version": __version__,
-            "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "date_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         },
     }
     return write_preset_file(
-        path, f"# shakermill preset fitted over its uncertain inputs; keys not listed come from {base_preset!r}.", document
+        path,
+        f"# shakermill preset fitted over its uncertain inputs; keys not listed come from {base_preset!r}.",
+        document,
     )

@@ -11,8 +11,9 @@ deterministic, so the same inputs give the same table.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable, Sequence
+from typing import TYPE_CHECKING
 
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
@@ -60,7 +61,9 @@ class KinematicSensitivity:
         """key, factor, value, the three measures and their relative changes (``<measure>_change``), baseline first."""
         import pandas as pd
 
-        rows = (SensitivityRow("baseline", 1.0, math.nan, self.baseline, _relative(self.baseline, self.baseline)),) + self.rows
+        rows = (
+            SensitivityRow("baseline", 1.0, math.nan, self.baseline, _relative(self.baseline, self.baseline)),
+        ) + self.rows
         return pd.DataFrame.from_records(
             {
                 "key": row.key,

@@ -21,9 +21,10 @@ in which they finish, or whether the points ran on a Dask cluster.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any
 
 import pandas as pd
 
@@ -135,7 +136,9 @@ def sweep(
             tracker = _Tracker(len(ids), finished_counts(stored), backend.slots, progress)
             for identifier, outcome in backend.outcomes(base_params, pending, keep_runs):
                 if isinstance(outcome, BaseException):
-                    unfinished[identifier] = f"not finished ({type(outcome).__name__}: {outcome}); re-run the sweep to retry"
+                    unfinished[identifier] = (
+                        f"not finished ({type(outcome).__name__}: {outcome}); re-run the sweep to retry"
+                    )
                     tracker.finished(failed=True)
                     continue
                 row = store_point(folder, identifier, outcome, preset)

@@ -8,10 +8,11 @@ import logging
 import os
 import sys
 import warnings
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.errors import ParameterError
@@ -86,7 +87,10 @@ class _Cluster:
         from distributed import as_completed
 
         # pure=False: a point is a computation to run, not a value Dask may deduplicate or cache.
-        futures = {self.client.submit(run_point, base, values, keep_runs, pure=False): identifier for identifier, values in tasks}
+        futures = {
+            self.client.submit(run_point, base, values, keep_runs, pure=False): identifier
+            for identifier, values in tasks
+        }
         self.submitted = list(futures)
         # The client is not Dask's default one (set_as_default=False), so as_completed is told its loop.
         for future in as_completed(futures, loop=self.client.loop):
@@ -127,7 +131,7 @@ def backend_for(workers: int | None, scheduler: str | None, timeout: float, pend
     context = _start_context()
     if context is None:
         warnings.warn(
-            "sweep: called from the top level of a script without an `if __name__ == \"__main__\":` guard, where "
+            'sweep: called from the top level of a script without an `if __name__ == "__main__":` guard, where '
             "worker processes cannot start on this platform; the points run one after another in this process",
             stacklevel=4,
         )
@@ -145,12 +149,11 @@ def backend_for(workers: int | None, scheduler: str | None, timeout: float, pend
 
 
 def _process_pool(size: int, context: Any) -> Any:
-    """A process pool of ``context`` whose workers ignore Ctrl-C; the sweep's own process handles it and stops the pool."""
+    """A process pool of ``context`` whose workers ignore Ctrl-C; the sweep's own process handles it and stops the
+    pool."""
     from concurrent.futures import ProcessPoolExecutor
 
-    return ProcessPoolExecutor(
-        max_workers=size, mp_context=context, initializer=_start_worker, initargs=(os.getpid(),)
-    )
+    return ProcessPoolExecutor(max_workers=size, mp_context=context, initializer=_start_worker, initargs=(os.getpid(),))
 
 
 def _start_context() -> Any:
@@ -294,7 +297,7 @@ def _check_scheduler_answers(address: str, timeout: float, security: Any) -> Non
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="scheduler-probe") as probe:
         try:
             probe.submit(asyncio.run, asyncio.wait_for(handshake(), 2 * timeout)).result()
-        except asyncio.TimeoutError:
+        except TimeoutError:
             raise ParameterError(
                 f"scheduler: {address} accepted the connection but did not answer as a Dask scheduler "
                 f"(waited {2 * timeout:g} s); give the scheduler's address (tcp://HOST:8786), not the dashboard's"

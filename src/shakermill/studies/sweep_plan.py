@@ -8,9 +8,10 @@ import itertools
 import json
 import math
 import re
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -79,7 +80,8 @@ def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray
         raise ParameterError(f"grid {shown}: {exc}") from None
     if Parameters.model_fields[key].annotation is not float:
         raise ParameterError(
-            f"grid {shown}: START:STOP:N is for real-valued parameters and {key} is not one; list its values as {key}=A,B,C"
+            f"grid {shown}: START:STOP:N is for real-valued parameters and {key} is not one; list its values as "
+            f"{key}=A,B,C"
         )
     if len(bounds) != 3:
         raise ParameterError(f"grid {shown}: expected KEY=START:STOP:N (three fields after '='), got {len(bounds)}")
@@ -206,11 +208,15 @@ def plan_sweep(grids: Sequence[str] = (), points_file: Path | str | None = None)
     return SweepPlan(tuple(keys), points, tuple(grids), str(points_file) if points_file is not None else None, units)
 
 
-def _units_written(table: tuple[Path, list[str], list[list[str]]] | None, grids: Mapping[str, str]) -> tuple[tuple[str, str], ...]:
+def _units_written(
+    table: tuple[Path, list[str], list[list[str]]] | None, grids: Mapping[str, str]
+) -> tuple[tuple[str, str], ...]:
     """(key, unit) for each real key whose values a points file's column or a ``--grid`` writes with a unit."""
     written = {key: first_unit(row[index] for row in table[2]) for index, key in enumerate(table[1])} if table else {}
     written |= {key: grid_unit(spec) for key, spec in grids.items()}
-    return tuple((key, unit) for key, unit in written.items() if unit and Parameters.model_fields[key].annotation is float)
+    return tuple(
+        (key, unit) for key, unit in written.items() if unit and Parameters.model_fields[key].annotation is float
+    )
 
 
 def as_plan(grid_points: SweepPlan | Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]]) -> SweepPlan:
@@ -229,7 +235,9 @@ def as_plan(grid_points: SweepPlan | Mapping[str, Sequence[Any]] | Sequence[Mapp
         check_known_keys(list(point))
         if tuple(point) != keys:
             raise ParameterError(f"sweep: point {number} sets {sorted(point)}, the first point {sorted(keys)}")
-    return SweepPlan(keys, tuple({key: normalize_value(key, value) for key, value in point.items()} for point in points))
+    return SweepPlan(
+        keys, tuple({key: normalize_value(key, value) for key, value in point.items()} for point in points)
+    )
 
 
 def check_keys_read(base: Parameters, plan: SweepPlan) -> None:

@@ -6,11 +6,12 @@ from __future__ import annotations
 import io
 import json
 import warnings
+from collections.abc import Mapping, Sequence
 from contextlib import suppress
 from dataclasses import dataclass
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import pandas as pd
 
@@ -76,7 +77,7 @@ def sweep_manifest(base: Parameters, plan: SweepPlan, ids: Sequence[str], preset
         {
             "format": MANIFEST_FORMAT,
             "shakermill_version": __version__,
-            "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
             "preset": preset,
             "base": base.model_dump(),
             "keys": list(plan.keys),
@@ -134,7 +135,8 @@ def _check_same_sweep(folder: Path, stored: dict[str, Any], wanted: dict[str, An
         )
     if stored.get("keys") != wanted["keys"] or stored.get("points") != wanted["points"]:
         raise ParameterError(
-            f"{folder}: holds a sweep over other points (grid {' '.join(stored.get('grids') or []) or 'from a points file'}); "
+            f"{folder}: holds a sweep over other points (grid "
+            f"{' '.join(stored.get('grids') or []) or 'from a points file'}); "
             "choose another --out"
         )
 
@@ -152,10 +154,13 @@ def read_manifest(folder: Path) -> dict[str, Any]:
     try:
         manifest = json.loads((folder / MANIFEST_FILE).read_text(encoding="utf-8"))
     except UnicodeDecodeError:
-        raise ParameterError(f"{folder}: {MANIFEST_FILE} is not UTF-8 text, so not the manifest a sweep writes; {damaged}") from None
+        raise ParameterError(
+            f"{folder}: {MANIFEST_FILE} is not UTF-8 text, so not the manifest a sweep writes; {damaged}"
+        ) from None
     except json.JSONDecodeError as exc:
         raise ParameterError(
-            f"{folder}: {MANIFEST_FILE} is not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg}), so not the "
+            f"{folder}: {MANIFEST_FILE} is not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg}), so not "
+            "the "
             f"manifest a sweep writes; {damaged}"
         ) from None
     except OSError as exc:
@@ -233,7 +238,9 @@ def store_point(folder: Path, identifier: str, outcome: PointOutcome, preset: st
         target = folder / RUNS_FOLDER / identifier
         provenance = {"command": "shakermill sweep", "sweep": str(folder.absolute()), "point_id": identifier}
         # A run folder without its point file was left by a killed sweep: this point's, so it is replaced.
-        row["output_dir"] = str(write_run(outcome.result, target, preset=preset, extra_provenance=provenance, overwrite=True))
+        row["output_dir"] = str(
+            write_run(outcome.result, target, preset=preset, extra_provenance=provenance, overwrite=True)
+        )
     document = {"point_id": identifier, "shakermill_version": __version__, "row": row}
     write_text_atomically(_point_path(folder, identifier), json.dumps(document, indent=1, allow_nan=False) + "\n")
     return row
@@ -271,6 +278,7 @@ def _tabulate(rows: list[dict[str, Any]], keys: Sequence[str]) -> pd.DataFrame:
 
 def _integer_columns(rows: list[dict[str, Any]], columns: Sequence[str]) -> list[str]:
     """The columns whose values are all integers (booleans excluded) or missing, with at least one integer."""
+
     def is_integer(value: Any) -> bool:
         return isinstance(value, int) and not isinstance(value, bool)
 
@@ -303,7 +311,9 @@ def load_sweep(path: Path | str) -> SweepData:
         table = _read_table(parquet, keys)
     else:
         entries = manifest["points"]
-        table = build_table(folder, keys, [entry["point_id"] for entry in entries], [entry["values"] for entry in entries])
+        table = build_table(
+            folder, keys, [entry["point_id"] for entry in entries], [entry["values"] for entry in entries]
+        )
     return SweepData(folder, manifest, keys, table)
 
 
@@ -311,7 +321,9 @@ def _read_table(path: Path, keys: Sequence[str]) -> pd.DataFrame:
     try:
         table = pd.read_parquet(path)
     except (OSError, ValueError) as exc:  # pyarrow's ArrowInvalid is a ValueError
-        raise ParameterError(f"{path}: cannot read the table ({in_one_line(exc)}); re-run the sweep to rebuild it") from None
+        raise ParameterError(
+            f"{path}: cannot read the table ({in_one_line(exc)}); re-run the sweep to rebuild it"
+        ) from None
     missing = [column for column in (*FIRST_COLUMNS, *keys, *OUTCOME_COLUMNS) if column not in table.columns]
     if missing:
         raise ParameterError(f"{path}: not this sweep's table (no column {missing[0]}); re-run the sweep to rebuild it")

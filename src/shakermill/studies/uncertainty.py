@@ -15,9 +15,9 @@ network alone, so a prediction's spread is taken on the network with the run's o
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from statistics import NormalDist
-from typing import Callable, Mapping
 
 import numpy as np
 
@@ -120,12 +120,17 @@ def intervals(result: Result, uncertainty: Uncertainty) -> Intervals | None:
     # The run's own values, which a full run's averaged network only approaches; the spread is the network's.
     reported = {name: float(result.summary[name]) for name in HEADLINE}
     shift = {name: reported[name] - found.centre[name] for name in HEADLINE}
-    return Intervals(reported, {name: found.low[name] + shift[name] for name in HEADLINE},
-                     {name: found.high[name] + shift[name] for name in HEADLINE}, found.sources)
+    return Intervals(
+        reported,
+        {name: found.low[name] + shift[name] for name in HEADLINE},
+        {name: found.high[name] + shift[name] for name in HEADLINE},
+        found.sources,
+    )
 
 
-def propagated(params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, heat_error: float,
-               quantities: Quantities) -> Intervals | None:
+def propagated(
+    params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, heat_error: float, quantities: Quantities
+) -> Intervals | None:
     """The 90 % intervals of ``quantities`` of ``params``' network under ``load``: from the posterior samples of
     ``uncertainty`` if it has some, else linearly from its covariance; with a relative error ``heat_error`` of the
     heat, independent of the fit. None when nothing is uncertain."""
@@ -134,8 +139,9 @@ def propagated(params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, 
     return _linear(params, load, uncertainty, heat_error, quantities)
 
 
-def _from_samples(params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, heat_error: float,
-                  quantities: Quantities) -> Intervals:
+def _from_samples(
+    params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, heat_error: float, quantities: Quantities
+) -> Intervals:
     samples = np.asarray(uncertainty.posterior, dtype=float)
     chosen = samples[np.linspace(0, len(samples) - 1, min(PROPAGATED_SAMPLES, len(samples))).astype(int)]
     heat_draws = np.random.default_rng(HEAT_DRAW_SEED).standard_normal(len(chosen)) * heat_error
@@ -146,18 +152,25 @@ def _from_samples(params: Parameters, load: NetworkLoad, uncertainty: Uncertaint
     centre = quantities(params, load)
     table = np.array([[value[name] for name in centre] for value in values])
     low, high = np.percentile(table, [50 * (1 - LEVEL), 50 * (1 + LEVEL)], axis=0)
-    sources = ("the calibration's posterior (emcee)",) + (("the averaging error of the heat",) if heat_error > 0 else ())
+    sources = ("the calibration's posterior (emcee)",) + (
+        ("the averaging error of the heat",) if heat_error > 0 else ()
+    )
     if uncertainty.left_out:
-        sources += (f"not the posterior of {', '.join(uncertainty.left_out)}, which moves the mechanics "
-                    "(shakermill uncertainty carries it)",)
+        sources += (
+            f"not the posterior of {', '.join(uncertainty.left_out)}, which moves the mechanics "
+            "(shakermill uncertainty carries it)",
+        )
     return Intervals(centre, dict(zip(centre, map(float, low))), dict(zip(centre, map(float, high))), sources)
 
 
-def _linear(params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, heat_error: float,
-            quantities: Quantities) -> Intervals | None:
+def _linear(
+    params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, heat_error: float, quantities: Quantities
+) -> Intervals | None:
     """The delta method: the spread of each quantity from its slopes in the logarithms of the keys and the heat."""
     keys = list(uncertainty.fitted) if uncertainty.covariance is not None else []
-    sources = (["the calibration's covariance"] if keys else []) + (["the averaging error of the heat"] if heat_error > 0 else [])
+    sources = (["the calibration's covariance"] if keys else []) + (
+        ["the averaging error of the heat"] if heat_error > 0 else []
+    )
     if not sources:
         return None
     variances = np.zeros((len(keys) + 1, len(keys) + 1))
@@ -170,9 +183,15 @@ def _linear(params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, hea
     gradients = np.array([_slopes(quantities(moved_params, moved_load), centre) for moved_params, moved_load in moves])
     # The standard library's normal quantile: scipy.stats would add half a second to every run of a calibrated preset.
     half = NormalDist().inv_cdf(0.5 + LEVEL / 2)
-    stderr = {name: math.sqrt(max(float(gradients[:, i] @ variances @ gradients[:, i]), 0.0)) for i, name in enumerate(centre)}
-    return Intervals(centre, {name: centre[name] - half * stderr[name] for name in centre},
-                     {name: centre[name] + half * stderr[name] for name in centre}, tuple(sources))
+    stderr = {
+        name: math.sqrt(max(float(gradients[:, i] @ variances @ gradients[:, i]), 0.0)) for i, name in enumerate(centre)
+    }
+    return Intervals(
+        centre,
+        {name: centre[name] - half * stderr[name] for name in centre},
+        {name: centre[name] + half * stderr[name] for name in centre},
+        tuple(sources),
+    )
 
 
 def _heated(load: NetworkLoad, log_factor: float) -> NetworkLoad:

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any
 
 from shakermill.parameters.csvinput import check_rectangular, read_csv_rows
 from shakermill.parameters.errors import ParameterError
@@ -100,7 +101,12 @@ def target_range(name: str) -> str:
 
 # The columns a curve file may measure, the node of the network each is of (the balls' mean, the vial) and the
 # offset that turns its unit into °C.
-NODE_COLUMNS = {"ball_C": ("ball", 0.0), "vial_C": ("vial", 0.0), "ball_K": ("ball", -273.15), "vial_K": ("vial", -273.15)}
+NODE_COLUMNS = {
+    "ball_C": ("ball", 0.0),
+    "vial_C": ("vial", 0.0),
+    "ball_K": ("ball", -273.15),
+    "vial_K": ("vial", -273.15),
+}
 TIME_COLUMNS = {"time_s": 1.0, "time_min": 60.0}
 NODE_VARIABLES = {"ball": "theta_ball", "vial": "theta_vial"}
 # A mill starts at room temperature: °C values that never fall below this are kelvin (293 K is 20 °C), and kelvin
@@ -135,7 +141,8 @@ class Curve:
         what = f"curve {self.source}".rstrip()
         if not 1 <= self.times.size <= MAX_CURVE_POINTS or self.times.shape != self.temperature_C.shape:
             raise ParameterError(
-                f"{what}: {self.times.size} times and {self.temperature_C.size} temperatures; allowed 1 to {MAX_CURVE_POINTS:,} of each"
+                f"{what}: {self.times.size} times and {self.temperature_C.size} temperatures; allowed 1 to "
+                f"{MAX_CURVE_POINTS:,} of each"
             )
         column = self.column or f"{self.node}_C"
         for index, (time, temperature) in enumerate(zip(self.times.tolist(), self.temperature_C.tolist())):
@@ -159,13 +166,22 @@ class Curve:
                 times.append(float(cells[time_column]) * TIME_COLUMNS[time_column])
                 temperatures.append(float(cells[measured]))
             except ValueError:
-                raise ParameterError(f"{what} line {number}: needs a number in {time_column} and in {measured}") from None
+                raise ParameterError(
+                    f"{what} line {number}: needs a number in {time_column} and in {measured}"
+                ) from None
         node, offset = NODE_COLUMNS[measured]
         _check_unit(what, measured, temperatures)
         import numpy as np
 
-        return cls(np.array(times), np.array(temperatures) + offset, str(path), node=node, conditions=tuple(conditions),
-                   column=measured, note=note)
+        return cls(
+            np.array(times),
+            np.array(temperatures) + offset,
+            str(path),
+            node=node,
+            conditions=tuple(conditions),
+            column=measured,
+            note=note,
+        )
 
     @property
     def variable(self) -> str:
@@ -196,7 +212,11 @@ def _curve_rows(path: Path, what: str) -> tuple[list[list[str]], str]:
     rows = [row for row in read_csv_rows(path, what, MAX_CURVE_POINTS) if any(cell.strip() for cell in row)]
     note = ""
     if rows and len(rows[0]) == 1 and ";" in rows[0][0]:
-        rows = [row for row in read_csv_rows(path, what, MAX_CURVE_POINTS, delimiter=";") if any(cell.strip() for cell in row)]
+        rows = [
+            row
+            for row in read_csv_rows(path, what, MAX_CURVE_POINTS, delimiter=";")
+            if any(cell.strip() for cell in row)
+        ]
         rows = [[cell.replace(",", ".") for cell in row] for row in rows]
         note = f"{what}: read as ';'-separated columns, with decimal commas as points"
     if len(rows) < 2:
@@ -208,7 +228,9 @@ def _curve_columns(header: list[str], what: str) -> tuple[str, str]:
     """The time column and the measured column of a curve file's header: one of each, each once."""
     repeated = sorted({name for name in header if name and header.count(name) > 1})
     if repeated:
-        raise ParameterError(f"{what}: the column {repeated[0]} appears {header.count(repeated[0])} times; allowed once")
+        raise ParameterError(
+            f"{what}: the column {repeated[0]} appears {header.count(repeated[0])} times; allowed once"
+        )
     times = [name for name in TIME_COLUMNS if name in header]
     measured = [name for name in NODE_COLUMNS if name in header]
     if len(times) > 1:
@@ -241,10 +263,13 @@ def _check_point(what: str, column: str, index: int, time: float, temperature: f
     if not (math.isfinite(time) and 0.0 <= time <= LONGEST_RUN_S):
         raise ParameterError(f"{what}: {point} is at {time:g} s; allowed times in [0, {LONGEST_RUN_S:g}] s")
     if previous is not None and time <= previous:
-        raise ParameterError(f"{what}: {point} at {time:g} s does not come after the one before ({previous:g} s); times must increase")
+        raise ParameterError(
+            f"{what}: {point} at {time:g} s does not come after the one before ({previous:g} s); times must increase"
+        )
     if not (math.isfinite(temperature) and temperature > ABSOLUTE_ZERO_C):
         raise ParameterError(
-            f"{what}: {point} has {column} = {temperature:g} °C; allowed a finite temperature above {ABSOLUTE_ZERO_C:g} °C"
+            f"{what}: {point} has {column} = {temperature:g} °C; allowed a finite temperature above "
+            f"{ABSOLUTE_ZERO_C:g} °C"
         )
 
 
@@ -324,8 +349,13 @@ class ValidationRun:
                 f"{', '.join(predicted)} are predictions."
             )
         targets = [row.quantity.key for row in self.rows if row.fitted]
-        through = f"the experiment's curve ({', '.join(targets)} through it)" if self.fitted_to_curve else ", ".join(targets)
-        return f"{self.preset}: {', '.join(self.fitted)} fitted to {through}; {deviation}; {', '.join(predicted)} predicted."
+        through = (
+            f"the experiment's curve ({', '.join(targets)} through it)" if self.fitted_to_curve else ", ".join(targets)
+        )
+        return (
+            f"{self.preset}: {', '.join(self.fitted)} fitted to {through}; {deviation}; "
+            f"{', '.join(predicted)} predicted."
+        )
 
 
 def validate(solver: str = "full", progress: Callable[[int], None] | None = None) -> list[ValidationRun]:

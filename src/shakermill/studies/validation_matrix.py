@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import math
 import tomllib
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -70,13 +71,22 @@ def load_experiments(folder: Path = EXPERIMENT_FOLDER) -> tuple[Experiment, ...]
     for path in sorted(folder.glob("*.toml")):
         with path.open("rb") as handle:
             data = tomllib.load(handle)
-        points = [Point(entry["node"], float(entry["time_s"]), float(entry["rise_K"])) for entry in data.get("measured", ())]
+        points = [
+            Point(entry["node"], float(entry["time_s"]), float(entry["rise_K"])) for entry in data.get("measured", ())
+        ]
         points += [Point(entry["node"], float(entry["time_s"]), None) for entry in data.get("predicted", ())]
-        experiments.append(Experiment(
-            name=path.stem, title=data["title"], source=data["source"], how_measured=data["how_measured"],
-            calibration_curve=bool(data["calibration_curve"]), conditions=dict(data["conditions"]), points=tuple(points),
-            falsifies=data.get("falsifies", ""),
-        ))
+        experiments.append(
+            Experiment(
+                name=path.stem,
+                title=data["title"],
+                source=data["source"],
+                how_measured=data["how_measured"],
+                calibration_curve=bool(data["calibration_curve"]),
+                conditions=dict(data["conditions"]),
+                points=tuple(points),
+                falsifies=data.get("falsifies", ""),
+            )
+        )
     return tuple(experiments)
 
 
@@ -105,9 +115,16 @@ class MatrixRow:
 
     def as_dict(self) -> dict[str, Any]:
         return {
-            "preset": self.preset, "thermal_model": self.thermal_model, "experiment": self.experiment.name,
-            "node": self.point.node, "time_s": self.point.time_s, "role": self.role, "measured_K": self.point.rise_K,
-            "predicted_K": self.predicted_K, "interval_90_K": [self.low_K, self.high_K], "relative_error": self.error,
+            "preset": self.preset,
+            "thermal_model": self.thermal_model,
+            "experiment": self.experiment.name,
+            "node": self.point.node,
+            "time_s": self.point.time_s,
+            "role": self.role,
+            "measured_K": self.point.rise_K,
+            "predicted_K": self.predicted_K,
+            "interval_90_K": [self.low_K, self.high_K],
+            "relative_error": self.error,
             "inside_interval": self.inside,
         }
 
@@ -120,16 +137,22 @@ class ValidationMatrix:
     def as_dict(self) -> dict[str, Any]:
         return {
             "experiments": {
-                experiment.name: {"title": experiment.title, "source": experiment.source,
-                                  "how_measured": experiment.how_measured, "conditions": dict(experiment.conditions),
-                                  "falsifies": experiment.falsifies}
+                experiment.name: {
+                    "title": experiment.title,
+                    "source": experiment.source,
+                    "how_measured": experiment.how_measured,
+                    "conditions": dict(experiment.conditions),
+                    "falsifies": experiment.falsifies,
+                }
                 for experiment in self.experiments
             },
             "rows": [row.as_dict() for row in self.rows],
         }
 
 
-def node_rises(points: tuple[Point, ...], network_of: Callable[[Parameters], ThermalNetwork]) -> Callable[[Parameters, NetworkLoad], dict[str, float]]:
+def node_rises(
+    points: tuple[Point, ...], network_of: Callable[[Parameters], ThermalNetwork]
+) -> Callable[[Parameters, NetworkLoad], dict[str, float]]:
     """The rises (K) of ``points`` of the network ``network_of`` builds, under a mean load, as named quantities."""
 
     def rises(params: Parameters, load: NetworkLoad) -> dict[str, float]:
@@ -139,19 +162,31 @@ def node_rises(points: tuple[Point, ...], network_of: Callable[[Parameters], The
         values = {}
         for point in points:
             history = np.atleast_2d(thermal.y[index[point.node]]).mean(axis=0)
-            values[f"{point.node}@{point.time_s:g}"] = float(np.interp(point.time_s, thermal.t, history)) - params.initial_temperature
+            values[f"{point.node}@{point.time_s:g}"] = (
+                float(np.interp(point.time_s, thermal.t, history)) - params.initial_temperature
+            )
         return values
 
     return rises
 
 
-def predict(preset: str, experiment: Experiment, run_for: Callable[[Parameters], Any],
-            overrides: Mapping[str, Any] | None = None) -> list[MatrixRow]:
-    """``preset`` under ``experiment``'s conditions (and ``overrides``), each point with its interval; ``run_for(params)``
-    runs it (the averaged solver's mechanics shared between presets that differ in thermal keys alone)."""
+def predict(
+    preset: str,
+    experiment: Experiment,
+    run_for: Callable[[Parameters], Any],
+    overrides: Mapping[str, Any] | None = None,
+) -> list[MatrixRow]:
+    """``preset`` under ``experiment``'s conditions (and ``overrides``), each point with its interval;
+    ``run_for(params)`` runs it (the averaged solver's mechanics shared between presets that differ in thermal
+    keys alone)."""
     uncertainty = uncertainty_of(PRESETS[preset]) or Uncertainty(())
-    settings = {"solver": "averaged", "record_windows": (), "attractor_starts": 1, **experiment.conditions,
-                **(overrides or {})}
+    settings = {
+        "solver": "averaged",
+        "record_windows": (),
+        "attractor_starts": 1,
+        **experiment.conditions,
+        **(overrides or {}),
+    }
     params = default_parameters(preset, **settings)
     result = run_for(params)
     quantities = node_rises(experiment.points, engine_named(params.engine).network_for)
@@ -160,13 +195,18 @@ def predict(preset: str, experiment: Experiment, run_for: Callable[[Parameters],
     rows = []
     for point, (key, value) in zip(experiment.points, values.items(), strict=True):
         low, high = found.bounds(key) if found is not None else (math.nan, math.nan)
-        rows.append(MatrixRow(preset, params.thermal_model, experiment, point, experiment.role(preset), value, low, high))
+        rows.append(
+            MatrixRow(preset, params.thermal_model, experiment, point, experiment.role(preset), value, low, high)
+        )
     return rows
 
 
-def validation_matrix(presets: tuple[str, ...] = THERMAL_MODEL_PRESETS, experiments: tuple[Experiment, ...] | None = None,
-                      progress: Callable[[int, int], None] | None = None,
-                      overrides: Mapping[str, Any] | None = None) -> ValidationMatrix:
+def validation_matrix(
+    presets: tuple[str, ...] = THERMAL_MODEL_PRESETS,
+    experiments: tuple[Experiment, ...] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    overrides: Mapping[str, Any] | None = None,
+) -> ValidationMatrix:
     """Every preset against every experiment (``overrides`` apply to every run); ``progress(done, total)`` counts the
     pairs. The mechanics of each experiment's conditions is measured once for all presets (they differ in
     thermal-only keys)."""
@@ -176,7 +216,7 @@ def validation_matrix(presets: tuple[str, ...] = THERMAL_MODEL_PRESETS, experime
     for experiment in experiments:
         shared: dict[str, Callable[[Parameters], Any]] = {}
 
-        def run_for(params: Parameters) -> Any:
+        def run_for(params: Parameters, shared: dict[str, Callable[[Parameters], Any]] = shared) -> Any:
             if "run" not in shared:
                 shared["run"] = thermal_variants(params)
             return shared["run"](params)
@@ -215,14 +255,27 @@ STRUCTURES: tuple[Structure, ...] = (
     Structure("paper: β, vial mass, h_outer", "spex8000m-3d", ("beta", "vial_mass", "h_outer")),
     Structure("mill-head: drive heat, clamp capacity", "spex8000m-3d-mill-head", ("drive_heat", "clamp_heat_capacity")),
     Structure("mill-head: drive heat, clamp capacity, clamp loss", "spex8000m-3d-mill-head", MILL_HEAD_FREE),
-    Structure("mill-head: drive heat, clamp capacity, clamp loss and joint", "spex8000m-3d-mill-head",
-              (*MILL_HEAD_FREE, "clamp_conductance")),
-    Structure("mill-head: … and the vial's mass (its outside was not found)", "spex8000m-3d-mill-head",
-              (*MILL_HEAD_FREE, "vial_mass")),
+    Structure(
+        "mill-head: drive heat, clamp capacity, clamp loss and joint",
+        "spex8000m-3d-mill-head",
+        (*MILL_HEAD_FREE, "clamp_conductance"),
+    ),
+    Structure(
+        "mill-head: … and the vial's mass (its outside was not found)",
+        "spex8000m-3d-mill-head",
+        (*MILL_HEAD_FREE, "vial_mass"),
+    ),
     # How much stronger than Whitaker's correlation the balls' convection must be before the curve is followed:
     # 1.3 is the correlation's own stated accuracy; Kramers' (1946) lies 1.1-1.2x above it at Re of 10³-3·10³.
-    *(Structure(f"mill-head with β fixed at {beta:g} (not at its correlation)", "spex8000m-3d-mill-head", MILL_HEAD_FREE,
-                (("beta", beta),)) for beta in (1.3, 1.6, 2.0)),
+    *(
+        Structure(
+            f"mill-head with β fixed at {beta:g} (not at its correlation)",
+            "spex8000m-3d-mill-head",
+            MILL_HEAD_FREE,
+            (("beta", beta),),
+        )
+        for beta in (1.3, 1.6, 2.0)
+    ),
     Structure("mill-head with β free (β not at its correlation)", "spex8000m-3d-mill-head", (*MILL_HEAD_FREE, "beta")),
 )
 # The one-ball curve is an exponential fitted to intermittent calorimetric measurements: a structure that follows it
@@ -246,16 +299,25 @@ class StructureOutcome:
 
     def as_dict(self) -> dict[str, Any]:
         return {
-            "label": self.structure.label, "preset": self.structure.preset, "free": list(self.structure.free),
+            "label": self.structure.label,
+            "preset": self.structure.preset,
+            "free": list(self.structure.free),
             "fixed": dict(self.structure.fixed),
-            "physical": self.structure.physical, "fitted": self.fitted, "curve_rms_K": self.curve_rms_K,
-            "edges": list(self.edges), "five_balls_ball_rise_K": self.ball_rise_K, "five_balls_vial_rise_K": self.vial_rise_K,
+            "physical": self.structure.physical,
+            "fitted": self.fitted,
+            "curve_rms_K": self.curve_rms_K,
+            "edges": list(self.edges),
+            "five_balls_ball_rise_K": self.ball_rise_K,
+            "five_balls_vial_rise_K": self.vial_rise_K,
             "meets_point_7": self.meets_point_7,
         }
 
 
-def structure_study(structures: tuple[Structure, ...] = STRUCTURES, overrides: Mapping[str, Any] | None = None,
-                    progress: Callable[[int, int], None] | None = None) -> tuple[StructureOutcome, ...]:
+def structure_study(
+    structures: tuple[Structure, ...] = STRUCTURES,
+    overrides: Mapping[str, Any] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> tuple[StructureOutcome, ...]:
     """Fit each structure to the one-ball curve and run five balls with the fit, nothing refitted. The mechanics of one
     ball and of five are each measured once (``thermal_variants``)."""
     settings = {"solver": "averaged", "record_windows": (), "attractor_starts": 1, **(overrides or {})}
@@ -266,12 +328,16 @@ def structure_study(structures: tuple[Structure, ...] = STRUCTURES, overrides: M
         five_balls = base.replace(n_balls=FIVE_BALLS, duration=3600.0, **calibration.fitted)
         summary = thermal_variants(five_balls)(five_balls).summary
         start = float(summary["initial_temperature_C"])
-        outcomes.append(StructureOutcome(
-            structure, calibration.fitted, float(calibration.curve_rms_K),
-            tuple(key for key in calibration.at_bounds if key in DEFENSIBLE_RANGES),
-            float(summary["ball_C"]) - start, float(summary["vial_C"]) - start,
-        ))
+        outcomes.append(
+            StructureOutcome(
+                structure,
+                calibration.fitted,
+                float(calibration.curve_rms_K),
+                tuple(key for key in calibration.at_bounds if key in DEFENSIBLE_RANGES),
+                float(summary["ball_C"]) - start,
+                float(summary["vial_C"]) - start,
+            )
+        )
         if progress is not None:
             progress(index + 1, len(structures))
     return tuple(outcomes)
-

@@ -5,8 +5,9 @@ curve (:func:`calibrate.free_set_study`), and the three-dimensional studies held
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Callable, Sequence
+from typing import Any
 
 from shakermill.parameters.config import load_config
 from shakermill.parameters.defaults import DEFAULT_PRESET
@@ -17,8 +18,8 @@ from shakermill.studies.held_out import HeldOutStudies, held_out_steps, held_out
 from shakermill.studies.validation import EXPERIMENT, TABLE5, VALIDATION_PRESETS, ValidationRun, validate
 from shakermill.studies.validation_matrix import (
     STRUCTURES,
-    Experiment,
     THERMAL_MODEL_PRESETS,
+    Experiment,
     StructureOutcome,
     ValidationMatrix,
     load_experiments,
@@ -55,13 +56,20 @@ class ValidationReport:
                 "table5": True,
                 "free_set_study": bool(self.outcomes),
                 "validation_matrix": self.matrix is not None,
-                "experiments": [] if self.matrix is None else [experiment.name for experiment in self.matrix.experiments],
+                "experiments": []
+                if self.matrix is None
+                else [experiment.name for experiment in self.matrix.experiments],
                 "structure_study": bool(self.structures),
                 "held_out": self.held_out is not None,
                 "cross_prediction": self.cross is not None,
             },
             "quantities": {
-                entry.key: {"label": entry.label, "unit": entry.unit, "experiment": entry.experiment, "paper_model": entry.paper_model}
+                entry.key: {
+                    "label": entry.label,
+                    "unit": entry.unit,
+                    "experiment": entry.experiment,
+                    "paper_model": entry.paper_model,
+                }
                 for entry in TABLE5
             },
             "runs": {run.preset: _run_entry(run) for run in self.runs},
@@ -103,8 +111,13 @@ def preset_parameters(name: str) -> Parameters:
     return load_config(preset=name, overrides=["record_windows="]).params
 
 
-def validation_report(solver: str, study: bool = True, three_d: bool = True,
-                      progress: Callable[[int, int], None] | None = None, everything: bool = True) -> ValidationReport:
+def validation_report(
+    solver: str,
+    study: bool = True,
+    three_d: bool = True,
+    progress: Callable[[int, int], None] | None = None,
+    everything: bool = True,
+) -> ValidationReport:
     """Validate with ``solver`` ('full' or 'averaged'); with ``study`` the free-set study of the default preset, with
     ``three_d`` the validation matrix of the thermal models (``progress(done, total)`` counts its runs) and, with
     ``everything``, its experiments of one ball, the structure study, the held-out studies and both directions of

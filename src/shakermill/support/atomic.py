@@ -16,8 +16,8 @@ import secrets
 import shutil
 import socket
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Mapping
 
 
 class StorageError(Exception):
@@ -158,7 +158,9 @@ def check_writable_place(path: Path, option: str = "--out") -> None:
         with tempfile.NamedTemporaryFile(dir=ancestor, prefix=".shakermill-probe-"):
             pass
     except OSError as exc:
-        raise StorageError(f"{path}: cannot write in {ancestor} ({exc.strerror or exc}); choose another {option}") from None
+        raise StorageError(
+            f"{path}: cannot write in {ancestor} ({exc.strerror or exc}); choose another {option}"
+        ) from None
 
 
 def _read_only(folder: Path) -> bool:

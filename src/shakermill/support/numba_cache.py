@@ -39,7 +39,9 @@ def sources_digest() -> str:
     return hashlib.sha256(b"".join(source.read_bytes() for source in _COMPILED_SOURCES)).hexdigest()
 
 
-def drop_stale_cache(stamp_folder: Path = _PACKAGE / "__pycache__", cache_folders: tuple[Path, ...] = _CACHE_FOLDERS) -> bool:
+def drop_stale_cache(
+    stamp_folder: Path = _PACKAGE / "__pycache__", cache_folders: tuple[Path, ...] = _CACHE_FOLDERS
+) -> bool:
     """Delete cached machine code compiled from other sources; return True when something was dropped."""
     digest = sources_digest()
     stamp = stamp_folder / _STAMP_NAME

@@ -8,7 +8,8 @@ views' presenters (cheaply: the views import Matplotlib only when they draw).
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 _PRESENTERS: dict[str, Callable[..., Any]] = {}
 

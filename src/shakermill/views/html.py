@@ -5,8 +5,9 @@ from __future__ import annotations
 import base64
 import errno
 import math
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING
 
 from shakermill.support.atomic import remove_abandoned_writes, write_text_atomically
 from shakermill.views.figures.common import png_bytes
@@ -50,10 +51,10 @@ def table(
     body = []
     for index, row in enumerate(rows):
         cells = "".join(
-            f"<td class=\"num\">{esc(cell)}</td>" if column in numeric else f"<td>{esc(cell)}</td>"
+            f'<td class="num">{esc(cell)}</td>' if column in numeric else f"<td>{esc(cell)}</td>"
             for column, cell in enumerate(row)
         )
-        css = f" class=\"{esc(classes[index])}\"" if index in classes else ""
+        css = f' class="{esc(classes[index])}"' if index in classes else ""
         body.append(f"<tr{css}>{cells}</tr>")
     return f"<table>\n{head}<tbody>\n" + "\n".join(body) + "\n</tbody>\n</table>"
 
@@ -63,7 +64,7 @@ def section(title: str, *parts: str) -> str:
 
 
 def paragraph(text: str, css_class: str = "") -> str:
-    css = f" class=\"{css_class}\"" if css_class else ""
+    css = f' class="{css_class}"' if css_class else ""
     return f"<p{css}>{esc(text)}</p>"
 
 
@@ -77,7 +78,7 @@ def figure_html(figure: Figure, caption: str, number: int) -> str:
     encoded = base64.b64encode(png_bytes(figure, EMBED_DPI)).decode("ascii")
     caption = f"Figure {number}: {caption}"
     return (
-        f"<figure><img src=\"data:image/png;base64,{encoded}\" alt=\"{esc(caption)}\">"
+        f'<figure><img src="data:image/png;base64,{encoded}" alt="{esc(caption)}">'
         f"<figcaption>{esc(caption)}</figcaption></figure>"
     )
 

@@ -11,7 +11,8 @@ from __future__ import annotations
 import base64
 import html
 import math
-from typing import TYPE_CHECKING, Any, Mapping
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
 
 from shakermill.support.presenters import register
 
@@ -114,7 +115,8 @@ def empty_mill_sentences(summary: Mapping[str, Any], v: Mapping[str, str], minut
     """The answer of a run with no balls (MODEL.md §13.4): the vial warmed by what does not depend on them."""
     drive = number(_number(summary.get("drive_heat_W")), ".3g")
     return [
-        f"An empty mill (no balls): after {minutes} min the vial is at {v['vial_C']} °C and the air at {v['air_C']} °C, "
+        f"An empty mill (no balls): after {minutes} min the vial is at {v['vial_C']} °C and the air at {v['air_C']} "
+        "°C, "
         f"warmed by the drive's {drive} W alone.",
         f"Run on, the vial would settle at {v['vial_steady_C']} °C (air {v['air_steady_C']} °C); the slowest time "
         f"constant of the thermal network is {v['slowest_time_constant_min']} min.",
@@ -137,7 +139,7 @@ def several_ball_sentences(summary: Mapping[str, Any], v: Mapping[str, str], min
 
 
 def _spread(values: Any) -> str:
-    """"20.5–20.8": the lowest and highest of a list of temperatures in °C (nulls left out), or "n/a"."""
+    """ "20.5–20.8": the lowest and highest of a list of temperatures in °C (nulls left out), or "n/a"."""
     finite = [value for value in values or () if isinstance(value, (int, float)) and math.isfinite(value)]
     return f"{min(finite):.1f}–{max(finite):.1f}" if finite else "n/a"
 
@@ -173,7 +175,7 @@ def experiment_comparison(summary: Mapping[str, Any], preset: str) -> str:
 
 def _rows(rows: list[tuple[str, str, str]]) -> str:
     return "".join(
-        f"<tr><td>{esc(label)}</td><td class=\"num\">{esc(value)}</td><td>{esc(unit)}</td></tr>"
+        f'<tr><td>{esc(label)}</td><td class="num">{esc(value)}</td><td>{esc(unit)}</td></tr>'
         for label, value, unit in rows
     )
 
@@ -195,7 +197,7 @@ def parameters_html(params: Parameters) -> str:
     """The key inputs in a small table, every key in a closed ``<details>`` below it."""
     everything = [(key, str(value), "") for key, value in params.model_dump().items()]
     return (
-        f"<div class=\"shakermill-view\">{STYLE}<strong>shakermill Parameters</strong>"
+        f'<div class="shakermill-view">{STYLE}<strong>shakermill Parameters</strong>'
         f"<table>{_rows(_input_rows(params))}</table>"
         f"<details><summary>all {len(everything)} keys (SI units)</summary><table>{_rows(everything)}</table></details>"
         "</div>"
@@ -206,12 +208,10 @@ def result_html(result: Result) -> str:
     """Status, the answer in sentences and a table, the key inputs and the warnings of ``result``."""
     summary = result.summary
     status = "completed" if result.success else f"stopped early (status {result.status})"
-    answer = [
-        (label, number(summary.get(key), spec), unit) for key, label, unit, spec in ANSWER_KEYS
-    ]
+    answer = [(label, number(summary.get(key), spec), unit) for key, label, unit, spec in ANSWER_KEYS]
     warnings = "".join(f"<li>{esc(line)}</li>" for line in result.warnings)
     return (
-        f"<div class=\"shakermill-view\">{STYLE}"
+        f'<div class="shakermill-view">{STYLE}'
         f"<strong>shakermill Result</strong>: {esc(status)}: {esc(result.message)}"
         f"<p>{esc(' '.join(answer_sentences(summary)))}</p>"
         f"<table><tr><th>result</th><th>value</th><th>unit</th></tr>{_rows(answer)}</table>"
@@ -228,11 +228,11 @@ class FigureSet(dict):
         from shakermill.views.figures.common import png_bytes
 
         images = (
-            f"<figure><img alt=\"{esc(name)}\" src=\"data:image/png;base64,"
-            f"{base64.b64encode(png_bytes(figure, NOTEBOOK_PNG_DPI)).decode('ascii')}\"></figure>"
+            f'<figure><img alt="{esc(name)}" src="data:image/png;base64,'
+            f'{base64.b64encode(png_bytes(figure, NOTEBOOK_PNG_DPI)).decode("ascii")}"></figure>'
             for name, figure in self.items()
         )
-        return "<div class=\"shakermill-figures\">" + "".join(images) + "</div>"
+        return '<div class="shakermill-figures">' + "".join(images) + "</div>"
 
 
 def run_figure_set(result: Result, *, impacts: bool = False) -> FigureSet:

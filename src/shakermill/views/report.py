@@ -15,8 +15,9 @@ from __future__ import annotations
 import itertools
 import math
 import tomllib
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import Any
 
 from shakermill.io.runs import CONFIG_FILE, RunData, load_run
 from shakermill.parameters.defaults import DEFAULT_PRESET, REPORT_FILE
@@ -66,7 +67,7 @@ PAPER_DIFFERENCES = (
     "Hertz force (4/3)·E*·√R·ζ^(3/2); the printed text garbles it to a square root of the whole product.",
     "Damping exponent β_e = ln e / √(ln²e + π²), the standard form; the printed text drops the square root.",
     "Heat from the relative motion of ball and wall, η·c·ζ̇² (frame invariant), not η·|F_d·v| as printed; "
-    "the printed form is available as heat_model = \"paper\".",
+    'the printed form is available as heat_model = "paper".',
     "The end faces are at x_v ± l_v/2.",
     "The air mass m_a, the air heat capacity c_a, the drive frequency ω and the vial's thermal mass are not "
     "printed in the paper; they are stated assumptions (listed above with their values).",
@@ -91,7 +92,8 @@ RESULT_QUANTITIES = (
     ("mean_impact_speed_m_s", "mean impact speed", "m/s", ".4g"),
 )
 
-# The rows of the exponential fit, left out where it does not describe the run (summary "exponential_fit_describes_run").
+# The rows of the exponential fit, left out where it does not describe the run (summary
+# "exponential_fit_describes_run").
 FIT_KEYS = ("theta_inf_C", "tau_min", "rate0_C_per_min")
 
 COMPARED_QUANTITIES = RESULT_QUANTITIES + (
@@ -162,10 +164,10 @@ def render_report(run: RunData, other: RunData | None = None) -> str:
     sections.append(citation_section())
     title = f"shakermill run report: {run_name(run)}"
     return (
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         f"<title>{esc(title)}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n"
         + "\n".join(sections)
-        + f"\n<p class=\"note\">Report written by shakermill {esc(__version__)}.</p>\n</body>\n</html>\n"
+        + f'\n<p class="note">Report written by shakermill {esc(__version__)}.</p>\n</body>\n</html>\n'
     )
 
 
@@ -200,7 +202,9 @@ def format_parameter(value: Any) -> str:
         return f"{value:.6g}"
     if isinstance(value, (tuple, list)):
         items = (
-            f"[{', '.join(format_parameter(part) for part in item)}]" if isinstance(item, (tuple, list)) else format_parameter(item)
+            f"[{', '.join(format_parameter(part) for part in item)}]"
+            if isinstance(item, (tuple, list))
+            else format_parameter(item)
             for item in value
         )
         return ", ".join(items) or "none"
@@ -254,10 +258,12 @@ def header_section(run: RunData, preset: Preset | None) -> str:
         ("command", str(provenance.get("command", "n/a"))),
         ("overrides (--set)", ", ".join(provenance.get("overrides", [])) or "none"),
     ]
-    warnings = "".join(f"<p class=\"status failed\">{esc('Warning: ' + line)}</p>\n" for line in run.summary.get("warnings", []))
+    warnings = "".join(
+        f'<p class="status failed">{esc("Warning: " + line)}</p>\n' for line in run.summary.get("warnings", [])
+    )
     return (
         f"<header>\n<h1>{esc('shakermill run report: ' + run_name(run))}</h1>\n"
-        f"<p class=\"status {status_class}\">{esc(status)}</p>\n{warnings}"
+        f'<p class="status {status_class}">{esc(status)}</p>\n{warnings}'
         + answer_html(run, preset)
         + table(None, facts)
         + "\n</header>"
@@ -277,15 +283,23 @@ def results_section(run: RunData) -> str:
     summary = run.summary
     # A summary written before the key existed showed the fit's rows whatever the run's length.
     describes = summary.get("exponential_fit_describes_run", True)
-    rows = [(label, number(summary.get(key), spec), unit) for key, label, unit, spec in RESULT_QUANTITIES
-            if key not in FIT_KEYS or describes]
+    rows = [
+        (label, number(summary.get(key), spec), unit)
+        for key, label, unit, spec in RESULT_QUANTITIES
+        if key not in FIT_KEYS or describes
+    ]
     uncertainty = (
-        f"Standard errors of the fit: θ∞ ± {number(summary.get('theta_inf_stderr_K'), '.2g')} K, "
-        f"τ ± {number(summary.get('tau_stderr_min'), '.2g')} min; "
-        f"RMS residual {number(summary.get('fit_rms_residual_K'), '.2g')} K."
-    ) if describes else (
-        "No exponential: the run is shorter than the network's slowest time constant, so one fitted to it describes "
-        "the start of the heating, not where it goes; the steady state is the answer to read."
+        (
+            f"Standard errors of the fit: θ∞ ± {number(summary.get('theta_inf_stderr_K'), '.2g')} K, "
+            f"τ ± {number(summary.get('tau_stderr_min'), '.2g')} min; "
+            f"RMS residual {number(summary.get('fit_rms_residual_K'), '.2g')} K."
+        )
+        if describes
+        else (
+            "No exponential: the run is shorter than the network's slowest time constant, so one fitted to it "
+            "describes "
+            "the start of the heating, not where it goes; the steady state is the answer to read."
+        )
     )
     return section("Results", table(("quantity", "value", "unit"), rows, numeric=(1,)), paragraph(uncertainty, "note"))
 

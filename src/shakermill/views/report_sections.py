@@ -4,7 +4,8 @@ of an engine of several, and the numerics."""
 from __future__ import annotations
 
 import math
-from typing import Any, Iterator, Mapping
+from collections.abc import Iterator, Mapping
+from typing import Any
 
 from shakermill.analysis.regime import classify_impacts, settled_run_impacts
 from shakermill.analysis.stress_energy import StressSpectrum
@@ -61,7 +62,9 @@ SEVERAL_BALL_CAPTIONS = {
         "The temperature of each ball in the record window nearest 10 min: it jumps at the ball's impacts "
         "(dotted: every impact of any ball) and falls by convection between them (cf. paper Fig. 5b)."
     ),
-    "impact_speed_histogram": "Normal impact speed relative to what is hit: an end face, the side wall or another ball.",
+    "impact_speed_histogram": (
+        "Normal impact speed relative to what is hit: an end face, the side wall or another ball."
+    ),
     "impact_energy_histogram": "Energy dissipated in each impact (mJ), by what was hit.",
     "stress_energy_spectrum": (
         "Stress-energy spectrum: impacts per second (left) and their power (right) at or above each stress energy, the "
@@ -204,17 +207,26 @@ def balls_section(run: RunData) -> str:
     rows = []
     for ball, radius in enumerate(run.params.ball_values("ball_radius")):
         mine = impacts["ball"] == ball
-        rows.append((
-            str(ball),
-            number(radius * 1e3, ".4g"),
-            number(at_end[ball] if ball < len(at_end) else None, ".2f"),
-            number(steady[ball] if ball < len(steady) else None, ".2f"),
-            str(int((mine & on_walls).sum())),
-            str(int((~on_walls & (mine | (impacts["other_ball"] == ball))).sum())),
-            number(float(heat[ball]) if heat is not None else None, ".4g"),
-        ))
-    headers = ("ball", "radius (mm)", "at the end (°C)", "steady state (°C)", "impacts on the walls",
-               "impacts with other balls", "heat received (W)")
+        rows.append(
+            (
+                str(ball),
+                number(radius * 1e3, ".4g"),
+                number(at_end[ball] if ball < len(at_end) else None, ".2f"),
+                number(steady[ball] if ball < len(steady) else None, ".2f"),
+                str(int((mine & on_walls).sum())),
+                str(int((~on_walls & (mine | (impacts["other_ball"] == ball))).sum())),
+                number(float(heat[ball]) if heat is not None else None, ".4g"),
+            )
+        )
+    headers = (
+        "ball",
+        "radius (mm)",
+        "at the end (°C)",
+        "steady state (°C)",
+        "impacts on the walls",
+        "impacts with other balls",
+        "heat received (W)",
+    )
     note = (
         f"Balls are numbered as in the run's files, from 0. Impacts are those of the impact table "
         f"({number(impact_span(run), '.4g')} s of the run); the heat received is the mean over the whole run."
@@ -247,24 +259,53 @@ def stress_energy_table(spectrum: StressSpectrum) -> str:
     part and on each target, then the power above each of the run's thresholds (analysis/stress_energy.py)."""
     parts = (("total", "all"), ("normal", "all"), ("tangential", "all"), ("total", "wall"), ("total", "ball"))
     rows = [
-        (f"{component}, {target if target != 'all' else 'all targets'}",
-         number(spectrum.events_per_second(0.0, component, target), ".4g"), number(spectrum.percentile(50, component, target), ".3g"),
-         number(spectrum.percentile(90, component, target), ".3g"), number(spectrum.power(0.0, component, target), ".4g"))
+        (
+            f"{component}, {target if target != 'all' else 'all targets'}",
+            number(spectrum.events_per_second(0.0, component, target), ".4g"),
+            number(spectrum.percentile(50, component, target), ".3g"),
+            number(spectrum.percentile(90, component, target), ".3g"),
+            number(spectrum.power(0.0, component, target), ".4g"),
+        )
         for component, target in parts
     ]
     rows += [
-        (f"total at or above {threshold:g} J", number(spectrum.events_per_second(threshold), ".4g"), "", "",
-         number(spectrum.power(threshold), ".4g"))
+        (
+            f"total at or above {threshold:g} J",
+            number(spectrum.events_per_second(threshold), ".4g"),
+            "",
+            "",
+            number(spectrum.power(threshold), ".4g"),
+        )
         for threshold in spectrum.thresholds
     ]
     lasting = number(spectrum.lasting_per_second(), ".4g")
     share = spectrum.lasting_share()
-    rows.append((f"lasting contacts (rolling, sliding: no stress events; {number(100 * share, '.3g')} % of the dissipation, "
-                 "left out of every row above)", lasting, "", "", number(spectrum.lasting_power(), ".4g")))
-    rows.append(("Kwade's stress energy ½·m*·v_n² at first touch (brought, not dissipated)",
-                 number(spectrum.events_per_second(0.0, "kinetic"), ".4g"), number(spectrum.percentile(50, "kinetic"), ".3g"),
-                 number(spectrum.percentile(90, "kinetic"), ".3g"), ""))
-    header = ("stress energy (J dissipated per impact)", "events per second (1/s)", "median (J)", "90th percentile (J)", "power (W)")
+    rows.append(
+        (
+            f"lasting contacts (rolling, sliding: no stress events; {number(100 * share, '.3g')} % of the dissipation, "
+            "left out of every row above)",
+            lasting,
+            "",
+            "",
+            number(spectrum.lasting_power(), ".4g"),
+        )
+    )
+    rows.append(
+        (
+            "Kwade's stress energy ½·m*·v_n² at first touch (brought, not dissipated)",
+            number(spectrum.events_per_second(0.0, "kinetic"), ".4g"),
+            number(spectrum.percentile(50, "kinetic"), ".3g"),
+            number(spectrum.percentile(90, "kinetic"), ".3g"),
+            "",
+        )
+    )
+    header = (
+        "stress energy (J dissipated per impact)",
+        "events per second (1/s)",
+        "median (J)",
+        "90th percentile (J)",
+        "power (W)",
+    )
     return table(header, rows, numeric=(1, 2, 3, 4))
 
 

@@ -11,7 +11,8 @@ Matplotlib is imported inside the functions, as in :mod:`shakermill.views.figure
 from __future__ import annotations
 
 import io
-from typing import TYPE_CHECKING, Sequence
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -43,6 +44,8 @@ def axis_label(params: Parameters, axis: str) -> str:
 
 def view_name(params: Parameters, name: str) -> str:
     return UPRIGHT_VIEW_NAMES[name] if KINEMATIC_MODELS[params.kinematics].axis_upright else name
+
+
 # A window of minutes at 10 kHz would be millions of points per ball: longer windows are drawn thinned to this.
 MOST_PATH_POINTS = 20_000
 ANIMATION_FPS = 24
@@ -79,7 +82,10 @@ def vial_frame(position: np.ndarray, vial_centre: np.ndarray, vial_angles: np.nd
 def window_in_vial_frame(window: xr.Dataset) -> np.ndarray:
     """The ball centres of a record window (time, ball, axis) in the vial frame, in mm."""
     position = window["position"].transpose("time", "ball", "axis").values
-    centre, angles = window["vial_centre"].transpose("time", "axis").values, window["vial_angles"].transpose("time", "angle").values
+    centre, angles = (
+        window["vial_centre"].transpose("time", "axis").values,
+        window["vial_angles"].transpose("time", "angle").values,
+    )
     return MM * vial_frame(position, centre, angles)
 
 
@@ -98,7 +104,8 @@ def new_figure(size: tuple[float, float]) -> Figure:
 
 
 def draw_vial(axis: Axes, across: str, up: str, params: Parameters) -> None:
-    """The vial's inner wall in the projection (``across``, ``up``) in mm: its length and bore, or its bore as a circle."""
+    """The vial's inner wall in the projection (``across``, ``up``) in mm: its length and bore, or its bore as a
+    circle."""
     from matplotlib.patches import Circle, Rectangle
 
     length, bore = params.vial_length * MM, params.vial_diameter * MM
@@ -116,7 +123,9 @@ def draw_vial(axis: Axes, across: str, up: str, params: Parameters) -> None:
     axis.set_ylabel(axis_label(params, up))
 
 
-def trajectory_figure(params: Parameters, window: xr.Dataset, record_window: tuple[float, float] | None = None) -> Figure:
+def trajectory_figure(
+    params: Parameters, window: xr.Dataset, record_window: tuple[float, float] | None = None
+) -> Figure:
     """Each ball's centre over ``window`` in the vial frame (mm): top, side and end view, the vial's inner
     wall, and each ball to scale where the window ends.
 
@@ -153,10 +162,15 @@ def trajectory_figure(params: Parameters, window: xr.Dataset, record_window: tup
 
 
 def animation_gif(
-    params: Parameters, window: xr.Dataset, *, frames: int = ANIMATION_FRAMES, fps: int = ANIMATION_FPS, dpi: int = ANIMATION_DPI
+    params: Parameters,
+    window: xr.Dataset,
+    *,
+    frames: int = ANIMATION_FRAMES,
+    fps: int = ANIMATION_FPS,
+    dpi: int = ANIMATION_DPI,
 ) -> bytes:
-    """A GIF of the balls (discs of their radius, with a trail of the last frames) in the side view of the vial frame over
-    ``window``: ``frames`` frames (1 to :data:`MOST_ANIMATION_FRAMES`; fewer if the window holds fewer
+    """A GIF of the balls (discs of their radius, with a trail of the last frames) in the side view of the vial frame
+    over ``window``: ``frames`` frames (1 to :data:`MOST_ANIMATION_FRAMES`; fewer if the window holds fewer
     samples) at ``fps``, ``dpi`` pixels per inch.
 
     Matplotlib's FuncAnimation with PillowWriter redraws the whole figure two or three times a frame (18 s

@@ -10,6 +10,7 @@ import math
 import numpy as np
 from numba import njit
 
+from shakermill.engines.dem import neighbours
 from shakermill.engines.dem.model import (
     DISSIPATED_NORMAL,
     DISSIPATED_ROLLING,
@@ -26,7 +27,6 @@ from shakermill.engines.dem.model import (
     Scratch,
     State,
 )
-from shakermill.engines.dem import neighbours
 from shakermill.engines.dem.vectors import copy_into, cross_into, difference_into, distance, dot, norm, scaled_into
 from shakermill.engines.thermal import kernel
 from shakermill.physics import contact, heat_paths
@@ -90,9 +90,21 @@ def bodies(slot: int, k: Constants, s: State) -> tuple[int, int, int]:
 
 
 @njit(cache=True, inline="always")
-def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: float, shear_modulus: float,
-              radius: float, mass: float, beta_e: float, friction: float, dt: float, k: Constants, s: State,
-              w: Scratch) -> None:
+def _response(
+    slot: int,
+    overlap: float,
+    relative_spin: np.ndarray,
+    modulus: float,
+    shear_modulus: float,
+    radius: float,
+    mass: float,
+    beta_e: float,
+    friction: float,
+    dt: float,
+    k: Constants,
+    s: State,
+    w: Scratch,
+) -> None:
     """Normal, tangential and rolling response of a contact (MODEL.md §12.3) into ``w``'s arrays of ``slot``, with
     the damping ratio ``beta_e`` and Coulomb coefficient ``friction`` of its pair of bodies.
 
@@ -141,7 +153,9 @@ def _response(slot: int, overlap: float, relative_spin: np.ndarray, modulus: flo
     w.stretch[slot] = dot(spring, spring)
     spin = norm(relative_spin)
     for axis in range(3):
-        w.rolling_torque[slot, axis] = -k.rolling_friction * radius * pressing * relative_spin[axis] / spin if spin > 0 else 0.0
+        w.rolling_torque[slot, axis] = (
+            -k.rolling_friction * radius * pressing * relative_spin[axis] / spin if spin > 0 else 0.0
+        )
     c.period[slot] = contact.contact_period(mass, radius, modulus, shear_modulus, overlap, approach)
     if not c.active[slot]:
         c.impact_period[slot] = c.period[slot]
@@ -199,8 +213,21 @@ def _contact_point_velocity(ball: int, lever_sign: float, s: State, w: Scratch, 
 
 
 @njit(cache=True, inline="always")
-def _engage(slot: int, t: float, overlap: float, modulus: float, shear_modulus: float, radius: float, mass: float,
-            ball_radius: float, dt: float, k: Constants, s: State, w: Scratch, live: int) -> int:
+def _engage(
+    slot: int,
+    t: float,
+    overlap: float,
+    modulus: float,
+    shear_modulus: float,
+    radius: float,
+    mass: float,
+    ball_radius: float,
+    dt: float,
+    k: Constants,
+    s: State,
+    w: Scratch,
+    live: int,
+) -> int:
     """A touching slot (ball pair or wall): start its record if it is new, its response with these effective
     values and its pair's restitution and friction, the tangential force's torque on ball i (of radius
     ``ball_radius``); returns the live-slot count."""
@@ -218,7 +245,8 @@ def _engage(slot: int, t: float, overlap: float, modulus: float, shear_modulus: 
 
 @njit(cache=True, inline="always")
 def pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live: int) -> tuple[int, float]:
-    """Responses of the touching pairs of the neighbour list; returns the live-slot count and the deepest overlap (m)."""
+    """Responses of the touching pairs of the neighbour list; returns the live-slot count and the deepest overlap
+    (m)."""
     nb = s.neighbours
     walls = N_WALLS * k.n_balls
     deepest = 0.0
@@ -267,8 +295,21 @@ def wall_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
             _contact_point_velocity(i, -k.radius[i], s, w, w.point_velocity)
             difference_into(w.point_velocity, w.wall_velocity[slot], w.point_velocity)
             difference_into(s.spin[i], w.angular, w.relative_spin)
-            live = _engage(slot, t, overlap, k.wall_modulus[i], k.wall_shear_modulus[i], k.wall_radius[i, wall],
-                           k.mass[i], k.radius[i], dt, k, s, w, live)
+            live = _engage(
+                slot,
+                t,
+                overlap,
+                k.wall_modulus[i],
+                k.wall_shear_modulus[i],
+                k.wall_radius[i, wall],
+                k.mass[i],
+                k.radius[i],
+                dt,
+                k,
+                s,
+                w,
+                live,
+            )
             w.lever_torque_j[slot, :] = 0.0
     return live, deepest
 
@@ -320,8 +361,7 @@ def _mean_work(slot: int, i: int, j: int, dt: float, s: State, w: Scratch) -> tu
 
 
 @njit(cache=True, inline="always")
-def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.ndarray,
-            count: int) -> int:
+def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.ndarray, count: int) -> int:
     """Book the step's work of the contact in ``slot`` by channel, turn it into heat, keep the new forces,
     and close the contact's record if it ended. Returns the record count."""
     c = s.contacts
@@ -412,18 +452,30 @@ def _add_conduction(drive: int, conducted: float, s: State) -> None:
 def _copy_slot(source: Contacts, a: int, target: Contacts, b: int) -> None:
     """Contact memory of slot ``a`` of ``source`` into slot ``b`` of ``target``."""
     target.active[b] = source.active[a]
-    for field_from, field_to in ((source.normal_force, target.normal_force), (source.tangential_force, target.tangential_force),
-                                 (source.lever_torque_i, target.lever_torque_i), (source.lever_torque_j, target.lever_torque_j),
-                                 (source.rolling_torque, target.rolling_torque), (source.wall_velocity, target.wall_velocity),
-                                 (source.spring, target.spring)):
+    for field_from, field_to in (
+        (source.normal_force, target.normal_force),
+        (source.tangential_force, target.tangential_force),
+        (source.lever_torque_i, target.lever_torque_i),
+        (source.lever_torque_j, target.lever_torque_j),
+        (source.rolling_torque, target.rolling_torque),
+        (source.wall_velocity, target.wall_velocity),
+        (source.spring, target.spring),
+    ):
         copy_into(field_from[a], field_to[b])
-    for scalar_from, scalar_to in ((source.elastic_energy, target.elastic_energy), (source.stiffness, target.stiffness),
-                                   (source.stretch, target.stretch), (source.slip_loss, target.slip_loss),
-                                   (source.period, target.period), (source.impact_period, target.impact_period),
-                                   (source.release, target.release), (source.started, target.started),
-                                   (source.normal_speed_in, target.normal_speed_in),
-                                   (source.tangential_speed_in, target.tangential_speed_in),
-                                   (source.peak_force, target.peak_force), (source.max_overlap, target.max_overlap)):
+    for scalar_from, scalar_to in (
+        (source.elastic_energy, target.elastic_energy),
+        (source.stiffness, target.stiffness),
+        (source.stretch, target.stretch),
+        (source.slip_loss, target.slip_loss),
+        (source.period, target.period),
+        (source.impact_period, target.impact_period),
+        (source.release, target.release),
+        (source.started, target.started),
+        (source.normal_speed_in, target.normal_speed_in),
+        (source.tangential_speed_in, target.tangential_speed_in),
+        (source.peak_force, target.peak_force),
+        (source.max_overlap, target.max_overlap),
+    ):
         scalar_to[b] = scalar_from[a]
     for channel in range(source.dissipated.shape[1]):
         target.dissipated[b, channel] = source.dissipated[a, channel]
@@ -434,8 +486,15 @@ def _clear_slot(c: Contacts, slot: int) -> None:
     """A slot no contact holds: what a step reads of a slot that did not touch at its start (forces, stored energies,
     spring) at zero."""
     c.active[slot] = False
-    for vectors in (c.normal_force, c.tangential_force, c.lever_torque_i, c.lever_torque_j, c.rolling_torque,
-                    c.wall_velocity, c.spring):
+    for vectors in (
+        c.normal_force,
+        c.tangential_force,
+        c.lever_torque_i,
+        c.lever_torque_j,
+        c.rolling_torque,
+        c.wall_velocity,
+        c.spring,
+    ):
         vectors[slot, :] = 0.0
     c.elastic_energy[slot] = 0.0
     c.stiffness[slot] = 0.0

@@ -19,7 +19,10 @@ STATUS_MESSAGES = {
         "A contact overlap exceeded 5 % of the smallest ball radius: the materials are too soft for these impact "
         "speeds, or contact_step_fraction is too large."
     ),
-    NEIGHBOURS_FULL: "The neighbour list could not hold the pairs of balls near each other: balls overlap far more than a step allows.",
+    NEIGHBOURS_FULL: (
+        "The neighbour list could not hold the pairs of balls near each other: balls overlap far more than a step "
+        "allows."
+    ),
 }
 
 IMPACT_UNITS = {
@@ -45,9 +48,24 @@ IMPACT_UNITS = {
 # its viscosity at the ambient temperature set each ball's Reynolds number there, the materials' conductivities
 # each contact's conduction).
 THERMAL_ONLY_KEYS = (
-    "h_inner", "h_outer", "inner_area", "outer_area", "vial_mass", "vial_heat_capacity", "beta",
-    "initial_temperature", "duration", "output_interval", "thermal_model", "outer_diameter", "outer_length",
-    "emissivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss", "drive_heat",
+    "h_inner",
+    "h_outer",
+    "inner_area",
+    "outer_area",
+    "vial_mass",
+    "vial_heat_capacity",
+    "beta",
+    "initial_temperature",
+    "duration",
+    "output_interval",
+    "thermal_model",
+    "outer_diameter",
+    "outer_length",
+    "emissivity",
+    "clamp_heat_capacity",
+    "clamp_conductance",
+    "clamp_loss",
+    "drive_heat",
 )
 
 DESCRIPTION = EngineDescription(
@@ -55,12 +73,26 @@ DESCRIPTION = EngineDescription(
     channels=CHANNELS,
     impact_units=IMPACT_UNITS,
     impact_target="target",
-    per_ball=("theta_balls", "theta_balls_C", "heat_into_balls", "velocity_term_integrals", "position", "velocity",
-              "angular_velocity"),
+    per_ball=(
+        "theta_balls",
+        "theta_balls_C",
+        "heat_into_balls",
+        "velocity_term_integrals",
+        "position",
+        "velocity",
+        "angular_velocity",
+    ),
     read_back=("time", "position", "velocity", "theta_ball", "theta_balls", "theta_vial", "theta_air"),
     motion=("position", "velocity", "angular_velocity"),
-    averaged_flows=("work_vial", "heat_generated", "heat_into_balls", "heat_into_vial", "velocity_term_integrals",
-                    "velocity_term_integral", "contact_conduction"),
+    averaged_flows=(
+        "work_vial",
+        "heat_generated",
+        "heat_into_balls",
+        "heat_into_vial",
+        "velocity_term_integrals",
+        "velocity_term_integral",
+        "contact_conduction",
+    ),
     heat_variables=("heat_into_balls", "heat_into_vial"),
     term_variables=("velocity_term_integrals",),
     status_messages=STATUS_MESSAGES,

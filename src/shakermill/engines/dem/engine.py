@@ -6,7 +6,8 @@ thermal network."""
 from __future__ import annotations
 
 import math
-from typing import ClassVar, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import ClassVar
 
 import numpy as np
 
@@ -55,8 +56,14 @@ class DemEngine(CompiledRun):
     first_steps_per_call: ClassVar[int] = 2_000
     most_steps_per_call: ClassVar[int] = 50_000_000
 
-    def __init__(self, params: Parameters, budget: RunBudget | None = None, samples: Sequence[float] = (0.0,),
-                 horizon: float = 0.0, replica: int = 0) -> None:
+    def __init__(
+        self,
+        params: Parameters,
+        budget: RunBudget | None = None,
+        samples: Sequence[float] = (0.0,),
+        horizon: float = 0.0,
+        replica: int = 0,
+    ) -> None:
         """See :class:`~shakermill.engines.interface.Engine`. The state is recorded as a row (:func:`model.row_fields`)
         at each sample and every WINDOW_INTERVAL inside the record windows; the start before the first step.
         A ``replica`` > 0 starts from the configured state with its balls kicked (:func:`model.kick_for_replica`)."""
@@ -73,7 +80,9 @@ class DemEngine(CompiledRun):
         self.marks = times[1:]
         self._rows = np.zeros((self.marks.size, model.row_width(params.n_balls, self.node_count)))
         # The stepping hands back when fewer rows are free than there are slots: a large charge starts with room.
-        self._records = np.zeros((max(INITIAL_RECORDS, 2 * self.state.contacts.active.size), len(stepper.RECORD_COLUMNS)))
+        self._records = np.zeros(
+            (max(INITIAL_RECORDS, 2 * self.state.contacts.active.size), len(stepper.RECORD_COLUMNS))
+        )
         self._count = 0
         self.start = self.row_now()
 
@@ -110,8 +119,17 @@ class DemEngine(CompiledRun):
 
     def compiled_call(self, t_stop: float, steps_allowed: int) -> int:
         status, self._count = stepper.advance(
-            t_stop, steps_allowed, self.constants, self.network.arrays, self.state, self.scratch, self._records, self._count,
-            self.stepper_counters, self.marks, self._rows,
+            t_stop,
+            steps_allowed,
+            self.constants,
+            self.network.arrays,
+            self.state,
+            self.scratch,
+            self._records,
+            self._count,
+            self.stepper_counters,
+            self.marks,
+            self._rows,
         )
         if status == stepper.RECORDS_FULL:
             self._records = np.concatenate([self._records, np.zeros_like(self._records)])
@@ -186,7 +204,8 @@ class DemEngine(CompiledRun):
         capacity = self.network.arrays.capacity
         initial = {name: values[0] for name, values in model.unpack_rows(self.start, n, self.node_count)[1].items()}
         kinetic_start = 0.5 * float(
-            np.sum(k.mass * np.sum(initial["velocity"] ** 2, axis=1)) + np.sum(k.inertia * np.sum(initial["angular_velocity"] ** 2, axis=1))
+            np.sum(k.mass * np.sum(initial["velocity"] ** 2, axis=1))
+            + np.sum(k.inertia * np.sum(initial["angular_velocity"] ** 2, axis=1))
         )
         warming = s.temperature - initial["temperature"]
         totals = s.totals - initial["totals"]
@@ -234,7 +253,9 @@ class DemEngine(CompiledRun):
         heat = np.asarray(heat_rates, dtype=float)
         terms = np.asarray(term_means, dtype=float)
         mean_term = float(terms.mean()) if terms.size else math.nan  # an empty mill has no ball to convect
-        return NetworkLoad(np.append(heat, 0.0), terms, float(heat.sum()), mean_term, np.asarray(conductances, dtype=float))
+        return NetworkLoad(
+            np.append(heat, 0.0), terms, float(heat.sum()), mean_term, np.asarray(conductances, dtype=float)
+        )
 
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
         """Each ball's contacts, with the vial or another ball; the vial's; the air's none."""
@@ -242,15 +263,24 @@ class DemEngine(CompiledRun):
         balls = [int(np.sum(impacts["ball"] == ball) + np.sum(impacts["other_ball"] == ball)) for ball in range(n)]
         return np.array([*balls, int(np.sum(impacts["target"] != "ball")), 0])
 
-    def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray,
-                         load: NetworkLoad, dissipated_power: float, network: ThermalNetwork) -> StateHistory:
+    def averaged_history(
+        self,
+        times: np.ndarray,
+        temperatures: np.ndarray,
+        heat_lost: np.ndarray,
+        load: NetworkLoad,
+        dissipated_power: float,
+        network: ThermalNetwork,
+    ) -> StateHistory:
         k, n = self.constants, self.params.n_balls
         count = times.size
         totals = np.zeros((count, len(model.TOTAL_NAMES)))
         totals[:, model.WORK_VIAL] = dissipated_power * times  # on average the balls' kinetic energy does not change
         totals[:, model.HEAT_GENERATED] = load.heat_power * times
         totals[:, model.HEAT_LOST] = heat_lost
-        totals[:, model.DISSIPATED_NORMAL : model.DISSIPATED_ROLLING + 1] = np.nan  # the split is in the window's impacts
+        totals[:, model.DISSIPATED_NORMAL : model.DISSIPATED_ROLLING + 1] = (
+            np.nan
+        )  # the split is in the window's impacts
         vial = np.zeros((count, 6))
         rates = np.zeros(6)
         for row, t in enumerate(times):
@@ -298,7 +328,9 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
     }
 
 
-def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Constants, network: ThermalNetwork) -> StateHistory:
+def history_of(
+    times: np.ndarray, fields: dict[str, np.ndarray], k: model.Constants, network: ThermalNetwork
+) -> StateHistory:
     """The states with units: temperatures of each ball (and their mean, ``theta_ball``), vial and air (and any
     further node of ``network``, ``theta_<name>``), the balls' motion in the lab frame (axis x, y, z; z up), the
     vial's pose and the running totals."""
@@ -329,13 +361,24 @@ def history_of(times: np.ndarray, fields: dict[str, np.ndarray], k: model.Consta
     variables["dissipated"] = (dissipated, attributes("J", "cumulative energy dissipated in contacts"))
     variables["heat_into_balls"] = (heat_into[:, :n], attributes("J", "cumulative impact heat into each ball"))
     variables["heat_into_vial"] = (heat_into[:, n], attributes("J", "cumulative impact heat into the vial"))
-    variables["velocity_term_integrals"] = (terms, attributes("s", "time integral of each ball's Whitaker velocity term"))
-    variables["velocity_term_integral"] = (network.mean_ball(terms), attributes("s", "the balls' mean of velocity_term_integrals"))
+    variables["velocity_term_integrals"] = (
+        terms,
+        attributes("s", "time integral of each ball's Whitaker velocity term"),
+    )
+    variables["velocity_term_integral"] = (
+        network.mean_ball(terms),
+        attributes("s", "the balls' mean of velocity_term_integrals"),
+    )
     variables["contact_conduction"] = (
         fields["drive_integrals"][:, n:],
-        attributes("J K-1", "heat per kelvin conducted by the contacts of each ball with the vial, then with the other balls"),
+        attributes(
+            "J K-1", "heat per kelvin conducted by the contacts of each ball with the vial, then with the other balls"
+        ),
     )
-    dimensions = {name: _PER_BALL for name in (BALL_TEMPERATURES, f"{BALL_TEMPERATURES}_C", "heat_into_balls", "velocity_term_integrals")}
+    dimensions = {
+        name: _PER_BALL
+        for name in (BALL_TEMPERATURES, f"{BALL_TEMPERATURES}_C", "heat_into_balls", "velocity_term_integrals")
+    }
     dimensions["contact_conduction"] = ("time", "contact")
     dimensions.update({name: _VECTORS for name in ("position", "velocity", "angular_velocity")})
     dimensions.update(vial_centre=("time", "axis"), vial_angles=("time", "angle"))

@@ -130,8 +130,8 @@ class State(NamedTuple):
     totals: np.ndarray  # (len(TOTAL_NAMES),) J
     heat_into: np.ndarray  # (N + 1,) J: all heat into each ball and the vial so far
     drive_integrals: np.ndarray  # (D,) ...and since the start
-    contacts: "Contacts"
-    neighbours: "Neighbours"
+    contacts: Contacts
+    neighbours: Neighbours
 
 
 class Contacts(NamedTuple):
@@ -178,7 +178,7 @@ class Neighbours(NamedTuple):
     cell_next: np.ndarray  # (N,) int64
     carried_first: np.ndarray  # (P,) int64: the pairs of the touching contacts being carried
     carried_second: np.ndarray  # (P,) int64
-    carried: "Contacts"  # (P slots)
+    carried: Contacts  # (P slots)
 
 
 def slot_count(n_balls: int, pair_capacity: int) -> int:
@@ -263,7 +263,9 @@ def network_of(params: Parameters) -> ThermalNetwork:
     radius = params.ball_values("ball_radius")
     capacity = _masses(params) * np.array(params.ball_values("ball_heat_capacity"))
     names = [f"ball {i}" for i in range(params.n_balls)]
-    share = "λ of the heat of its contacts with the vial, its effusivity share of those with other balls (MODEL.md §12.4)"
+    share = (
+        "λ of the heat of its contacts with the vial, its effusivity share of those with other balls (MODEL.md §12.4)"
+    )
     return build_network(params, radius, capacity, names, share)
 
 
@@ -305,7 +307,9 @@ def constants_from(params: Parameters) -> Constants:
         youngs_modulus=youngs,
         poisson_ratio=poisson,
         wall_modulus=np.array([contact.effective_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]),
-        wall_shear_modulus=np.array([contact.effective_shear_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]),
+        wall_shear_modulus=np.array(
+            [contact.effective_shear_modulus(e, nu, e_v, nu_v) for e, nu in zip(youngs, poisson)]
+        ),
         wall_radius=wall_radius,
         effusivity=effusivity,
         conductivity=conductivity,
@@ -419,8 +423,15 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
 
 
 # Contacts' fields by shape per slot (the rest are one number per slot).
-CONTACT_VECTORS = ("normal_force", "tangential_force", "lever_torque_i", "lever_torque_j", "rolling_torque",
-                   "wall_velocity", "spring")
+CONTACT_VECTORS = (
+    "normal_force",
+    "tangential_force",
+    "lever_torque_i",
+    "lever_torque_j",
+    "rolling_torque",
+    "wall_velocity",
+    "spring",
+)
 
 
 def empty_contacts(slots: int) -> Contacts:
@@ -445,7 +456,12 @@ def contact_memory(k: Constants, record_columns: int) -> int:
     )
     per_entry = 4 * 8 + sum(array.nbytes for array in empty_contacts(1))
     per_ball = 8 * (1 + 3 + 1)
-    return slots * (per_slot + 2 * 8 * record_columns) + capacity * per_entry + k.n_balls * per_ball + 8 * k.cells_per_side**3
+    return (
+        slots * (per_slot + 2 * 8 * record_columns)
+        + capacity * per_entry
+        + k.n_balls * per_ball
+        + 8 * k.cells_per_side**3
+    )
 
 
 def neighbours_of(k: Constants, position: np.ndarray, centre: np.ndarray) -> Neighbours:

@@ -43,8 +43,11 @@ def build(k, position: np.ndarray, centre: np.ndarray, nb) -> bool:
                 nb.first_ball[count], nb.second_ball[count] = i, j
                 count += 1
             continue
-        home = (_cell_index(position[i], centre, k, 0), _cell_index(position[i], centre, k, 1),
-                _cell_index(position[i], centre, k, 2))
+        home = (
+            _cell_index(position[i], centre, k, 0),
+            _cell_index(position[i], centre, k, 1),
+            _cell_index(position[i], centre, k, 2),
+        )
         for x in range(max(home[0] - 1, 0), min(home[0] + 2, side)):
             for y in range(max(home[1] - 1, 0), min(home[1] + 2, side)):
                 for z in range(max(home[2] - 1, 0), min(home[2] + 2, side)):
@@ -73,7 +76,8 @@ def _within(position: np.ndarray, i: int, j: int, reach: float) -> bool:
 @njit(cache=True, inline="always")
 def moved_since_build(ball: int, position: np.ndarray, centre: np.ndarray, nb) -> float:
     """How far ``ball`` has moved relative to the vial's ``centre`` since the list was built (m). A common motion of
-    every ball changes no pair's distance, so that the vial's own travel, centimetres a cycle, never forces a rebuild."""
+    every ball changes no pair's distance, so that the vial's own travel, centimetres a cycle, never forces a
+    rebuild."""
     squared = 0.0
     for axis in range(3):
         moved = position[ball, axis] - centre[axis] - nb.reference[ball, axis]

@@ -35,6 +35,7 @@ from shakermill.engines.dem.contacts import (
     sum_forces,
     wall_contacts,
 )
+from shakermill.engines.dem.description import NEIGHBOURS_FULL
 from shakermill.engines.dem.model import (
     ENDURING_AFTER,
     HEAT_LOST,
@@ -46,7 +47,6 @@ from shakermill.engines.dem.model import (
     Scratch,
     State,
 )
-from shakermill.engines.dem.description import NEIGHBOURS_FULL
 from shakermill.engines.dem.neighbours import moved_since_build, needs_rebuild
 from shakermill.engines.dem.vectors import copy_into, cross_into, distance, dot, norm, squared_distance
 from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
@@ -75,7 +75,9 @@ RECORD_COLUMNS = (
     "conduction",
 )
 COUNTER_NAMES = ("steps", "contact_steps", "flight_steps", "impacts", "thermal_updates", "neighbour_builds")
-STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES, NEIGHBOUR_BUILDS, ROWS_WRITTEN = range(len(COUNTER_NAMES) + 1)
+STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES, NEIGHBOUR_BUILDS, ROWS_WRITTEN = range(
+    len(COUNTER_NAMES) + 1
+)
 # ``other`` of a record: the other ball's index, or −1 − wall for the vial's left end, right end and side.
 
 
@@ -122,7 +124,13 @@ def advance_thermal(k: Constants, net: NetworkArrays, s: State) -> None:
     for drive in range(s.pending_drives.size):
         s.pending_drives[drive] /= span
     s.totals[HEAT_LOST] += kernel.advance(
-        s.temperature, s.pending_heat, s.pending_drives, span, net, np.empty(net.kind.size), np.empty(s.temperature.size)
+        s.temperature,
+        s.pending_heat,
+        s.pending_drives,
+        span,
+        net,
+        np.empty(net.kind.size),
+        np.empty(s.temperature.size),
     )
     s.pending_heat[:] = 0.0
     s.pending_drives[:] = 0.0
@@ -214,8 +222,9 @@ def _flight_step(cap: float, k: Constants, s: State, w: Scratch) -> float:
         # and by the relative acceleration alone: balls sliding or rolling past each other only part.
         closing = 0.0
         for component in range(3):
-            closing -= ((s.position[i, component] - s.position[j, component])
-                        * (s.velocity[i, component] - s.velocity[j, component]))
+            closing -= (s.position[i, component] - s.position[j, component]) * (
+                s.velocity[i, component] - s.velocity[j, component]
+            )
         step = _shortened(step, gap, closing / centres, relative_acceleration)
     return max(step, k.contact_step)
 
@@ -276,8 +285,9 @@ def _final_kick(dt: float, k: Constants, s: State, w: Scratch) -> None:
 
 
 @njit(cache=True, inline="always")
-def _step(t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.ndarray,
-          count: int) -> tuple[int, int, float, float]:
+def _step(
+    t: float, dt: float, k: Constants, s: State, w: Scratch, records: np.ndarray, count: int
+) -> tuple[int, int, float, float]:
     """One velocity-Verlet step of length ``dt`` ending at ``t``; returns (record count, contacts touching,
     deepest overlap, the longest next step the touching contacts allow)."""
     copy_into(w.angular, w.angular_before)
@@ -308,8 +318,16 @@ def write_row(k: Constants, net: NetworkArrays, s: State, w: Scratch, row: np.nd
     vial_frame(s.clock[0], k, w)
     row[0] = s.clock[0]
     offset = 1
-    for block in (s.position.ravel(), s.velocity.ravel(), s.spin.ravel(), s.temperature, s.totals, s.heat_into,
-                  s.drive_integrals, w.coordinates):
+    for block in (
+        s.position.ravel(),
+        s.velocity.ravel(),
+        s.spin.ravel(),
+        s.temperature,
+        s.totals,
+        s.heat_into,
+        s.drive_integrals,
+        w.coordinates,
+    ):
         row[offset : offset + block.size] = block
         offset += block.size
 
@@ -320,8 +338,19 @@ def write_row(k: Constants, net: NetworkArrays, s: State, w: Scratch, row: np.nd
 # allocates nothing, so it needs none of Numba's runtime. The option is Numba's own (``numba.core.options``),
 # private by its underscore: a Numba without it would refuse to compile this loop, which every 3-D test runs.
 @njit(cache=True, nogil=True, _nrt=False)
-def advance(t_stop: float, max_steps: int, k: Constants, net: NetworkArrays, s: State, w: Scratch, records: np.ndarray,
-            count: int, counters: np.ndarray, marks: np.ndarray, rows: np.ndarray) -> tuple[int, int]:
+def advance(
+    t_stop: float,
+    max_steps: int,
+    k: Constants,
+    net: NetworkArrays,
+    s: State,
+    w: Scratch,
+    records: np.ndarray,
+    count: int,
+    counters: np.ndarray,
+    marks: np.ndarray,
+    rows: np.ndarray,
+) -> tuple[int, int]:
     """Step to ``t_stop`` (s); returns (status, record count). Steps end on each time in ``marks`` (sorted),
     where the state is written into the next row of ``rows``. Hands back early with PAUSED after ``max_steps``
     steps and with RECORDS_FULL when ``records`` may overflow; the thermal network is brought up to the time

@@ -49,8 +49,9 @@ def _gap_rate(t: float, velocity: float, wall: int, k: Constants) -> float:
 
 
 @njit(cache=True)
-def _refine_root(t: float, x: float, velocity: float, wall: int, k: Constants,
-                 a: float, b: float, resolution: float) -> float:
+def _refine_root(
+    t: float, x: float, velocity: float, wall: int, k: Constants, a: float, b: float, resolution: float
+) -> float:
     """The single zero of a monotone gap on [a, b] (gap(a) > 0 ≥ gap(b)), by safeguarded Newton.
 
     Returns the lower end of the final bracket: the landing point is a hair before the onset
@@ -75,8 +76,9 @@ def _refine_root(t: float, x: float, velocity: float, wall: int, k: Constants,
 
 
 @njit(cache=True)
-def _first_touch_of_wall(t: float, h: float, x: float, velocity: float, wall: int, curvature: float,
-                         k: Constants, stack: np.ndarray) -> float:
+def _first_touch_of_wall(
+    t: float, h: float, x: float, velocity: float, wall: int, curvature: float, k: Constants, stack: np.ndarray
+) -> float:
     """Earliest s in [0, h] where the free-flight gap to ``wall`` reaches 0, or −1 if none.
 
     Intervals are examined left to right. One is discarded only when the bound
@@ -136,8 +138,18 @@ def _separation_step_limit(t: float, x: float, p: float, wall: int, speed_in: fl
 
 
 @njit(cache=True)
-def bound_step(t: float, h: float, t_stop: float, x: float, p: float, wall: int, speed_in: float, k: Constants,
-                contact_step_limit: float, stack: np.ndarray) -> tuple[float, int]:
+def bound_step(
+    t: float,
+    h: float,
+    t_stop: float,
+    x: float,
+    p: float,
+    wall: int,
+    speed_in: float,
+    k: Constants,
+    contact_step_limit: float,
+    stack: np.ndarray,
+) -> tuple[float, int]:
     """The step to try from (t, x, p), at most ``h`` and ending by ``t_stop``, and the wall it ends on.
 
     In a contact with ``wall`` the step is graded towards the separation. In flight (``wall`` = NO_WALL)

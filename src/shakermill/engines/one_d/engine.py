@@ -5,7 +5,8 @@ its energy audit, and the load of its thermal network for the averaged solver an
 from __future__ import annotations
 
 import math
-from typing import Callable, ClassVar, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import ClassVar
 
 import numpy as np
 
@@ -92,9 +93,14 @@ def impact_columns(records: np.ndarray, lam: float, since: float = -math.inf) ->
     return columns
 
 
-def state_history(times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters) -> StateHistory:
-    """The state history with units and long names, temperatures also in °C, the ball's velocity and the vial's position."""
-    variables = {name: (states[:, index], attributes(units, long_name)) for name, (index, units, long_name) in _VARIABLES.items()}
+def state_history(
+    times: np.ndarray, states: np.ndarray, constants: model.Constants, params: Parameters
+) -> StateHistory:
+    """The state history with units and long names, temperatures also in °C, the ball's velocity and the vial's
+    position."""
+    variables = {
+        name: (states[:, index], attributes(units, long_name)) for name, (index, units, long_name) in _VARIABLES.items()
+    }
     with_celsius(variables, CELSIUS_VARIABLES)
     variables["velocity"] = (states[:, model.P] / constants.ball_mass, attributes("m s-1", "ball velocity"))
     variables["vial_position"] = (
@@ -109,8 +115,13 @@ class OneDimensionalEngine:
 
     description: ClassVar[EngineDescription] = DESCRIPTION
 
-    def __init__(self, params: Parameters, budget: RunBudget | None = None, samples: Sequence[float] = (0.0,),
-                 horizon: float = 0.0) -> None:
+    def __init__(
+        self,
+        params: Parameters,
+        budget: RunBudget | None = None,
+        samples: Sequence[float] = (0.0,),
+        horizon: float = 0.0,
+    ) -> None:
         """See :class:`~shakermill.engines.interface.Engine`; the integrator keeps every step inside a record
         window as it takes it, so ``horizon`` asks nothing of it."""
         self.params = params
@@ -200,7 +211,9 @@ class OneDimensionalEngine:
 
     def measured(self) -> Measured:
         y = self.integrator.y
-        return Measured(np.array([y[model.HEAT_GENERATED]]), np.array([y[model.VELOCITY_TERM]]), float(y[model.DISSIPATED]))
+        return Measured(
+            np.array([y[model.HEAT_GENERATED]]), np.array([y[model.VELOCITY_TERM]]), float(y[model.DISSIPATED])
+        )
 
     def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
         """The impacts' heat P splits λ : 1 − λ between the ball and the vial (MODEL.md §3); its network (the paper's)
@@ -214,8 +227,15 @@ class OneDimensionalEngine:
         count = len(impacts["time"])
         return np.array([count, count, 0])
 
-    def averaged_history(self, times: np.ndarray, temperatures: np.ndarray, heat_lost: np.ndarray,
-                         load: NetworkLoad, dissipated_power: float, network: ThermalNetwork) -> StateHistory:
+    def averaged_history(
+        self,
+        times: np.ndarray,
+        temperatures: np.ndarray,
+        heat_lost: np.ndarray,
+        load: NetworkLoad,
+        dissipated_power: float,
+        network: ThermalNetwork,
+    ) -> StateHistory:
         states = np.full((times.size, model.N_STATE), np.nan)
         states[:, model.THETA_BALL] = temperatures[0]
         states[:, model.THETA_VIAL] = temperatures[1]

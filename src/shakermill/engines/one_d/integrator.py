@@ -154,7 +154,9 @@ def _grow(buffer: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _hermite(theta: float, h: float, y0: np.ndarray, f0: np.ndarray, y1: np.ndarray, f1: np.ndarray, out: np.ndarray) -> None:
+def _hermite(
+    theta: float, h: float, y0: np.ndarray, f0: np.ndarray, y1: np.ndarray, f1: np.ndarray, out: np.ndarray
+) -> None:
     """Cubic Hermite interpolant of a step at fraction ``theta`` (the dense output of ode23)."""
     t2 = theta * theta
     t3 = t2 * theta
@@ -169,8 +171,18 @@ def _hermite(theta: float, h: float, y0: np.ndarray, f0: np.ndarray, y1: np.ndar
 # Inlined into the loop: as a call it cost a reference count for each of its seven arrays on every trial
 # step, ~1.5 % of a default run.
 @njit(cache=True, inline="always")
-def _rk_step(t: float, h: float, y: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, k: Constants,
-             stages: np.ndarray, y_new: np.ndarray, work: np.ndarray) -> None:
+def _rk_step(
+    t: float,
+    h: float,
+    y: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    c: np.ndarray,
+    k: Constants,
+    stages: np.ndarray,
+    y_new: np.ndarray,
+    work: np.ndarray,
+) -> None:
     """One explicit FSAL step: ``stages[0]`` holds f(t, y) on entry, the last stage holds f(t+h, y_new) on exit."""
     n_stages = c.shape[0]
     n = y.shape[0]
@@ -190,8 +202,9 @@ def _rk_step(t: float, h: float, y: np.ndarray, a: np.ndarray, b: np.ndarray, c:
 
 
 @njit(cache=True)
-def _lab_error_scale(y: np.ndarray, y_new: np.ndarray, rtol: float, atol: np.ndarray, origin: np.ndarray,
-                     scale: np.ndarray) -> None:
+def _lab_error_scale(
+    y: np.ndarray, y_new: np.ndarray, rtol: float, atol: np.ndarray, origin: np.ndarray, scale: np.ndarray
+) -> None:
     """SciPy's scale of the dynamic components, atol + rtol·max(|y − origin|, |y_new − origin|)."""
     for i in range(atol.shape[0]):
         scale[i] = atol[i] + rtol * max(abs(y[i] - origin[i]), abs(y_new[i] - origin[i]))
@@ -241,8 +254,9 @@ def _append_window_point(buffer: np.ndarray, counters: np.ndarray, time: float, 
 
 
 @njit(cache=True)
-def _project_momentum(impact: np.ndarray, y_new: np.ndarray, elastic_new: float, k: Constants,
-                      diagnostics: np.ndarray) -> None:
+def _project_momentum(
+    impact: np.ndarray, y_new: np.ndarray, elastic_new: float, k: Constants, diagnostics: np.ndarray
+) -> None:
     """Project |p| onto the mechanical energy balance of the contact so far.
 
     E_mech(now) = E_mech(onset) + W_vial − E_diss over the contact, with W_vial
@@ -253,11 +267,7 @@ def _project_momentum(impact: np.ndarray, y_new: np.ndarray, elastic_new: float,
     dissipated energy, which makes the heat, untouched. Every correction is
     accumulated in ``diagnostics`` so the truncation error stays visible.
     """
-    target = (
-        impact[_ENERGY0]
-        + (y_new[WORK_VIAL] - impact[_WORK0])
-        - (y_new[DISSIPATED] - impact[_DISSIPATED0])
-    )
+    target = impact[_ENERGY0] + (y_new[WORK_VIAL] - impact[_WORK0]) - (y_new[DISSIPATED] - impact[_DISSIPATED0])
     kinetic_now = 0.5 * y_new[P] * y_new[P] / k.ball_mass
     kinetic_target = target - elastic_new
     if kinetic_target > 0.0 and y_new[P] != 0.0:
@@ -296,8 +306,16 @@ def _step_factor(error: float, rejected_last: bool, control: _StepControl) -> fl
 
 
 @njit(cache=True)
-def _project_energy(t_new: float, y_new: np.ndarray, f_new: np.ndarray, elastic_new: float, impact: np.ndarray,
-                    k: Constants, counters: np.ndarray, diagnostics: np.ndarray) -> None:
+def _project_energy(
+    t_new: float,
+    y_new: np.ndarray,
+    f_new: np.ndarray,
+    elastic_new: float,
+    impact: np.ndarray,
+    k: Constants,
+    counters: np.ndarray,
+    diagnostics: np.ndarray,
+) -> None:
     """Apply :func:`_project_momentum` to the end of a contact step, and evaluate the derivative there again.
 
     Called where the ball left the wall during the step, and where a compiled call ends inside a contact,
@@ -336,8 +354,18 @@ def _meets_a_window(t: float, t_new: float, windows: np.ndarray) -> bool:
 
 
 @njit(cache=True)
-def _record_samples(t: float, h: float, y: np.ndarray, f0: np.ndarray, y_new: np.ndarray, f_new: np.ndarray,
-                    sample_times: np.ndarray, samples: np.ndarray, counters: np.ndarray, point: np.ndarray) -> None:
+def _record_samples(
+    t: float,
+    h: float,
+    y: np.ndarray,
+    f0: np.ndarray,
+    y_new: np.ndarray,
+    f_new: np.ndarray,
+    sample_times: np.ndarray,
+    samples: np.ndarray,
+    counters: np.ndarray,
+    point: np.ndarray,
+) -> None:
     """Write the samples of the regular output grid that fall in the accepted step (t, t + h], by dense output."""
     t_new = t + h
     index = counters[SAMPLES_WRITTEN]
@@ -352,8 +380,18 @@ def _record_samples(t: float, h: float, y: np.ndarray, f0: np.ndarray, y_new: np
 
 
 @njit(cache=True)
-def _record_windows(t: float, h: float, y: np.ndarray, f0: np.ndarray, y_new: np.ndarray, f_new: np.ndarray,
-                    windows: np.ndarray, buffer: np.ndarray, counters: np.ndarray, point: np.ndarray) -> np.ndarray:
+def _record_windows(
+    t: float,
+    h: float,
+    y: np.ndarray,
+    f0: np.ndarray,
+    y_new: np.ndarray,
+    f_new: np.ndarray,
+    windows: np.ndarray,
+    buffer: np.ndarray,
+    counters: np.ndarray,
+    point: np.ndarray,
+) -> np.ndarray:
     """Append the accepted step's points inside the record windows to ``buffer``; returns it (grown when full).
 
     Every step point inside a window is kept, and a window's edges by dense output, so that it spans
@@ -374,8 +412,9 @@ def _record_windows(t: float, h: float, y: np.ndarray, f0: np.ndarray, y_new: np
 
 
 @njit(cache=True)
-def _open_impact(t_new: float, y_new: np.ndarray, wall: int, speed_in: float, elastic_new: float, impact: np.ndarray,
-                 k: Constants) -> None:
+def _open_impact(
+    t_new: float, y_new: np.ndarray, wall: int, speed_in: float, elastic_new: float, impact: np.ndarray, k: Constants
+) -> None:
     """Start the impact in progress on ``wall`` at the contact onset ``t_new``, approached at ``speed_in``.
 
     The dissipated energy, heat, mechanical energy and vial work at the onset are kept so that the
@@ -404,8 +443,16 @@ def _follow_contact(overlap: float, overlap_rate: float, max_overlap: float, imp
 
 
 @njit(cache=True)
-def _close_impact(t_new: float, y_new: np.ndarray, overlap: float, overlap_rate: float, impact: np.ndarray,
-                  impact_buffer: np.ndarray, counters: np.ndarray, k: Constants) -> np.ndarray:
+def _close_impact(
+    t_new: float,
+    y_new: np.ndarray,
+    overlap: float,
+    overlap_rate: float,
+    impact: np.ndarray,
+    impact_buffer: np.ndarray,
+    counters: np.ndarray,
+    k: Constants,
+) -> np.ndarray:
     """Write the record of the impact in progress, which ended during the step to ``t_new``, and end it.
 
     Returns the impact buffer (grown when full).
@@ -432,8 +479,9 @@ def _close_impact(t_new: float, y_new: np.ndarray, overlap: float, overlap_rate:
 
 
 @njit(cache=True)
-def _next_step_size(h: float, factor: float, landed: bool, left_wall: bool, speed_in: float, k: Constants,
-                    contact_step_limit: float) -> float:
+def _next_step_size(
+    h: float, factor: float, landed: bool, left_wall: bool, speed_in: float, k: Constants, contact_step_limit: float
+) -> float:
     """The step to try after an accepted step of ``h`` whose error allows ``factor`` times it."""
     if landed:
         # A contact starts with a short step: see ONSET_STEP_FRACTION.
@@ -447,9 +495,18 @@ def _next_step_size(h: float, factor: float, landed: bool, left_wall: bool, spee
 
 
 @njit(cache=True)
-def _advance(t_stop: float, steps_allowed: int, k: Constants, tableau: tuple, control: _StepControl,
-             accuracy: _Accuracy, state: _State, recording: _Recording, window_buffer: np.ndarray,
-             impact_buffer: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
+def _advance(
+    t_stop: float,
+    steps_allowed: int,
+    k: Constants,
+    tableau: tuple,
+    control: _StepControl,
+    accuracy: _Accuracy,
+    state: _State,
+    recording: _Recording,
+    window_buffer: np.ndarray,
+    impact_buffer: np.ndarray,
+) -> tuple[int, np.ndarray, np.ndarray]:
     """Integrate from ``state.clock[0]`` to ``t_stop``, or for ``steps_allowed`` accepted steps (status PAUSED)
     if that comes first (see :meth:`Integrator.advance`); returns (status, window buffer, impact buffer).
 
@@ -593,15 +650,30 @@ class Integrator(CompiledRun):
 
     def compiled_call(self, t_stop: float, steps_allowed: int) -> int:
         controller, tolerances = self.controller, self.tolerances
-        control = _StepControl(controller.safety, controller.min_factor, controller.max_factor,
-                               -1.0 / (self.tableau.error_order + 1))
-        accuracy = _Accuracy(tolerances.rtol, tolerances.atol, tolerances.origin, tolerances.contact_step_limit,
-                             tolerances.max_overlap, self.project_energy)
+        control = _StepControl(
+            controller.safety, controller.min_factor, controller.max_factor, -1.0 / (self.tableau.error_order + 1)
+        )
+        accuracy = _Accuracy(
+            tolerances.rtol,
+            tolerances.atol,
+            tolerances.origin,
+            tolerances.contact_step_limit,
+            tolerances.max_overlap,
+            self.project_energy,
+        )
         state = _State(self.clock, self.y, self.f, self._impact, self.counters, self.diagnostics)
         recording = _Recording(self.sample_times, self.samples, self.windows)
         status, self._window_buffer, self._impact_buffer = _advance(
-            t_stop, steps_allowed, self.constants, self._tableau, control, accuracy, state, recording,
-            self._window_buffer, self._impact_buffer,
+            t_stop,
+            steps_allowed,
+            self.constants,
+            self._tableau,
+            control,
+            accuracy,
+            state,
+            recording,
+            self._window_buffer,
+            self._impact_buffer,
         )
         return int(status)
 

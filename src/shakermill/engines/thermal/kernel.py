@@ -5,9 +5,9 @@ temperature and the heat it receives whatever the balls do (the drive's, into a 
 path's model (:data:`WHITAKER`, :data:`CONSTANT`, :data:`CONTACT`, :data:`RADIATION`, :data:`AMONG_BALLS`), its
 two ends (a node, :data:`ROOM` or :data:`BALLS`) and its coefficients. Paths that depend on the motion read it from
 ``drives``: each ball's mean Whitaker velocity term, then the mean conductances of each ball's contacts with the
-vial and with the other balls (:func:`drive_count`). The flows are positive from a path's ``hot`` end to its ``cold`` end.
-Every engine and solver evaluates the network through these functions: the 'dem' engine's stepping, the
-averaged solvers' integration and the steady state. The 1-D engine's right-hand side keeps the three-node
+vial and with the other balls (:func:`drive_count`). The flows are positive from a path's ``hot`` end to its
+``cold`` end. Every engine and solver evaluates the network through these functions: the 'dem' engine's stepping,
+the averaged solvers' integration and the steady state. The 1-D engine's right-hand side keeps the three-node
 network written out for speed (``engines.one_d.model.thermal_network``); a test holds it to these, term by term.
 """
 
@@ -70,7 +70,9 @@ def contact_drive(ball: int, other: int, n_balls: int) -> int:
 
 
 @njit(cache=True)
-def whitaker_flow(theta_ball: float, theta_air: float, velocity_term: float, radius: float, net: NetworkArrays) -> float:
+def whitaker_flow(
+    theta_ball: float, theta_air: float, velocity_term: float, radius: float, net: NetworkArrays
+) -> float:
     """Q̇ = 4πR²·β·h·(θ_b − θ_a) (W) with Whitaker's h at the ball's velocity term, Sutherland's factor taken at
     the ball's temperature (MODEL.md §4)."""
     ratio = thermal.sutherland_viscosity(theta_ball, net.mu_ref, net.t_ref, net.sutherland) / net.mu_ref
@@ -159,8 +161,9 @@ def balance(heat: np.ndarray, flows: np.ndarray, span: float, net: NetworkArrays
 
 
 @njit(cache=True)
-def temperature_rates(theta: np.ndarray, heat: np.ndarray, drives: np.ndarray, net: NetworkArrays,
-                      flows: np.ndarray, out: np.ndarray) -> float:
+def temperature_rates(
+    theta: np.ndarray, heat: np.ndarray, drives: np.ndarray, net: NetworkArrays, flows: np.ndarray, out: np.ndarray
+) -> float:
     """dθ/dt (K/s) of every node into ``out`` (held nodes: 0) with ``heat`` (W) into each from the contacts;
     returns the heat leaving the system (W). ``flows`` receives each path's flow (W)."""
     path_flows(theta, drives, net, flows)
@@ -171,8 +174,15 @@ def temperature_rates(theta: np.ndarray, heat: np.ndarray, drives: np.ndarray, n
 
 
 @njit(cache=True)
-def advance(theta: np.ndarray, heat: np.ndarray, drives: np.ndarray, span: float, net: NetworkArrays,
-            flows: np.ndarray, energy: np.ndarray) -> float:
+def advance(
+    theta: np.ndarray,
+    heat: np.ndarray,
+    drives: np.ndarray,
+    span: float,
+    net: NetworkArrays,
+    flows: np.ndarray,
+    energy: np.ndarray,
+) -> float:
     """One explicit Euler step of ``span`` (s) from ``theta`` in place, with ``heat`` (J) received from the contacts
     in it and the flows at its start; returns the heat that left the system (J), and leaves in ``flows`` the
     heat through each path (J). Energy is conserved exactly."""

@@ -6,8 +6,8 @@ engine builds its network here and evaluates it through :mod:`kernel`."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 
@@ -165,11 +165,19 @@ def air_constants(params: Parameters) -> dict[str, float]:
     viscosity = thermal.sutherland_viscosity(
         params.ambient_temperature, params.air_viscosity_ref, params.air_reference_temperature, params.sutherland
     )
-    return {"viscosity_ambient": viscosity, "prandtl": thermal.prandtl_number(params.air_cp, viscosity, params.air_conductivity)}
+    return {
+        "viscosity_ambient": viscosity,
+        "prandtl": thermal.prandtl_number(params.air_cp, viscosity, params.air_conductivity),
+    }
 
 
-def build_network(params: Parameters, radii: Sequence[float], capacities: Sequence[float],
-                  ball_names: Sequence[str], contact_share: str) -> ThermalNetwork:
+def build_network(
+    params: Parameters,
+    radii: Sequence[float],
+    capacities: Sequence[float],
+    ball_names: Sequence[str],
+    contact_share: str,
+) -> ThermalNetwork:
     """The network of ``params`` for balls of ``radii`` (m) and heat ``capacities`` (J/K): each ball convects to
     the air (Whitaker), the vial exchanges heat with the air inside and the room outside. ``thermal_model``
     'paper': the outside at a constant h·A, and in the ``ball_only`` model the vial and the air held at the ambient
@@ -185,8 +193,14 @@ def build_network(params: Parameters, radii: Sequence[float], capacities: Sequen
     ]
     paths = [
         *(ball_convection(f"{ball_names[i]} → air", i, air, i, radius) for i, radius in enumerate(radii)),
-        newton_cooling("vial → air", vial, air, params.h_inner, params.inner_area,
-                       f"h_inner, inner_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)"),
+        newton_cooling(
+            "vial → air",
+            vial,
+            air,
+            params.h_inner,
+            params.inner_area,
+            f"h_inner, inner_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)",
+        ),
     ]
     sources = [
         *(HeatSource(i, contact_share) for i in range(n)),
@@ -200,8 +214,16 @@ def build_network(params: Parameters, radii: Sequence[float], capacities: Sequen
         sources.append(HeatSource(clamp, "drive_heat: the motor's and bearings' losses, whatever the balls do"))
         fixed_heat = np.append(fixed_heat, params.drive_heat)
     else:
-        paths.append(newton_cooling("vial → room", vial, kernel.ROOM, params.h_outer, params.outer_area,
-                                    f"h_outer, outer_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)"))
+        paths.append(
+            newton_cooling(
+                "vial → room",
+                vial,
+                kernel.ROOM,
+                params.h_outer,
+                params.outer_area,
+                f"h_outer, outer_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)",
+            )
+        )
     return ThermalNetwork(n, tuple(nodes), tuple(paths), tuple(sources), _arrays(params, nodes, paths, fixed_heat))
 
 
@@ -212,15 +234,35 @@ def mill_head_paths(params: Parameters, ball_names: Sequence[str], vial: int, cl
     n = len(ball_names)
     outer = vial_outer_convection(params)
     return [
-        newton_cooling("vial → room, convection", vial, kernel.ROOM, outer.coefficient, outer.area, outer.source, outer.validity),
+        newton_cooling(
+            "vial → room, convection", vial, kernel.ROOM, outer.coefficient, outer.area, outer.source, outer.validity
+        ),
         radiation("vial → room, radiation", vial, kernel.ROOM, params.emissivity, outer.area),
-        *(contact_conduction(f"{ball_names[i]} → vial, contacts", i, vial, kernel.contact_drive(i, -1, n)) for i in range(n)),
-        *(among_balls_conduction(f"{ball_names[i]} → other balls, contacts", i, kernel.contact_drive(i, i, n))
-          for i in range(n) if n > 1),
-        fixed_conductance("vial → clamp", vial, clamp, params.clamp_conductance, "clamp_conductance (see its source)",
-                          "a steady joint: the vial's and the clamp's own conduction are fast beside it"),
-        fixed_conductance("clamp → room", clamp, kernel.ROOM, params.clamp_loss, "clamp_loss (see its source)",
-                          "the clamp and mill head lumped at one temperature"),
+        *(
+            contact_conduction(f"{ball_names[i]} → vial, contacts", i, vial, kernel.contact_drive(i, -1, n))
+            for i in range(n)
+        ),
+        *(
+            among_balls_conduction(f"{ball_names[i]} → other balls, contacts", i, kernel.contact_drive(i, i, n))
+            for i in range(n)
+            if n > 1
+        ),
+        fixed_conductance(
+            "vial → clamp",
+            vial,
+            clamp,
+            params.clamp_conductance,
+            "clamp_conductance (see its source)",
+            "a steady joint: the vial's and the clamp's own conduction are fast beside it",
+        ),
+        fixed_conductance(
+            "clamp → room",
+            clamp,
+            kernel.ROOM,
+            params.clamp_loss,
+            "clamp_loss (see its source)",
+            "the clamp and mill head lumped at one temperature",
+        ),
     ]
 
 
@@ -252,16 +294,24 @@ def vial_outer_convection(params: Parameters) -> OuterConvection:
     diameter, length, k_air = params.outer_diameter, params.outer_length, params.air_conductivity
     side_area, end_area = math.pi * diameter * length, 2.0 * math.pi * diameter**2 / 4.0
     rayleigh = heat_paths.rayleigh_number(
-        diameter, NATURAL_CONVECTION_RISE_K, params.ambient_temperature + NATURAL_CONVECTION_RISE_K / 2, viscosity,
-        params.air_density, k_air, params.air_cp,
+        diameter,
+        NATURAL_CONVECTION_RISE_K,
+        params.ambient_temperature + NATURAL_CONVECTION_RISE_K / 2,
+        viscosity,
+        params.air_density,
+        k_air,
+        params.air_cp,
     )
     natural = heat_paths.churchill_chu_cylinder_nusselt(rayleigh, prandtl) * k_air / diameter
     faces = _across_the_axis if KINEMATIC_MODELS[params.kinematics].axis_upright else _along_the_axis
     h_side, h_end, correlations, validity = faces(params, speed, viscosity, prandtl)
     area = side_area + end_area
     return OuterConvection(
-        coefficient=(heat_paths.mixed_convection_coefficient(h_side, natural) * side_area
-                     + heat_paths.mixed_convection_coefficient(h_end, natural) * end_area) / area,
+        coefficient=(
+            heat_paths.mixed_convection_coefficient(h_side, natural) * side_area
+            + heat_paths.mixed_convection_coefficient(h_end, natural) * end_area
+        )
+        / area,
         area=area,
         speed=speed,
         source=(
@@ -276,36 +326,52 @@ def _reynolds(length: float, params: Parameters, speed: float, viscosity: float)
     return thermal.reynolds_number(length, params.air_density, speed, viscosity)
 
 
-def _along_the_axis(params: Parameters, speed: float, viscosity: float, prandtl: float) -> tuple[float, float, str, str]:
+def _along_the_axis(
+    params: Parameters, speed: float, viscosity: float, prandtl: float
+) -> tuple[float, float, str, str]:
     """The forced coefficients (W/(m²·K)) of a vial shaken along its axis: the side a plate along the flow, each end
     a disk facing it; what they rest on and where they hold."""
     diameter, length, k_air = params.outer_diameter, params.outer_length, params.air_conductivity
     side = heat_paths.flat_plate_nusselt(_reynolds(length / 2, params, speed, viscosity), prandtl) * k_air / length
     end = heat_paths.disk_nusselt(_reynolds(diameter / 2, params, speed, viscosity), prandtl) * k_air / diameter
-    return side, end, (
-        "side: laminar flat plate, Nu = 0.664 Re_L^1/2 Pr^1/3 (Incropera & DeWitt Eq. 7.30); ends: disk facing the "
-        "flow, Nu = 1.05 Re_D^1/2 Pr^0.36 (Sparrow & Geiger 1985, recalled, not re-read)"
-    ), (
-        "quasi-steady flow: the vial's stroke is ~3 diameters (Keulegan-Carpenter number ~3), so steady "
-        "correlations at the rms speed are a ±30 % estimate; Re_L < 5e5 (laminar), the disk measured for "
-        "5e3 < Re_D < 5e4"
+    return (
+        side,
+        end,
+        (
+            "side: laminar flat plate, Nu = 0.664 Re_L^1/2 Pr^1/3 (Incropera & DeWitt Eq. 7.30); ends: disk facing the "
+            "flow, Nu = 1.05 Re_D^1/2 Pr^0.36 (Sparrow & Geiger 1985, recalled, not re-read)"
+        ),
+        (
+            "quasi-steady flow: the vial's stroke is ~3 diameters (Keulegan-Carpenter number ~3), so steady "
+            "correlations at the rms speed are a ±30 % estimate; Re_L < 5e5 (laminar), the disk measured for "
+            "5e3 < Re_D < 5e4"
+        ),
     )
 
 
-def _across_the_axis(params: Parameters, speed: float, viscosity: float, prandtl: float) -> tuple[float, float, str, str]:
+def _across_the_axis(
+    params: Parameters, speed: float, viscosity: float, prandtl: float
+) -> tuple[float, float, str, str]:
     """The forced coefficients (W/(m²·K)) of a jar carried across its axis: the side a cylinder in cross flow, each
     end a plate along the flow, as long as the jar is wide; what they rest on and where they hold."""
     diameter, k_air = params.outer_diameter, params.air_conductivity
     reynolds = _reynolds(diameter, params, speed, viscosity)
     side = heat_paths.churchill_bernstein_nusselt(reynolds, prandtl) * k_air / diameter
     end = heat_paths.flat_plate_nusselt(reynolds, prandtl) * k_air / diameter
-    return side, end, (
-        "side: cylinder in cross flow, Churchill & Bernstein 1977 (Incropera & DeWitt Eq. 7.54); ends: laminar flat "
-        "plate along the flow, Nu = 0.664 Re_D^1/2 Pr^1/3 (Eq. 7.30)"
-    ), (
-        "the jar's speed round the sun wheel taken as the air's speed past it: the air inside a mill's housing turns "
-        "with the wheel and the jar's own spin adds (1 + k)·ω·D_o/2 at its surface, so this is a ±50 % estimate; "
-        "Re_D·Pr > 0.2"
+    return (
+        side,
+        end,
+        (
+            "side: cylinder in cross flow, Churchill & Bernstein 1977 (Incropera & DeWitt Eq. 7.54); ends: laminar "
+            "flat "
+            "plate along the flow, Nu = 0.664 Re_D^1/2 Pr^1/3 (Eq. 7.30)"
+        ),
+        (
+            "the jar's speed round the sun wheel taken as the air's speed past it: the air inside a mill's housing "
+            "turns "
+            "with the wheel and the jar's own spin adds (1 + k)·ω·D_o/2 at its surface, so this is a ±50 % estimate; "
+            "Re_D·Pr > 0.2"
+        ),
     )
 
 
@@ -319,7 +385,9 @@ def vial_rms_speed(params: Parameters) -> float:
     return math.sqrt(mean_square)
 
 
-def _arrays(params: Parameters, nodes: Sequence[Node], paths: Sequence[HeatPath], fixed_heat: np.ndarray) -> kernel.NetworkArrays:
+def _arrays(
+    params: Parameters, nodes: Sequence[Node], paths: Sequence[HeatPath], fixed_heat: np.ndarray
+) -> kernel.NetworkArrays:
     constants = air_constants(params)
     return kernel.NetworkArrays(
         capacity=np.array([node.capacity for node in nodes]),

@@ -43,18 +43,29 @@ class HeatPath:
 
 def ball_convection(name: str, hot: int, cold: int, ball: int, radius: float) -> HeatPath:
     """A ball's convection to the air around it (MODEL.md §4)."""
-    return HeatPath(name, hot, cold, WHITAKER, WHITAKER_CORRELATION, WHITAKER_SOURCE, WHITAKER_VALIDITY, radius=radius, drive=ball)
+    return HeatPath(
+        name, hot, cold, WHITAKER, WHITAKER_CORRELATION, WHITAKER_SOURCE, WHITAKER_VALIDITY, radius=radius, drive=ball
+    )
 
 
-def newton_cooling(name: str, hot: int, cold: int, h: float, area: float, source: str,
-                   validity: str = "h and A as given: no dependence on speed or temperature") -> HeatPath:
+def newton_cooling(
+    name: str,
+    hot: int,
+    cold: int,
+    h: float,
+    area: float,
+    source: str,
+    validity: str = "h and A as given: no dependence on speed or temperature",
+) -> HeatPath:
     """Heat through ``area`` (m²) at a constant coefficient ``h`` (W/(m²·K)) (MODEL.md §5)."""
     return HeatPath(name, hot, cold, CONSTANT, NEWTON_CORRELATION, source, validity, conductance=h * area)
 
 
 def fixed_conductance(name: str, hot: int, cold: int, conductance: float, source: str, validity: str) -> HeatPath:
     """Heat through a fixed conductance (W/K): a joint or a loss known as a whole, not per area."""
-    return HeatPath(name, hot, cold, CONSTANT, "Q = G·(θ_hot − θ_cold), G constant", source, validity, conductance=conductance)
+    return HeatPath(
+        name, hot, cold, CONSTANT, "Q = G·(θ_hot − θ_cold), G constant", source, validity, conductance=conductance
+    )
 
 
 CONTACT_HEAT_PER_KELVIN = (
@@ -88,13 +99,19 @@ AMONG_BALLS_CORRELATION = (
 def among_balls_conduction(name: str, ball: int, drive: int) -> HeatPath:
     """Conduction through the contacts of ``ball`` with the other balls (``kernel.among_balls_mean``): one path per
     ball, however many balls it touches."""
-    return HeatPath(name, ball, BALLS, AMONG_BALLS, AMONG_BALLS_CORRELATION, CONTACT_SOURCE, CONTACT_VALIDITY, drive=drive)
+    return HeatPath(
+        name, ball, BALLS, AMONG_BALLS, AMONG_BALLS_CORRELATION, CONTACT_SOURCE, CONTACT_VALIDITY, drive=drive
+    )
 
 
 def radiation(name: str, hot: int, cold: int, emissivity: float, area: float) -> HeatPath:
     """A grey surface of ``area`` (m²) radiating to large surroundings: Q = ε·σ·A·(θ_hot⁴ − θ_cold⁴)."""
     return HeatPath(
-        name, hot, cold, RADIATION, "Q = ε·σ·A·(θ_hot⁴ − θ_cold⁴)",
+        name,
+        hot,
+        cold,
+        RADIATION,
+        "Q = ε·σ·A·(θ_hot⁴ − θ_cold⁴)",
         "Stefan-Boltzmann law for a small grey body in large isothermal surroundings (Incropera & DeWitt, Eq. 1.7)",
         "ε the key emissivity, the room's walls at the ambient temperature",
         conductance=emissivity * STEFAN_BOLTZMANN * area,

@@ -8,8 +8,9 @@ Matplotlib is imported inside the functions, so that importing :mod:`shakermill`
 from __future__ import annotations
 
 import io
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol, Sequence
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 import pandas as pd
@@ -59,7 +60,8 @@ class RunLike(Protocol):
 
 
 def several_balls(params: Parameters) -> bool:
-    """Whether a run's engine moves several balls (the 'dem' engine, MODEL.md §12): its figures differ from the paper's."""
+    """Whether a run's engine moves several balls (the 'dem' engine, MODEL.md §12): its figures differ from the
+    paper's."""
     return describe(params.engine).several_balls
 
 
@@ -72,7 +74,7 @@ def check_window(params: Parameters, window: int) -> None:
 
 
 def run_context(run: RunLike) -> str:
-    """"spex8000m, 60 min, averaged solver": what a figure of ``run`` shows, for its title.
+    """ "spex8000m, 60 min, averaged solver": what a figure of ``run`` shows, for its title.
 
     The preset is known for a stored run (:class:`shakermill.io.runs.RunData`), not for a bare Result.
     """

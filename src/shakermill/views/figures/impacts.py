@@ -6,7 +6,8 @@ end faces, and for an engine of several balls the side wall and the other balls)
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Sequence
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -26,7 +27,11 @@ if TYPE_CHECKING:
 
 
 IMPACT_FIGURES = (
-    "impact_speed_histogram", "impact_energy_histogram", "stress_energy_spectrum", "impacts_per_second", "impact_phase_histogram"
+    "impact_speed_histogram",
+    "impact_energy_histogram",
+    "stress_energy_spectrum",
+    "impacts_per_second",
+    "impact_phase_histogram",
 )
 
 
@@ -100,7 +105,12 @@ SPECTRUM_DECADES = 1e-6
 SPECTRUM_CURVES = (
     ("total", "all", "all impacts, normal + tangential", {"color": "black", "lw": 2.0}),
     ("normal", "all", "normal part", {"color": "tab:blue", "lw": 1.5}),
-    ("tangential", "all", "tangential part (damping, sliding, rolling)", {"color": "tab:orange", "lw": 1.5, "ls": "--"}),
+    (
+        "tangential",
+        "all",
+        "tangential part (damping, sliding, rolling)",
+        {"color": "tab:orange", "lw": 1.5, "ls": "--"},
+    ),
     ("total", "wall", "impacts on the vial", {"color": "tab:green", "lw": 1.2, "ls": ":"}),
     ("total", "ball", "impacts between balls", {"color": "tab:purple", "lw": 1.2, "ls": ":"}),
 )
@@ -112,24 +122,36 @@ def run_stress_spectrum(run: RunLike) -> StressSpectrum | None:
     window = run.summary.get("stress_window_s")
     if not window:
         return None
-    return stress_spectrum(run.impacts, window, run.params.stress_energy_thresholds,
-                           run.summary.get("dissipated_power_W", math.nan), run.params.ball_masses())
+    return stress_spectrum(
+        run.impacts,
+        window,
+        run.params.stress_energy_thresholds,
+        run.summary.get("dissipated_power_W", math.nan),
+        run.params.ball_masses(),
+    )
 
 
 def stress_energy_figure(spectrum: StressSpectrum) -> Figure:
     """The stress-energy spectrum of one run: its total, the total's normal and tangential parts and (where balls
     hit balls) its impacts on each target, with the run's thresholds marked (:func:`spectra_figure`)."""
-    curves = [(label, spectrum, component, target, style) for component, target, label, style in SPECTRUM_CURVES
-              if target == "all" or spectrum.hit_ball.any()]
+    curves = [
+        (label, spectrum, component, target, style)
+        for component, target, label, style in SPECTRUM_CURVES
+        if target == "all" or spectrum.hit_ball.any()
+    ]
     figure = spectra_figure(curves, spectrum.thresholds)
     events, power = figure.axes
     events.set_title(f"Stress frequency ({spectrum.of().size} impacts in {spectrum.window:.3g} s)")
     if spectrum.lasting.any():
-        power.set_title(f"Stress power; contacts over {LASTING_CONTACT_S * 1e3:g} ms apart: {spectrum.lasting_power():.3g} W")
+        power.set_title(
+            f"Stress power; contacts over {LASTING_CONTACT_S * 1e3:g} ms apart: {spectrum.lasting_power():.3g} W"
+        )
     return figure
 
 
-def spectra_figure(curves: Sequence[tuple[str, StressSpectrum, str, str, dict]], thresholds: Sequence[float] = ()) -> Figure:
+def spectra_figure(
+    curves: Sequence[tuple[str, StressSpectrum, str, str, dict]], thresholds: Sequence[float] = ()
+) -> Figure:
     """Stress events per second (left) and their power (right) at or above each stress energy E, one line per
     ``(label, spectrum, component, target, style)``; ``thresholds`` (J) dash-dot."""
     figure, (events, power) = new_figure(columns=2, height=4.5, width=11.0)
@@ -154,8 +176,10 @@ def spectra_figure(curves: Sequence[tuple[str, StressSpectrum, str, str, dict]],
     power.set_title("Stress power" + (" (dash-dot: the run's thresholds)" if thresholds else ""))
     events.legend(loc="lower left", fontsize="small")
     # Energies below a millionth of the largest carry nothing a reader can see: the axes start there.
-    largest = max((float(np.max(spectrum.of(component, target), initial=0.0)) for _, spectrum, component, target, _ in curves),
-                  default=0.0)
+    largest = max(
+        (float(np.max(spectrum.of(component, target), initial=0.0)) for _, spectrum, component, target, _ in curves),
+        default=0.0,
+    )
     if largest > 0.0:
         for axis in (events, power):
             axis.set_xlim(left=largest * SPECTRUM_DECADES)
@@ -178,8 +202,12 @@ def impact_histogram_figure(impacts: pd.DataFrame, column: str, scale: float, qu
     edges = np.histogram_bin_edges(values, bins=HISTOGRAM_BINS)
     _stacked_by_kind(axis, values, *impact_kinds(impacts), edges)
     axis.text(
-        0.98, 0.96, f"mean {values.mean():.3g} {unit}\nmax {values.max():.3g} {unit}",
-        transform=axis.transAxes, ha="right", va="top",
+        0.98,
+        0.96,
+        f"mean {values.mean():.3g} {unit}\nmax {values.max():.3g} {unit}",
+        transform=axis.transAxes,
+        ha="right",
+        va="top",
         bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
     )
     # Headroom above the highest bar for the legend and the statistics box.
@@ -195,7 +223,8 @@ def impact_histogram_figure(impacts: pd.DataFrame, column: str, scale: float, qu
 def _stacked_by_kind(
     axis: object, values: np.ndarray, kinds: np.ndarray, categories: Sequence[tuple[str, str, str]], edges: np.ndarray
 ) -> None:
-    """A histogram of ``values`` stacked by what was hit (``categories``: :func:`impact_kinds`), each labelled with its count."""
+    """A histogram of ``values`` stacked by what was hit (``categories``: :func:`impact_kinds`), each labelled with its
+    count."""
     parts = [values[kinds == kind] for kind, _, _ in categories]
     axis.hist(  # type: ignore[attr-defined]
         parts,

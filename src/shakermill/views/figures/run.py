@@ -19,8 +19,9 @@ wall and the other balls apart.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
@@ -121,7 +122,9 @@ def write_animation(
     if not several_balls(params):
         raise ParameterError("animate: the animation shows the balls of a 'dem' run; this run is 1-D (engine = '1d')")
     if params.n_balls == 0:
-        raise ParameterError("animate: the animation shows the balls of a 'dem' run; this run is an empty mill (n_balls = 0)")
+        raise ParameterError(
+            "animate: the animation shows the balls of a 'dem' run; this run is an empty mill (n_balls = 0)"
+        )
     check_window(params, window)
     motion = window_data(run, window)
     if motion is None:
@@ -162,15 +165,28 @@ def temperature_figure(run: RunLike) -> Figure:
         axis.set_ylim(low, max(high, steady + 0.05 * (steady - low)))
     if run.params.n_balls:
         slowest = run.summary.get("slowest_time_constant_min", math.nan)
-        said = (f"exponential fitted over {window}:\n{_fit_text(fit)}" if describes else
-                f"no exponential: the run ({window}) is shorter\nthan the slowest time constant ({slowest:.3g} min)")
-        axis.text(0.98, 0.55, said, transform=axis.transAxes, ha="right", va="bottom",
-                  bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85})
+        said = (
+            f"exponential fitted over {window}:\n{_fit_text(fit)}"
+            if describes
+            else f"no exponential: the run ({window}) is shorter\nthan the slowest time constant ({slowest:.3g} min)"
+        )
+        axis.text(
+            0.98,
+            0.55,
+            said,
+            transform=axis.transAxes,
+            ha="right",
+            va="bottom",
+            bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.85},
+        )
     axis.set_xlabel("time (min)")
     axis.set_ylabel("temperature (°C)")
     named = f"the {run.params.n_balls} balls" if balls and run.params.n_balls > 1 else "ball"
-    axis.set_title(f"Temperatures of {named}, vial and inner air (cf. paper Fig. 5a)" if run.params.n_balls
-                   else "Temperatures of an empty mill's vial and inner air (no balls)")
+    axis.set_title(
+        f"Temperatures of {named}, vial and inner air (cf. paper Fig. 5a)"
+        if run.params.n_balls
+        else "Temperatures of an empty mill's vial and inner air (no balls)"
+    )
     if balls:
         legend_below(figure, bodies)
         lines = [line for line in axis.get_lines() if line not in bodies]
@@ -235,9 +251,7 @@ def heating_zoom_window(params: Parameters) -> int | None:
     return int(np.argmin([abs(start - HEATING_ZOOM_TIME) for start in starts]))
 
 
-def motion_figure(
-    params: Parameters, window: xr.Dataset, record_window: tuple[float, float] | None = None
-) -> Figure:
+def motion_figure(params: Parameters, window: xr.Dataset, record_window: tuple[float, float] | None = None) -> Figure:
     """Paper Fig. 4: ball centre (with its positions at contact with either end face) and ball momentum.
 
     ``record_window`` (start, length) in s sets the time axis; without it the stored points do. The
@@ -280,7 +294,9 @@ def heating_zoom_figure(run: RunLike, window: xr.Dataset, start: float) -> Figur
     if balls:
         temperatures = window[BALL_TEMPERATURES].transpose("time", "ball").values
         for ball, colour in enumerate(ball_colours(temperatures.shape[1])):
-            axis.plot((time - start) * 1e3, to_celsius(temperatures[:, ball]), color=colour, lw=1.2, label=f"ball {ball}")
+            axis.plot(
+                (time - start) * 1e3, to_celsius(temperatures[:, ball]), color=colour, lw=1.2, label=f"ball {ball}"
+            )
         legend_below(figure, axis.get_lines())
     else:
         axis.plot((time - start) * 1e3, to_celsius(window["theta_ball"].values), color="tab:red", lw=1.2)
@@ -325,12 +341,16 @@ def heat_by_channel_figure(run: RunLike) -> Figure:
         made.bar(positions, power, bottom=total, color=colour, label=f"{label} ({power.sum():.3g} W)")
         total += power
     for position, value in zip(positions, total):
-        made.annotate(f"{value:.3g} W", (position, value), xytext=(0, 2), textcoords="offset points", ha="center", va="bottom")
+        made.annotate(
+            f"{value:.3g} W", (position, value), xytext=(0, 2), textcoords="offset points", ha="center", va="bottom"
+        )
     made.set_xticks(positions, channels)
     made.set_xlabel("dissipation channel")
     made.set_ylabel("heat generated, mean power (W)")
     covered = averaging_window_note(run)
-    made.set_title(f"made in each channel, by what was hit: {total.sum():.3g} W" + (f"\n({covered})" if covered else ""))
+    made.set_title(
+        f"made in each channel, by what was hit: {total.sum():.3g} W" + (f"\n({covered})" if covered else "")
+    )
     made.legend(loc="upper right", fontsize="small")
     _heat_received(received, run)
     figure.suptitle("Heat of the impacts, as mean power")

@@ -4,8 +4,9 @@ with regimes and contour levels) and the bifurcation diagram of a scan with its 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -39,7 +40,12 @@ DISPLAY_UNITS = {"m": (1e3, "mm")}
 CONTOUR_STYLE = {"colors": "white", "linewidths": 2.0, "linestyles": "--"}
 
 
-NOTE_STYLE = {"fontsize": "small", "ha": "left", "va": "bottom", "bbox": {"facecolor": "white", "alpha": 0.85, "edgecolor": "0.6"}}
+NOTE_STYLE = {
+    "fontsize": "small",
+    "ha": "left",
+    "va": "bottom",
+    "bbox": {"facecolor": "white", "alpha": 0.85, "edgecolor": "0.6"},
+}
 
 
 REGIME_COLOURS = {"no impacts": "0.85", "irregular": "0.25"}
@@ -63,7 +69,16 @@ SHORT_NAMES = {
 
 
 # Units of the summary columns by the suffix of their names (theta_inf_C, tau_min, impact_rate_hz, ...).
-SUFFIX_UNITS = (("_C", "°C"), ("_K", "K"), ("_min", "min"), ("_hz", "1/s"), ("_W", "W"), ("_m_s", "m/s"), ("_J", "J"), ("_s", "s"))
+SUFFIX_UNITS = (
+    ("_C", "°C"),
+    ("_K", "K"),
+    ("_min", "min"),
+    ("_hz", "1/s"),
+    ("_W", "W"),
+    ("_m_s", "m/s"),
+    ("_J", "J"),
+    ("_s", "s"),
+)
 
 
 MISSING_STYLE = {"marker": "x", "color": "tab:red", "s": 40, "zorder": 3}
@@ -92,7 +107,7 @@ def rpm_axis(axis: object, key: str, which: str = "x") -> None:
 
 
 def sweep_context(manifest: Mapping[str, Any], keys: Sequence[str]) -> str:
-    """"spex8000m, 60 min, averaged solver" from a sweep's ``sweep.json``; the duration only when it is not swept."""
+    """ "spex8000m, 60 min, averaged solver" from a sweep's ``sweep.json``; the duration only when it is not swept."""
     base = manifest.get("base", {})
     duration = base.get("duration")
     parts = [
@@ -208,7 +223,8 @@ def contour_notes(table: pd.DataFrame, contours: Sequence[tuple[str, float]]) ->
         elif not _straddled(values, level):
             side = "above" if values.min() >= level else "below"
             notes.append(
-                f"{column} = {level:g} not crossed: {column} is {values.min():.4g} to {values.max():.4g}, {side} it at every point"
+                f"{column} = {level:g} not crossed: {column} is {values.min():.4g} to {values.max():.4g}, {side} it at "
+                "every point"
             )
     return notes
 
@@ -240,8 +256,14 @@ def sweep_line_figure(
     missing = ~np.isfinite(y)
     if missing.any():
         # At the foot of the axis: a failed point has no value to place it at, but it must not vanish.
-        axis.scatter(x[missing], np.zeros(missing.sum()), transform=axis.get_xaxis_transform(), clip_on=False,
-                     label=f"failed or no value ({missing.sum()})", **MISSING_STYLE)
+        axis.scatter(
+            x[missing],
+            np.zeros(missing.sum()),
+            transform=axis.get_xaxis_transform(),
+            clip_on=False,
+            label=f"failed or no value ({missing.sum()})",
+            **MISSING_STYLE,
+        )
     for contour_column, level in contours:
         values = _numeric(ordered, contour_column)
         for crossing in _crossings(x, values, level):
@@ -320,7 +342,9 @@ def sweep_map_figure(
     gridded = _grid_of(x_all, y_all, _numeric(table, column)) if not table.empty else None
     if gridded is not None:
         x, y, values = gridded
-        mesh = axis.pcolormesh(_cell_edges(x), _cell_edges(y), np.ma.masked_invalid(values), cmap="inferno", shading="flat")
+        mesh = axis.pcolormesh(
+            _cell_edges(x), _cell_edges(y), np.ma.masked_invalid(values), cmap="inferno", shading="flat"
+        )
         for contour_column, level in contours:
             _, _, levels = _grid_of(x_all, y_all, _numeric(table, contour_column))  # type: ignore[misc]
             if _straddled(levels, level):
@@ -372,12 +396,20 @@ def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
             axis.scatter(x[inside], y[inside], marker="x", color="tab:red", s=40, label=f"failed ({inside.sum()})")
             continue
         # Colours by rank among the periods present, so that period-4 and period-12 never share one.
-        colour = PERIOD_COLOURS[periods.index(label) % len(PERIOD_COLOURS)] if label in periods else REGIME_COLOURS[label]
+        colour = (
+            PERIOD_COLOURS[periods.index(label) % len(PERIOD_COLOURS)] if label in periods else REGIME_COLOURS[label]
+        )
         axis.scatter(x[inside], y[inside], marker="s", s=70, color=colour, label=f"{label} ({inside.sum()})")
     if "n_attractors" in table:  # sweeps before attractors were probed have no such column
         several = _numeric(table, "n_attractors") > 1
         axis.scatter(
-            x[several], y[several], marker="s", s=150, facecolors="none", edgecolors="black", lw=1.2,
+            x[several],
+            y[several],
+            marker="s",
+            s=150,
+            facecolors="none",
+            edgecolors="black",
+            lw=1.2,
             label=f"more than one attractor ({several.sum()})",
         )
     axis.set_xlabel(axis_label(keys[0]))
@@ -427,7 +459,11 @@ def bifurcation_figure(phases: pd.DataFrame, attractors: pd.DataFrame, key: str,
     # Above the axes: inside, the legend would hide branches near 0 or 2π.
     phase_axis.legend(
         handles=_attractor_handles(labels) + _wall_handles(),
-        loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=4, fontsize="small", frameon=False,
+        loc="lower left",
+        bbox_to_anchor=(0.0, 1.0),
+        ncols=4,
+        fontsize="small",
+        frameon=False,
     )
     figure.suptitle(f"Bifurcation diagram over {key}: impact phases of every attractor")
     _attractor_periods(period_axis, attractors, key)
@@ -451,7 +487,9 @@ def _attractor_periods(axis: object, attractors: pd.DataFrame, key: str) -> None
     x = display_values(key, attractors[key].to_numpy())
     colours = [PERIOD_COLOURS[label % len(PERIOD_COLOURS)] for label in attractors["attractor"]]
     # Open markers: two attractors of the same period at one value show as concentric rings.
-    axis.scatter(x, shown, s=FULL_BASIN_AREA * attractors["basin_fraction"].to_numpy(), facecolors="none", edgecolors=colours)  # type: ignore[attr-defined]
+    axis.scatter(
+        x, shown, s=FULL_BASIN_AREA * attractors["basin_fraction"].to_numpy(), facecolors="none", edgecolors=colours
+    )  # type: ignore[attr-defined]
     # Periods are whole numbers: half a period of room either way keeps the ticks on them.
     axis.set_ylim(0.5, np.nanmax(shown, initial=1.0) + 0.5)  # type: ignore[attr-defined]
     ticks = [tick for tick in MaxNLocator(integer=True, min_n_ticks=1).tick_values(1, top - 1) if 1 <= tick < top]
@@ -468,8 +506,14 @@ def _attractor_handles(labels: Sequence[int]) -> list:
     from matplotlib.lines import Line2D
 
     return [
-        Line2D([], [], ls="", marker="s", color=PERIOD_COLOURS[label % len(PERIOD_COLOURS)],
-               label="attractor 0 (configured start)" if label == 0 else f"attractor {label}")
+        Line2D(
+            [],
+            [],
+            ls="",
+            marker="s",
+            color=PERIOD_COLOURS[label % len(PERIOD_COLOURS)],
+            label="attractor 0 (configured start)" if label == 0 else f"attractor {label}",
+        )
         for label in labels
     ]
 
