@@ -36,6 +36,7 @@ BROWSER ?=
 test: install
 	$(BIN)/ruff format --check --quiet .
 	$(BIN)/ruff check --quiet .
+	$(BIN)/mypy
 	@reason="$$(BROWSER=$(BROWSER) scripts/ensure-browser)"; SHAKERMILL_BROWSER_UNAVAILABLE="$$reason" $(BIN)/python -m pytest -n auto --maxprocesses 4
 
 # The unit tests alone: every test not marked slow (pyproject.toml), in under a minute.

@@ -59,15 +59,15 @@ def main() -> None:
         averaged, averaged_time = _timed(base.replace(solver="averaged", attractor_starts=1), args.repeats)
         _, probed_time = _timed(base.replace(solver="averaged"), args.repeats)
         f, a = full.summary, averaged.summary
-        d_inf = 100 * (a["theta_inf_C"] - f["theta_inf_C"]) / (f["theta_inf_C"] - 20.0)
-        d_tau = 100 * (a["tau_min"] / f["tau_min"] - 1)
-        d_steady = a["ball_steady_C"] - f["ball_steady_C"]
-        d_temp = max(abs(a[key] - f[key]) for key in ("ball_C", "vial_C", "air_C"))
+        d_inf = 100 * (a.theta_inf_C - f.theta_inf_C) / (f.theta_inf_C - 20.0)
+        d_tau = 100 * (a.tau_min / f.tau_min - 1)
+        d_steady = a.ball_steady_C - f.ball_steady_C
+        d_temp = max(abs(a.value(key) - f.value(key)) for key in ("ball_C", "vial_C", "air_C"))
         ratios.append(full_time / averaged_time)
         probed_ratios.append(full_time / probed_time)
-        note = "fell back to full resolution" if averaged.solver == "full" else a["averaging_message"]
+        note = "fell back to full resolution" if averaged.solver == "full" else a.averaging_message
         print(
-            f"{omega:6.0f} {amplitude * 1e3:5.0f} | {f['theta_inf_C']:8.2f} {d_inf:7.3f} | {f['tau_min']:7.2f} "
+            f"{omega:6.0f} {amplitude * 1e3:5.0f} | {f.theta_inf_C:8.2f} {d_inf:7.3f} | {f.tau_min:7.2f} "
             f"{d_tau:7.3f} | "
             f"{d_steady:9.3f} | {d_temp:8.3f} | {full_time:6.2f} {averaged_time:6.3f} {ratios[-1]:6.0f} "
             f"{probed_time:8.3f} {probed_ratios[-1]:6.0f} | {note}"

@@ -23,6 +23,7 @@ import math
 import time
 
 import shakermill as sm
+from shakermill.solvers.summary import Summary
 
 MILLS = {
     "spex8000m-3d, 1 ball": ("spex8000m-3d", {}),
@@ -33,7 +34,7 @@ BEFORE = 0.001  # below the impact's fraction of a period: the stepping from bef
 FRACTIONS = (BEFORE, 0.02, 0.05, 0.1)
 
 
-def one_second(preset: str, settings: dict, fraction: float) -> tuple[float, dict]:
+def one_second(preset: str, settings: dict, fraction: float) -> tuple[float, Summary]:
     params = sm.default_parameters(
         preset, **settings, duration=1.0, solver="full", record_windows=(), enduring_step_fraction=fraction
     )
@@ -42,7 +43,7 @@ def one_second(preset: str, settings: dict, fraction: float) -> tuple[float, dic
     return time.process_time() - started, result.summary
 
 
-def averaged(preset: str, settings: dict, fraction: float) -> tuple[float, dict]:
+def averaged(preset: str, settings: dict, fraction: float) -> tuple[float, Summary]:
     params = sm.default_parameters(preset, **settings, attractor_starts=1, enduring_step_fraction=fraction)
     started = time.process_time()
     result = sm.simulate(params)
@@ -74,8 +75,8 @@ def main() -> None:
             for fraction in options.fractions:
                 cpu, summary = one_second(preset, settings, fraction)
                 print(
-                    f"    enduring_step_fraction {fraction:<5g}  {cpu:6.2f} CPU-s  {summary['steps']:>9,} steps  "
-                    f"{summary['impacts']:>5} impacts"
+                    f"    enduring_step_fraction {fraction:<5g}  {cpu:6.2f} CPU-s  {summary.steps:>9,} steps  "
+                    f"{summary.impacts:>5} impacts"
                 )
         if options.no_averaged:
             continue
@@ -83,12 +84,12 @@ def main() -> None:
         reference = None
         for fraction in options.fractions:
             cpu, summary = averaged(preset, {**settings, **tighter, "dem_replicas": options.replicas}, fraction)
-            power, error = summary["averaged_heat_power_W"], summary["averaged_heat_power_stderr_W"]
-            rate, speed = summary["impact_rate_hz"], summary["mean_impact_speed_m_s"]
+            power, error = summary.averaged_heat_power_W, summary.averaged_heat_power_stderr_W
+            rate, speed = summary.impact_rate_hz, summary.mean_impact_speed_m_s
             line = (
                 f"    enduring_step_fraction {fraction:<5g}  {cpu:6.1f} CPU-s  heat {power:.4g} ± {error:.2g} W  "
                 f"impacts {rate:.4g} /s  mean impact speed {speed:.4g} m/s  mechanics "
-                f"{summary['averaging_window_s']:.3g} s"
+                f"{summary.averaging_window_s:.3g} s"
             )
             if reference is None:
                 reference = (power, error, rate, speed)

@@ -91,7 +91,7 @@ def measure_second() -> dict:
             "cpu": cpu_seconds() - started,
             "steps": result.counters["steps"],
             "impacts": result.counters["impacts"],
-            "heat": result.summary["heat_power_W"],
+            "heat": result.summary.heat_power_W,
         }
     return figures
 
@@ -105,7 +105,7 @@ def measure_averaged(fraction_scale: float) -> dict:
         params = params.replace(contact_step_fraction=params.contact_step_fraction * fraction_scale)
         started = cpu_seconds()
         summary = sm.simulate(params).summary
-        figures[mill] = {key: summary[key] for key in AVERAGED_KEYS}
+        figures[mill] = {key: summary.value(key) for key in AVERAGED_KEYS}
         figures[mill]["cpu"] = cpu_seconds() - started
     return figures
 

@@ -152,8 +152,8 @@ def five_balls(base: sm.Parameters, preset: str) -> None:
     )
     print(f"  status {result.status}: {result.message}")
     print(
-        f"  wall {wall:.1f} s; heat power {summary['heat_power_W']:.3f} W; balls {summary['ball_C']:.1f} °C, "
-        f"vial {summary['vial_C']:.1f} °C after 1 h"
+        f"  wall {wall:.1f} s; heat power {summary.heat_power_W:.3f} W; balls {summary.ball_C:.1f} °C, "
+        f"vial {summary.vial_C:.1f} °C after 1 h"
     )
 
 

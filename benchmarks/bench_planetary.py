@@ -27,6 +27,7 @@ from pathlib import Path
 
 import shakermill as sm
 from shakermill.analysis.stress_energy import stress_spectrum
+from shakermill.solvers.summary import Summary
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURE = ROOT / "docs" / "figures" / "stress-energy-spex-vs-planetary.png"
@@ -61,17 +62,14 @@ def timed(params: sm.Parameters) -> tuple[sm.Result, float, float]:
     return result, time.perf_counter() - wall, cpu_seconds() - cpu
 
 
-def spectrum_line(summary: dict) -> str:
-    thresholds = [key for key in summary if key.startswith("stress_power_above_")]
-    above = ", ".join(
-        f"{key.removeprefix('stress_power_above_').removesuffix('_W')}: {summary[key]:.3g} W" for key in thresholds
-    )
+def spectrum_line(summary: Summary) -> str:
+    above = ", ".join(f"{threshold}: {power:.3g} W" for threshold, power in summary.stress_power_above_W.items())
     return (
-        f"stress energy median {summary['stress_energy_median_J'] * 1e3:.3g} mJ, 90th percentile "
-        f"{summary['stress_energy_p90_J'] * 1e3:.3g} mJ (normal {summary['stress_energy_normal_median_J'] * 1e3:.3g}, "
-        f"tangential {summary['stress_energy_tangential_median_J'] * 1e3:.3g} mJ median); power above {above}; "
-        f"contacts lasting over 1 ms {summary['stress_lasting_contacts_hz']:.3g}/s, "
-        f"{summary['stress_lasting_power_W']:.3g} W"
+        f"stress energy median {summary.stress_energy_median_J * 1e3:.3g} mJ, 90th percentile "
+        f"{summary.stress_energy_p90_J * 1e3:.3g} mJ (normal {summary.stress_energy_normal_median_J * 1e3:.3g}, "
+        f"tangential {summary.stress_energy_tangential_median_J * 1e3:.3g} mJ median); power above {above}; "
+        f"contacts lasting over 1 ms {summary.stress_lasting_contacts_hz:.3g}/s, "
+        f"{summary.stress_lasting_power_W:.3g} W"
     )
 
 
@@ -83,8 +81,8 @@ def second_part() -> None:
         print(
             f"{LABELS[preset]}: {seconds:g} simulated s in {cpu:.1f} CPU-s ({wall:.1f} wall-s), {cpu / seconds:.3g} "
             "CPU-s "
-            f"per simulated s; {result.counters['steps']} steps, {summary['impact_rate_hz']:.4g} impacts/s, heat "
-            f"{summary['heat_power_W']:.3g} W, audit residual {summary['energy_audit_residual']:.1e}"
+            f"per simulated s; {result.counters['steps']} steps, {summary.impact_rate_hz:.4g} impacts/s, heat "
+            f"{summary.heat_power_W:.3g} W, audit residual {summary.energy_audit_residual:.1e}"
         )
         print(f"  {spectrum_line(summary)}")
 
@@ -98,25 +96,25 @@ def hour_part(presets: list[str], batch_periods: int | None) -> None:
         params = sm.default_parameters(preset, duration=HOUR_S, **overrides, **settings)
         result, wall, cpu = timed(params)
         summary = result.summary
-        paths = sorted(summary["heat_paths_W"].items(), key=lambda item: -abs(item[1]))[:4]
+        paths = sorted(summary.heat_paths_W.items(), key=lambda item: -abs(item[1]))[:4]
         print(
             f"{LABELS[preset]}, averaged hour (batches of {params.averaging_batch_periods} periods): {wall:.0f} "
-            f"wall-s, {cpu:.0f} CPU-s; {summary.get('averaging_window_s', float('nan')):.3g} s of mechanics kept; "
+            f"wall-s, {cpu:.0f} CPU-s; {summary.number('averaging_window_s'):.3g} s of mechanics kept; "
             f"status {result.status}: {result.message}"
         )
         print(
-            f"  balls {summary['ball_C']:.1f} °C (mean; hottest {summary['hottest_ball_C']:.1f} °C), jar "
-            f"{summary['vial_C']:.1f} °C, air {summary['air_C']:.1f} °C, holder "
-            f"{summary.get('clamp_C', float('nan')):.1f} °C; "
-            f"heat {summary['heat_power_W']:.3g} W at {summary['impact_rate_hz']:.4g} impacts/s"
+            f"  balls {summary.ball_C:.1f} °C (mean; hottest {summary.hottest_ball_C:.1f} °C), jar "
+            f"{summary.vial_C:.1f} °C, air {summary.air_C:.1f} °C, holder "
+            f"{summary.number('holder_C'):.1f} °C; "
+            f"heat {summary.heat_power_W:.3g} W at {summary.impact_rate_hz:.4g} impacts/s"
         )
         print(f"  {spectrum_line(summary)}")
         print("  largest heat paths: " + "; ".join(f"{name} {flow:.3g} W" for name, flow in paths))
         spectrum = stress_spectrum(
             result.impact_columns,
-            summary["stress_window_s"],
+            summary.stress_window_s,
             params.stress_energy_thresholds,
-            summary["dissipated_power_W"],
+            summary.dissipated_power_W,
         )
         curves.append((LABELS[preset], spectrum, "total", "all", style))
     figure = spectra_figure(curves, params.stress_energy_thresholds)

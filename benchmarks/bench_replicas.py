@@ -60,7 +60,7 @@ def measure_reference(settings: dict) -> None:
                 "wall": time.perf_counter() - wall,
                 "heat": result.averages.heat_power,
                 "stderr": result.averages.heat_power_stderr,
-                "ball_C": result.summary["ball_C"],
+                "ball_C": result.summary.ball_C,
             }
         )
     )
@@ -103,7 +103,7 @@ def main() -> None:
                 f"mechanics {averages.transient + averages.window:5.1f} s "
                 f"each, {averages.batches} batches pooled  heat {averages.heat_power:.5g} ± "
                 f"{averages.heat_power_stderr:.2g} W  "
-                f"balls {result.summary['ball_C']:.1f} °C"
+                f"balls {result.summary.ball_C:.1f} °C"
             )
             if reference is None:
                 reference = averages

@@ -31,7 +31,7 @@ def hour(replicas: int) -> tuple[float, sm.Result]:
 
 
 def fingerprint(result: sm.Result) -> tuple:
-    return (result.summary["heat_power_W"], result.summary["ball_C"], result.counters["steps"])
+    return (result.summary.heat_power_W, result.summary.ball_C, result.counters["steps"])
 
 
 def main() -> None:
@@ -46,7 +46,7 @@ def main() -> None:
     del os.environ[THREADS_VARIABLE]
     print(f"# {PRESET}, averaged hour, {args.replicas} replicas; reference: one thread, {reference_wall:.1f} s wall")
     print(
-        f"# reference: heat {reference.summary['heat_power_W']:.6g} W, balls {reference.summary['ball_C']:.6g} °C, "
+        f"# reference: heat {reference.summary.heat_power_W:.6g} W, balls {reference.summary.ball_C:.6g} °C, "
         f"{reference.counters['steps']} steps; {reference.message[:120]}"
     )
     print(f"{'workers':>7} {'wall s':>8} {'speed-up':>9} {'efficiency':>10} {'same numbers':>13}")

@@ -3,6 +3,8 @@
 * The docstrings use Sphinx's cross-reference roles (:func:`~shakermill.solvers.full.simulate_full`), which
   mkdocstrings shows as written: the role is dropped and, for a ``~`` target, the module path too, so the API
   reference reads ``simulate_full``.
+* ``<!-- summary-keys -->`` in a page becomes the table of every key of the run summary, with its unit and meaning,
+  generated from its schema (``shakermill.solvers.summary``): the guide cannot fall behind the code.
 * Some pages, docs/MODEL.md among them (kept byte-equal to the shared specification, so never edited here), start a
   list right under a paragraph, as GitHub allows; Python-Markdown would run it into the paragraph. A blank line is
   put before such a list when the page is read.
@@ -14,6 +16,7 @@ import re
 
 ROLE = re.compile(r":(?:py:)?(?:func|class|meth|mod|attr|data|exc|obj|const):<code>(~?)([^<]*)</code>")
 LIST_ITEM = re.compile(r"^(?:[-*+]|\d+\.) ")
+SUMMARY_KEYS_MARKER = "<!-- summary-keys -->"
 FENCE = re.compile(r"^\s*(```|~~~)")
 
 
@@ -30,7 +33,20 @@ def _opens_list_under_paragraph(previous: str, line: str) -> bool:
     )
 
 
+def summary_keys_table() -> str:
+    """Every declared key of the run summary as a Markdown table: key, unit, whether every run has it, meaning."""
+    from shakermill.solvers.summary import summary_keys
+
+    rows = [
+        f"| `{key.name}` | {key.unit} | {'yes' if key.required else 'no'} | {key.meaning.replace('|', '&#124;')} |"
+        for key in summary_keys()
+    ]
+    return "\n".join(["| key | unit | every run | meaning |", "|---|---|---|---|", *rows])
+
+
 def on_page_markdown(markdown: str, **_: object) -> str:
+    if SUMMARY_KEYS_MARKER in markdown:
+        markdown = markdown.replace(SUMMARY_KEYS_MARKER, summary_keys_table())
     lines, fenced = [], False
     for line in markdown.split("\n"):
         if FENCE.match(line):

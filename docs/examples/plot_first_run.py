@@ -9,15 +9,17 @@ the summary holds every number the run table shows.
 
 from shakermill.parameters.presets import default_parameters
 from shakermill.solvers.simulate import simulate
+from shakermill.solvers.summary import unit_of
 
 params = default_parameters("spex8000m", solver="averaged")
 result = simulate(params)
 print(result)
 
 # %%
-# The steady state is where the network would settle; the exponential is fitted to the ball over the hour.
+# The steady state is where the network would settle; the exponential is fitted to the ball over the hour. Each key
+# of the summary is an attribute with its unit (``shakermill.solvers.summary``); ``value`` reads one chosen by name.
 for key in ("theta_inf_C", "tau_min", "ball_steady_C", "vial_steady_C", "slowest_time_constant_min"):
-    print(f"{key:28s} {result.summary[key]:8.2f}")
+    print(f"{key:28s} {result.summary.value(key):8.2f} {unit_of(key)}")
 
 # %%
 # The temperatures of paper Fig. 5a, drawn by the function ``shakermill plot`` uses.

@@ -106,7 +106,7 @@ def test_steady_state_is_where_a_ten_hour_averaged_run_ends():
     assert result.success, result.message
     last = result.timeseries.isel(time=-1)
     for node in ("ball", "vial", "air"):
-        assert float(last[f"theta_{node}"]) - 273.15 == pytest.approx(result.summary[f"{node}_steady_C"], abs=0.5)
+        assert float(last[f"theta_{node}"]) - 273.15 == pytest.approx(result.summary.value(f"{node}_steady_C"), abs=0.5)
     # Ten hours are more than three slowest time constants, so no note about the run's length.
     assert not any("slowest time constants" in line for line in result.notes)
 
@@ -118,19 +118,19 @@ def test_steady_state_is_where_a_long_full_resolution_run_ends():
     assert result.success, result.message
     last = result.timeseries.isel(time=-1)
     for node in ("ball", "vial", "air"):
-        assert float(last[f"theta_{node}"]) - 273.15 == pytest.approx(result.summary[f"{node}_steady_C"], abs=0.5)
+        assert float(last[f"theta_{node}"]) - 273.15 == pytest.approx(result.summary.value(f"{node}_steady_C"), abs=0.5)
 
 
 def test_an_hour_of_the_calibrated_preset_notes_that_its_fit_is_not_the_steady_state():
     result = sm.simulate(sm.default_parameters("spex8000m-calibrated", solver="averaged", record_windows=()))
-    slowest = result.summary["slowest_time_constant_min"]
+    slowest = result.summary.slowest_time_constant_min
     assert 60.0 < SETTLED_TIME_CONSTANTS * slowest
     # Advice, not a problem: the steady state is reported beside it, so it is a note of the answer, not a warning.
     lines = [line for line in result.notes if "slowest time constants" in line]
     assert len(lines) == 1
     assert f"{SETTLED_TIME_CONSTANTS:g} x {slowest:.3g} min" in lines[0]
     assert not any("slowest time constants" in line for line in result.warnings)
-    assert result.summary["notes"] == result.notes
+    assert result.summary.notes == result.notes
     assert lines[0] in answer_sentences(result.summary)
 
 

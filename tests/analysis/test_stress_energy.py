@@ -100,11 +100,9 @@ def test_the_stress_power_of_a_run_is_the_power_its_impacts_dissipate():
     result = sm.simulate(sm.default_parameters(duration=30.0))
     spectrum = stress_spectrum(result.impact_columns, result.t_end)
     assert spectrum.lasting_power() == 0.0
-    assert result.summary["stress_lasting_power_W"] == pytest.approx(
-        0.0, abs=1e-3 * result.summary["dissipated_power_W"]
-    )
-    assert spectrum.power() == pytest.approx(result.summary["dissipated_power_W"], rel=1e-3)
-    assert spectrum.events_per_second() == pytest.approx(result.summary["impact_rate_hz"], rel=1e-12)
+    assert result.summary.stress_lasting_power_W == pytest.approx(0.0, abs=1e-3 * result.summary.dissipated_power_W)
+    assert spectrum.power() == pytest.approx(result.summary.dissipated_power_W, rel=1e-3)
+    assert spectrum.events_per_second() == pytest.approx(result.summary.impact_rate_hz, rel=1e-12)
 
 
 def test_distinct_thresholds_get_distinct_summary_keys():

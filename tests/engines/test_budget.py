@@ -28,7 +28,7 @@ TINY_STEPS = {**TIGHTEST_TOLERANCES, "record_windows": ()}
 def test_a_step_budget_stops_the_run_exactly_and_keeps_what_it_computed() -> None:
     result = sm.simulate(sm.default_parameters(duration=20.0, record_windows=((0.0, 1.0),), max_steps=5000))
     assert result.status == BUDGET_EXCEEDED and not result.success
-    assert result.summary["steps"] == 5000
+    assert result.summary.steps == 5000
     assert "max_steps = 5000" in result.message and "--set max_steps=10000" in result.message
     assert 1.0 < result.t_end < 20.0
     assert result.history.times[-1] == result.t_end and result.history.times[0] == 0.0
@@ -71,7 +71,7 @@ def test_a_3d_run_that_cannot_end_within_its_budget_stops_at_its_pace_not_at_the
         and "stopped early" in result.message
         and "max_wall_time = 30 s" in result.message
     )
-    assert 0.0 < result.t_end < 600.0 and result.summary["wall_time_s"] < 10.0
+    assert 0.0 < result.t_end < 600.0 and result.summary.wall_time_s < 10.0
     assert result.history.times[-1] == result.t_end
 
 
@@ -108,17 +108,17 @@ def test_one_budget_covers_the_averaged_solvers_mechanics_phase() -> None:
     result = sm.simulate(sm.default_parameters(solver="averaged", max_steps=3000, record_windows=()))
     assert result.status == BUDGET_EXCEEDED and result.solver == "averaged"
     assert "mechanics phase" in result.message
-    assert result.summary["steps"] == 3000
+    assert result.summary.steps == 3000
     assert list(result.history.times) == [0.0, result.t_end] and result.impact_count > 0
 
 
 def test_a_probe_that_uses_up_the_budget_stops_an_averaged_run_that_finished() -> None:
     base = sm.default_parameters(solver="averaged", duration=600.0, record_windows=())
-    mechanics_steps = sm.simulate(base.replace(attractor_starts=1)).summary["steps"]
+    mechanics_steps = sm.simulate(base.replace(attractor_starts=1)).summary.steps
     result = sm.simulate(base.replace(attractor_starts=4, max_steps=mechanics_steps + 1000))
     assert result.status == BUDGET_EXCEEDED
     assert "probing attractors (4 of 4 starts not settled); the run itself finished" in result.message
-    assert result.t_end == 600.0 and result.summary["attractor_failed_starts"] == 4
+    assert result.t_end == 600.0 and result.summary.attractor_failed_starts == 4
     probe_lines = [line for line in result.warnings if line.startswith("attractor probe")]
     assert len(probe_lines) == 1 and probe_lines[0].startswith("attractor probe: starts 0, 1, 2, 3 did not settle")
 
@@ -166,9 +166,9 @@ def test_presets_close_their_energy_audit_well_within_the_tolerance(preset: str,
 
 
 def test_an_audit_with_a_non_finite_term_has_no_relative_residual() -> None:
-    terms = dict.fromkeys(EnergyAudit.__dataclass_fields__, 0.0)
-    closed = EnergyAudit(**terms)
-    broken = EnergyAudit(**{**terms, "stored_ball": math.nan})
+    terms = {**dict.fromkeys(EnergyAudit.__dataclass_fields__, 0.0), "heat_into": {}, "dissipated_by_channel": {}}
+    closed = EnergyAudit(**{**terms, "stored": {"balls": 0.0}})
+    broken = EnergyAudit(**{**terms, "stored": {"balls": math.nan}})
     assert closed.relative_residual == 0.0
     assert math.isnan(broken.relative_residual)
 

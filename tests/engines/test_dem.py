@@ -67,7 +67,7 @@ def test_the_energy_audit_closes_with_friction_gravity_and_rolling_resistance():
     # The channels sum to the dissipation; η of it is heat, split between the balls and the vial.
     assert sum(energy.dissipated_by_channel.values()) == pytest.approx(energy.dissipated, rel=1e-12)
     assert energy.heat_generated == pytest.approx(params.eta * energy.dissipated, rel=1e-12)
-    assert energy.heat_to_ball + energy.heat_to_vial == pytest.approx(energy.heat_generated, rel=1e-12)
+    assert energy.heat_into["balls"] + energy.heat_into["vial"] == pytest.approx(energy.heat_generated, rel=1e-12)
 
 
 @pytest.mark.slow

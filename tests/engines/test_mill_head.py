@@ -13,7 +13,8 @@ from shakermill.analysis.steady import steady_state
 from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import DemEngine
 from shakermill.engines.thermal import kernel
-from shakermill.engines.thermal.network import NetworkLoad, vial_outer_convection, vial_rms_speed
+from shakermill.engines.thermal.mill_head import vial_outer_convection, vial_rms_speed
+from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.errors import ParameterError
 from shakermill.physics import heat_paths
 
@@ -22,9 +23,11 @@ def mill_head(**settings):
     return sm.default_parameters("spex8000m-3d", thermal_model="mill-head", **settings)
 
 
-def test_the_network_has_a_clamp_node_and_every_path_of_a_real_mill():
+def test_the_network_has_a_holder_node_and_every_path_of_a_real_mill():
     network = DemEngine.network_for(mill_head(n_balls=2, drive_heat=7.0))
-    assert [node.name for node in network.nodes] == ["ball 0", "ball 1", "vial", "air", "clamp"]
+    assert [node.name for node in network.nodes] == ["ball 0", "ball 1", "vial", "air", "holder"]
+    assert [node.role for node in network.nodes] == ["ball", "ball", "vessel", "gas", "holder"]
+    assert network.nodes[-1].title == "clamp and mill head"
     assert [path.name for path in network.paths] == [
         "ball 0 → air",
         "ball 1 → air",
@@ -35,8 +38,8 @@ def test_the_network_has_a_clamp_node_and_every_path_of_a_real_mill():
         "ball 1 → vial, contacts",
         "ball 0 → other balls, contacts",
         "ball 1 → other balls, contacts",
-        "vial → clamp",
-        "clamp → room",
+        "vial → holder",
+        "holder → room",
     ]
     assert list(network.arrays.fixed_heat) == [0.0, 0.0, 0.0, 0.0, 7.0]
     assert all(path.correlation and path.source and path.validity for path in network.paths)
@@ -102,8 +105,8 @@ def test_each_new_path_flows_as_its_correlation_says():
     assert flows["ball 1 → vial, contacts"] == pytest.approx(0.006 * 20.0)
     assert flows["ball 0 → other balls, contacts"] == pytest.approx(0.001 * 10.0)
     assert flows["ball 1 → other balls, contacts"] == pytest.approx(-0.001 * 10.0)
-    assert flows["vial → clamp"] == pytest.approx(params.clamp_conductance * 10.0)
-    assert flows["clamp → room"] == pytest.approx(params.clamp_loss * (300.0 - ambient))
+    assert flows["vial → holder"] == pytest.approx(params.clamp_conductance * 10.0)
+    assert flows["holder → room"] == pytest.approx(params.clamp_loss * (300.0 - ambient))
 
 
 def test_the_balance_books_the_drives_heat():
@@ -131,10 +134,10 @@ def test_with_the_drive_alone_the_steady_state_is_the_hand_solved_network():
     # Δ_clamp = Q/(G_k + G_vo·G_vk/(G_vk + G_vo)); Δ_vial = G_vk·Δ_clamp/(G_vk + G_vo); ball and air follow the vial.
     clamp_rise = 10.0 / (2.0 + room * 8.0 / (8.0 + room))
     vial_rise = 8.0 * clamp_rise / (8.0 + room)
-    assert dict(steady.others)["clamp"] - params.ambient_temperature == pytest.approx(clamp_rise, rel=1e-9)
+    assert dict(steady.others)["holder"] - params.ambient_temperature == pytest.approx(clamp_rise, rel=1e-9)
     assert steady.vial - params.ambient_temperature == pytest.approx(vial_rise, rel=1e-9)
     assert steady.ball == pytest.approx(steady.vial, rel=1e-12)
-    assert steady.as_summary()["clamp_steady_C"] == pytest.approx(params.ambient_temperature - 273.15 + clamp_rise)
+    assert steady.as_summary()["holder_steady_C"] == pytest.approx(params.ambient_temperature - 273.15 + clamp_rise)
 
 
 def test_a_contact_records_what_it_conducted():
@@ -193,13 +196,14 @@ def test_an_averaged_mill_head_run_reports_each_paths_heat_and_closes_its_balanc
     )
     result = sm.simulate(params)
     assert result.success, result.message
-    paths = result.summary["heat_paths_W"]
+    paths = result.summary.heat_paths_W
     assert set(paths) == {path.name for path in DemEngine.network_for(params).paths}
     assert paths["ball 0 → vial, contacts"] > 0.0  # the ball is warmer than the vial it touches
-    assert result.summary["drive_heat_W"] == pytest.approx(6.0)
-    assert math.isfinite(result.summary["clamp_C"]) and result.summary["clamp_steady_C"] > result.summary["clamp_C"]
+    assert result.summary.drive_heat_W == pytest.approx(6.0)
+    assert math.isfinite(result.summary.holder_C) and result.summary.holder_steady_C > result.summary.holder_C
     assert abs(result.energy.thermal_residual) < 1e-6 * (result.energy.heat_generated + result.energy.drive_heat)
     # What leaves to the room, by the paths' means, is what the run lost, to the trapezoidal rule's error.
     lost = sum(value for name, value in paths.items() if "room" in name) * params.duration
     assert lost == pytest.approx(result.energy.heat_lost_to_surroundings, rel=1e-3)
-    assert model.row_width(1, 4) == model.row_width(1, 3) + 1
+    # A node adds two numbers to each recorded row: its temperature and the contacts' heat into it so far.
+    assert model.row_width(1, 4) == model.row_width(1, 3) + 2

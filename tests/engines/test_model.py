@@ -130,7 +130,9 @@ def test_constants_from_default_parameters(params: Parameters, hand: Hand) -> No
     assert k.beta_e == pytest.approx(-0.1128085, rel=1e-6)  # ln 0.7/√(ln² 0.7 + π²)
     assert k.viscosity_ambient == pytest.approx(1.81346e-5, rel=1e-5)  # Sutherland at 293.15 K
     assert k.prandtl == pytest.approx(0.75511, rel=1e-4)  # 1003.5·1.81346e-5/0.0241
-    assert k.inner_area == k.outer_area == pytest.approx(567.06e-6, rel=1e-4)  # Table 1
+    # h·A of Table 3 over Table 1's A_i = A_o = 567.06 mm²
+    assert k.inner_conductance == pytest.approx(200.0 * 567.06e-6, rel=1e-4)
+    assert k.outer_conductance == pytest.approx(45.0 * 567.06e-6, rel=1e-4)
     assert k.half_length == pytest.approx(0.029, rel=1e-12)
     assert k.capacity_ball == pytest.approx(hand.cap_ball, rel=1e-12)  # 8.36574e-3·461 = 3.85661 J/K
     assert k.capacity_ball == pytest.approx(3.85661, rel=1e-5)

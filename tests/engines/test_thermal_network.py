@@ -61,12 +61,15 @@ def test_each_path_flows_as_its_correlation_says():
     )
 
 
-def test_every_path_and_source_says_what_it_rests_on():
-    network = DemEngine.network_for(sm.default_parameters(engine="dem", n_balls=3, vial_diameter="38 mm"))
+def test_every_path_and_deposit_says_what_it_rests_on():
+    params = sm.default_parameters(engine="dem", n_balls=3, vial_diameter="38 mm", powder_mass=0.002)
+    network = DemEngine.network_for(params)
     for path in network.paths:
         assert path.correlation and path.source and path.validity
     assert "Whitaker" in network.paths[0].source and "Re" in network.paths[0].validity
-    assert [network.nodes[source.node].name for source in network.sources] == ["ball 0", "ball 1", "ball 2", "vial"]
+    assert "effusivity" in network.split.description and network.split.wall_ball_share == params.lam
+    (deposit,) = network.deposits
+    assert network.nodes[deposit.node].role == "powder" and "powder_heat_share" in deposit.source
 
 
 def test_the_balance_conserves_energy_and_counts_what_leaves():

@@ -17,17 +17,26 @@ import numpy as np
 import pytest
 import xarray as xr
 from scipy.integrate import solve_ivp
+from typer.testing import CliRunner
 
 import shakermill as sm
+from shakermill.cli.commands import app
 from shakermill.engines.budget import RunBudget
-from shakermill.engines.interface import EngineDescription, Measured
+from shakermill.engines.interface import ENGINE_CORE, Averaging, EngineDescription, Measured, capabilities_of
 from shakermill.engines.records import CELSIUS_VARIABLES, EnergyAudit, StateHistory, attributes, with_celsius
-from shakermill.engines.registry import describe, engine_named, register, unregister
+from shakermill.engines.registry import describe, engine_named, engine_names, register, unregister
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork, air_constants, build_network
 from shakermill.io.runs import load_run, write_run
-from shakermill.parameters.engine_keys import EngineKeys
-from shakermill.parameters.keys import Parameters
+from shakermill.parameters.config import load_config
+from shakermill.parameters.engine_keys import (
+    AVERAGED_SOLVER,
+    GEOMETRY_AND_DRIVE,
+    PAPER_THERMAL,
+    RUN_CONTROL,
+    EngineKeys,
+)
+from shakermill.parameters.keys import FIELD_NAMES, Parameters
 from shakermill.physics import thermal
 from shakermill.views.figures.run import temperature_figure
 
@@ -51,6 +60,12 @@ DESCRIPTION = EngineDescription(
         thermal_models=("three_node",),
         networks=("paper",),
         air_moves_with_vial=False,
+        # It keeps no record windows, and its ball starts at the gap's end whatever the drive's phase.
+        reads=(RUN_CONTROL - {"record_windows"})
+        | AVERAGED_SOLVER
+        | (GEOMETRY_AND_DRIVE - {"phase"})
+        | PAPER_THERMAL
+        | {"averaging_rel_error", "restitution", "ball_density", "ball_material", "vial_material"},
     ),
     channels=("normal",),
     impact_units=IMPACT_UNITS,
@@ -63,15 +78,19 @@ DESCRIPTION = EngineDescription(
     term_variables=("velocity_term_integral",),
     status_messages={REACHED_STOP: "The toy reached the end."},
     averaging_error_key="averaging_rel_error",
-    thermal_only_keys=(),
     attractor_starts=False,
+)
+# The toy's core alone, registered under a name of its own: an engine without the capability Averaging.
+CORE_DESCRIPTION = dataclasses.replace(
+    DESCRIPTION, keys=dataclasses.replace(DESCRIPTION.keys, name="toy-core", title="the core of the toy engine")
 )
 
 
-class ToyEngine:
-    """The engine interface, implemented for the toy (module docstring)."""
+class CoreToy:
+    """The engine core (engines/interface.py, Engine), implemented for the toy (module docstring): all the full
+    solver needs."""
 
-    description: ClassVar[EngineDescription] = DESCRIPTION
+    description: ClassVar[EngineDescription] = CORE_DESCRIPTION
 
     def __init__(
         self,
@@ -201,12 +220,9 @@ class ToyEngine:
             elastic_energy_change=0.0,
             dissipated=dissipated,
             heat_generated=heat,
-            heat_to_ball=self.params.lam * heat,
-            heat_to_vial=(1.0 - self.params.lam) * heat,
+            heat_into=self.network.grouped(self.network.wall_contact_heat(heat)),
             not_converted_to_heat=dissipated - heat,
-            stored_ball=float(capacity[0] * warming[0]),
-            stored_vial=float(capacity[1] * warming[1]),
-            stored_air=float(capacity[2] * warming[2]),
+            stored=self.network.grouped(capacity * warming),
             heat_lost_to_surroundings=self.lost[-1],
             projection_correction=0.0,
         )
@@ -218,13 +234,6 @@ class ToyEngine:
     def no_impact_note(self) -> str:
         return ""
 
-    def measured(self) -> Measured:
-        return Measured(
-            np.array([self.heat_power * self.clock]),
-            np.array([self.term * self.clock]),
-            self.heat_power / self.params.eta * self.clock,
-        )
-
     def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
         power, lam = float(heat_rates[0]), self.params.lam
         return NetworkLoad(
@@ -232,6 +241,19 @@ class ToyEngine:
             np.array(term_means, dtype=float),
             power,
             float(term_means[0]),
+        )
+
+
+class ToyEngine(CoreToy, Averaging):
+    """The toy with the capability Averaging: the averaged solver drives it too."""
+
+    description: ClassVar[EngineDescription] = DESCRIPTION
+
+    def measured(self) -> Measured:
+        return Measured(
+            np.array([self.heat_power * self.clock]),
+            np.array([self.term * self.clock]),
+            self.heat_power / self.params.eta * self.clock,
         )
 
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
@@ -284,18 +306,18 @@ def test_a_registered_engine_runs_through_simulate_storage_the_summary_and_a_fig
     engine = ToyEngine(toy)
     # A hit every crossing of the free gap, the first after half of one.
     assert hits == math.floor((600.0 - engine.gap / engine.speed) * engine.speed / (2 * engine.gap)) + 1
-    assert result.summary["impact_rate_hz"] == pytest.approx(hits / 600.0)
-    assert result.summary["mean_impact_speed_m_s"] == pytest.approx(toy.amplitude * toy.omega)
-    assert result.summary["heat_power_W"] == pytest.approx(engine.heat_power, rel=1e-12)
+    assert result.summary.impact_rate_hz == pytest.approx(hits / 600.0)
+    assert result.summary.mean_impact_speed_m_s == pytest.approx(toy.amplitude * toy.omega)
+    assert result.summary.heat_power_W == pytest.approx(engine.heat_power, rel=1e-12)
     # The steady state of the shared network: all the heat leaves through h_o·A_o.
-    assert result.summary["vial_steady_C"] == pytest.approx(
+    assert result.summary.vial_steady_C == pytest.approx(
         toy.ambient_temperature + engine.heat_power / (toy.h_outer * toy.outer_area) - 273.15, rel=1e-9
     )
     assert result.energy.relative_residual < 1e-6
     folder = write_run(result, tmp_path / "run", preset="spex8000m")
     stored = load_run(folder)
     assert stored.params.engine == "toy"
-    assert stored.summary["heat_power_W"] == result.summary["heat_power_W"]
+    assert stored.summary.heat_power_W == result.summary.heat_power_W
     np.testing.assert_array_equal(stored.timeseries["theta_ball"].values, result.history["theta_ball"])
     assert stored.impact_units == IMPACT_UNITS
     figure = temperature_figure(stored)
@@ -319,3 +341,90 @@ def test_the_averaged_solver_drives_a_registered_engine_too(toy, tmp_path):
         assert "heat_generated, velocity_term_integral are the averaging window's mean" in series.attrs["coverage"]
         assert "mean rate times time" in series["velocity_term_integral"].attrs["coverage"]
         assert "not computed" in series["x"].attrs["coverage"] and "coverage" not in series["theta_air"].attrs
+
+
+@pytest.fixture(name="core_toy")
+def core_toy_fixture():
+    register(CoreToy)
+    yield sm.default_parameters(engine="toy-core", duration=60.0, output_interval=10.0, record_windows=())
+    unregister("toy-core")
+
+
+@pytest.mark.parametrize(
+    ("setting", "applies"),
+    [
+        ("friction=0.5", "it applies to engine = 'dem'"),
+        ("rtol=1e-4", "it applies to engine = '1d'"),
+        ("phase=1", "it applies to another engine"),
+        ("record_windows=0:1", "it applies to another engine"),
+    ],
+)
+def test_a_key_the_toy_does_not_read_is_refused_in_one_line(toy, setting, applies):
+    key = setting.partition("=")[0]
+    assert key not in DESCRIPTION.keys.reads
+    with pytest.raises(sm.ParameterError) as raised:
+        load_config(overrides=["engine=toy", setting])
+    assert str(raised.value) == (
+        f"{key}: set explicitly, but the toy engine (engine = 'toy') does not read it; {applies}"
+    )
+    # The keys it reads are taken: those of the shared groups and its own.
+    assert load_config(overrides=["engine=toy", "solver=averaged", "restitution=0.5", "averaging_fallback=fail"])
+
+
+def test_the_keys_the_toy_reads_are_those_it_lists_and_the_command_line_refuses_the_others(toy):
+    listed = CliRunner().invoke(app, ["keys", "--engine", "toy"], terminal_width=200)
+    assert listed.exit_code == 0, listed.output
+    assert f"read by the toy engine: {len(DESCRIPTION.keys.reads)} of {len(FIELD_NAMES)}" in listed.output
+    assert DESCRIPTION.keys.reads < set(FIELD_NAMES)
+    refused = CliRunner().invoke(app, ["run", "--set", "engine=toy", "--set", "gravity=false", "--no-plots"])
+    assert refused.exit_code == 2, refused.output
+    assert (
+        refused.output.strip()
+        .splitlines()[-1]
+        .startswith("error: gravity: set explicitly, but the toy engine (engine = 'toy') does not read it")
+    )
+
+
+def test_an_engine_without_averaging_runs_the_full_solver_and_the_averaged_one_refuses_it(core_toy, tmp_path):
+    """The core alone serves the full solver; the averaged solver asks for the capability Averaging and refuses, in
+    one line, an engine without it (exit code 2 from the command line, before anything runs)."""
+    assert capabilities_of(CoreToy) == () and capabilities_of(ToyEngine) == ("Averaging",)
+    full = sm.simulate(core_toy)
+    assert full.success, full.message
+    assert full.description is CORE_DESCRIPTION and full.summary.heat_power_W == pytest.approx(
+        CoreToy(core_toy).heat_power, rel=1e-12
+    )
+    refusal = (
+        "solver: the averaged solver needs an engine that measures the means it averages (the capability Averaging, "
+        "engines/interface.py); engine = 'toy-core' has not; allowed solver = 'full'"
+    )
+    with pytest.raises(sm.ParameterError) as raised:
+        sm.simulate(core_toy.replace(solver="averaged", duration=3600.0))
+    assert str(raised.value) == refusal
+    outcome = CliRunner().invoke(
+        app,
+        ["run", "--set", "engine=toy-core", "--set", "solver=averaged", "--out", str(tmp_path / "run"), "--no-plots"],
+    )
+    assert outcome.exit_code == 2 and outcome.output.strip().splitlines()[-1] == f"error: {refusal}"
+    assert not (tmp_path / "run").exists()
+
+
+def test_registering_checks_the_engine_core_and_the_keys_it_says_it_reads():
+    without_load = type("NoLoad", (), {name: getattr(CoreToy, name) for name in ENGINE_CORE if name != "load"})
+    without_load.description = dataclasses.replace(
+        CORE_DESCRIPTION, keys=dataclasses.replace(CORE_DESCRIPTION.keys, name="no-load")
+    )
+    with pytest.raises(ValueError, match=r"^engine 'no-load': lacks load of the engine core"):
+        register(without_load)
+    misspelt = dataclasses.replace(
+        CORE_DESCRIPTION,
+        keys=dataclasses.replace(CORE_DESCRIPTION.keys, name="misspelt", reads=CORE_DESCRIPTION.keys.reads | {"omgea"}),
+    )
+    with pytest.raises(ValueError, match=r"^engine 'misspelt': reads 'omgea', which Parameters has no key of"):
+        register(type("Misspelt", (CoreToy,), {"description": misspelt}))
+    replicated = dataclasses.replace(
+        DESCRIPTION, keys=dataclasses.replace(DESCRIPTION.keys, name="replicated", replicas_key="dem_replicas")
+    )
+    with pytest.raises(ValueError, match=r"^engine 'replicated': names replicas_key = 'dem_replicas' without"):
+        register(type("Replicated", (ToyEngine,), {"description": replicated}))
+    assert "no-load" not in engine_names() and "misspelt" not in engine_names()

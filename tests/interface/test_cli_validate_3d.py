@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from shakermill import cli
 from shakermill.parameters.assumed import AssumedInput
-from shakermill.studies import cross_prediction, held_out, joint_calibration, validation_report
+from shakermill.studies import cross_prediction, held_out, joint_calibration, powder, validation_report
 from shakermill.studies.validation import VALIDATION_PRESETS
 from shakermill.studies.validation_matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
 from shakermill.views.validation_page import CROSS_TITLE, QUICK_NOTE
@@ -29,6 +29,7 @@ def quick_runs_fixture(monkeypatch):
     monkeypatch.setattr(held_out, "five_ball_sensitivity", functools.partial(held_out.five_ball_sensitivity, QUICK))
     monkeypatch.setattr(held_out, "engine_comparison", functools.partial(held_out.engine_comparison, overrides=QUICK))
     monkeypatch.setattr(validation_report, "validation_matrix", functools.partial(validation_matrix, overrides=QUICK))
+    monkeypatch.setattr(validation_report, "powder_studies", functools.partial(powder.powder_studies, QUICK))
     # Each structure's fit runs the one-ball hour: its study has tests of its own.
     monkeypatch.setattr(validation_report, "structure_study", lambda progress: ())
     # Both directions run 64 averaged hours: emulators of made-up rises stand in
@@ -99,6 +100,18 @@ def test_validate_json_holds_predictions_with_errors_and_what_was_fitted(quick_r
             assert point["inside_90"] == (point["p5"] <= point["measured_K"] <= point["p95"])
         assert direction["verdict"][1:] in html
     assert payload["ran"]["cross_prediction"] is True and CROSS_TITLE in html
+    # Five SPEX balls and the planetary mill, each without and with its stated powder; the published ordering's sign.
+    five_powder, planetary = payload["powder"]
+    assert (five_powder["powder_kg"], planetary["powder_kg"]) == (
+        powder.FIVE_BALL_POWDER_KG,
+        powder.PLANETARY_POWDER_KG,
+    )
+    vial = next(row for row in planetary["rows"] if row["label"].startswith("vial"))
+    assert (vial["measured_without"], vial["measured_with"]) == (10.0, 20.0)
+    assert planetary["vial_warmer_with_powder"] == (vial["with_powder"] > vial["without"])
+    assert five_powder["rows"][0]["measured_with"] == five_powder["rows"][0]["measured_without"] == 46.0
+    assert five_powder["rows"][-1]["without"] is None  # no powder node, no powder temperature
+    assert five_powder["title"] in html and "A planetary mill without and with powder" in html
     five = payload["five_balls"]
     assert five["preset"] == "spex8000m-3d-calibrated" and five["fitted_parameters"]
     rows = five["rows"]
@@ -146,13 +159,14 @@ def test_validate_is_quick_by_default_and_says_each_run_when_piped(quick_runs, t
     assert "five_balls" not in payload and "structure_study" not in payload
     held_out_rows = [row for row in payload["validation_matrix"]["rows"] if row["role"] == "held out"]
     assert {row["experiment"] for row in held_out_rows} == {"takacs-mchenry-five-balls"}
-    # Not a terminal: a plain line for each step (Table 5's runs, then each 3-D run), so a log shows the study moving.
-    steps = len(VALIDATION_PRESETS) + len(quick) * len(THERMAL_MODEL_PRESETS)
+    # Not a terminal: a plain line for each step (Table 5's runs, then each 3-D run, then the two powder comparisons),
+    # so a log shows the study moving.
+    steps = len(VALIDATION_PRESETS) + len(quick) * len(THERMAL_MODEL_PRESETS) + powder.POWDER_STEPS
     lines = [line for line in outcome.stderr.splitlines() if line.startswith("validation: ")]
     assert [line.split(",")[0] for line in lines] == [
         f"validation: {done}/{steps} steps" for done in range(1, steps + 1)
     ]
-    assert outcome.stderr.startswith("validate: quick, ~45 s; --full for everything")
+    assert outcome.stderr.startswith("validate: quick, ~2.5 min; --full for everything")
     # Its page says it is the quick one, and what --full adds.
     assert html.escape(QUICK_NOTE) in page.read_text(encoding="utf-8")
 

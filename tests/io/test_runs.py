@@ -18,6 +18,7 @@ from shakermill.io import runs as storage
 from shakermill.io.runs import StorageError, load_run, to_jsonable, write_run
 from shakermill.parameters.config import load_config
 from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.solvers.summary_versions import SCHEMA_VERSION
 
 
 @pytest.fixture(scope="module")
@@ -83,7 +84,8 @@ def test_summary_json_is_strict_json_matching_the_result(run_folder, short_resul
     assert document["success"] is True
     assert document["message"] == short_result.message
     assert document["counters"] == short_result.counters
-    for key, value in short_result.summary.items():
+    assert document["schema_version"] == SCHEMA_VERSION
+    for key, value in short_result.summary.flat().items():
         if isinstance(value, (str, list)):
             assert document["summary"][key] == value
         elif isinstance(value, dict):
@@ -111,7 +113,7 @@ def test_load_run_returns_what_was_written(run_folder, short_result):
     assert run.ball_fit == short_result.ball_fit
     assert run.impact_units == IMPACT_UNITS
     assert run.counters == short_result.counters
-    assert run.summary["impacts"] == short_result.summary["impacts"]
+    assert run.summary.impacts == short_result.summary.impacts
     xr.testing.assert_identical(run.timeseries.drop_attrs(), short_result.timeseries.drop_attrs())
     pd.testing.assert_frame_equal(run.impacts, short_result.impacts, check_dtype=False)
 
@@ -154,7 +156,7 @@ def test_load_run_refuses_a_file_of_the_right_format_that_no_run_wrote(run_folde
 def test_nan_values_are_written_as_null(tmp_path):
     # Too short to fit an exponential and without impacts: the summary holds NaNs.
     result = sm.simulate(sm.default_parameters(duration=0.001, record_windows=()))
-    assert math.isnan(result.summary["theta_inf_C"])
+    assert math.isnan(result.summary.theta_inf_C)
     folder = write_run(result, tmp_path / "short", preset=DEFAULT_PRESET)
     document = strict_json((folder / "summary.json").read_text(encoding="utf-8"))
     assert document["summary"]["theta_inf_C"] is None
@@ -264,3 +266,57 @@ def test_arrow_arrays_built_from_buffers_hold_the_values(values):
     array = storage.arrow_array(values)
     assert len(array) == values.size and array.null_count == 0
     np.testing.assert_array_equal(array.to_numpy(zero_copy_only=False), values)
+
+
+def as_version_1(folder: Path, change) -> None:
+    """Make ``folder``'s summary.json one an older shakermill wrote (no schema_version), its summary changed by
+    ``change``."""
+    path = folder / "summary.json"
+    document = json.loads(path.read_text(encoding="utf-8"))
+    del document["schema_version"]
+    change(document["summary"])
+    path.write_text(json.dumps(document), encoding="utf-8")
+
+
+def test_an_old_run_folder_is_read_with_its_keys_brought_forward(run_folder):
+    def older(summary):
+        summary["clamp_C"], summary["clamp_steady_C"] = 25.5, 31.0  # the holder's keys, before it was called so
+        for added_since in ("exponential_fit_describes_run", "stress_window_s", "fast_impact_rate_hz"):
+            del summary[added_since]
+        summary["a_key_since_removed"] = 1.0
+
+    as_version_1(run_folder, older)
+    summary = load_run(run_folder).summary
+    assert (summary.holder_C, summary.holder_steady_C) == (25.5, 31.0)
+    # As the readers of version 1 assumed: the fit's rows shown; a key it lacked is NaN (shown "n/a").
+    assert summary.exponential_fit_describes_run is True
+    assert math.isnan(summary.stress_window_s) and math.isnan(summary.fast_impact_rate_hz)
+    assert summary.impacts > 0
+
+
+def test_an_old_run_folder_that_does_not_fit_is_refused_in_one_line_that_says_to_re_run_it(run_folder):
+    as_version_1(run_folder, lambda summary: summary.pop("impacts"))
+    with pytest.raises(StorageError) as refused:
+        load_run(run_folder)
+    message = str(refused.value)
+    assert "\n" not in message and message.startswith(f"{run_folder}: summary.json")
+    assert "older shakermill (summary schema 1)" in message and "'impacts'" in message
+    assert f"re-run it to read it here: shakermill run {run_folder / 'config.toml'} --out NEW_FOLDER" in message
+
+
+def test_a_run_folder_of_a_newer_schema_is_refused_in_one_line(run_folder):
+    path = run_folder / "summary.json"
+    document = json.loads(path.read_text(encoding="utf-8"))
+    document["schema_version"] = SCHEMA_VERSION + 1
+    path.write_text(json.dumps(document), encoding="utf-8")
+    with pytest.raises(StorageError, match=f"newer shakermill \\(summary schema {SCHEMA_VERSION + 1}.*upgrade"):
+        load_run(run_folder)
+
+
+def test_a_current_summary_with_a_key_the_schema_does_not_declare_is_refused(run_folder):
+    path = run_folder / "summary.json"
+    document = json.loads(path.read_text(encoding="utf-8"))
+    document["summary"]["ball_c"] = 20.0
+    path.write_text(json.dumps(document), encoding="utf-8")
+    with pytest.raises(StorageError, match="summary.json: 'ball_c' is not a summary key .*did you mean 'ball_C'"):
+        load_run(run_folder)

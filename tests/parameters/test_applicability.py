@@ -46,12 +46,21 @@ def test_a_reader_names_where_a_key_applies():
         dem.not_read("drive_heat") == "the 'paper' network does not read it; it applies to thermal_model = 'mill-head'"
     )
     assert Reader("dem", "averaged", "mill-head", "axial").not_read("drive_heat") is None
+    # The powder's keys apply with powder, and then it coats every contact: the bare restitutions give way.
+    assert dem.not_read("powder_heat_share") == (
+        "a run without powder (powder_mass = 0) does not read it; it applies to powder_mass > 0"
+    )
+    coated = Reader("dem", "averaged", "paper", "axial", 0.004)
+    assert coated.not_read("powder_heat_share") is None and dem.not_read("restitution") is None
+    assert "powder_restitution applies instead" in coated.not_read("pair_restitution")
+    assert "engine = 'dem'" in Reader("1d", "full", "paper", "axial", 0.004).not_read("powder_heat_share")
     # Every key of these sets is one some run reads: none is dead.
     readers = [
         Reader("1d", "averaged", "paper", "axial"),
         *(Reader("dem", "averaged", "mill-head", motion) for motion in KINEMATIC_MODELS),
+        Reader("dem", "averaged", "paper", "axial", 0.004),
     ]
-    for key in AVERAGED_ONLY | MILL_HEAD_ONLY | MOTION_KEYS | ENGINE_KEYS["1d"].unread | ENGINE_KEYS["dem"].unread:
+    for key in AVERAGED_ONLY | MILL_HEAD_ONLY | MOTION_KEYS | ENGINE_KEYS["1d"].reads | ENGINE_KEYS["dem"].reads:
         assert any(reader.not_read(key) is None for reader in readers), key
 
 

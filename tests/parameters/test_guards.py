@@ -161,7 +161,7 @@ def test_a_run_whose_ball_exceeds_the_material_limit_is_not_ok():
     # 1060 rad/s (rpm meant): ~1 kW of heat melts the ball within seconds.
     result = sm.simulate(sm.default_parameters(omega=1060, duration=30.0, record_windows=()))
     assert result.status == OUT_OF_PHYSICAL_BOUNDS
-    assert not result.success and result.summary["success"] is False
+    assert not result.success and result.summary.success is False
     assert "ball_temperature_limit" in result.message
     assert float(result.timeseries["theta_ball"].max()) > result.params.ball_temperature_limit
 

@@ -239,21 +239,21 @@ def test_averaged_run_follows_the_configured_start_and_warns_of_the_other_attrac
     base = params.replace(solver="averaged", duration=10800.0, record_windows=())
     alone = sm.simulate(base.replace(attractor_starts=1))
     probed = sm.simulate(base)
-    assert probed.summary["heat_power_W"] == alone.summary["heat_power_W"]
-    assert probed.summary["theta_inf_C"] == alone.summary["theta_inf_C"]
-    assert "n_attractors" not in alone.summary and alone.warnings == []
-    assert probed.summary["n_attractors"] == len(scan.attractors) == 2
+    assert probed.summary.heat_power_W == alone.summary.heat_power_W
+    assert probed.summary.theta_inf_C == alone.summary.theta_inf_C
+    assert alone.summary.n_attractors is None and alone.warnings == []
+    assert probed.summary.n_attractors == len(scan.attractors) == 2
     other = scan.attractors[1]
     (warning,) = probed.warnings
     assert f"basin fraction {other.basin_fraction:.2f}" in warning and f"{other.heat_power_W:.4g} W" in warning
-    assert probed.summary["warnings"] == [warning]
+    assert probed.summary.warnings == [warning]
 
 
 @pytest.mark.slow
 def test_one_attractor_at_the_default_stroke_and_no_warning():
     result = sm.simulate(sm.default_parameters(solver="averaged", duration=10800.0, omega=110.0, record_windows=()))
-    assert result.summary["n_attractors"] == len(result.attractors.attractors) == 1
-    assert result.summary["heat_power_spread_W"] == 0.0
+    assert result.summary.n_attractors == len(result.attractors.attractors) == 1
+    assert result.summary.heat_power_spread_W == 0.0
     assert result.warnings == []
 
 

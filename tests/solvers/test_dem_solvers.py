@@ -34,11 +34,11 @@ def test_the_averaged_solver_heats_as_the_full_one(pair):
     rise = lambda result, name: result.history[name][-1] - result.params.initial_temperature  # noqa: E731
     for name in ("theta_ball", "theta_vial", "theta_air"):
         assert rise(averaged, name) == pytest.approx(rise(full, name), rel=0.05), name
-    assert averaged.summary["heat_power_W"] == pytest.approx(full.summary["heat_power_W"], rel=0.05)
+    assert averaged.summary.heat_power_W == pytest.approx(full.summary.heat_power_W, rel=0.05)
     # The averaged run splits its heat by channel as the contacts of its averaging window did.
     for channel in ("normal", "sliding"):
         key = f"heat_{channel}_W"
-        assert averaged.summary[key] == pytest.approx(full.summary[key], rel=0.15), key
+        assert averaged.summary.value(key) == pytest.approx(full.summary.value(key), rel=0.15), key
 
 
 @pytest.mark.slow
@@ -47,9 +47,9 @@ def test_both_solvers_give_each_ball_its_own_temperature_and_a_steady_state(pair
         temperatures = result.history[BALL_TEMPERATURES]
         assert temperatures.shape == (result.history.times.size, 5)
         assert np.allclose(temperatures.mean(axis=1), result.history["theta_ball"])
-        assert len(result.summary["balls_steady_C"]) == 5
+        assert len(result.summary.balls_steady_C) == 5
         assert result.steady.solved and len(result.steady.time_constants) == 7  # five balls, vial, air
-        assert result.summary["ball_steady_C"] == pytest.approx(np.mean(result.summary["balls_steady_C"]))
+        assert result.summary.ball_steady_C == pytest.approx(np.mean(result.summary.balls_steady_C))
 
 
 @pytest.mark.slow

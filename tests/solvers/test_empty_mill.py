@@ -26,29 +26,27 @@ def test_the_drive_alone_warms_an_empty_mill_and_its_heat_is_accounted_for(solve
     params = default_parameters("spex8000m-3d-calibrated", n_balls=0, duration=60.0, solver=solver)
     result = simulate(params)
     summary = result.summary
-    assert result.success and summary["impacts"] == 0 and summary["heat_power_W"] == 0.0
-    assert (
-        math.isnan(summary["ball_C"]) and math.isnan(summary["ball_steady_C"]) and summary["ball_temperatures_C"] == []
-    )
-    assert summary["drive_heat_W"] == pytest.approx(params.drive_heat)
-    assert 20.0 < summary["vial_C"] < summary["clamp_C"] < summary["vial_steady_C"]
+    assert result.success and summary.impacts == 0 and summary.heat_power_W == 0.0
+    assert math.isnan(summary.ball_C) and math.isnan(summary.ball_steady_C) and summary.ball_temperatures_C == []
+    assert summary.drive_heat_W == pytest.approx(params.drive_heat)
+    assert 20.0 < summary.vial_C < summary.holder_C < summary.vial_steady_C
     # The drive's heat is the only flow of the balance, and all of it is accounted for.
     assert abs(result.energy.thermal_residual) < 1e-9 * result.energy.drive_heat
-    assert summary["energy_audit_residual"] == pytest.approx(abs(result.energy.residual) / result.energy.drive_heat)
+    assert summary.energy_audit_residual == pytest.approx(abs(result.energy.residual) / result.energy.drive_heat)
     # At the steady state everything the drive puts in leaves to the room.
     steady = result.steady
     network = engine_named(params.engine).network_for(params)
-    theta = np.array([steady.vial, steady.air, dict(steady.others)["clamp"]])
+    theta = np.array([steady.vial, steady.air, dict(steady.others)["holder"]])
     flows = dict(zip((path.name for path in network.paths), network.flows(theta, np.zeros(0)), strict=True))
-    to_room = flows["clamp → room"] + flows["vial → room, convection"] + flows["vial → room, radiation"]
+    to_room = flows["holder → room"] + flows["vial → room, convection"] + flows["vial → room, radiation"]
     assert to_room == pytest.approx(params.drive_heat, rel=1e-6)
     assert not any("ball" in warning for warning in result.warnings)
 
 
 def test_an_empty_mill_of_the_paper_network_stays_at_the_ambient():
     result = simulate(default_parameters("spex8000m-3d-calibrated-paper", n_balls=0, duration=600.0))
-    assert result.summary["vial_C"] == pytest.approx(20.0, abs=1e-12)
-    assert result.summary["vial_steady_C"] == pytest.approx(20.0, abs=1e-9)
+    assert result.summary.vial_C == pytest.approx(20.0, abs=1e-12)
+    assert result.summary.vial_steady_C == pytest.approx(20.0, abs=1e-9)
 
 
 def test_the_one_dimensional_engine_refuses_an_empty_mill():
@@ -78,7 +76,7 @@ def test_run_prints_and_stores_an_empty_mill(tmp_path):
     assert outcome.exit_code == 0, outcome.output
     assert (
         re.search(r"amplitude; ball radius\s*│\s*25; none", outcome.stdout)
-        and "drive heat into the clamp" in outcome.stdout
+        and "drive heat into the holder" in outcome.stdout
     )
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))["summary"]
     assert summary["n_balls"] == 0 and summary["ball_C"] is None and summary["vial_C"] > 20.0

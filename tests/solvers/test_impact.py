@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import shakermill as sm
+from shakermill.engines.registry import describe
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.physics.contact import (
@@ -359,17 +360,18 @@ def test_the_keys_a_lone_impact_does_not_read_are_keys_and_refused_with_why():
 
 def test_a_coarse_contact_step_is_warned_of_and_the_default_one_is_not():
     coarse = sm.default_parameters(engine="dem", contact_step_fraction=0.9)
-    warning = restitution_warning(coarse)
+    warning = restitution_warning(coarse, describe("dem"))
     assert warning is not None and "contact_step_fraction = 0.9" in warning and "% off" in warning
     achieved = float(warning.split("restitution of ")[1].split(",")[0])
     assert abs(achieved - coarse.restitution) > 0.01 * coarse.restitution
-    assert restitution_warning(sm.default_parameters(engine="dem")) is None
-    # The 1-D engine has no contact step.
-    assert restitution_warning(sm.default_parameters(contact_step_fraction=0.9)) is None
+    assert restitution_warning(sm.default_parameters(engine="dem"), describe("dem")) is None
+    # The 1-D engine has no contact step to guard: its description says so.
+    assert not describe("1d").contact_step_guard and describe("dem").contact_step_guard
+    assert restitution_warning(sm.default_parameters(contact_step_fraction=0.9), describe("1d")) is None
 
 
 @pytest.mark.slow
 def test_a_dem_run_with_a_coarse_contact_step_carries_the_warning_once():
     coarse = sm.simulate(sm.default_parameters(engine="dem", contact_step_fraction=0.9, duration=0.2, solver="full"))
     assert sum("contact_step_fraction = 0.9" in line for line in coarse.warnings) == 1
-    assert sum("contact_step_fraction" in line for line in coarse.summary["warnings"]) == 1
+    assert sum("contact_step_fraction" in line for line in coarse.summary.warnings) == 1

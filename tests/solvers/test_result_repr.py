@@ -14,8 +14,7 @@ def test_a_results_repr_says_what_ran_its_headlines_and_the_sizes_of_its_data_in
     assert lines[0].startswith("<shakermill.Result: engine '1d', solver 'averaged', success, 60 s simulated")
     assert lines[1].strip() == result.message
     assert (
-        f"ball °C {result.summary['ball_C']:.4g}" in lines[2]
-        and f"heat W {result.summary['heat_power_W']:.4g}" in lines[2]
+        f"ball °C {result.summary.ball_C:.4g}" in lines[2] and f"heat W {result.summary.heat_power_W:.4g}" in lines[2]
     )
     assert (
         f"{result.history.times.size} samples of {len(result.history.variables)} series, {len(result.impacts)} impacts"

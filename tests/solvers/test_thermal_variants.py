@@ -41,10 +41,10 @@ def test_a_thermal_variant_is_the_run_it_would_be_on_its_own(base):
     alone = sm.simulate(variant)
     assert shared.success and alone.success and shared.averages.converged
     # The mechanics are deterministic, so the reused means are the very numbers a fresh run measures.
-    assert shared.summary["heat_power_W"] == alone.summary["heat_power_W"]
+    assert shared.summary.heat_power_W == alone.summary.heat_power_W
     for name in ("theta_ball", "theta_vial", "theta_air"):
         np.testing.assert_allclose(shared.history[name], alone.history[name], rtol=1e-12)
-    assert shared.summary["vial_C"] != run(base).summary["vial_C"]  # the variant did change the network
+    assert shared.summary.vial_C != run(base).summary.vial_C  # the variant did change the network
 
 
 @pytest.mark.slow
@@ -71,8 +71,8 @@ def test_hits_leave_out_contacts_slower_than_the_hit_speed(base):
     speeds = np.asarray(result.impact_columns["impact_speed"])
     hits = speeds[speeds >= HIT_SPEED]
     assert 0 < hits.size < speeds.size  # resting balls chatter; flying ones hit
-    assert result.summary["hit_rate_hz"] == pytest.approx(hits.size / 2.0)
-    assert result.summary["mean_hit_speed_m_s"] == pytest.approx(hits.mean())
+    assert result.summary.hit_rate_hz == pytest.approx(hits.size / 2.0)
+    assert result.summary.mean_hit_speed_m_s == pytest.approx(hits.mean())
     fast = speeds[speeds >= FAST_IMPACT_SPEED]
     assert 0 < fast.size < hits.size
-    assert result.summary["fast_impact_rate_hz"] == pytest.approx(fast.size / 2.0)
+    assert result.summary.fast_impact_rate_hz == pytest.approx(fast.size / 2.0)

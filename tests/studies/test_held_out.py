@@ -21,8 +21,9 @@ from shakermill.studies.held_out import (
 QUICK = {"solver": "full", "duration": 0.3}
 
 
-def test_the_rises_and_their_errors_are_read_from_the_summary():
-    rows = five_ball_rows({"initial_temperature_C": 20.0, "ball_C": 89.0, "vial_C": 41.0, "vial_ball_ratio": 0.3})
+def test_the_rises_and_their_errors_are_read_from_the_summary(default_run_20s):
+    summary = default_run_20s.summary.updated(initial_temperature_C=20.0, ball_C=89.0, vial_C=41.0, vial_ball_ratio=0.3)
+    rows = five_ball_rows(summary)
     ball, vial, ratio = rows
     assert (ball.experiment, vial.experiment, ratio.experiment) == (46.0, 21.0, 0.46)
     assert ball.predicted == 69.0 and ball.relative_error == pytest.approx(0.5)
@@ -42,9 +43,9 @@ def test_the_held_out_preset_was_fitted_to_one_ball_and_runs_five_unrefitted():
 @pytest.mark.slow
 def test_the_prediction_says_what_was_fitted_and_that_the_rest_is_predicted():
     prediction = five_ball_prediction(QUICK)
-    assert prediction.summary["n_balls"] == FIVE_BALLS
+    assert prediction.summary.n_balls == FIVE_BALLS
     assert all(math.isfinite(row.predicted) for row in prediction.rows)
-    assert prediction.rows[0].predicted == pytest.approx(prediction.summary["ball_C"] - 20.0)
+    assert prediction.rows[0].predicted == pytest.approx(prediction.summary.ball_C - 20.0)
     assert "nothing was refitted" in prediction.statement
     assert all(key in prediction.statement for key in PRESETS[HELD_OUT_PRESET].fitted)
 

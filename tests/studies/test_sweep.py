@@ -304,7 +304,7 @@ def test_in_process_table(base, in_process, tmp_path):
 
     alone = simulate(base.replace(**plan.points[4])).summary
     for key in ("theta_inf_C", "tau_min", "impacts", "heat_power_W"):
-        assert table.loc[4, key] == alone[key], key
+        assert table.loc[4, key] == alone.value(key), key
 
 
 @pytest.mark.slow
@@ -585,7 +585,7 @@ def test_keep_runs_writes_each_point_run_folder(base, tmp_path):
         folder = Path(row["output_dir"])
         assert folder == tmp_path / "kept" / "runs" / row["point_id"]
         run = load_run(folder)
-        assert run.summary["impacts"] == row["impacts"]
+        assert run.summary.impacts == row["impacts"]
         assert run.params.amplitude == row["amplitude"]
 
 

@@ -25,8 +25,10 @@ def test_intervals_hold_the_run_and_scale_with_the_covariance(full_run):
     four = intervals(full_run, Uncertainty(("beta", "vial_mass"), 4.0 * covariance))
     for key in HEADLINE:
         low, high = one.bounds(key)
-        assert low < full_run.summary[key] < high
-        assert high - full_run.summary[key] == pytest.approx(full_run.summary[key] - low, rel=1e-9)  # linear: symmetric
+        assert low < full_run.summary.value(key) < high
+        assert high - full_run.summary.value(key) == pytest.approx(
+            full_run.summary.value(key) - low, rel=1e-9
+        )  # linear: symmetric
         # A full run has no averaging error: the spread is the calibration's alone, linear in its standard deviations.
         assert four.high[key] - four.low[key] == pytest.approx(2.0 * (high - low), rel=1e-9)
     assert one.as_summary()["ball_C_high"] == one.bounds("ball_C")[1]
@@ -37,7 +39,7 @@ def test_intervals_hold_the_run_and_scale_with_the_covariance(full_run):
 def test_the_steady_vials_error_is_its_rise_times_the_error_of_its_only_way_out(full_run):
     # At steady state all the heat P leaves through h_outer·outer_area: Δθ_vial = P/(h_o·A_o), so d Δθ/d ln h_o = −Δθ.
     found = intervals(full_run, Uncertainty(("h_outer",), np.array([[0.01]])))
-    rise = full_run.summary["vial_steady_C"] - (full_run.params.ambient_temperature - 273.15)
+    rise = full_run.summary.vial_steady_C - (full_run.params.ambient_temperature - 273.15)
     low, high = found.bounds("vial_steady_C")
     assert (high - low) / 2 == pytest.approx(Z90 * 0.1 * rise, rel=2e-3)
 
@@ -47,7 +49,7 @@ def test_the_averaging_error_of_the_heat_widens_the_intervals_in_proportion():
     result = sm.simulate(sm.default_parameters(record_windows=(), solver="averaged"))
     found = intervals(result, Uncertainty(()))
     relative = result.averages.heat_power_stderr / result.averages.heat_power
-    rise = result.summary["vial_steady_C"] - (result.params.ambient_temperature - 273.15)
+    rise = result.summary.vial_steady_C - (result.params.ambient_temperature - 273.15)
     # The network is linear in the heat but for Sutherland's factor, which the vial does not see.
     low, high = found.bounds("vial_steady_C")
     assert (high - low) / 2 == pytest.approx(Z90 * relative * rise, rel=2e-3)
@@ -59,7 +61,7 @@ def test_posterior_samples_give_percentile_intervals(full_run):
     base = np.log(full_run.params.h_outer)
     samples = base + np.linspace(-0.2, 0.2, 100)[:, None]
     found = intervals(full_run, Uncertainty(("h_outer",), posterior=samples))
-    rise = full_run.summary["vial_steady_C"] - (full_run.params.ambient_temperature - 273.15)
+    rise = full_run.summary.vial_steady_C - (full_run.params.ambient_temperature - 273.15)
     low, high = found.bounds("vial_steady_C")
     ambient = full_run.params.ambient_temperature - 273.15
     assert low - ambient == pytest.approx(rise * np.exp(-np.percentile(samples[:, 0] - base, 95)), rel=2e-3)

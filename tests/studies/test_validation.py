@@ -33,8 +33,8 @@ def test_table5_holds_the_published_numbers(paper: dict) -> None:
     assert "five balls" in by_key["vial_ball_ratio"].experiment_note
 
 
-def test_compare_marks_fitted_and_predicted_rows() -> None:
-    summary = {"theta_inf_C": 50.0, "tau_min": 16.7, "rate0_C_per_min": 1.8, "vial_ball_ratio": 0.5}
+def test_compare_marks_fitted_and_predicted_rows(default_run_20s) -> None:
+    summary = default_run_20s.summary.updated(theta_inf_C=50.0, tau_min=16.7, rate0_C_per_min=1.8, vial_ball_ratio=0.5)
     rows = compare(summary, fitted_keys=("theta_inf_C",))
     assert [row.role for row in rows] == ["fitted", "predicted", "predicted", "predicted"]
     assert rows[0].error_vs_experiment == pytest.approx(relative_error(50.0, 48.0)) == pytest.approx(2.0 / 48.0)

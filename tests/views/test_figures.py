@@ -115,7 +115,7 @@ def test_temperature_figure_shows_celsius_minutes_and_the_fit(hour):
     window = f"0–{minutes[-1]:.3g} min"
     fit_line = lines[f"ball, exponential fitted over {window}"]
     assert fit_line.get_linestyle() == "--"
-    steady = result.summary["ball_steady_C"]
+    steady = result.summary.ball_steady_C
     (steady_line,) = [line for label, line in lines.items() if label.startswith("ball steady state")]
     np.testing.assert_allclose(steady_line.get_ydata(), [steady, steady])
     assert f"{steady:.1f} °C" in steady_line.get_label()
@@ -242,7 +242,7 @@ def test_impacts_per_second_integrate_to_the_impacts_at_each_wall(result):
 @pytest.mark.slow
 def test_the_stress_spectrum_counts_every_impact_and_its_power_at_the_lowest_energy(result):
     events, power = impact_figures(result)["stress_energy_spectrum"].axes[:2]
-    window = result.summary["stress_window_s"]
+    window = result.summary.stress_window_s
     # One ball on the axis: the total and its normal part, which is all of it; no tangential part, no ball hit.
     assert [line.get_label() for line in events.get_lines() if not line.get_label().startswith("_")] == [
         "all impacts, normal + tangential",
@@ -276,11 +276,11 @@ def test_no_impacts_no_impact_figures(result):
 
 def test_a_run_shorter_than_the_slowest_time_constant_draws_no_exponential_and_says_why(result):
     """Issue 37, point 4: a fitted exponential that misses the curve was drawn as a headline."""
-    assert result.summary["exponential_fit_describes_run"] is False
+    assert result.summary.exponential_fit_describes_run is False
     (axis,) = temperature_figure(result).axes
     assert not [line for line in axis.get_lines() if "exponential" in line.get_label()]
     box = "\n".join(text.get_text() for text in axis.texts)
-    slowest = result.summary["slowest_time_constant_min"]
+    slowest = result.summary.slowest_time_constant_min
     assert box.startswith("no exponential: the run") and f"({slowest:.3g} min)" in box
 
 
@@ -636,7 +636,7 @@ def test_run_figures_name_the_run_and_averaged_impact_figures_their_window(tmp_p
     params = sm.default_parameters(solver="averaged", duration=600.0)
     run = load_run(write_run(sm.simulate(params), tmp_path / "run", preset="spex8000m"))
     figures = run_figures(run, impacts=True)
-    window = f"impacts of the {run.summary['averaging_window_s']:.3g} s averaging window only"
+    window = f"impacts of the {run.summary.averaging_window_s:.3g} s averaging window only"
     for name, figure in figures.items():
         title = figure.get_suptitle() or figure.axes[0].get_title()
         assert "spex8000m, 10 min, averaged solver" in title, name

@@ -12,7 +12,7 @@ from xarray.plot.utils import label_from_attrs
 
 import shakermill as sm
 from shakermill.io.runs import load_run, write_run
-from shakermill.views.notebook import CALIBRATED_PRESET, answer_sentences
+from shakermill.views.notebook import ANSWER_KEYS, CALIBRATED_PRESET, answer_sentences
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -23,8 +23,8 @@ def test_result_html_repr_gives_status_answer_and_inputs_escaped(default_run_20s
     document = result._repr_html_()
     assert "<b onmouseover" not in document and "&lt;b onmouseover=&quot;x()&quot;&gt;" in document
     summary = result.summary
-    assert f'<td class="num">{summary["ball_steady_C"]:.1f}</td><td>°C</td>' in document
-    assert f"After {summary['simulated_s'] / 60:.3g} min the ball is at {summary['ball_C']:.1f} °C" in document
+    assert f'<td class="num">{summary.ball_steady_C:.1f}</td><td>°C</td>' in document
+    assert f"After {summary.simulated_s / 60:.3g} min the ball is at {summary.ball_C:.1f} °C" in document
     assert '<td>drive frequency</td><td class="num">1060</td><td>rpm</td>' in document
     # Small: the key inputs only, not all the keys the plain repr prints.
     assert document.count("<tr>") < 25
@@ -68,8 +68,10 @@ def test_result_plot_returns_the_paper_figures_shown_inline(default_run_20s):
 
 
 @pytest.mark.parametrize("fitted", [False, True])
-def test_the_answer_says_when_an_uncalibrated_steady_state_is_far_above_the_experiment(fitted):
-    summary = {"ball_steady_C": 124.6, "initial_temperature_C": 20.0, "simulated_s": 3600.0, "ball_C": 120.3}
+def test_the_answer_says_when_an_uncalibrated_steady_state_is_far_above_the_experiment(fitted, default_run_20s):
+    summary = default_run_20s.summary.updated(
+        ball_steady_C=124.6, initial_temperature_C=20.0, simulated_s=3600.0, ball_C=120.3
+    )
     sentences = answer_sentences(summary, "spex8000m", fitted=fitted)
     assert sentences[0].startswith("After 60 min the ball is at 120.3 °C")
     far_above = [sentence for sentence in sentences if "far above the experiment" in sentence]
@@ -79,13 +81,15 @@ def test_the_answer_says_when_an_uncalibrated_steady_state_is_far_above_the_expe
         assert len(far_above) == 1 and "3.7 times" in far_above[0] and CALIBRATED_PRESET in far_above[0]
 
 
-def test_a_3d_run_far_above_the_experiment_is_pointed_to_the_3d_calibrated_preset():
-    summary = {"ball_steady_C": 124.6, "initial_temperature_C": 20.0, "engine": "dem"}
+def test_a_3d_run_far_above_the_experiment_is_pointed_to_the_3d_calibrated_preset(default_run_20s):
+    summary = default_run_20s.summary.updated(ball_steady_C=124.6, initial_temperature_C=20.0, engine="dem")
     (far_above,) = (sentence for sentence in answer_sentences(summary, "spex8000m-3d") if "far above" in sentence)
     assert "Preset spex8000m-3d-calibrated is fitted to that experiment" in far_above
 
 
-def test_the_answer_of_a_run_close_to_the_experiment_makes_no_comparison():
-    summary = {"ball_steady_C": 50.0, "initial_temperature_C": 20.0}
+def test_the_answer_of_a_run_close_to_the_experiment_makes_no_comparison(default_run_20s):
+    summary = default_run_20s.summary.updated(ball_steady_C=50.0, initial_temperature_C=20.0)
     assert not any("experiment" in sentence for sentence in answer_sentences(summary, "spex8000m"))
-    assert "n/a" in answer_sentences({}, "spex8000m")[0]
+    # Numbers a run did not measure (NaN, null in summary.json) read "n/a".
+    unmeasured = summary.updated(simulated_s=float("nan"), **{key: float("nan") for key, *_ in ANSWER_KEYS})
+    assert "n/a" in answer_sentences(unmeasured, "spex8000m")[0]

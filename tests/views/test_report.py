@@ -109,7 +109,7 @@ def test_report_names_the_assumptions_and_the_deliberate_differences(report_html
 def at_the_experiments_operating_point(run: RunData, **changes) -> RunData:
     """``run`` as if it had lasted the experiment's hour (with ``changes``): Table 5 compares only such runs."""
     params = run.params.replace(duration=3600.0, **changes)
-    return dataclasses.replace(run, params=params, summary={**run.summary, "simulated_s": 3600.0})
+    return dataclasses.replace(run, params=params, summary=run.summary.updated(simulated_s=3600.0))
 
 
 def test_the_report_of_a_preset_whose_validation_failed_says_what_it_found(run_folder):
@@ -166,7 +166,7 @@ def test_report_shows_the_energy_audit_with_its_residual(run_folder, report_html
     energy = load_run(run_folder).energy
     rows = rows_of_table_after(report_html, "Energy audit")
     text = "\n".join(rows)
-    for key in ("work_by_vial", "dissipated", "heat_generated", "stored_ball", "residual", "relative_residual"):
+    for key in ("work_by_vial", "dissipated", "heat_generated", "stored_balls", "residual", "relative_residual"):
         assert f"<td>{key}</td>" in text, key
     assert number(energy["relative_residual"], ".3e") in text
     assert number(energy["work_by_vial"], ".6g") in text
@@ -175,7 +175,7 @@ def test_report_shows_the_energy_audit_with_its_residual(run_folder, report_html
 def test_report_shows_impact_statistics_and_numerics(run_folder, report_html):
     run = load_run(run_folder)
     impacts = "\n".join(rows_of_table_after(report_html, "Impacts"))
-    assert f">{run.summary['impacts']}<" in impacts
+    assert f">{run.summary.impacts}<" in impacts
     for wall in ("left", "right"):
         count = int((run.impacts["wall"] == wall).sum())
         assert f'impacts at the {wall} end face</td><td class="num">{count} (' in impacts
@@ -186,7 +186,7 @@ def test_report_shows_impact_statistics_and_numerics(run_folder, report_html):
     numerics = "\n".join(rows_of_table_after(report_html, "Numerics"))
     for label in ("accepted steps", "rejected steps", "right-hand-side evaluations", "wall time"):
         assert label in numerics
-    assert f">{run.summary['steps']}<" in numerics
+    assert f">{run.summary.steps}<" in numerics
 
 
 def test_report_is_self_contained_with_embedded_png_figures(report_html):
@@ -210,7 +210,7 @@ def test_text_from_the_run_is_escaped(run_folder):
 
 def test_unknown_preset_and_missing_numbers_still_render(run_folder):
     run = at_the_experiments_operating_point(load_run(run_folder))
-    summary = {**run.summary, "theta_inf_C": None, "tau_min": None}
+    summary = run.summary.updated(theta_inf_C=float("nan"), tau_min=float("nan"))  # null in summary.json
     document = render_report(dataclasses.replace(run, preset="no-such-preset", summary=summary))
     assert "is not known to this version of shakermill" in document
     assert "fitted</td>" not in document
@@ -327,14 +327,14 @@ def test_report_renders_in_headless_chromium(run_folder, tmp_path):
 def test_report_shows_the_runs_warnings_and_its_steady_state(run_folder, report_html):
     summary = load_run(run_folder).summary
     # 30 s is far shorter than the slowest time constant: the run says so in its answer, not as a warning.
-    assert any("slowest time constant" in line for line in summary["notes"])
-    assert not any("slowest time constant" in line for line in summary["warnings"])
+    assert any("slowest time constant" in line for line in summary.notes)
+    assert not any("slowest time constant" in line for line in summary.warnings)
     answer = re.search(r'<p class="statement answer">(.*?)</p>', report_html).group(1)
-    assert all(html.escape(note) in answer for note in summary["notes"])
-    for line in summary["warnings"]:
+    assert all(html.escape(note) in answer for note in summary.notes)
+    for line in summary.warnings:
         assert html.escape("Warning: " + line) in report_html
     results = "".join(rows_of_table_after(report_html, "Results"))
-    assert "ball steady state" in results and number(summary["ball_steady_C"], ".2f") in results
+    assert "ball steady state" in results and number(summary.ball_steady_C, ".2f") in results
 
 
 def test_table5_is_left_out_off_the_experiments_operating_point_and_the_report_says_why(run_folder, report_html):
@@ -352,9 +352,9 @@ def test_report_opens_with_the_answer_and_points_the_default_preset_to_the_calib
     answer = re.search(r'<p class="statement answer">(.*?)</p>', report_html).group(1)
     # Before every table: the answer is the first thing read.
     assert report_html.index(answer) < report_html.index("<table>")
-    assert f"the ball would settle at {summary['ball_steady_C']:.1f} °C" in answer
-    assert f"slowest time constant of the thermal network is {summary['slowest_time_constant_min']:.1f} min" in answer
-    assert f"{summary['heat_power_W']:.3g} W of heat at {summary['impact_rate_hz']:.3g} impacts per second" in answer
+    assert f"the ball would settle at {summary.ball_steady_C:.1f} °C" in answer
+    assert f"slowest time constant of the thermal network is {summary.slowest_time_constant_min:.1f} min" in answer
+    assert f"{summary.heat_power_W:.3g} W of heat at {summary.impact_rate_hz:.3g} impacts per second" in answer
     assert "far above the experiment" in answer and CALIBRATED_PRESET in answer
 
 

@@ -118,7 +118,7 @@ def test_the_temperature_figure_has_a_line_per_ball_in_celsius(stored):
     for ball in range(3):
         np.testing.assert_allclose(lines[f"ball {ball}"].get_ydata(), balls[:, ball])
     np.testing.assert_allclose(lines["vial"].get_ydata(), stored.timeseries["theta_vial_C"].values)
-    np.testing.assert_allclose(lines["air"].get_ydata(), stored.timeseries["theta_air_C"].values)
+    np.testing.assert_allclose(lines["inner air"].get_ydata(), stored.timeseries["theta_air_C"].values)
     assert axis.get_ylabel() == "temperature (°C)" and axis.get_xlabel() == "time (min)"
     assert "3 balls" in axis.get_title()
 
@@ -129,17 +129,17 @@ def test_heat_by_channel_adds_up_to_the_runs_heat(stored):
     for bar in made.patches:
         heights[round(bar.get_x() + bar.get_width() / 2)] += bar.get_height()
     assert [tick.get_text() for tick in made.get_xticklabels()] == list(CHANNELS)
-    impacts, span = stored.impacts, stored.summary["simulated_s"]
+    impacts, span = stored.impacts, stored.summary.simulated_s
     expected = [stored.params.eta * impacts[f"dissipated_{channel}"].sum() / span for channel in CHANNELS]
     np.testing.assert_allclose(heights, expected, rtol=1e-9)
     # The impact table misses only the contacts still open at the end: within a percent of the energy audit.
     np.testing.assert_allclose(
-        heights, [stored.summary[f"heat_{channel}_W"] for channel in CHANNELS], rtol=0.01, atol=1e-3
+        heights, [stored.summary.value(f"heat_{channel}_W") for channel in CHANNELS], rtol=0.01, atol=1e-3
     )
     assert heights[CHANNELS.index("sliding")] > 0.0  # friction is on: the channels are not all normal damping
     powers = [bar.get_height() for bar in received.patches]
     assert [tick.get_text() for tick in received.get_xticklabels()] == ["0", "1", "2", "vial"]
-    assert sum(powers) == pytest.approx(stored.summary["heat_power_W"], rel=1e-9)
+    assert sum(powers) == pytest.approx(stored.summary.heat_power_W, rel=1e-9)
     for axis in (made, received):
         assert axis.get_ylabel().endswith("(W)")
 
@@ -188,7 +188,7 @@ def test_an_animation_is_refused_for_a_window_without_motion_and_for_a_1d_run(st
 def test_the_report_has_a_table_per_ball_and_leaves_out_what_is_one_dimensional(stored):
     document = render_report(stored)
     assert "<h2>Balls</h2>" in document
-    temperatures = stored.summary["ball_temperatures_C"]
+    temperatures = stored.summary.ball_temperatures_C
     for ball, value in enumerate(temperatures):
         assert f'<td>{ball}</td><td class="num">6.35</td><td class="num">{value:.2f}</td>' in document
     assert "regime of the settled motion" not in document

@@ -60,7 +60,7 @@ def _walls(impacts: ImpactColumns) -> np.ndarray:
 
 def settled_run_impacts(run: Any) -> dict[str, np.ndarray]:
     """:func:`settled_impacts` of a :class:`~shakermill.simulate.Result` or a stored run (from its summary)."""
-    return settled_impacts(run.impacts, str(run.summary["solver"]), float(run.summary["simulated_s"]))
+    return settled_impacts(run.impacts, run.summary.solver, run.summary.simulated_s)
 
 
 def impact_phases(impacts: ImpactColumns, omega: float, phase: float) -> ImpactPhases:

@@ -106,22 +106,22 @@ class StressSpectrum:
     def as_summary(self) -> dict[str, float]:
         """The summary's keys: the median and 90th percentile of the total, of each part and for each target, and
         per threshold the events per second and their power."""
-        summary: dict[str, float] = {
+        keys: dict[str, float] = {
             "stress_window_s": self.window,
             "stress_lasting_power_W": self.lasting_power(),
             "stress_lasting_share": self.lasting_share(),
             "stress_lasting_contacts_hz": self.lasting_per_second(),
         }
         for name, q in PERCENTILES:
-            summary[f"stress_energy_{name}_J"] = self.percentile(q)
+            keys[f"stress_energy_{name}_J"] = self.percentile(q)
             for part in COMPONENTS[1:]:
-                summary[f"stress_energy_{part}_{name}_J"] = self.percentile(q, part)
+                keys[f"stress_energy_{part}_{name}_J"] = self.percentile(q, part)
             for target in TARGETS[1:]:
-                summary[f"stress_energy_{target}_{name}_J"] = self.percentile(q, target=target)
+                keys[f"stress_energy_{target}_{name}_J"] = self.percentile(q, target=target)
         for threshold in self.thresholds:
-            summary[f"stress_events_above_{threshold_name(threshold)}_hz"] = self.events_per_second(threshold)
-            summary[f"stress_power_above_{threshold_name(threshold)}_W"] = self.power(threshold)
-        return summary
+            keys[f"stress_events_above_{threshold_name(threshold)}_hz"] = self.events_per_second(threshold)
+            keys[f"stress_power_above_{threshold_name(threshold)}_W"] = self.power(threshold)
+        return keys
 
 
 def collision_energy(impacts: Mapping[str, Sequence], masses: Sequence[float]) -> np.ndarray:

@@ -120,7 +120,6 @@ def _plot_run_folder(
     folder: Path, target: Path, dpi: int, *, impacts: bool, window: int | None, frames: int | None
 ) -> list[Path]:
     """The figures of a run folder, and its animation of ``frames`` frames unless None; the files written."""
-    from shakermill.engines.registry import describe
     from shakermill.views.figures.common import check_window, plot_figures, several_balls
     from shakermill.views.figures.impacts import impact_figures
     from shakermill.views.figures.run import run_figures, write_animation
@@ -129,7 +128,7 @@ def _plot_run_folder(
     if frames is not None and not several_balls(run_data.params):
         fail(
             "--animate: the animation shows the balls of an engine that moves several in three dimensions (--set "
-            f"engine=dem); this run's engine is {describe(run_data.params.engine).keys.title}"
+            f"engine=dem); this run's engine is {run_data.description.keys.title}"
         )
     with user_errors():
         if window is not None:

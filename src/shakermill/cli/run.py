@@ -4,9 +4,10 @@ side, one impact on its own."""
 from __future__ import annotations
 
 import json
+import math
 import re
 import shutil
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, NoReturn
@@ -41,6 +42,7 @@ from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S, HIT_SPEE
 if TYPE_CHECKING:
     from shakermill.parameters.keys import Parameters
     from shakermill.solvers.result import Result
+    from shakermill.solvers.summary import Summary
 
 FIGURES_FOLDER = "figures"
 
@@ -72,6 +74,7 @@ def run(
     from shakermill.parameters.keys import unit_slip_warnings
     from shakermill.solvers.result import INTERRUPTED
     from shakermill.solvers.simulate import preflight
+    from shakermill.solvers.summary_versions import SCHEMA_VERSION, VERSION_KEY
 
     overrides = settings or []
     with user_errors():
@@ -98,12 +101,16 @@ def run(
     finished = not stopped and not held
     if finished:
         # An interrupted run is short by choice: its warnings (steady state, fit) stay in summary.json, unsaid.
-        echo_warnings([line for line in result.summary["warnings"] if line not in said_first])
+        echo_warnings([line for line in result.summary.warnings if line not in said_first])
         # After a Ctrl-C the figures are left to `plot`, so that it exits within a second.
         finished = no_plots or _draw_figures(result, target)
     if json_output:
         typer.echo(
-            json.dumps(to_jsonable({**result.summary, "output_dir": str(target)}), sort_keys=True, allow_nan=False)
+            json.dumps(
+                to_jsonable({VERSION_KEY: SCHEMA_VERSION, **result.summary.flat(), "output_dir": str(target)}),
+                sort_keys=True,
+                allow_nan=False,
+            )
         )
     elif finished:
         console = stdout_console()
@@ -119,17 +126,15 @@ def cluster_for_replicas(params: Parameters, scheduler: str | None, timeout: flo
     (solvers/replicas.py), or here. A scheduler a run would not use is refused in one line."""
     from contextlib import nullcontext
 
-    from shakermill.engines.registry import describe
     from shakermill.parameters.errors import ParameterError
     from shakermill.solvers.averaged import full_resolution_instead, replica_count
     from shakermill.studies.sweep_backends import connect
 
     if scheduler is None:
         return nullcontext()
-    description = describe(params.engine)
-    replicas = replica_count(params, description)
+    replicas = replica_count(params)
     if params.solver != "averaged" or full_resolution_instead(params) is not None or replicas < 2:
-        key = description.replicas_key
+        key = params.engine_keys.replicas_key
         wanted = f"{key} >= 2" if key else "an engine with replicas (engine = 'dem', dem_replicas >= 2)"
         raise ParameterError(
             f"--scheduler: this run sends nothing to a cluster (solver = {params.solver!r}, {replicas} "
@@ -175,23 +180,23 @@ def with_preset_findings(result: Result, preset: str | None, refitted: Sequence[
     known = PRESETS.get(preset) if preset is not None else None
     caveat = known.caveat_for(result.params.model_dump(), refitted) if known is not None else None
     if caveat:
-        result.summary["validation_caveat"] = caveat
+        result.summary = result.summary.updated(validation_caveat=caveat)
     uncertainty = uncertainty_of(known) if known is not None else None
     found = intervals(result, uncertainty) if uncertainty is not None else None
     if found is not None:
-        result.summary.update(found.as_summary())
+        result.summary = result.summary.updated(**found.as_summary())
 
 
-def answer_text(summary: Mapping[str, Any], preset: str | None, said: Sequence[str] = ()) -> str:
+def answer_text(summary: Summary, preset: str | None, said: Sequence[str] = ()) -> str:
     """The run's answer under its table: the report's sentences with the run's notes (but those ``said`` before the
     run), then the preset's caveat."""
     from shakermill.parameters.presets import PRESETS
     from shakermill.views.notebook import answer_sentences
 
     known = PRESETS.get(preset) if preset is not None else None
-    unsaid = {**summary, "notes": [note for note in summary.get("notes") or () if note not in said]}
+    unsaid = summary.updated(notes=[note for note in summary.notes if note not in said])
     text = " ".join(answer_sentences(unsaid, preset, fitted=known is None or bool(known.fitted)))
-    caveat = summary.get("validation_caveat")
+    caveat = summary.validation_caveat
     return text + (f"\nCaveat ({preset}): {caveat}" if caveat else "")
 
 
@@ -248,56 +253,53 @@ def _radii_mm(params: Parameters) -> str:
 
 def summary_table(result: Result, target: Path) -> Table:
     """The human summary of a run: fitted and final temperatures, impacts, power, numerics."""
-    from shakermill.engines.registry import describe
-
     s = result.summary
     table = Table(title="shakermill run", show_header=True)
     table.add_column("quantity")
     table.add_column("value", justify="right")
     table.add_column("unit")
-    fit_window = f"0–{number(s['simulated_s'] / 60.0, '.4g')} min"
-    description = describe(result.params.engine)
+    fit_window = f"0–{number(s.simulated_s / 60.0, '.4g')} min"
+    description = result.description
     # With several balls the temperatures, steady state and fit are the balls' means; their own rows say more.
     ball = "balls' mean" if description.several_balls else "ball"
     rows = [
-        ("status", s["message"] if not result.success else "ok", ""),
-        ("solver", s["solver"], ""),
+        ("status", s.message if not result.success else "ok", ""),
+        ("solver", s.solver, ""),
         (
             "drive ω",
-            f"{number(s['omega_rad_s'], '.4g')} rad/s = {number(s['omega_hz'], '.4g')} Hz = "
-            f"{number(s['omega_rpm'], '.0f')}",
+            f"{number(s.omega_rad_s, '.4g')} rad/s = {number(s.omega_hz, '.4g')} Hz = {number(s.omega_rpm, '.0f')}",
             "rpm",
         ),
         _size_row(result),
         (
             "ambient; initial temperature",
-            f"{number(s['ambient_temperature_C'], '.4g')}; {number(s['initial_temperature_C'], '.4g')}",
+            f"{number(s.ambient_temperature_C, '.4g')}; {number(s.initial_temperature_C, '.4g')}",
             "°C",
         ),
-        ("simulated time", number(s["simulated_s"], ".6g"), "s"),
-        (f"{ball} steady state", number(s["ball_steady_C"], ".2f"), "°C"),
-        ("vial; air steady state", f"{number(s['vial_steady_C'], '.2f')}; {number(s['air_steady_C'], '.2f')}", "°C"),
-        ("slowest time constant", number(s["slowest_time_constant_min"], ".1f"), "min"),
+        ("simulated time", number(s.simulated_s, ".6g"), "s"),
+        (f"{ball} steady state", number(s.ball_steady_C, ".2f"), "°C"),
+        ("vial; air steady state", f"{number(s.vial_steady_C, '.2f')}; {number(s.air_steady_C, '.2f')}", "°C"),
+        ("slowest time constant", number(s.slowest_time_constant_min, ".1f"), "min"),
         *_fit_rows(result, ball, fit_window),
-        (f"{ball} at the end", number(s["ball_C"], ".2f"), "°C"),
-        ("vial at the end", number(s["vial_C"], ".2f"), "°C"),
-        ("air at the end", number(s["air_C"], ".2f"), "°C"),
-        ("vial/ball increment ratio", number(s["vial_ball_ratio"], ".3f"), ""),
+        (f"{ball} at the end", number(s.ball_C, ".2f"), "°C"),
+        ("vial at the end", number(s.vial_C, ".2f"), "°C"),
+        ("air at the end", number(s.air_C, ".2f"), "°C"),
+        ("vial/ball increment ratio", number(s.vial_ball_ratio, ".3f"), ""),
         *interval_rows(s),
         *(several_ball_rows(s, description.channels) if description.several_balls else ()),
         *heat_path_rows(s),
-        ("impacts", number(s["impacts"], "d"), ""),
-        ("impact rate", number(s["impact_rate_hz"], ".2f"), "Hz"),
-        ("mean impact speed", number(s["mean_impact_speed_m_s"], ".3f"), "m/s"),
+        ("impacts", number(s.impacts, "d"), ""),
+        ("impact rate", number(s.impact_rate_hz, ".2f"), "Hz"),
+        ("mean impact speed", number(s.mean_impact_speed_m_s, ".3f"), "m/s"),
         (
             f"hits ≥ {HIT_SPEED:g} m/s: rate; mean speed",
-            f"{number(s['hit_rate_hz'], '.2f')} Hz; {number(s['mean_hit_speed_m_s'], '.3f')}",
+            f"{number(s.hit_rate_hz, '.2f')} Hz; {number(s.mean_hit_speed_m_s, '.3f')}",
             "m/s",
         ),
-        ("heat generated", number(s["heat_power_W"], ".3f"), "W"),
-        ("steps (rejected)", f"{s['steps']} ({s['rejected_steps']})", ""),
-        ("wall time", number(s["wall_time_s"], ".2f"), "s"),
-        ("energy audit residual", number(s["energy_audit_residual"], ".2e"), "relative"),
+        ("heat generated", number(s.heat_power_W, ".3f"), "W"),
+        ("steps (rejected)", f"{s.steps} ({s.rejected_steps})", ""),
+        ("wall time", number(s.wall_time_s, ".2f"), "s"),
+        ("energy audit residual", number(s.energy_audit_residual, ".2e"), "relative"),
         ("output folder", str(target), ""),
     ]
     for row in rows:
@@ -312,7 +314,7 @@ def _size_row(result: Result) -> tuple[str, str, str]:
     radii = _radii_mm(result.params)
     if reader_of(result.params).not_read("amplitude") is not None:
         return ("ball radius", radii, "mm")
-    return ("amplitude; ball radius", f"{number(result.summary['amplitude_mm'], '.4g')}; {radii}", "mm")
+    return ("amplitude; ball radius", f"{number(result.summary.amplitude_mm, '.4g')}; {radii}", "mm")
 
 
 def _fit_rows(result: Result, ball: str, fit_window: str) -> list[tuple[str, str, str]]:
@@ -326,55 +328,45 @@ def _fit_rows(result: Result, ball: str, fit_window: str) -> list[tuple[str, str
             (
                 "exponential fit",
                 f"none: the run is shorter than the slowest time constant "
-                f"({number(s['slowest_time_constant_min'], '.1f')} min)",
+                f"({number(s.slowest_time_constant_min, '.1f')} min)",
                 "",
             )
         ]
     return [
-        (f"{ball} θ∞ of the exponential fitted over {fit_window}", number(s["theta_inf_C"], ".2f"), "°C"),
-        ("τ of that fit", number(s["tau_min"], ".2f"), "min"),
-        ("initial heating rate θ̇₀ of that fit", number(s["rate0_C_per_min"], ".3f"), "°C/min"),
+        (f"{ball} θ∞ of the exponential fitted over {fit_window}", number(s.theta_inf_C, ".2f"), "°C"),
+        ("τ of that fit", number(s.tau_min, ".2f"), "min"),
+        ("initial heating rate θ̇₀ of that fit", number(s.rate0_C_per_min, ".3f"), "°C/min"),
     ]
 
 
-def interval_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
-    """The clamp's temperatures (thermal_model = 'mill-head') and the 90 % intervals of a calibrated preset's run."""
-    rows = []
-    if "clamp_C" in s:
-        rows.append(
-            (
-                "clamp at the end; steady state",
-                f"{number(s['clamp_C'], '.2f')}; {number(s.get('clamp_steady_C'), '.2f')}",
-                "°C",
-            )
-        )
-    for key, label in (
-        ("ball_C", "ball at the end"),
-        ("vial_C", "vial at the end"),
-        ("ball_steady_C", "ball steady state"),
-        ("vial_steady_C", "vial steady state"),
+def interval_rows(s: Summary) -> list[tuple[str, str, str]]:
+    """The temperatures of the nodes only some networks have (the holder of thermal_model = 'mill-head', ...) and the
+    90 % intervals of a calibrated preset's run."""
+    rows = [
+        (f"{node} at the end; steady state", f"{number(end, '.2f')}; {number(steady, '.2f')}", "°C")
+        for node, (end, steady) in s.further_nodes().items()
+    ]
+    for label, low, high in (
+        ("ball at the end", s.ball_C_low, s.ball_C_high),
+        ("vial at the end", s.vial_C_low, s.vial_C_high),
+        ("ball steady state", s.ball_steady_C_low, s.ball_steady_C_high),
+        ("vial steady state", s.vial_steady_C_low, s.vial_steady_C_high),
     ):
-        if f"{key}_low" in s:
-            rows.append(
-                (
-                    f"  90 % interval, {label}",
-                    f"{number(s[f'{key}_low'], '.1f')} to {number(s[f'{key}_high'], '.1f')}",
-                    "°C",
-                )
-            )
+        if low is not None:
+            rows.append((f"  90 % interval, {label}", f"{number(low, '.1f')} to {number(high, '.1f')}", "°C"))
     return rows
 
 
-def heat_path_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
+def heat_path_rows(s: Summary) -> list[tuple[str, str, str]]:
     """Each heat path's mean flow over the run, the balls' like paths summed (``ball 2 → air`` counts in
     ``balls → air``)."""
     totals: dict[str, float] = {}
-    for name, value in (s.get("heat_paths_W") or {}).items():
-        general = re.sub(r"ball \d+", "balls", name) if s.get("n_balls", 1) > 1 else name
-        totals[general] = totals.get(general, 0.0) + (value or 0.0)
+    for name, value in s.heat_paths_W.items():
+        general = re.sub(r"ball \d+", "balls", name) if (s.n_balls or 1) > 1 else name
+        totals[general] = totals.get(general, 0.0) + (0.0 if math.isnan(value) else value)
     rows = [(f"heat path {name}", number(value, ".3g"), "W") for name, value in totals.items()]
-    if s.get("drive_heat_W"):
-        rows.append(("drive heat into the clamp", number(s["drive_heat_W"], ".3g"), "W"))
+    if s.drive_heat_W:
+        rows.append(("drive heat into the holder", number(s.drive_heat_W, ".3g"), "W"))
     return rows
 
 
@@ -382,18 +374,18 @@ def heat_path_rows(s: Mapping[str, Any]) -> list[tuple[str, str, str]]:
 EACH_BALL_UP_TO = 6
 
 
-def several_ball_rows(s: Mapping[str, Any], channels: Sequence[str]) -> list[tuple[str, str, str]]:
+def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, str, str]]:
     """The run table's rows of an engine of several balls: balls, their temperatures at the end and steady states,
     impacts on the walls and between balls, heat by dissipation channel (``channels``)."""
     rows = [
         (
             "engine; balls; fill of the vial",
-            f"{s['engine']}; {s['n_balls']}; {number(s.get('fill_fraction'), '.3f')}",
+            f"{s.engine}; {s.n_balls}; {number(s.fill_fraction, '.3f')}",
             "",
         )
     ]
-    for key, what in (("ball_temperatures_C", "at the end"), ("balls_steady_C", "steady state")):
-        values = [value for value in s.get(key) or () if value is not None]
+    for each, what in ((s.ball_temperatures_C, "at the end"), (s.balls_steady_C, "steady state")):
+        values = [value for value in each or () if not math.isnan(value)]
         if not values:
             continue
         if len(values) <= EACH_BALL_UP_TO:
@@ -402,41 +394,39 @@ def several_ball_rows(s: Mapping[str, Any], channels: Sequence[str]) -> list[tup
             rows.append(
                 (f"balls {what}: coolest; hottest", f"{number(min(values), '.2f')}; {number(max(values), '.2f')}", "°C")
             )
-    rows.append(("impacts on the walls; between balls", f"{s['wall_impacts']}; {s['ball_ball_impacts']}", ""))
-    if s.get("stress_energy_median_J") is not None:
-        # Kwade's ½·m*·v_n² beside the energy dissipated, and how much of the dissipation neither describes.
-        rows.append(
-            (
-                "stress energy dissipated per impact: median; p90",
-                f"{number(s.get('stress_energy_median_J'), '.3g')}; {number(s.get('stress_energy_p90_J'), '.3g')}",
-                "J",
-            )
+    rows.append(("impacts on the walls; between balls", f"{s.wall_impacts}; {s.ball_ball_impacts}", ""))
+    # Kwade's ½·m*·v_n² beside the energy dissipated, and how much of the dissipation neither describes.
+    rows.append(
+        (
+            "stress energy dissipated per impact: median; p90",
+            f"{number(s.stress_energy_median_J, '.3g')}; {number(s.stress_energy_p90_J, '.3g')}",
+            "J",
         )
-        rows.append(
-            (
-                "½·m*·v_n² at contact (Kwade): median; p90",
-                f"{number(s.get('stress_energy_kinetic_median_J'), '.3g')}; "
-                f"{number(s.get('stress_energy_kinetic_p90_J'), '.3g')}",
-                "J",
-            )
+    )
+    rows.append(
+        (
+            "½·m*·v_n² at contact (Kwade): median; p90",
+            f"{number(s.stress_energy_kinetic_median_J, '.3g')}; {number(s.stress_energy_kinetic_p90_J, '.3g')}",
+            "J",
         )
-        share = s.get("stress_lasting_share")
-        rows.append(
-            (
-                "dissipation in lasting contacts (not in the medians)",
-                number(None if share is None else 100 * share, ".3g"),
-                "%",
-            )
+    )
+    share = s.stress_lasting_share
+    rows.append(
+        (
+            "dissipation in lasting contacts (not in the medians)",
+            number(100 * share, ".3g"),
+            "%",
         )
-    if s.get("charge_regime") is not None:
+    )
+    if s.charge_regime is not None:
         rows.append(
             (
                 "motion (pack: lasting contacts, under one impact > 1 m/s a ball and turn; else active)",
-                f"{s['charge_regime']}, {number(s.get('fast_impact_rate_hz'), '.4g')} impacts > 1 m/s a second",
+                f"{s.charge_regime}, {number(s.fast_impact_rate_hz, '.4g')} impacts > 1 m/s a second",
                 "",
             )
         )
-    heat = [s.get(f"heat_{channel}_W") for channel in channels]
+    heat = [s.heat_by_channel_W.get(channel) for channel in channels]
     if any(value is not None for value in heat):
         # The averaged solver has no split by channel: its heat comes from the thermal network's means.
         rows.append((f"heat by channel: {'; '.join(channels)}", "; ".join(number(value, ".3g") for value in heat), "W"))

@@ -45,6 +45,8 @@ if TYPE_CHECKING:
 SWEEP_PREVIEW_ROWS = 20
 
 
+# (column, label, unit): the sweep's regime, then summary keys (their names checked against solvers/summary.py where
+# the preview is drawn).
 SWEEP_PREVIEW_COLUMNS = (
     ("regime", "regime", ""),
     ("ball_steady_C", "steady", "°C"),
@@ -183,7 +185,11 @@ def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path, units:
     results."""
     import pandas as pd
 
+    from shakermill.solvers.summary import declared_names
     from shakermill.studies.sweep_storage import TABLE_CSV, TABLE_PARQUET, failed_points
+
+    regime, *summary_columns = (column for column, _, _ in SWEEP_PREVIEW_COLUMNS)
+    columns = (regime, *declared_names(summary_columns))
 
     preview = Table(title=f"shakermill sweep: {len(table)} points, {len(failed_points(table))} failed")
     for key in keys:
@@ -195,7 +201,7 @@ def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path, units:
         if pd.notna(row["error"]):
             results = ["failed", *([""] * (len(SWEEP_PREVIEW_COLUMNS) - 1))]
         else:
-            results = [_cell(row.get(column), ".4g") for column, _, _ in SWEEP_PREVIEW_COLUMNS]
+            results = [_cell(row.get(column), ".4g") for column in columns]
         add_plain_row(preview, *values, *results)
     more = len(table) - SWEEP_PREVIEW_ROWS
     preview.caption = (f"{more} more rows; " if more > 0 else "") + f"table: {target / TABLE_PARQUET} and {TABLE_CSV}"

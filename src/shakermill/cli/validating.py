@@ -39,7 +39,7 @@ def validate(
             help="Everything (~30 min on two cores): Table 5 at full resolution, the matrix's "
             "experiments of one ball, the structure study, the engines' one-ball comparison and the "
             "sensitivity to the assumed SPEX kinematics, and both SPEX experiments fitted over every uncertain input, "
-            "each predicting the other. Without it, a quick validation (~45 s on two cores).",
+            "each predicting the other. Without it, a quick validation (~2.5 min on two cores).",
         ),
     ] = False,
     solver: Annotated[
@@ -89,7 +89,7 @@ def validate(
             fail("report: the page holds the three-dimensional studies; allowed --report with --three-d (the default)")
         check_report_target(html, overwrite)
     typer.echo(
-        f"validate: {'everything (--full), ~30 min' if full else 'quick, ~45 s; --full for everything (~30 min)'}; "
+        f"validate: {'everything (--full), ~30 min' if full else 'quick, ~2.5 min; --full for everything (~30 min)'}; "
         f"Table 5 with the {solver} solver" + (", then the 3-D validation matrix" if three_d else ""),
         err=True,
     )
@@ -133,6 +133,8 @@ def print_report(report: Any) -> None:
         print_matrix(console, report.matrix)
     if report.structures:
         print_structures(console, report.structures)
+    for comparison in report.powder:
+        print_powder(console, comparison)
     if report.held_out is not None:
         print_held_out(console, report.held_out)
     if report.cross is not None:
@@ -194,6 +196,16 @@ def check_report_target(target: Path, overwrite: bool) -> None:
         fail(f"{target}: exists; choose another --report, or add --overwrite to replace it")
     with user_errors():
         check_writable_place(target, "--report")
+
+
+def print_powder(console: Console, comparison: Any) -> None:
+    from shakermill.views.validation_page import POWDER_HEADERS, powder_rows, powder_statement
+
+    table = Table(*POWDER_HEADERS, title=comparison.title)
+    for row in powder_rows(comparison):
+        add_plain_row(table, *row)
+    console.print(table)
+    console.print(Text(powder_statement(comparison)))
 
 
 def print_held_out(console: Console, held_out: Any) -> None:
@@ -259,7 +271,7 @@ def validation_table(runs: Sequence[Any]) -> Table:
     # The experiment's exponential plateau is its own estimate of the steady state; the paper gives none.
     steady = ["ball steady state (MODEL.md §11)", "°C", f"{TABLE5[0].experiment:g}", "n/a"]
     for run in runs:
-        value = run.summary["ball_steady_C"]
+        value = run.summary.number("ball_steady_C")
         steady += [f"{value:.4g} (predicted)", f"{100 * (value - TABLE5[0].experiment) / TABLE5[0].experiment:+.2f} %"]
     add_plain_row(table, *steady)
     deviation = ["RMS deviation from the experiment's curve, 0–60 min", "K", "0", "n/a"]

@@ -1,18 +1,22 @@
-"""The engine interface: what an engine declares (:class:`EngineDescription`) and what a run of it does
-(:class:`Engine`). The solvers drive any engine through it, and the files, figures, report and command line
-read an engine's description instead of asking which engine a run used (docs/ARCHITECTURE.md, "A new engine")."""
+"""The engine interface: what an engine declares (:class:`EngineDescription`), the core every run of an engine
+implements (:class:`Engine`: all the full solver needs) and the capabilities a solver may need beyond it and checks
+for (:class:`Averaging`, :class:`Replicas`, :class:`StepBound`, :class:`MemoryBound`). The solvers drive any engine
+through it, and the files, figures, report and command line read an engine's description instead of asking which
+engine a run used (docs/ARCHITECTURE.md, "The engine interface"). mypy checks that the built-in engines implement
+what they declare (pyproject.toml, ``[tool.mypy]``)."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, NamedTuple, Protocol
+from typing import TYPE_CHECKING, ClassVar, NamedTuple, Protocol, runtime_checkable
 
 from shakermill.parameters.engine_keys import EngineKeys
 
 if TYPE_CHECKING:
     import numpy as np
+    from numpy.typing import ArrayLike
 
     from shakermill.engines.budget import RunBudget
     from shakermill.engines.records import EnergyAudit, StateHistory
@@ -41,18 +45,14 @@ class EngineDescription:
         int, str
     ]  # every status code it reports (engines/status.py's and its own) and what it means
     averaging_error_key: str  # the key of its averaged solver's target relative standard error
-    # Keys that enter its thermal network alone, never its mechanics: runs that differ in these share one
-    # measured mechanics (solvers.simulate.thermal_variants). Empty where the temperatures share the mechanics'
-    # error control, as in the 1-D engine.
-    thermal_only_keys: tuple[str, ...]
     # Whether its runs can start from the spread of one-ball starts on the axis that the attractor probe settles.
     attractor_starts: bool
     # History variables that accumulate the heat per kelvin its contacts conducted (J/K), if it measures it: their
     # rates over the settled half of a full run are the contact conductances of the network (``kernel.contact_drive``).
     conduction_variables: tuple[str, ...] = ()
-    # The key of how many independent replicas of its mechanics the averaged solver runs and pools, if it takes any:
-    # its constructor then takes ``replica``, the number that seeds each replica's start (0: the configured start).
-    replicas_key: str | None = None
+    # Whether its contacts are the 'dem' engine's contact law stepped at ``contact_step_fraction``, so that a run of it
+    # is first checked on one lone impact of that law against the configured restitution (solvers/impact.py).
+    contact_step_guard: bool = False
 
     @property
     def name(self) -> str:
@@ -61,6 +61,16 @@ class EngineDescription:
     @property
     def several_balls(self) -> bool:
         return self.keys.several_balls
+
+    @property
+    def thermal_only_keys(self) -> tuple[str, ...]:
+        """The keys that enter its thermal network alone (:attr:`EngineKeys.thermal_only_keys`)."""
+        return self.keys.thermal_only_keys
+
+    @property
+    def replicas_key(self) -> str | None:
+        """The key of its number of replicas of the mechanics, if it takes any (:attr:`EngineKeys.replicas_key`)."""
+        return self.keys.replicas_key
 
 
 class Measured(NamedTuple):
@@ -72,14 +82,17 @@ class Measured(NamedTuple):
     heat: np.ndarray
     terms: np.ndarray
     dissipated: float
-    conduction: np.ndarray = ()
+    conduction: ArrayLike = ()
 
 
 ProgressCallback = Callable[[float, float], None]
 
 
 class Engine(Protocol):
-    """A run of an engine, from :class:`Parameters`: its state, advanced in budgeted calls, and what it produced."""
+    """The core every engine implements, and all the full solver needs: a run of it from :class:`Parameters`, its
+    state advanced in budgeted calls, what it produced and the load of its thermal network. What else a solver needs
+    is a capability the engine declares by deriving from it (:class:`Averaging`, :class:`Replicas`,
+    :class:`StepBound`, :class:`MemoryBound`), which the solver checks for."""
 
     description: ClassVar[EngineDescription]
     params: Parameters
@@ -90,7 +103,7 @@ class Engine(Protocol):
         self,
         params: Parameters,
         budget: RunBudget | None = None,
-        samples: Sequence[float] = (0.0,),
+        samples: Sequence[float] | np.ndarray = (0.0,),
         horizon: float = 0.0,
     ) -> None:
         """A run from ``params``' initial state, within ``budget`` (``params``' own if None); its history is sampled
@@ -128,18 +141,30 @@ class Engine(Protocol):
 
     @property
     def projection_correction(self) -> float:
-        """Kinetic energy (J) any energy projection of the engine added or removed so far."""
+        """Kinetic energy (J) any energy projection of the engine added or removed so far (``energy_audit``'s)."""
 
     def no_impact_note(self) -> str:
         """A hint for a run in which no impact happened (appended to its message), or ''."""
 
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: ArrayLike = ()) -> NetworkLoad:
+        """The thermal network's load from the mean rates of the heat of its sources (W), each ball's mean
+        velocity term and its contacts' mean conductances (W/K, if it measures them), of ``heat_variables``,
+        ``term_variables`` and ``conduction_variables`` (or of :meth:`Averaging.measured`): the steady state of every
+        run, and the drive of an averaged run's network."""
+
+
+# The members of the core, by name: what `engines.registry.register` checks a class it is given for (the data
+# members ``params``, ``budget`` and ``network`` are set by the constructor, and ``description`` is checked there).
+ENGINE_CORE = tuple(name for name in vars(Engine) if not name.startswith("_"))
+
+
+@runtime_checkable
+class Averaging(Protocol):
+    """Capability: the averaged solver can drive it (``solver = 'averaged'``). It measures cumulative means while its
+    mechanics runs, counts the impacts that heat each node, and builds the history of an averaged run."""
+
     def measured(self) -> Measured:
         """The cumulative quantities the averaged solver averages (:class:`Measured`)."""
-
-    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
-        """The thermal network's load from the mean rates of the heat of its sources (W), each ball's mean
-        velocity term and its contacts' mean conductances (W/K, if it measures them): of :meth:`measured` or of
-        ``heat_variables`` and ``term_variables``."""
 
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
         """How many of ``impacts`` heated each node of the network."""
@@ -155,3 +180,62 @@ class Engine(Protocol):
     ) -> StateHistory:
         """The history of an averaged run: the network's ``temperatures`` (node, time) and the cumulative heat
         lost; the flows as the load's mean rates times time; the motion, not computed, NaN."""
+
+
+@runtime_checkable
+class Replicas(Protocol):
+    """Capability: independent replicas of its mechanics, pooled by the averaged solver (solvers/replicas.py), for an
+    engine whose keys name a ``replicas_key``. Its constructor takes ``replica``, the number that seeds a replica's
+    start (0: the configured start); a replica advanced on a Dask cluster is counted by these two."""
+
+    def steps_taken(self) -> int:
+        """Accepted steps of the run so far."""
+
+    def take_impact_times(self) -> np.ndarray:
+        """The start times (s) of the impacts recorded since the last call, which it then forgets."""
+
+
+@runtime_checkable
+class StepBound(Protocol):
+    """Capability: a floor on a run's steps, so that a run its ``max_steps`` cannot finish is refused before it starts
+    (``solvers.simulate.preflight``)."""
+
+    @classmethod
+    def least_steps(cls, params: Parameters, simulated: float) -> float:
+        """The fewest steps ``simulated`` seconds of a run of ``params`` can take."""
+
+
+@runtime_checkable
+class MemoryBound(Protocol):
+    """Capability: what a run allocates at its start, so that one the machine's free memory cannot hold is refused
+    before it starts (``solvers.simulate.preflight``)."""
+
+    @classmethod
+    def memory_needed(cls, params: Parameters, samples: int) -> int:
+        """Bytes a run of ``params`` sampled ``samples`` times allocates at its start."""
+
+
+# Every capability an engine may have beyond the core.
+CAPABILITIES: tuple[type, ...] = (Averaging, Replicas, StepBound, MemoryBound)
+
+
+def capabilities_of(engine: type) -> tuple[str, ...]:
+    """The names of the capabilities the engine class ``engine`` has."""
+    return tuple(capability.__name__ for capability in CAPABILITIES if issubclass(engine, capability))
+
+
+class AveragedEngine(Engine, Averaging, Protocol):
+    """An engine with the :class:`Averaging` capability, as the averaged solver types it."""
+
+
+class ReplicatedEngine(AveragedEngine, Replicas, Protocol):
+    """An engine with :class:`Averaging` and :class:`Replicas`, built as the replica ``replica`` of a run."""
+
+    def __init__(
+        self,
+        params: Parameters,
+        budget: RunBudget | None = None,
+        samples: Sequence[float] | np.ndarray = (0.0,),
+        horizon: float = 0.0,
+        replica: int = 0,
+    ) -> None: ...

@@ -21,6 +21,10 @@ TIME_ATTRIBUTES = {"units": "s", "long_name": "simulated time"}
 
 # The variable of every ball's temperature (K), over (time, ball), of an engine that moves several balls.
 BALL_TEMPERATURES = "theta_balls"
+# The variable of the contacts' cumulative heat (J) into each node but the balls, over (time, node), and its attribute
+# that names the nodes in order (comma-separated): a run's files carry its network's nodes, whatever they are.
+HEAT_INTO_NODES = "heat_into_nodes"
+NODE_NAMES = "node_names"
 
 
 @dataclass(frozen=True)
@@ -78,7 +82,11 @@ class EnergyAudit:
 
     work_by_vial = Δkinetic + Δelastic + dissipated
     dissipated   = heat_generated + not_converted_to_heat
-    heat_generated + drive_heat = Δstored (ball + vial + air + clamp) + heat_lost_to_surroundings
+    heat_generated + drive_heat = Σ stored (every node) + heat_lost_to_surroundings
+
+    ``heat_into`` and ``stored`` hold the heat each node received from the contacts and the heat it stored, by node
+    as ``ThermalNetwork.grouped`` names them (the balls summed as "balls", then the vial, the air and any further
+    node: the holder, the powder), so that a new node is audited without a field of its own.
 
     ``projection_correction`` is the total |Δ kinetic energy| the energy
     projection applied at the end of contacts: the integrator's truncation
@@ -91,12 +99,9 @@ class EnergyAudit:
     elastic_energy_change: float
     dissipated: float
     heat_generated: float
-    heat_to_ball: float
-    heat_to_vial: float
+    heat_into: Mapping[str, float]
     not_converted_to_heat: float
-    stored_ball: float
-    stored_vial: float
-    stored_air: float
+    stored: Mapping[str, float]
     heat_lost_to_surroundings: float
     projection_correction: float
     # The 'dem' engine adds the work of gravity and splits the dissipation by channel (MODEL.md §12.4).
@@ -104,8 +109,8 @@ class EnergyAudit:
     # ... and the energy its tangential springs gain by stiffening with the load (engines.dem.model.TOTAL_NAMES)
     work_by_stiffening: float = 0.0
     dissipated_by_channel: Mapping[str, float] = field(default_factory=dict)
-    # A network with a mill head (thermal_model = 'mill-head') stores heat there and receives the drive's.
-    stored_clamp: float = 0.0
+    # Heat a node receives whatever the balls do: the drive's, into the holder of a mill head (thermal_model =
+    # 'mill-head').
     drive_heat: float = 0.0
 
     @property
@@ -115,7 +120,7 @@ class EnergyAudit:
 
     @property
     def thermal_residual(self) -> float:
-        stored = self.stored_ball + self.stored_vial + self.stored_air + self.stored_clamp
+        stored = sum(self.stored.values())
         return self.heat_generated + self.drive_heat - stored - self.heat_lost_to_surroundings
 
     @property
@@ -132,8 +137,12 @@ class EnergyAudit:
         return abs(self.residual) / scale if scale > 0.0 else 0.0
 
     def as_dict(self) -> dict[str, float]:
-        values = {key: value for key, value in self.__dict__.items() if key != "dissipated_by_channel"}
-        values.update({f"dissipated_{channel}": value for channel, value in self.dissipated_by_channel.items()})
+        """Every term as one flat mapping (J): the mappings by channel and by node spread as ``dissipated_<channel>``,
+        ``heat_into_<node>`` and ``stored_<node>``, and the residuals."""
+        mappings = {"dissipated_by_channel": "dissipated", "heat_into": "heat_into", "stored": "stored"}
+        values = {key: value for key, value in self.__dict__.items() if key not in mappings}
+        for key, prefix in mappings.items():
+            values.update({f"{prefix}_{name}": value for name, value in getattr(self, key).items()})
         values.update(
             mechanical_residual=self.mechanical_residual,
             thermal_residual=self.thermal_residual,

@@ -5,7 +5,8 @@ A run folder holds
 * ``timeseries.nc``   the sampled state history (NetCDF4 via h5netcdf; kelvin, SI units in attributes),
 * ``windows.nc``      the full-resolution state inside the record windows,
 * ``impacts.parquet`` one row per impact, units as JSON in the schema metadata under ``units``,
-* ``summary.json``    summary, energy audit, exponential fit, counters, status and message,
+* ``summary.json``    summary (its keys declared in ``solvers/summary.py``, their version as ``schema_version``),
+                      energy audit, exponential fit, counters, status and message,
 * ``config.toml``     the resolved parameters with provenance; ``shakermill run config.toml`` repeats the run,
 
 and, once it is in place, the figures the command line draws into it (``figures/``, in a folder of its own).
@@ -32,12 +33,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from shakermill.analysis.fit import ExponentialFit
+from shakermill.engines.interface import EngineDescription
 from shakermill.engines.records import TIME_ATTRIBUTES, StateHistory
 from shakermill.engines.registry import describe
 from shakermill.engines.status import REACHED_STOP
 from shakermill.parameters.config import load_config, write_config_toml
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.result import Result
+from shakermill.solvers.summary import Summary
+from shakermill.solvers.summary_versions import SCHEMA_VERSION, VERSION_KEY, SummaryVersionError, summary_from_document
 from shakermill.support.atomic import (
     SET_ASIDE,
     StorageError,
@@ -81,10 +85,11 @@ class RunData:
     windows: xr.Dataset
     impacts: pd.DataFrame
     impact_units: dict[str, str]
-    summary: dict[str, Any]
+    summary: Summary
     energy: dict[str, Any]
     ball_fit: ExponentialFit
     counters: dict[str, int]
+    description: EngineDescription  # what the run's engine declares, as a Result's
 
     @property
     def success(self) -> bool:
@@ -183,7 +188,7 @@ def write_run(
 
 def _write_contents(result: Result, folder: Path, *, preset: str, extra_provenance: Mapping[str, Any]) -> None:
     attributes = _run_attributes(result, preset)
-    description = describe(result.params.engine)
+    description = result.description
     coverage = averaging_coverage(result)
     history = _mark_averaged_variables(result.history, description, coverage) if coverage else result.history
     title = "shakermill sampled state history"
@@ -217,7 +222,7 @@ def averaging_coverage(result: Result) -> dict[str, str]:
     averages = result.averages
     if result.impact_window is None or averages is None:
         return {}
-    description = describe(result.params.engine)
+    description = result.description
     start, end = averages.transient, averages.transient + averages.window
     motion = (
         f"the ball's motion was integrated at full resolution only up to t = {end:.6g} s (the averaged solver's "
@@ -336,7 +341,8 @@ def summary_document(result: Result, preset: str) -> dict[str, Any]:
             "message": result.message,
             "preset": preset,
             "shakermill_version": __version__,
-            "summary": result.summary,
+            VERSION_KEY: SCHEMA_VERSION,
+            "summary": result.summary.flat(),
             "energy_audit": result.energy.as_dict(),
             "ball_fit": result.ball_fit.as_dict(),
             "counters": result.counters,
@@ -377,25 +383,33 @@ def load_run(path: Path | str) -> RunData:
         raise StorageError(f"{folder}: a file, not a shakermill run folder")
     if not summary_path.is_file():
         raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
-    document = _read_part(summary_path, _summary_document)
+    try:
+        document = _read_part(summary_path, _summary_document)
+    except SummaryVersionError as exc:
+        # What to do in the same line: re-run an old run (its config.toml repeats it), or read a newer one with a newer
+        # shakermill.
+        rerun = f"; re-run it to read it here: shakermill run {folder / CONFIG_FILE} --out NEW_FOLDER"
+        rerun = rerun if exc.older else ""
+        raise StorageError(f"{folder}: {SUMMARY_FILE} {exc}{rerun}") from None
     config = _read_part(folder / CONFIG_FILE, load_config)
-    impacts, impact_units = _read_part(
-        folder / IMPACTS_FILE, lambda path: _read_impact_table(path, config.params.engine)
-    )
+    # The one lookup by name: a run folder names its engine in config.toml; the run data carry its description.
+    description = describe(config.params.engine)
+    impacts, impact_units = _read_part(folder / IMPACTS_FILE, lambda path: _read_impact_table(path, description))
     return RunData(
         path=folder,
         params=config.params,
         preset=config.preset,
         status=document["status"],
         message=document["message"],
-        timeseries=_read_part(folder / TIMESERIES_FILE, lambda path: _read_history(path, config.params.engine)),
-        windows=_read_part(folder / WINDOWS_FILE, lambda path: _read_history(path, config.params.engine)),
+        timeseries=_read_part(folder / TIMESERIES_FILE, lambda path: _read_history(path, description)),
+        windows=_read_part(folder / WINDOWS_FILE, lambda path: _read_history(path, description)),
         impacts=impacts,
         impact_units=impact_units,
         summary=document["summary"],
         energy=document["energy_audit"],
         ball_fit=_fit_from_dict(document["ball_fit"]),
         counters=document["counters"],
+        description=description,
     )
 
 
@@ -421,27 +435,29 @@ SUMMARY_SHAPE = {
 
 
 def _summary_document(path: Path) -> dict[str, Any]:
+    """``summary.json`` with its summary read into the schema (an older version's brought forward where it can be:
+    :func:`~shakermill.solvers.summary_versions.summary_from_document`)."""
     document = json.loads(path.read_text(encoding="utf-8"))
     if not isinstance(document, dict):
         raise ValueError(f"a JSON {type(document).__name__}, not an object")
     for key, kind in SUMMARY_SHAPE.items():
         if type(document.get(key)) is not kind:  # not isinstance: true is no status
             raise ValueError(f"{key!r} is missing or not a JSON {kind.__name__}")
-    return document
+    return {**document, "summary": summary_from_document(document["summary"], document.get(VERSION_KEY))}
 
 
-def _read_history(path: Path, engine: str) -> xr.Dataset:
+def _read_history(path: Path, description: EngineDescription) -> xr.Dataset:
     import xarray as xr
 
     dataset = xr.load_dataset(path, engine=NETCDF_ENGINE)
     # What plot and report read (every version wrote them).
-    _require(describe(engine).read_back, dataset.variables, "variable")
+    _require(description.read_back, dataset.variables, "variable")
     return dataset
 
 
-def _read_impact_table(path: Path, engine: str) -> tuple[pd.DataFrame, dict[str, str]]:
+def _read_impact_table(path: Path, description: EngineDescription) -> tuple[pd.DataFrame, dict[str, str]]:
     impacts, units = read_impacts(path)
-    _require(describe(engine).impact_units, impacts.columns, "column")
+    _require(description.impact_units, impacts.columns, "column")
     return impacts, units
 
 

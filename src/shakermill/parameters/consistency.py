@@ -10,7 +10,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from shakermill.parameters.engine_keys import ENGINE_KEYS, MAX_BALLS, engine_problem
+from shakermill.parameters.engine_keys import MAX_BALLS, engine_problem
 from shakermill.parameters.geometry import ball_volume, balls_for_fill
 from shakermill.parameters.kinematic_models import (
     MAX_MOTION_TRANSLATION,
@@ -158,7 +158,7 @@ def _check_motion(motion: tuple[tuple[str, int, float, float], ...]) -> None:
 
 def balls_fit_side_by_side(params: Any) -> None:
     """Every ball moves in the bore, and the balls of an engine of several fit the vial together."""
-    if not ENGINE_KEYS[params.engine].several_balls:
+    if not params.engine_keys.several_balls:
         return
     radii = params.ball_values("ball_radius")
     largest = max(radii, default=0.0)

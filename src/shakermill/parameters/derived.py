@@ -7,12 +7,16 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from shakermill.parameters.engine_keys import ENGINE_KEYS
+from shakermill.parameters.engine_keys import ENGINE_KEYS, EngineKeys
 from shakermill.parameters.geometry import ball_volume, end_faces_area, vial_volume
+
+if TYPE_CHECKING:
+    import numpy
 
 
 class DerivedQuantities:
-    """Periods, masses, areas and volumes of a run, from the keys of the ``Parameters`` that inherit them."""
+    """Periods, masses, areas and volumes of a run, where its balls start and how its convection takes their speed,
+    from the keys of the ``Parameters`` that inherit them."""
 
     if TYPE_CHECKING:
         omega: float
@@ -25,7 +29,17 @@ class DerivedQuantities:
         air_cp: float
         air_heat_capacity_ratio: float
 
+        n_balls: int
+        ball_position: float
+        convection_velocity: str
+
         def ball_values(self, scalar_key: str) -> tuple[float, ...]: ...
+
+    @property
+    def engine_keys(self) -> EngineKeys:
+        """What the run's engine (the key ``engine``) takes and reads (``engine_keys.py``): the engine that every
+        layer below the engines knows of a run, without asking for it by name."""
+        return ENGINE_KEYS[self.engine]
 
     @property
     def period(self) -> float:
@@ -60,7 +74,7 @@ class DerivedQuantities:
     @property
     def balls_volume(self) -> float:
         """Σ 4/3·π R³ over every ball of the 'dem' engine, or the one ball of the 1-D engine (m³)."""
-        radii = self.ball_values("ball_radius") if ENGINE_KEYS[self.engine].several_balls else (self.ball_radius,)
+        radii = self.ball_values("ball_radius") if self.engine_keys.several_balls else (self.ball_radius,)
         return sum(ball_volume(radius) for radius in radii)
 
     @property
@@ -78,3 +92,22 @@ class DerivedQuantities:
     def air_heat_capacity(self) -> float:
         """c_a = c_p,a/γ: the trapped air is heated at constant volume (J/(kg·K))."""
         return self.air_cp / self.air_heat_capacity_ratio
+
+    @property
+    def relative_convection(self) -> bool:
+        """Whether Re takes the ball's speed relative to the vial (MODEL.md §§4, 12.5): by default where the air moves
+        with the vial, as the engine says (``engine_keys``)."""
+        if self.convection_velocity == "auto":
+            return self.engine_keys.air_moves_with_vial
+        return self.convection_velocity == "relative"
+
+    def initial_positions(self) -> numpy.ndarray | None:
+        """Ball centres (n_balls, 3) in the vial frame at t = 0 (m): one ball at ``ball_position`` on the axis,
+        several (or none) filled in from the bottom (:mod:`shakermill.parameters.packing`); None if they do not fit."""
+        import numpy as np
+
+        from shakermill.parameters.packing import placement
+
+        if self.n_balls == 1:
+            return np.array([[self.ball_position, 0.0, 0.0]])
+        return placement(np.array(self.ball_values("ball_radius")), self.vial_length, self.vial_diameter)

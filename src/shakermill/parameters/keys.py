@@ -43,7 +43,7 @@ from shakermill.support.limits import MAX_RECORD_WINDOWS, MAX_RECORDED_SECONDS, 
 from shakermill.support.presenters import present
 
 if TYPE_CHECKING:
-    import numpy
+    pass
 
 
 # Every key has hard bounds: a value outside them is refused with one line naming the key and its range.
@@ -151,6 +151,21 @@ class Parameters(DerivedQuantities, BaseModel):
     clamp_loss: float = quantity("W/K", "clamp-to-room conductance G_k (thermal_model = 'mill-head')", ge=0, le=1e3)
     drive_heat: float = quantity(
         "W", "heat Q_m the drive puts into the clamp whatever the balls do ('mill-head')", ge=0, le=1e3
+    )
+    # Powder (engine = 'dem'; MODEL.md §13, engines/thermal/powder.py): up to 1 kg, far beyond a planetary bowl's
+    # charge; 0 leaves the network without a powder node. The coefficient spans a loose layer millimetres thick
+    # (2k/ℓ with k ~0.05 W/(m·K)) to a thin, compacted one; 0 decouples the layer.
+    powder_mass: float = quantity("kg", "mass m_p of powder in the vial (engine = 'dem'); 0: none", ge=0, le=1.0)
+    powder_material: str = material_name("the powder", "powder_heat_capacity")
+    powder_heat_capacity: float = quantity("J/(kg*K)", "powder specific heat c_p (powder_mass > 0)", ge=50, le=5000)
+    powder_heat_share: float = quantity(
+        "", "share φ of each contact's heat deposited in the powder between the bodies (powder_mass > 0)", ge=0, le=1
+    )
+    powder_restitution: float = quantity(
+        "", "coefficient of restitution of powder-coated contacts, on the vial and between balls", gt=0, le=1
+    )
+    powder_contact_coefficient: float = quantity(
+        "W/(m^2*K)", "h_p through the powder layer to the vial's wall and the balls it coats", ge=0, le=1e5
     )
     # Collision and heat generation (Table 4)
     # A perfectly plastic contact (0) has no damping ratio. Towards 0 the ball chatters on the face and a
@@ -406,29 +421,10 @@ class Parameters(DerivedQuantities, BaseModel):
         consistency.thresholds_are_distinct(self)
         return self
 
-    @property
-    def relative_convection(self) -> bool:
-        """Whether Re takes the ball's speed relative to the vial (MODEL.md §§4, 12.5): by default where the air moves
-        with the vial, as the engine says (``engine_keys``)."""
-        if self.convection_velocity == "auto":
-            return ENGINE_KEYS[self.engine].air_moves_with_vial
-        return self.convection_velocity == "relative"
-
     def ball_values(self, scalar_key: str) -> tuple[float, ...]:
         """Each ball's value of ``scalar_key`` (e.g. 'ball_radius'): its per-ball list, or the scalar for all."""
         values = getattr(self, PER_BALL_KEY_OF[scalar_key])
         return tuple(values) if values else (getattr(self, scalar_key),) * self.n_balls
-
-    def initial_positions(self) -> numpy.ndarray | None:
-        """Ball centres (n_balls, 3) in the vial frame at t = 0 (m): one ball at ``ball_position`` on the axis,
-        several (or none) filled in from the bottom (:mod:`shakermill.parameters.packing`); None if they do not fit."""
-        import numpy as np
-
-        from shakermill.parameters.packing import placement
-
-        if self.n_balls == 1:
-            return np.array([[self.ball_position, 0.0, 0.0]])
-        return placement(np.array(self.ball_values("ball_radius")), self.vial_length, self.vial_diameter)
 
     @property
     def thermal_time_constants_at_rest(self) -> dict[str, tuple[float, tuple[str, ...]]]:
@@ -457,7 +453,7 @@ PER_BALL_KEY_OF = {
 }
 PER_BALL_KEYS = tuple(PER_BALL_KEY_OF.values())
 SCALAR_KEY_OF = {per_ball: scalar for scalar, per_ball in PER_BALL_KEY_OF.items()}
-MATERIAL_KEYS = ("ball_material", "vial_material", "ball_materials")
+MATERIAL_KEYS = ("ball_material", "vial_material", "powder_material", "ball_materials")
 
 
 def _check_per_ball(key: str, values: tuple[float, ...], n_balls: int) -> None:
@@ -561,7 +557,8 @@ def with_materials(layer: Mapping[str, Any]) -> dict[str, Any]:
 
 def material_sources(layer: Mapping[str, Any]) -> dict[str, tuple[Any, str]]:
     """The keys that the materials named in ``layer`` stand for, each with the material's value and source."""
-    return materials.filled_keys(layer, FIELD_NAMES, PER_BALL_KEY_OF)
+    single = tuple(key for key in MATERIAL_KEYS if key.endswith("_material"))
+    return materials.filled_keys(layer, FIELD_NAMES, PER_BALL_KEY_OF, single)
 
 
 def choices_of(key: str) -> tuple[str, ...]:

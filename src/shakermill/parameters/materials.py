@@ -166,13 +166,14 @@ def _named(key: str, name: Any) -> str:
 
 
 def filled_keys(
-    layer: Mapping[str, Any], keys: Sequence[str], per_ball_key_of: Mapping[str, str]
+    layer: Mapping[str, Any], keys: Sequence[str], per_ball_key_of: Mapping[str, str], material_keys: Sequence[str]
 ) -> dict[str, tuple[Any, str]]:
-    """The ``keys`` that the materials named in ``layer`` fill in, each with the material's value and source: a ball's
-    or the vial's properties (``ball_material``, ``vial_material``), each ball's per-ball list (``ball_materials``,
-    its list key by ``per_ball_key_of``)."""
+    """The ``keys`` that the materials named in ``layer`` fill in, each with the material's value and source: the
+    properties of what each of ``material_keys`` names (``ball_material`` fills ``ball_density``, ...), each ball's
+    per-ball list (``ball_materials``, its list key by ``per_ball_key_of``)."""
     filled: dict[str, tuple[Any, str]] = {}
-    for key, prefix in (("ball_material", "ball_"), ("vial_material", "vial_")):
+    for key in material_keys:
+        prefix = key.removesuffix("material")
         name = names_in(key, layer.get(key, ""))
         if name:
             found = material(name)

@@ -153,6 +153,25 @@ SPEX_8000M = Preset(
             "frame (not measured)",
         ),
         "drive_heat": Cited(0.0, "none unless measured or fitted (thermal_model = 'mill-head')"),
+        "powder_mass": Cited(0.0, "none: the paper's runs are of balls alone; set it for a charge with powder"),
+        "powder_material": Cited("iron", "assumption: iron, a common powder of mechanical alloying; set the charge's"),
+        "powder_heat_capacity": Cited(449.0, "material iron (CRC Handbook; recalled, not re-read)"),
+        "powder_heat_share": Cited(
+            0.5,
+            "assumption, range 0.2-0.8: powder caught between colliding bodies takes part of the impact's "
+            "deformation and friction as its own (Suryanarayana, Prog. Mater. Sci. 46 (2001) 1, §5: the powder is "
+            "trapped, deformed and heated at each collision; recalled); no measured share found",
+        ),
+        "powder_restitution": Cited(
+            0.5,
+            "assumption, range 0.2-0.8: a powder layer makes impacts less elastic than bare steel's 0.7 (no measured "
+            "value for coated milling media found)",
+        ),
+        "powder_contact_coefficient": Cited(
+            300.0,
+            "assumption, range 50-2000: 2k/ℓ of a powder layer ℓ ≈ 0.3 mm thick with a bed conductivity k ≈ 0.05 "
+            "W/(m·K) (loose metal powder in air, Zehner-Schlünder order of magnitude; recalled)",
+        ),
         "restitution": Cited(0.7, f"{PAPER}, Table 4 (e)"),
         "eta": Cited(0.9, f"{PAPER}, Table 4 (η)"),
         "lam": Cited(0.368, f"{PAPER}, Table 4 (λ)"),

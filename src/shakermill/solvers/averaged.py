@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -29,11 +29,18 @@ from scipy.integrate import solve_ivp
 
 from shakermill.analysis.fit import fit_exponential
 from shakermill.engines.budget import RunBudget
-from shakermill.engines.interface import Engine, EngineDescription, ProgressCallback
+from shakermill.engines.interface import (
+    AveragedEngine,
+    Averaging,
+    Engine,
+    ProgressCallback,
+    Replicas,
+    ReplicatedEngine,
+)
 from shakermill.engines.records import EnergyAudit
-from shakermill.engines.registry import describe
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
+from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.attractors import probe_attractors
 from shakermill.solvers.driver import Means, least_rounds, measure_means, sample_times
@@ -57,7 +64,7 @@ class Mechanics:
     differ in the engine's ``thermal_only_keys`` alone can reuse it (:meth:`serves`)."""
 
     params: Parameters
-    engine: Engine
+    engine: AveragedEngine
     means: Means | None  # None when Ctrl-C ended the mechanics
     status: int
 
@@ -78,10 +85,13 @@ def settle_mechanics(
 ) -> Mechanics:
     """Run the mechanics until its means converge; Ctrl-C ends it with the status INTERRUPTED and keeps the engine,
     so that what it integrated can still be returned. Only the start is sampled; the record windows are kept, by
-    the first of the replicas that an engine with a ``replicas_key`` runs (solvers/replicas.py) alone."""
-    engine = engine_class(params, budget, np.zeros(1), params.averaging_max_time)
-    count = replica_count(params, engine_class.description)
-    others = [engine_class(params, budget, np.zeros(1), 0.0, replica=number) for number in range(1, count)]
+    the first of the replicas that an engine with a ``replicas_key`` runs (solvers/replicas.py) alone. Raises
+    :class:`ParameterError` for an engine without the capabilities this needs (:func:`averaging_engine`)."""
+    engine = averaging_engine(engine_class)(params, budget, np.zeros(1), params.averaging_max_time)
+    count, others = replica_count(params), []
+    if count > 1:
+        replicated = replicated_engine(engine_class)
+        others = [replicated(params, budget, np.zeros(1), 0.0, replica=number) for number in range(1, count)]
     replicas, threads = replicas_of(engine, others)
     try:
         means, status = measure_means(params, replicas, progress, threads)
@@ -105,6 +115,7 @@ def simulate_averaged(
     the attractors, and a warning names every one whose heat power differs from the configured start's by more
     than 1 %. ``progress(done, total)`` is told the simulated seconds of each phase in turn.
     """
+    averaging_engine(engine_class)
     budget = budget if budget is not None else RunBudget.of(params)
     reason = full_resolution_instead(params)
     if reason is not None and mechanics is None:
@@ -129,17 +140,42 @@ def simulate_averaged(
     return result
 
 
-def replica_count(params: Parameters, description: EngineDescription) -> int:
-    """How many replicas of the mechanics an averaged run of ``params`` on the engine ``description`` describes
-    runs: the value of its ``replicas_key``, or 1."""
-    key = description.replicas_key
-    return getattr(params, key) if key else 1
+def averaging_engine(engine_class: type[Engine]) -> type[AveragedEngine]:
+    """``engine_class``, which the averaged solver drives through the capability Averaging (engines/interface.py);
+    :class:`ParameterError` in one line where the engine has it not."""
+    if not issubclass(engine_class, Averaging):
+        raise ParameterError(
+            "solver: the averaged solver needs an engine that measures the means it averages (the capability "
+            f"Averaging, engines/interface.py); engine = {engine_class.description.name!r} has not; allowed solver = "
+            "'full'"
+        )
+    return engine_class
+
+
+def replicated_engine(engine_class: type[Engine]) -> type[ReplicatedEngine]:
+    """``engine_class``, of which the averaged solver runs replicas (the capability Replicas besides Averaging);
+    :class:`ParameterError` in one line where the engine has it not."""
+    averaging = averaging_engine(engine_class)
+    if not issubclass(averaging, Replicas):
+        key = averaging.description.replicas_key or "replicas"
+        raise ParameterError(
+            f"{key}: the averaged solver runs replicas of an engine that builds them (the capability Replicas, "
+            f"engines/interface.py); engine = {averaging.description.name!r} has not; allowed {key} = 1"
+        )
+    return averaging
+
+
+def replica_count(params: Parameters) -> int:
+    """How many replicas of the mechanics an averaged run of ``params`` runs: the value of its engine's
+    ``replicas_key``, or 1."""
+    key = params.engine_keys.replicas_key
+    return int(getattr(params, key)) if key else 1
 
 
 def least_mechanics(params: Parameters) -> float:
     """The least mechanics (s) an averaged run can end with, all its replicas together: each runs
     :func:`~solvers.driver.least_rounds` batches of ``averaging_batch_periods`` drive periods."""
-    replicas = replica_count(params, describe(params.engine))
+    replicas = replica_count(params)
     return replicas * least_rounds(params, replicas) * params.averaging_batch_periods * params.period
 
 
@@ -150,7 +186,7 @@ def full_resolution_instead(params: Parameters) -> str | None:
     needed = least_mechanics(params)
     if params.solver != "averaged" or params.duration > needed:
         return None
-    replicas = replica_count(params, describe(params.engine))
+    replicas = replica_count(params)
     each = f" in each of {replicas} replicas" if replicas > 1 else ""
     return (
         f"Full resolution instead of the averaged solver: duration = {params.duration:g} s is no longer than the "
@@ -169,9 +205,11 @@ def _from_mechanics(
 ) -> Result:
     if mechanics.status != REACHED_STOP or mechanics.means is None:
         return _stopped(mechanics, mechanics.status, mechanics.explanation, started)
-    means = mechanics.means
-    # The mechanics may have been measured for parameters that differ in thermal-only keys: the network is params'.
+    # The mechanics may have been measured for parameters that differ in thermal-only keys: the network is params',
+    # the heat measured into each node moved onto it by name.
     network = engine_class.network_for(params)
+    measured = mechanics.means
+    means = replace(measured, load=measured.load.moved(mechanics.engine.network, network))
     problem = (
         means.averages.message if not means.averages.converged else time_scale_problem(mechanics.engine, network, means)
     )
@@ -183,15 +221,14 @@ def _from_mechanics(
     if not thermal.success:
         averages = _not_valid(means.averages, f"the thermal network solver failed: {thermal.message}")
         return _refuse(params, engine_class, mechanics, averages, progress, budget, started)
-    return _averaged_result(params, network, mechanics, thermal, started)
+    return _averaged_result(params, network, mechanics.engine, means, thermal, started)
 
 
 def _averaged_result(
-    params: Parameters, network: ThermalNetwork, mechanics: Mechanics, thermal: Any, started: float
+    params: Parameters, network: ThermalNetwork, engine: AveragedEngine, means: Means, thermal: Any, started: float
 ) -> Result:
     """The result of a valid averaged run: the network's temperatures for the whole duration, the motion and
     impacts of the averaging window, the audit of the mean rates."""
-    engine, means = mechanics.engine, mechanics.means
     averages, load = means.averages, means.load
     history = engine.averaged_history(
         thermal.t, thermal.y[:-1], thermal.y[-1], load, averages.dissipated_power, network
@@ -210,6 +247,7 @@ def _averaged_result(
         wall_time=time.perf_counter() - started,
         energy=averaged_energy(engine, network, means, thermal, impacts, params.duration),
         ball_fit=fit_exponential(thermal.t, history["theta_ball"], params.initial_temperature),
+        description=engine.description,
         solver="averaged",
         impact_window=averages.window,
         averages=averages,
@@ -217,7 +255,7 @@ def _averaged_result(
     return conclude(result, network, load)
 
 
-def time_scale_problem(engine: Engine, network: ThermalNetwork, means: Means) -> str | None:
+def time_scale_problem(engine: AveragedEngine, network: ThermalNetwork, means: Means) -> str | None:
     """Why averaging is not valid, or None: every heated node's thermal time constant must exceed the time between
     the impacts that heat it by TIME_SCALE_SEPARATION, or its temperature follows single impacts. The air, heated
     only by convection, is smooth between impacts, and its linear response to the fluctuating convection
@@ -263,7 +301,6 @@ def averaged_energy(
     """The audit of an averaged run: mean rates times the duration; the split by channel is that of the contacts of
     the averaging window."""
     load = means.load
-    balls, vial, air = slice(0, network.n_balls), network.vial, network.air
     capacity = network.arrays.capacity
     heat = load.heat_power * duration
     dissipated = means.averages.dissipated_power * duration
@@ -280,13 +317,9 @@ def averaged_energy(
         elastic_energy_change=0.0,
         dissipated=dissipated,
         heat_generated=heat,
-        heat_to_ball=float(load.heat[balls].sum() * duration),
-        heat_to_vial=float(load.heat[vial] * duration),
+        heat_into=network.grouped(load.heat * duration),
         not_converted_to_heat=dissipated - heat,
-        stored_ball=float(np.dot(capacity[balls], warming[balls])),
-        stored_vial=float(capacity[vial] * warming[vial]),
-        stored_air=float(capacity[air] * warming[air]),
-        stored_clamp=float(np.dot(capacity[air + 1 :], warming[air + 1 :])),
+        stored=network.grouped(capacity * warming),
         drive_heat=network.fixed_heat * duration,
         heat_lost_to_surroundings=float(thermal.y[-1, -1]),
         projection_correction=engine.projection_correction,
@@ -320,7 +353,7 @@ def _full_resolution_out_of_reach(params: Parameters, mechanics: Mechanics, star
     simulated = engine.t
     if simulated <= 0:
         return None
-    replicas = replica_count(params, engine.description)
+    replicas = replica_count(params)
     steps = engine.counters()["steps"] / simulated * params.duration
     wall = (time.perf_counter() - started) / (replicas * simulated) * params.duration
     if steps <= params.max_steps and wall <= params.max_wall_time:

@@ -26,7 +26,7 @@ from shakermill.engines.interface import Engine, Measured, ProgressCallback
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.keys import Parameters, bounds
-from shakermill.solvers.replicas import ReplicaSet
+from shakermill.solvers.replicas import Replica, ReplicaSet
 from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages
 
 # Simulated seconds per chunk: the granularity of progress reports (tiny steps hand back control sooner,
@@ -91,7 +91,7 @@ def _flat(measured: Measured) -> np.ndarray:
 
 
 def measure_means(
-    params: Parameters, engines: Sequence[Engine], progress: ProgressCallback | None, threads: int = 1
+    params: Parameters, engines: Sequence[Replica], progress: ProgressCallback | None, threads: int = 1
 ) -> tuple[Means, int]:
     """Run the mechanics of ``engines`` (independent replicas of one run, solvers/replicas.py) batch by batch, side by
     side on ``threads`` threads, until their pooled means converge (or :func:`mechanics_limit`); returns the means and
@@ -219,7 +219,7 @@ def _longer_window_hint(settled: Settled | None, t: float, target: float, limit_
     )
 
 
-def _in_each(engines: Sequence[Engine]) -> str:
+def _in_each(engines: Sequence[Replica]) -> str:
     return f" in each of {len(engines)} replicas" if len(engines) > 1 else ""
 
 
@@ -253,7 +253,7 @@ def mechanics_limit(params: Parameters) -> tuple[float, str]:
 
 
 def _means(
-    engines: Sequence[Engine], settled: Settled, sources: int, balls: int, rounds: int, converged: bool, message: str
+    engines: Sequence[Replica], settled: Settled, sources: int, balls: int, rounds: int, converged: bool, message: str
 ) -> Means:
     """The means of the settled, grouped batch rates of every replica (columns: each source's heat, each ball's
     term, each contact conductance, the dissipation). The conductances are averaged but not held to the target
@@ -306,7 +306,7 @@ def _change(settled: Settled, heat_power: float, error: float) -> str:
 CHANGE_SHARE = 0.1
 
 
-def _nothing_moves(engine: Engine, first: Measured) -> Means:
+def _nothing_moves(engine: Replica, first: Measured) -> Means:
     """The means of an empty mill (n_balls = 0): no contact heats anything, so there is nothing to average."""
     averages = MechanicsAverages(
         heat_power=0.0,

@@ -15,7 +15,7 @@ from shakermill.engines.records import StateHistory
 from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.driver import run_until, sample_times, stop_message
-from shakermill.solvers.result import Result, conclude
+from shakermill.solvers.result import MechanicsAverages, Result, conclude
 
 
 def simulate_full(
@@ -24,7 +24,8 @@ def simulate_full(
     progress: ProgressCallback | None = None,
     budget: RunBudget | None = None,
 ) -> Result:
-    """Run ``params`` at full resolution for ``params.duration`` seconds, within ``budget`` (``params``' if None).
+    """Run ``params`` at full resolution for ``params.duration`` seconds, within ``budget`` (``params``' if None):
+    any engine, through its core alone (``engines.interface.Engine``).
 
     ``progress(t, duration)`` is called after every chunk of simulated time, and more often when steps are tiny.
     Ctrl-C ends the run early with status ``INTERRUPTED`` and keeps everything computed so far; a spent budget
@@ -37,13 +38,28 @@ def simulate_full(
     return concluded(engine, status, stop_message(engine, status), time.perf_counter() - started)
 
 
-def concluded(engine: Engine, status: int, message: str, wall_time: float, **extra: object) -> Result:
-    """The result of what ``engine`` has integrated, concluded with the steady state of its settled means."""
-    result = result_of(engine, status, message, wall_time, **extra)
+def concluded(
+    engine: Engine,
+    status: int,
+    message: str,
+    wall_time: float,
+    solver: str = "full",
+    averages: MechanicsAverages | None = None,
+) -> Result:
+    """The result of what ``engine`` has integrated, concluded with the steady state of its settled means; ``solver``
+    and ``averages`` say what ran it (the averaged solver's mechanics, stopped)."""
+    result = result_of(engine, status, message, wall_time, solver, averages)
     return conclude(result, engine.network, settled_load(engine, result.history))
 
 
-def result_of(engine: Engine, status: int, message: str, wall_time: float, **extra: object) -> Result:
+def result_of(
+    engine: Engine,
+    status: int,
+    message: str,
+    wall_time: float,
+    solver: str = "full",
+    averages: MechanicsAverages | None = None,
+) -> Result:
     """``engine``'s history, windows, impacts, counters and energy audit as a :class:`Result` (not concluded)."""
     history = engine.history()
     impacts = engine.impact_columns()
@@ -59,7 +75,9 @@ def result_of(engine: Engine, status: int, message: str, wall_time: float, **ext
         wall_time=wall_time,
         energy=engine.energy_audit(),
         ball_fit=fit_exponential(history.times, history["theta_ball"], engine.params.initial_temperature),
-        **extra,
+        description=engine.description,
+        solver=solver,
+        averages=averages,
     )
 
 

@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from shakermill.engines.dem.engine import DemEngine
+    from shakermill.engines.interface import EngineDescription
 
 TARGETS = ("wall", "ball")
 # Faster than any mill or verification test; a ball this fast overlaps beyond what the engine allows anyway.
@@ -275,11 +276,13 @@ def single_impact(
     return _outcome(engine, record, incoming, speed, math.radians(angle_deg), kinetic_in)
 
 
-def restitution_warning(params: Parameters) -> str | None:
-    """A warning where the 'dem' engine's contact step misses the configured restitution by more than
-    :data:`RESTITUTION_TOLERANCE`, measured on one head-on impact of a ball on the end face at the vial's peak
-    speed (within :data:`GUARD_SPEEDS`); None for another engine, or where the impact is within it."""
-    if params.engine != "dem":
+def restitution_warning(params: Parameters, description: EngineDescription) -> str | None:
+    """A warning where the contact step of a run of ``params`` on the engine ``description`` describes misses the
+    configured restitution by more than :data:`RESTITUTION_TOLERANCE`, measured on one head-on impact of a ball on the
+    end face at the vial's peak speed (within :data:`GUARD_SPEEDS`) in the 'dem' engine, whose contact law it is;
+    None for an engine whose contacts are not that law (``description.contact_step_guard``), or where the impact is
+    within it."""
+    if not description.contact_step_guard:
         return None
     low, high = GUARD_SPEEDS
     speed = min(max(params.amplitude * params.omega, low), high)

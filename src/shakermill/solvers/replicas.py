@@ -17,17 +17,20 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_EXCEPTION, Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.calls import CALL_SECONDS
-from shakermill.engines.interface import Engine
+from shakermill.engines.interface import AveragedEngine, EngineDescription, Measured, ReplicatedEngine
+from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.environment import threads_cap
 
 if TYPE_CHECKING:
     from distributed import Client
+
 
 # Times a round is sent before its cancellation is taken as the cluster's answer (future.result() then raises it).
 ROUND_ATTEMPTS = 3
@@ -58,13 +61,34 @@ def _advance_elsewhere(engine: Any, t_stop: float) -> tuple[Any, int, np.ndarray
     return engine, status, engine.take_impact_times()
 
 
+class Replica(Protocol):
+    """What the averaged solver's driver (solvers/driver.py) asks of each replica of a run's mechanics: an engine with
+    the capability Averaging here, or a :class:`RemoteReplica` advanced on a cluster."""
+
+    @property
+    def description(self) -> EngineDescription: ...
+
+    @property
+    def t(self) -> float: ...
+
+    def advance(self, t_stop: float, heartbeat: Callable[[float], None] | None = None) -> int: ...
+
+    def explain(self, status: int) -> str: ...
+
+    def measured(self) -> Measured: ...
+
+    def impact_columns(self, since: float = -np.inf) -> dict[str, np.ndarray]: ...
+
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: ArrayLike = ()) -> NetworkLoad: ...
+
+
 class RemoteReplica:
     """A replica advanced as one Dask task per round: the task takes the engine as the last round left it and gives it
     back advanced, with the times of its impacts (the only records the averaged solver reads of a replica after the
     first). The numbers are those of the same engine advanced here, to the same round ends. A worker lost in a round
     loses that round alone: the scheduler runs the task again elsewhere from the same engine, to the same numbers."""
 
-    def __init__(self, engine: Engine, client: Client) -> None:
+    def __init__(self, engine: ReplicatedEngine, client: Client) -> None:
         self._engine = engine
         self._budget = engine.budget
         self._client = client
@@ -102,8 +126,11 @@ class RemoteReplica:
         self._impact_times.append(times)
         return status
 
-    def measured(self) -> Any:
+    def measured(self) -> Measured:
         return self._engine.measured()
+
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: ArrayLike = ()) -> NetworkLoad:
+        return self._engine.load(heat_rates, term_means, conductances)
 
     def explain(self, status: int) -> str:
         return self._engine.explain(status)
@@ -114,7 +141,7 @@ class RemoteReplica:
         return {"time": times[times >= since]}
 
 
-def replicas_of(first: Engine, others: Sequence[Engine]) -> tuple[list[Engine | RemoteReplica], int]:
+def replicas_of(first: AveragedEngine, others: Sequence[ReplicatedEngine]) -> tuple[list[Replica], int]:
     """The replicas of a run, the first here and the others on the cluster of :func:`replicas_on` if any, and the
     threads that advance them: one per replica with a cluster (they wait on it), else :func:`replica_threads`."""
     client = replica_cluster()
@@ -138,7 +165,7 @@ class _Stopped(Exception):
 class ReplicaSet:
     """Engines advanced together to the same times, on ``threads`` threads (use as a context manager)."""
 
-    def __init__(self, engines: Sequence[Engine], threads: int) -> None:
+    def __init__(self, engines: Sequence[Replica], threads: int) -> None:
         self.engines = list(engines)
         self.threads = max(1, min(threads, len(self.engines)))
         self._stop = threading.Event()

@@ -17,18 +17,18 @@ from shakermill.analysis.fit import ExponentialFit, increment_ratio
 from shakermill.analysis.regime import charge_regime
 from shakermill.analysis.steady import SteadyState, fits_no_exponential, run_length_note, steady_state
 from shakermill.analysis.stress_energy import stress_spectrum
+from shakermill.engines.interface import EngineDescription
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
-    CELSIUS_VARIABLES,
     EnergyAudit,
     StateHistory,
     kelvin_to_celsius,
 )
-from shakermill.engines.registry import describe
 from shakermill.engines.status import REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.defaults import FAST_IMPACT_SPEED, HIT_SPEED
 from shakermill.parameters.keys import Parameters, unit_slip_warnings
+from shakermill.solvers.summary import Summary, node_key
 from shakermill.support.presenters import present
 
 if TYPE_CHECKING:
@@ -117,6 +117,8 @@ class Result:
     wall_time: float
     energy: EnergyAudit
     ball_fit: ExponentialFit
+    # What its engine declares (engines/interface.py): the layers above read it here, not by the engine's name.
+    description: EngineDescription
     solver: str = "full"
     impact_window: float | None = None  # s covered by ``impacts``; None means the whole run
     averages: MechanicsAverages | None = None
@@ -131,7 +133,8 @@ class Result:
     # Sentences of advice that is not a problem (how the solver was chosen, a run shorter than its time to steady
     # state): they belong to the run's answer, not to its warnings.
     notes: list[str] = field(default_factory=list)
-    summary: dict[str, float | int | str | bool | list[str]] = field(default_factory=dict)
+    # Every number of the run by key, with its unit (solvers/summary.py); None until the run is concluded.
+    summary: Summary | None = None
 
     @property
     def success(self) -> bool:
@@ -140,11 +143,8 @@ class Result:
     def __repr__(self) -> str:
         """A few lines, as xarray and pandas objects print: what ran and how it ended, its headline numbers and the
         sizes of its data; the data themselves are ``timeseries``, ``impacts``, ``windows`` and ``summary``."""
-        shown = [
-            f"{REPR_HEADLINES[key]} {self.summary[key]:.4g}"
-            for key in REPR_HEADLINES
-            if isinstance(self.summary.get(key), (int, float))
-        ]
+        summary = self.summary
+        shown = [f"{label} {summary.number(key):.4g}" for key, label in REPR_HEADLINES.items() if summary is not None]
         impacts = next(iter(self.impact_columns.values()), np.zeros(0)).size
         lines = [
             f"<shakermill.Result: engine {self.params.engine!r}, solver {self.solver!r}, "
@@ -153,7 +153,7 @@ class Result:
             f"  {self.message if len(self.message) <= REPR_MESSAGE else self.message[: REPR_MESSAGE - 1] + '…'}",
             *([f"  {', '.join(shown)}"] if shown else []),
             f"  data: {self.history.times.size} samples of {len(self.history.variables)} series, {impacts} impacts, "
-            f"{self.window_history.times.size} window samples, {len(self.summary)} summary keys",
+            f"{self.window_history.times.size} window samples, {len(summary) if summary else 0} summary keys",
             *(
                 [f"  {len(self.warnings)} warning{'s' if len(self.warnings) != 1 else ''} (.warnings)"]
                 if self.warnings
@@ -325,11 +325,11 @@ def understood_inputs(params: Parameters) -> dict[str, float]:
     }
 
 
-def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]:
-    """The flat summary printed by ``run --json`` and stored as ``summary.json``."""
+def summarize(result: Result) -> Summary:
+    """The run's :class:`~shakermill.solvers.summary.Summary` (``Result.summary``), printed by ``run --json`` and
+    stored in ``summary.json``: every key is declared in ``solvers/summary.py`` with its unit and meaning."""
     params = result.params
     series = result.history
-    last = {name: float(series[name][-1]) for name in CELSIUS_VARIABLES}
     fit = result.ball_fit
     theta_0 = params.initial_temperature
     impacts = result.impact_columns
@@ -337,7 +337,12 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
     duration = max(result.t_end, 1e-300)
     impact_window = result.impact_window if result.impact_window else duration
     impact_rate = count / impact_window if impact_window > 0 else math.nan
-    summary = {
+    dissipated_power = result.energy.dissipated / duration
+    hit_rate, mean_hit_speed, fast_rate = _hits(impacts["impact_speed"], impact_window)
+    spectrum = stress_spectrum(
+        impacts, impact_window, params.stress_energy_thresholds, dissipated_power, params.ball_masses()
+    )
+    values: dict[str, Any] = {
         "status": result.status,
         "success": result.success,
         "message": result.message,
@@ -350,17 +355,17 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         "fit_rms_residual_K": fit.rms_residual,
         # Whether the exponential is worth reading: fitted, over a run no shorter than the slowest time constant.
         "exponential_fit_describes_run": bool(fit.success) and not shorter_than_its_network(result),
-        "ball_C": kelvin_to_celsius(float(last["theta_ball"])),
-        "vial_C": kelvin_to_celsius(float(last["theta_vial"])),
-        "air_C": kelvin_to_celsius(float(last["theta_air"])),
-        "vial_ball_ratio": increment_ratio(float(last["theta_vial"]), float(last["theta_ball"]), theta_0),
+        **end_temperatures(series),
+        "vial_ball_ratio": increment_ratio(float(series["theta_vial"][-1]), float(series["theta_ball"][-1]), theta_0),
         "solver": result.solver,
         "impacts": count if result.impact_window is None else int(round(impact_rate * duration)),
         "impact_rate_hz": impact_rate,
         "heat_power_W": result.energy.heat_generated / duration,
-        "dissipated_power_W": result.energy.dissipated / duration,
+        "dissipated_power_W": dissipated_power,
         "mean_impact_speed_m_s": float(impacts["impact_speed"].mean()) if count else math.nan,
-        **_hits(impacts["impact_speed"], impact_window),
+        "hit_rate_hz": hit_rate,
+        "mean_hit_speed_m_s": mean_hit_speed,
+        "fast_impact_rate_hz": fast_rate,
         "max_impact_speed_m_s": float(impacts["impact_speed"].max()) if count else math.nan,
         "mean_dissipated_per_impact_J": float(impacts["dissipated_energy"].mean()) if count else math.nan,
         "steps": result.counters["steps"],
@@ -371,51 +376,63 @@ def summarize(result: Result) -> dict[str, float | int | str | bool | list[str]]
         "energy_projection_relative": (
             result.energy.projection_correction / result.energy.dissipated if result.energy.dissipated > 0 else 0.0
         ),
+        **understood_inputs(params),
+        **spectrum.as_summary(),
+        **several_ball_summary(result),
+        **(steady_summary(result.steady) if result.steady is not None else {}),
+        "heat_paths_W": dict(result.heat_paths),
+        "drive_heat_W": result.energy.drive_heat / duration,
+        **(result.averages.as_summary() if result.averages is not None else {}),
+        **(result.attractors.as_summary() if result.attractors is not None else {}),
+        "warnings": list(result.warnings),
+        "notes": list(result.notes),
     }
-    summary.update(understood_inputs(params))
-    summary.update(
-        stress_spectrum(
-            impacts, impact_window, params.stress_energy_thresholds, summary["dissipated_power_W"], params.ball_masses()
-        ).as_summary()
-    )
-    summary.update(several_ball_summary(result))
-    if describe(params.engine).several_balls and math.isfinite(summary["stress_lasting_share"]):
-        summary["charge_regime"] = charge_regime(
-            summary["stress_lasting_share"],
-            summary["fast_impact_rate_hz"],
-            params.n_balls,
-            params.omega / (2.0 * math.pi),
+    if result.description.several_balls and math.isfinite(spectrum.lasting_share()):
+        values["charge_regime"] = charge_regime(
+            spectrum.lasting_share(), fast_rate, params.n_balls, params.omega / (2.0 * math.pi)
         )
-    if "theta_clamp" in series.variables:
-        summary["clamp_C"] = kelvin_to_celsius(float(series["theta_clamp"][-1]))
-    if result.steady is not None:
-        summary.update(result.steady.as_summary())
-    summary["heat_paths_W"] = dict(result.heat_paths)
-    summary["drive_heat_W"] = result.energy.drive_heat / duration
-    if result.averages is not None:
-        summary.update(result.averages.as_summary())
-    if result.attractors is not None:
-        summary.update(result.attractors.as_summary())
-    summary["warnings"] = list(result.warnings)
-    summary["notes"] = list(result.notes)
-    return summary
+    return Summary.of(values)
 
 
-def _hits(speeds: np.ndarray, window: float) -> dict[str, float]:
+def end_temperatures(history: StateHistory) -> dict[str, float]:
+    """The temperature (°C) at the end of every node ``history`` holds as ``theta_<node>`` (K, over time alone), as
+    the key ``<node>_C``: the ball (the balls' mean), the vial, the air and any further node of the network (the
+    holder, ..., and one no key names: the family ``{node}_C``). A name of no declared form fails the summary."""
+    found = {}
+    for name, (values, attributes) in history.variables.items():
+        node = name.removeprefix("theta_")
+        if node != name and attributes.get("units") == "K" and history.dims(name) == ("time",):
+            found[f"{node_key(node)}_C"] = kelvin_to_celsius(float(values[-1]))
+    return found
+
+
+def steady_summary(steady: SteadyState) -> dict[str, Any]:
+    """The steady state's keys (MODEL.md §11): each node's steady temperature (a further node under its summary name,
+    ``holder_steady_C``), the slowest time constant, the heat power it was computed for."""
+    values: dict[str, Any] = {}
+    for key, value in steady.as_summary().items():
+        node = key.removesuffix("_steady_C")
+        values[f"{node_key(node)}_steady_C" if node != key else key] = value
+    return values
+
+
+def _hits(speeds: np.ndarray, window: float) -> tuple[float, float, float]:
+    """Hits (impacts at or above HIT_SPEED) per second, their mean speed, and impacts at or above FAST_IMPACT_SPEED
+    per second."""
     speeds = np.asarray(speeds)
     hits = speeds[speeds >= HIT_SPEED]
     fast = np.count_nonzero(speeds >= FAST_IMPACT_SPEED)
-    return {
-        "hit_rate_hz": hits.size / window if window > 0 else math.nan,
-        "mean_hit_speed_m_s": float(hits.mean()) if hits.size else math.nan,
-        "fast_impact_rate_hz": fast / window if window > 0 else math.nan,
-    }
+    return (
+        hits.size / window if window > 0 else math.nan,
+        float(hits.mean()) if hits.size else math.nan,
+        fast / window if window > 0 else math.nan,
+    )
 
 
 def several_ball_summary(result: Result) -> dict[str, Any]:
     """The keys of an engine that moves several balls: impacts by kind, each ball's temperature and steady state, the
     heat by channel (none for an engine of one ball)."""
-    description = describe(result.params.engine)
+    description = result.description
     if not description.several_balls:
         return {}
     impacts = result.impact_columns
@@ -437,8 +454,7 @@ def several_ball_summary(result: Result) -> dict[str, Any]:
     }
     if result.steady is not None and result.steady.balls:
         keys["balls_steady_C"] = [kelvin_to_celsius(value) for value in result.steady.balls]
-    eta = result.params.eta
-    for channel, dissipated in result.energy.dissipated_by_channel.items():
-        keys[f"dissipated_{channel}_W"] = dissipated / duration
-        keys[f"heat_{channel}_W"] = eta * dissipated / duration
+    by_channel = {channel: dissipated / duration for channel, dissipated in result.energy.dissipated_by_channel.items()}
+    keys["dissipated_by_channel_W"] = by_channel
+    keys["heat_by_channel_W"] = {channel: result.params.eta * power for channel, power in by_channel.items()}
     return keys

@@ -7,15 +7,18 @@ import math
 from collections.abc import Callable
 
 from shakermill.engines.budget import BudgetExceeded, RunBudget
-from shakermill.engines.interface import ProgressCallback
+from shakermill.engines.interface import MemoryBound, ProgressCallback, StepBound
 from shakermill.engines.registry import engine_named
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.averaged import (
     Mechanics,
+    averaging_engine,
     full_resolution_instead,
     least_mechanics,
+    replica_count,
+    replicated_engine,
     settle_mechanics,
     simulate_averaged,
 )
@@ -30,9 +33,9 @@ def simulate(params: Parameters, progress: ProgressCallback | None = None, budge
     :func:`~shakermill.solvers.full.simulate_full` and :func:`~shakermill.solvers.averaged.simulate_averaged`.
     Raises :class:`ParameterError` before anything is allocated for a run that would not fit (:func:`preflight`)."""
     preflight(params)
-    # Measured before the run, so that a Ctrl-C is not kept waiting for it (its first call loads compiled code).
-    caution = restitution_warning(params)
     engine = engine_named(params.engine)
+    # Measured before the run, so that a Ctrl-C is not kept waiting for it (its first call loads compiled code).
+    caution = restitution_warning(params, engine.description)
     if params.solver == "averaged":
         result = simulate_averaged(params, engine, progress, budget)
     else:
@@ -48,17 +51,20 @@ MEMORY_SHARE = 0.8
 
 
 def preflight(params: Parameters) -> None:
-    """Raise :class:`ParameterError` with the estimate and the keys to change where a run of ``params`` could not end
-    within its step budget or the records and windows it allocates at its start exceed the memory free on this
-    machine (an engine that declares ``least_steps`` and ``memory_needed``; the 1-D engine's work and windows are
-    capped instead). Its wall-clock budget is judged by the run's pace once it runs (``RunBudget.outpaced``)."""
+    """Raise :class:`ParameterError` in one line where the run's engine lacks a capability its solver needs
+    (``engines.interface``: Averaging, and Replicas for several replicas), where a run of ``params`` could not end
+    within its step budget, or where the records and windows it allocates at its start exceed the memory free on this
+    machine (an engine with the capabilities StepBound and MemoryBound; the 1-D engine's work and windows are capped
+    instead). Its wall-clock budget is judged by the run's pace once it runs (``RunBudget.outpaced``)."""
     engine = engine_named(params.engine)
-    least_steps = getattr(engine, "least_steps", None)
-    if least_steps is not None:
-        _check_step_budget(params, least_steps)
-    needed_by = getattr(engine, "memory_needed", None)
-    if needed_by is not None:
-        _check_memory(params, needed_by)
+    if params.solver == "averaged":
+        averaging_engine(engine)
+        if replica_count(params) > 1:
+            replicated_engine(engine)
+    if issubclass(engine, StepBound):
+        _check_step_budget(params, engine.least_steps)
+    if issubclass(engine, MemoryBound):
+        _check_memory(params, engine.memory_needed)
 
 
 def _check_step_budget(params: Parameters, least_steps: Callable[[Parameters, float], float]) -> None:

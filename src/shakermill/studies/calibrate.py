@@ -29,7 +29,6 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from shakermill.engines.interface import ProgressCallback
-from shakermill.engines.registry import describe
 from shakermill.parameters.config import parse_overrides
 from shakermill.parameters.defaults import DEFAULT_FREE, DEFAULT_FREE_BY_NETWORK
 from shakermill.parameters.engine_keys import reader_of
@@ -205,7 +204,7 @@ def unstarted_defaults(params: Parameters) -> tuple[str, ...]:
 
 def _default_candidates(params: Parameters) -> tuple[str, ...]:
     reader = reader_of(params)
-    thermal_only = describe(params.engine).thermal_only_keys
+    thermal_only = params.engine_keys.thermal_only_keys
     return tuple(
         key
         for key in DEFAULT_FREE_BY_NETWORK[params.thermal_model]
@@ -286,7 +285,7 @@ def calibrate(
     residuals, results = evaluate(solution.x)
     result = results[()]
     fitted = {key: float(math.exp(v)) for key, v in zip(free, solution.x)}
-    achieved = {key: float(result.summary[key]) for key in targets}
+    achieved = {key: result.summary.number(key) for key in targets}
     at_bounds = [
         key for key, x, lo, hi in zip(free, solution.x, lower, upper) if x - lo < AT_BOUND or hi - x < AT_BOUND
     ]
@@ -297,9 +296,7 @@ def calibrate(
     predicted = [key for key in PREDICTED_KEYS if key not in targets]
     prediction_stderr = {} if full_resolution else _prediction_stderr(evaluate, solution.x, covariance, predicted)
     # Sampled only where an evaluation is a network alone: thousands of them take minutes there, hours elsewhere.
-    sampled = (
-        sample_posterior and covariance is not None and describe(base.engine).thermal_only_keys and not full_resolution
-    )
+    sampled = sample_posterior and covariance is not None and base.engine_keys.thermal_only_keys and not full_resolution
     posterior = (
         _sampled_posterior(evaluate, solution.x, (lower, upper), residuals, curves, on_posterior) if sampled else None
     )
@@ -316,7 +313,7 @@ def calibrate(
         covariance=None if covariance is None else covariance.tolist(),
         posterior=posterior,
         sensitivities=sensitivities(solution.jac, free, targets, curves),
-        predictions={key: float(result.summary[key]) for key in predicted},
+        predictions={key: result.summary.number(key) for key in predicted},
         prediction_stderr=prediction_stderr,
         at_bounds=at_bounds,
         success=status == "fitted",
@@ -421,7 +418,7 @@ TYPICAL_EVALUATIONS = 2000
 def check_full_resolution_work(base: Parameters, duration: float) -> None:
     """Refuse, with the estimate, a full-resolution fit that could not end in reasonable time: each evaluation a
     run of the 'dem' engine over the whole curve."""
-    if not describe(base.engine).several_balls or duration <= LONGEST_FULL_RESOLUTION_FIT_S:
+    if not base.engine_keys.several_balls or duration <= LONGEST_FULL_RESOLUTION_FIT_S:
         return
     raise ParameterError(
         f"--full-resolution: each of the fit's ~{TYPICAL_EVALUATIONS} evaluations would run {duration:g} s of "
@@ -474,7 +471,7 @@ def check_free_for_engine(base: Parameters, free: Sequence[str]) -> None:
     problem = reader_of(base).unread_problem(free, how="fitted")
     if problem is not None:
         raise ParameterError(f"free: {problem}")
-    thermal_only = describe(base.engine).thermal_only_keys
+    thermal_only = base.engine_keys.thermal_only_keys
     moving = [key for key in free if key not in thermal_only]
     if thermal_only and moving:
         raise ParameterError(
@@ -531,7 +528,7 @@ def _curve_residuals_K(results: Mapping[tuple[str, ...], Result], measured: Curv
 def _residuals(
     results: Mapping[tuple[str, ...], Result], targets: Mapping[str, float], curves: Sequence[Curve]
 ) -> np.ndarray:
-    parts = [(float(results[()].summary[key]) - value) / value for key, value in targets.items()]
+    parts = [(results[()].summary.number(key) - value) / value for key, value in targets.items()]
     for measured in curves:
         parts.extend(_curve_residuals_K(results, measured) / CURVE_SCALE_K)
     values = np.array(parts, dtype=float)
@@ -573,7 +570,10 @@ def _prediction_stderr(
     summary = evaluate(best)[1][()].summary
     gradients = np.array(
         [
-            [(evaluate(best + JACOBIAN_STEP * unit)[1][()].summary[key] - summary[key]) / JACOBIAN_STEP for key in keys]
+            [
+                (evaluate(best + JACOBIAN_STEP * unit)[1][()].summary.number(key) - summary.number(key)) / JACOBIAN_STEP
+                for key in keys
+            ]
             for unit in np.eye(best.size)
         ]
     )

@@ -45,14 +45,14 @@ class SolverComparison:
         """(quantity, unit, full, averaged, averaged − full) of each compared quantity."""
         full, averaged = self.full.summary, self.averaged.summary
         return [
-            (label, unit, full[key], averaged[key], averaged[key] - full[key])
+            (label, unit, full.value(key), averaged.value(key), averaged.number(key) - full.number(key))
             for key, label, unit in COMPARED_QUANTITIES
         ]
 
     def as_dict(self) -> dict[str, Any]:
         return {
-            "full": {key: self.full.summary[key] for key, _, _ in COMPARED_QUANTITIES},
-            "averaged": {key: self.averaged.summary[key] for key, _, _ in COMPARED_QUANTITIES},
+            "full": {key: self.full.summary.value(key) for key, _, _ in COMPARED_QUANTITIES},
+            "averaged": {key: self.averaged.summary.value(key) for key, _, _ in COMPARED_QUANTITIES},
             "averaged_solver_used": self.averaged.solver,
             "averaged_message": self.averaged.message,
             "speed_ratio": self.speed_ratio,

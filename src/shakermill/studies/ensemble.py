@@ -38,6 +38,7 @@ from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
+from shakermill.solvers.summary import declared_names, family_members
 from shakermill.studies.sweep import ProgressCallback, sweep
 
 # The headlines an ensemble reports: summary key -> (what it is, unit). Rises are computed from the end and
@@ -55,14 +56,17 @@ HEADLINES: dict[str, tuple[str, str]] = {
     "stress_energy_p90_J": ("stress energy, 90th percentile", "J"),
     "stress_lasting_share": ("share of the dissipation in lasting contacts", ""),
 }
-RISES = {
-    "ball_rise_K": "ball_C",
-    "vial_rise_K": "vial_C",
-    "air_rise_K": "air_C",
-    "ball_steady_rise_K": "ball_steady_C",
-    "vial_steady_rise_K": "vial_steady_C",
-}
-POWER_ABOVE = "stress_power_above_"
+RISES = dict(
+    zip(
+        ("ball_rise_K", "vial_rise_K", "air_rise_K", "ball_steady_rise_K", "vial_steady_rise_K"),
+        declared_names(("ball_C", "vial_C", "air_C", "ball_steady_C", "vial_steady_C")),
+        strict=True,
+    )
+)
+# The sweep table's columns read here besides: summary keys, their names checked against solvers/summary.py.
+START, REGIME = declared_names(("initial_temperature_C", "charge_regime"))
+# The powers above each stress-energy threshold: a family of summary keys, one per threshold.
+POWER_ABOVE = "stress_power_above_{threshold}_W"
 QUANTILES = (0.05, 0.5, 0.95)
 # The surrogate's cross-validated Q² below which its Sobol' indices are not reported, and its folds.
 LEAST_Q2 = 0.5
@@ -319,8 +323,8 @@ def analyse(
     finished = table[table["error"].isna()].copy() if "error" in table else table.copy()
     for rise, end in RISES.items():
         if end in finished:
-            finished[rise] = finished[end] - finished["initial_temperature_C"]
-    keys = [key for key in (*HEADLINES, *sorted(c for c in finished if c.startswith(POWER_ABOVE))) if key in finished]
+            finished[rise] = finished[end] - finished[START]
+    keys = [key for key in (*HEADLINES, *sorted(family_members(finished, POWER_ABOVE))) if key in finished]
     unit = to_unit(inputs, finished[[item.key for item in inputs]].to_numpy(dtype=float))
     names = [item.key for item in inputs]
     if posterior is not None:
@@ -340,7 +344,7 @@ def analyse(
 
 
 def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]) -> HeadlineSpread:
-    label, symbol = HEADLINES.get(key, (_power_label(key), "W"))
+    label, symbol = HEADLINES[key] if key in HEADLINES else (_power_label(key), "W")
     good = np.isfinite(values)
     quantiles = tuple(float(q) for q in np.quantile(values[good], QUANTILES)) if good.any() else (math.nan,) * 3
     varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * np.max(np.abs(values[good]))
@@ -351,7 +355,7 @@ def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]
 
 
 def _power_label(key: str) -> str:
-    return f"power in impacts above {key.removeprefix(POWER_ABOVE).removesuffix('_W')}"
+    return f"power in impacts above {family_members([key], POWER_ABOVE)[key]}"
 
 
 ASSUMED_PART, POSTERIOR_PART, NOISE_PART = "assumed inputs", "fitted keys' posterior", "unexplained"
@@ -429,9 +433,9 @@ def q2_of(values: np.ndarray, predicted: np.ndarray) -> float:
 def _regimes(finished: pd.DataFrame, keys: Sequence[str]) -> dict[str, dict[str, Any]]:
     """Each regime's share of the members, as their summaries name it (``charge_regime``: an engine of several
     balls), and its headlines' medians (MODEL.md §14.2)."""
-    if finished.empty or "charge_regime" not in finished:
+    if finished.empty or REGIME not in finished:
         return {}
-    named = finished["charge_regime"].to_numpy()
+    named = finished[REGIME].to_numpy()
     regimes = {}
     for name in (ACTIVE, PACK):
         members = named == name

@@ -17,6 +17,7 @@ from shakermill.parameters.keys import Parameters
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.parameters.presets import PRESETS, default_parameters
 from shakermill.solvers.simulate import thermal_variants
+from shakermill.solvers.summary import Summary
 from shakermill.studies.kinematics import DEFAULT_FACTORS, KinematicSensitivity, kinematic_sensitivity, measured
 from shakermill.studies.validation import relative_error
 
@@ -50,7 +51,7 @@ class HeldOutPrediction:
     fitted: tuple[str, ...]
     fitted_to: str
     rows: tuple[HeldOutRow, ...]
-    summary: Mapping[str, Any]
+    summary: Summary
 
     @property
     def statement(self) -> str:
@@ -62,27 +63,25 @@ class HeldOutPrediction:
         )
 
 
-def five_ball_rows(summary: Mapping[str, Any]) -> tuple[HeldOutRow, ...]:
+def five_ball_rows(summary: Summary) -> tuple[HeldOutRow, ...]:
     """The rises after one hour of the balls' mean and of the vial, and their ratio, beside the experiment."""
-    start = float(summary["initial_temperature_C"])
+    start = summary.initial_temperature_C
     return (
         HeldOutRow(
             "ball_rise_C",
             "ball temperature rise after 1 h",
             "K",
             FIVE_BALL_BALL_RISE_K,
-            float(summary["ball_C"]) - start,
+            summary.ball_C - start,
         ),
         HeldOutRow(
             "vial_rise_C",
             "vial temperature rise after 1 h",
             "K",
             FIVE_BALL_VIAL_RISE_K,
-            float(summary["vial_C"]) - start,
+            summary.vial_C - start,
         ),
-        HeldOutRow(
-            "vial_ball_ratio", "vial/ball rise ratio after 1 h", "", FIVE_BALL_RATIO, float(summary["vial_ball_ratio"])
-        ),
+        HeldOutRow("vial_ball_ratio", "vial/ball rise ratio after 1 h", "", FIVE_BALL_RATIO, summary.vial_ball_ratio),
     )
 
 

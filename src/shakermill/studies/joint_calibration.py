@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from shakermill.engines.registry import describe, engine_named
+from shakermill.engines.registry import engine_named
 from shakermill.parameters.assumed import AssumedInput, with_derived
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
@@ -135,7 +135,7 @@ def train(
     for name, count in (("members", members), ("thermal draws", thermal_draws)):
         if count < 1 or count & (count - 1):
             raise ParameterError(f"{name}: {count} is not allowed; a power of two (a Sobol' design is balanced there)")
-    thermal_only = set(describe(params.engine).thermal_only_keys)
+    thermal_only = set(params.engine_keys.thermal_only_keys)
     mechanical = [index for index, item in enumerate(inputs) if item.key not in thermal_only]
     network = [index for index, item in enumerate(inputs) if item.key in thermal_only]
     draws = thermal_draws if network else 1

@@ -108,7 +108,7 @@ def kinematic_sensitivity(
 def measured(params: Parameters, measures: Sequence[str]) -> dict[str, float]:
     """The summary keys ``measures`` of a whole run of ``params``."""
     summary = simulate_whole(params).summary
-    return {name: float(summary[name]) for name in measures}  # type: ignore[arg-type]
+    return {name: summary.number(name) for name in measures}
 
 
 def _relative(values: dict[str, float], baseline: dict[str, float]) -> dict[str, float]:

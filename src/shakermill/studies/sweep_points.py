@@ -6,7 +6,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from shakermill.engines.registry import describe
 from shakermill.io.runs import to_jsonable
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
@@ -50,7 +49,7 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
         # The averaged solver probed the other starts already; a full run has them probed here, unless
         # it stopped early: a probe would start a budget of its own after the run had spent the point's.
         # The probe settles one ball started on the axis: an engine whose runs do not start so has no such starts.
-        if result.success and describe(params.engine).attractor_starts:
+        if result.success and result.description.attractor_starts:
             probed(result)
     except PointInterrupted:
         raise
@@ -58,17 +57,16 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
         if _caused_by_ctrl_c(exc):
             raise PointInterrupted(str(exc)) from None
         return PointOutcome(failed_row(swept, f"{type(exc).__name__}: {exc}"))
-    summary = {(f"{key}{USED_SUFFIX}" if key in swept else key): value for key, value in result.summary.items()}
-    # A table cell holds one value: the warnings and notes become one string each, or none (CSV cannot tell "" from
-    # missing).
-    summary["warnings"] = "; ".join(summary["warnings"]) or None
-    summary["notes"] = " ".join(summary["notes"]) or None
+    # The summary's flat keys (solvers/summary.py) are the row's columns. A table cell holds one value: the warnings
+    # and notes become one string each, or none (CSV cannot tell "" from missing).
+    told = {"warnings": "; ".join(result.summary.warnings) or None, "notes": " ".join(result.summary.notes) or None}
+    columns = {**result.summary.flat(), **told}
     row = {
         **swept,
         "regime": regime,
         "period": period,
         "error": None if result.success else result.message,
-        **summary,
+        **{(f"{key}{USED_SUFFIX}" if key in swept else key): value for key, value in columns.items()},
         "output_dir": None,
     }
     return PointOutcome(to_jsonable(row), result if keep_run else None)

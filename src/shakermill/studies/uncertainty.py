@@ -118,7 +118,7 @@ def intervals(result: Result, uncertainty: Uncertainty) -> Intervals | None:
     if found is None:
         return None
     # The run's own values, which a full run's averaged network only approaches; the spread is the network's.
-    reported = {name: float(result.summary[name]) for name in HEADLINE}
+    reported = {name: result.summary.number(name) for name in HEADLINE}
     shift = {name: reported[name] - found.centre[name] for name in HEADLINE}
     return Intervals(
         reported,

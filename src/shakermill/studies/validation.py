@@ -17,6 +17,8 @@ from shakermill.support.limits import MAX_CURVE_POINTS, quoted
 if TYPE_CHECKING:
     import numpy as np
 
+    from shakermill.solvers.summary import Summary
+
 PAPER = "Son 2025, Mathematics 13, 446"
 EXPERIMENT = "Takacs & McHenry 2006 (J. Mater. Sci. 41, 5246), one ball, SPEX 8000"
 
@@ -321,9 +323,9 @@ class ComparisonRow:
         return "fitted" if self.fitted else "predicted"
 
 
-def compare(summary: Mapping[str, float], fitted_keys: tuple[str, ...] = ()) -> list[ComparisonRow]:
+def compare(summary: Summary, fitted_keys: tuple[str, ...] = ()) -> list[ComparisonRow]:
     """This model's Table 5 quantities from a run summary, marked fitted or predicted."""
-    return [ComparisonRow(entry, float(summary[entry.key]), entry.key in fitted_keys) for entry in TABLE5]
+    return [ComparisonRow(entry, summary.number(entry.key), entry.key in fitted_keys) for entry in TABLE5]
 
 
 VALIDATION_PRESETS = ("spex8000m", "spex8000m-calibrated")
@@ -334,7 +336,7 @@ class ValidationRun:
     preset: str
     fitted: tuple[str, ...]
     rows: list[ComparisonRow]
-    summary: Mapping[str, float]
+    summary: Summary
     curve_rms_K: float  # RMS deviation from the experiment's curve over the hour
     fitted_to_curve: bool
 

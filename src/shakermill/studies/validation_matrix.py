@@ -327,15 +327,15 @@ def structure_study(
         calibration = calibrate(base, structure.free, sample_posterior=False)
         five_balls = base.replace(n_balls=FIVE_BALLS, duration=3600.0, **calibration.fitted)
         summary = thermal_variants(five_balls)(five_balls).summary
-        start = float(summary["initial_temperature_C"])
+        start = summary.initial_temperature_C
         outcomes.append(
             StructureOutcome(
                 structure,
                 calibration.fitted,
                 float(calibration.curve_rms_K),
                 tuple(key for key in calibration.at_bounds if key in DEFENSIBLE_RANGES),
-                float(summary["ball_C"]) - start,
-                float(summary["vial_C"]) - start,
+                summary.ball_C - start,
+                summary.vial_C - start,
             )
         )
         if progress is not None:

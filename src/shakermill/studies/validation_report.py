@@ -15,6 +15,7 @@ from shakermill.parameters.keys import Parameters
 from shakermill.studies.calibrate import FREE_SET_STUDY, FreeSetOutcome, free_set_study
 from shakermill.studies.cross_prediction import CrossPrediction, cross_prediction
 from shakermill.studies.held_out import HeldOutStudies, held_out_steps, held_out_studies
+from shakermill.studies.powder import POWDER_STEPS, PowderComparison, powder_studies
 from shakermill.studies.validation import EXPERIMENT, TABLE5, VALIDATION_PRESETS, ValidationRun, validate
 from shakermill.studies.validation_matrix import (
     STRUCTURES,
@@ -45,6 +46,8 @@ class ValidationReport:
     everything: bool = True
     # Fitted over every uncertain input on one SPEX experiment, the other predicted (--full only).
     cross: CrossPrediction | None = None
+    # Five SPEX balls and a planetary mill, each without and with powder (with the 3-D studies).
+    powder: tuple[PowderComparison, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON object of ``validate --json``."""
@@ -62,6 +65,7 @@ class ValidationReport:
                 "structure_study": bool(self.structures),
                 "held_out": self.held_out is not None,
                 "cross_prediction": self.cross is not None,
+                "powder": bool(self.powder),
             },
             "quantities": {
                 entry.key: {
@@ -78,6 +82,7 @@ class ValidationReport:
             **({"validation_matrix": self.matrix.as_dict()} if self.matrix is not None else {}),
             **({"structure_study": [outcome.as_dict() for outcome in self.structures]} if self.structures else {}),
             **({"cross_prediction": self.cross.as_dict()} if self.cross is not None else {}),
+            **({"powder": [comparison.as_dict() for comparison in self.powder]} if self.powder else {}),
         }
 
 
@@ -89,8 +94,8 @@ def _run_entry(run: ValidationRun) -> dict[str, Any]:
         "relative_error_vs_experiment": {row.quantity.key: row.error_vs_experiment for row in run.rows},
         "role": {row.quantity.key: row.role for row in run.rows},
         "curve_rms_K": run.curve_rms_K,
-        "ball_steady_C": run.summary["ball_steady_C"],
-        "slowest_time_constant_min": run.summary["slowest_time_constant_min"],
+        "ball_steady_C": run.summary.ball_steady_C,
+        "slowest_time_constant_min": run.summary.slowest_time_constant_min,
     }
 
 
@@ -127,7 +132,7 @@ def validation_report(
     experiments = load_experiments() if everything else quick_experiments(load_experiments())
     # Every step counted, Table 5's runs and the free-set fits first: minutes pass before the 3-D studies begin.
     first = len(VALIDATION_PRESETS) + (len(FREE_SET_STUDY) if study else 0)
-    pairs = len(experiments) * len(THERMAL_MODEL_PRESETS) if three_d else 0
+    pairs = len(experiments) * len(THERMAL_MODEL_PRESETS) + POWDER_STEPS if three_d else 0
     runs = tuple(validate(solver, lambda done: show(done, first + pairs)))
 
     def fitted(done: int) -> None:
@@ -136,16 +141,20 @@ def validation_report(
     outcomes = tuple(free_set_study(preset_parameters(DEFAULT_PRESET), progress=fitted)) if study else ()
     if not three_d:
         return ValidationReport(solver, runs, outcomes, None, everything=False)
-    matrix = validation_matrix(experiments=experiments, progress=lambda done, total: show(first + done, first + total))
+    matrix = validation_matrix(
+        experiments=experiments, progress=lambda done, total: show(first + done, first + total + POWDER_STEPS)
+    )
+    done_matrix = first + pairs - POWDER_STEPS
+    powder = powder_studies(progress=lambda done, total: show(done_matrix + done, first + pairs))
     if not everything:
-        return ValidationReport(solver, runs, outcomes, None, matrix, everything=False)
+        return ValidationReport(solver, runs, outcomes, None, matrix, everything=False, powder=powder)
     before = first + pairs
     structures = structure_study(progress=lambda done, total: show(before + done, before + total))
     before += len(STRUCTURES)
     held_out = held_out_studies(lambda done, total: show(before + done, before + total))
     before += held_out_steps()
     cross = cross_prediction(progress=lambda done, total: show(before + done, before + total))
-    return ValidationReport(solver, runs, outcomes, held_out, matrix, structures, cross=cross)
+    return ValidationReport(solver, runs, outcomes, held_out, matrix, structures, cross=cross, powder=powder)
 
 
 def quick_experiments(experiments: Sequence[Experiment]) -> tuple[Experiment, ...]:

@@ -19,6 +19,7 @@ from shakermill.support.presenters import register
 if TYPE_CHECKING:
     from shakermill.parameters.keys import Parameters
     from shakermill.solvers.result import Result
+    from shakermill.solvers.summary import Summary
 
 # The experiment's ball temperature after the hour it lasted (Takacs & McHenry 2006 via Son 2025 Table 5).
 EXPERIMENT_BALL_C = 48.0
@@ -79,19 +80,19 @@ def rpm(omega: float) -> float:
     return omega * 60.0 / (2.0 * math.pi)
 
 
-def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitted: bool = False) -> list[str]:
+def answer_sentences(summary: Summary, preset: str | None = None, fitted: bool = False) -> list[str]:
     """The run's answer in plain sentences: where it ends, where it would settle, how fast, driven by what.
 
     For a preset that nothing was fitted to (``fitted`` False), one more sentence compares the
     steady state with the experiment and points to the calibrated preset. The run's notes (advice that is not a
     problem, such as a run shorter than its time to steady state) end it.
     """
-    v = {key: number(summary.get(key), spec) for key, _, _, spec in ANSWER_KEYS}
-    minutes = number(_number(summary.get("simulated_s")) / 60.0, ".3g")
-    notes = list(summary.get("notes") or ())
-    if summary.get("n_balls") == 0:
+    v = {key: number(summary.value(key), spec) for key, _, _, spec in ANSWER_KEYS}
+    minutes = number(_number(summary.simulated_s) / 60.0, ".3g")
+    notes = list(summary.notes)
+    if summary.n_balls == 0:
         return empty_mill_sentences(summary, v, minutes) + notes
-    if _number(summary.get("n_balls")) > 1:
+    if _number(summary.n_balls) > 1:
         # The experiment had one ball: several balls are not compared with it.
         return several_ball_sentences(summary, v, minutes) + notes
     sentences = [
@@ -111,9 +112,9 @@ def answer_sentences(summary: Mapping[str, Any], preset: str | None = None, fitt
     return sentences + notes
 
 
-def empty_mill_sentences(summary: Mapping[str, Any], v: Mapping[str, str], minutes: str) -> list[str]:
+def empty_mill_sentences(summary: Summary, v: Mapping[str, str], minutes: str) -> list[str]:
     """The answer of a run with no balls (MODEL.md §13.4): the vial warmed by what does not depend on them."""
-    drive = number(_number(summary.get("drive_heat_W")), ".3g")
+    drive = number(_number(summary.drive_heat_W), ".3g")
     return [
         f"An empty mill (no balls): after {minutes} min the vial is at {v['vial_C']} °C and the air at {v['air_C']} "
         "°C, "
@@ -123,14 +124,14 @@ def empty_mill_sentences(summary: Mapping[str, Any], v: Mapping[str, str], minut
     ]
 
 
-def several_ball_sentences(summary: Mapping[str, Any], v: Mapping[str, str], minutes: str) -> list[str]:
+def several_ball_sentences(summary: Summary, v: Mapping[str, str], minutes: str) -> list[str]:
     """The answer of a 'dem' run with several balls: the range of their temperatures and their mean."""
-    walls, between = _number(summary.get("wall_impacts")), _number(summary.get("ball_ball_impacts"))
+    walls, between = _number(summary.wall_impacts), _number(summary.ball_ball_impacts)
     share = walls / (walls + between) if walls + between > 0 else math.nan
     return [
-        f"After {minutes} min the {summary['n_balls']} balls are at {_spread(summary.get('ball_temperatures_C'))} °C "
+        f"After {minutes} min the {summary.n_balls} balls are at {_spread(summary.ball_temperatures_C)} °C "
         f"(mean {v['ball_C']} °C), the vial at {v['vial_C']} °C and the air at {v['air_C']} °C.",
-        f"Run on, the balls would settle at {_spread(summary.get('balls_steady_C'))} °C (mean {v['ball_steady_C']} °C; "
+        f"Run on, the balls would settle at {_spread(summary.balls_steady_C)} °C (mean {v['ball_steady_C']} °C; "
         f"vial {v['vial_steady_C']} °C, air {v['air_steady_C']} °C); the slowest time constant of the thermal "
         f"network is {v['slowest_time_constant_min']} min.",
         f"The impacts generate {v['heat_power_W']} W of heat at {v['impact_rate_hz']} impacts per second, "
@@ -148,17 +149,17 @@ def _number(value: Any) -> float:
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
 
 
-def _averaging_note(summary: Mapping[str, Any]) -> str:
-    if summary.get("solver") != "averaged":
+def _averaging_note(summary: Summary) -> str:
+    if summary.solver != "averaged":
         return ""
-    window = number(summary.get("averaging_window_s"), ".3g")
+    window = number(summary.averaging_window_s, ".3g")
     return f" (impacts resolved over the {window} s averaging window, the rate holding for the whole run)"
 
 
-def experiment_comparison(summary: Mapping[str, Any], preset: str) -> str:
+def experiment_comparison(summary: Summary, preset: str) -> str:
     """A sentence on how the uncalibrated steady state stands to the experiment's 48 °C; empty without one."""
-    steady = _number(summary.get("ball_steady_C"))
-    start = _number(summary.get("initial_temperature_C"))
+    steady = _number(summary.ball_steady_C)
+    start = _number(summary.initial_temperature_C)
     if not (math.isfinite(steady) and math.isfinite(start)):
         return ""
     ratio = (steady - start) / (EXPERIMENT_BALL_C - start)
@@ -168,7 +169,7 @@ def experiment_comparison(summary: Mapping[str, Any], preset: str) -> str:
         f"With preset {preset}, which uses the published parameters and fits nothing, this is far above the "
         f"experiment: the ball's temperature rise is {ratio:.1f} times the experiment's, which approached "
         f"{EXPERIMENT_BALL_C:g} °C within the hour (Takacs & McHenry 2006). Preset "
-        f"{CALIBRATED_PRESETS.get(str(summary.get('engine')), CALIBRATED_PRESET)} is fitted to that experiment; use it "
+        f"{CALIBRATED_PRESETS.get(str(summary.engine), CALIBRATED_PRESET)} is fitted to that experiment; use it "
         "for predictions near it."
     )
 
@@ -208,7 +209,7 @@ def result_html(result: Result) -> str:
     """Status, the answer in sentences and a table, the key inputs and the warnings of ``result``."""
     summary = result.summary
     status = "completed" if result.success else f"stopped early (status {result.status})"
-    answer = [(label, number(summary.get(key), spec), unit) for key, label, unit, spec in ANSWER_KEYS]
+    answer = [(label, number(summary.value(key), spec), unit) for key, label, unit, spec in ANSWER_KEYS]
     warnings = "".join(f"<li>{esc(line)}</li>" for line in result.warnings)
     return (
         f'<div class="shakermill-view">{STYLE}'

@@ -21,7 +21,6 @@ from typing import Any
 
 from shakermill.io.runs import CONFIG_FILE, RunData, load_run
 from shakermill.parameters.defaults import DEFAULT_PRESET, REPORT_FILE
-from shakermill.parameters.engine_keys import reads
 from shakermill.parameters.keys import field_description, field_unit, material_sources
 from shakermill.parameters.presets import PRESETS, Preset
 from shakermill.studies.validation import (
@@ -53,7 +52,6 @@ from shakermill.views.report_sections import (
     balls_section,
     captions_of,
     energy_section,
-    finite_summary,
     impacts_section,
     numerics_section,
 )
@@ -251,16 +249,14 @@ def header_section(run: RunData, preset: Preset | None) -> str:
         ("run folder", str(run.path.resolve())),
         ("preset", f"{run.preset}: {preset.description}" if preset else f"{run.preset} (not known to this version)"),
         ("model", model_name(run)),
-        ("solver", str(run.summary.get("solver", "n/a"))),
-        ("simulated time", f"{number(run.summary.get('simulated_s'), '.6g')} s"),
+        ("solver", run.summary.solver),
+        ("simulated time", f"{number(run.summary.simulated_s, '.6g')} s"),
         ("written by", f"shakermill {provenance.get('shakermill_version', 'n/a')}"),
         ("created (UTC)", str(provenance.get("created_utc", "n/a"))),
         ("command", str(provenance.get("command", "n/a"))),
         ("overrides (--set)", ", ".join(provenance.get("overrides", [])) or "none"),
     ]
-    warnings = "".join(
-        f'<p class="status failed">{esc("Warning: " + line)}</p>\n' for line in run.summary.get("warnings", [])
-    )
+    warnings = "".join(f'<p class="status failed">{esc("Warning: " + line)}</p>\n' for line in run.summary.warnings)
     return (
         f"<header>\n<h1>{esc('shakermill run report: ' + run_name(run))}</h1>\n"
         f'<p class="status {status_class}">{esc(status)}</p>\n{warnings}'
@@ -281,18 +277,17 @@ def answer_html(run: RunData, preset: Preset | None) -> str:
 
 def results_section(run: RunData) -> str:
     summary = run.summary
-    # A summary written before the key existed showed the fit's rows whatever the run's length.
-    describes = summary.get("exponential_fit_describes_run", True)
+    describes = summary.exponential_fit_describes_run
     rows = [
-        (label, number(summary.get(key), spec), unit)
+        (label, number(summary.value(key), spec), unit)
         for key, label, unit, spec in RESULT_QUANTITIES
         if key not in FIT_KEYS or describes
     ]
     uncertainty = (
         (
-            f"Standard errors of the fit: θ∞ ± {number(summary.get('theta_inf_stderr_K'), '.2g')} K, "
-            f"τ ± {number(summary.get('tau_stderr_min'), '.2g')} min; "
-            f"RMS residual {number(summary.get('fit_rms_residual_K'), '.2g')} K."
+            f"Standard errors of the fit: θ∞ ± {number(summary.theta_inf_stderr_K, '.2g')} K, "
+            f"τ ± {number(summary.tau_stderr_min, '.2g')} min; "
+            f"RMS residual {number(summary.fit_rms_residual_K, '.2g')} K."
         )
         if describes
         else (
@@ -307,9 +302,13 @@ def results_section(run: RunData) -> str:
 TABLE5_TITLE = "Table 5: experiment, the paper's model and this run"
 
 
+def _or_zero(value: float) -> float:
+    return value if math.isfinite(value) else 0.0
+
+
 def table5_section(run: RunData, preset: Preset | None) -> str:
     vial = (preset or PRESETS[DEFAULT_PRESET]).values
-    values = {**run.params.model_dump(), "duration": float(run.summary.get("simulated_s") or 0.0)}
+    values = {**run.params.model_dump(), "duration": _or_zero(run.summary.simulated_s)}
     mismatches = operating_point_mismatches(values, {key: cited.value for key, cited in vial.items()})
     if run.params.n_balls != 1:
         mismatches.append(f"n_balls = {run.params.n_balls} (experiment: one ball)")
@@ -321,7 +320,7 @@ def table5_section(run: RunData, preset: Preset | None) -> str:
             "are not comparable with the experiment's."
         )
         return section(TABLE5_TITLE, paragraph(reason, "statement"))
-    rows = compare(finite_summary(run.summary), fitted_targets(preset))
+    rows = compare(run.summary, fitted_targets(preset))
     cells = []
     notes = []
     for row in rows:
@@ -410,7 +409,7 @@ def configuration_section(run: RunData, preset: Preset | None) -> str:
     differs = {}
     everything = run.params.model_dump()
     from_materials = material_sources(everything)
-    values = {key: value for key, value in everything.items() if reads(run.params.engine, key)}
+    values = {key: value for key, value in everything.items() if key in run.params.engine_keys.reads}
     for index, (key, value) in enumerate(values.items()):
         cited = preset.values.get(key) if preset else None
         if cited is None:
@@ -465,10 +464,10 @@ def comparison_section(run: RunData, other: RunData, numbers: Iterator[int]) -> 
     rows = [
         ("model", "", model_name(run), model_name(other), ""),
         ("preset", "", run.preset, other.preset, ""),
-        ("solver", "", str(run.summary.get("solver")), str(other.summary.get("solver")), ""),
+        ("solver", "", run.summary.solver, other.summary.solver, ""),
     ]
     for key, label, unit, spec in COMPARED_QUANTITIES:
-        a, b = run.summary.get(key), other.summary.get(key)
+        a, b = run.summary.value(key), other.summary.value(key)
         difference = b - a if isinstance(a, (int, float)) and isinstance(b, (int, float)) else None
         rows.append((label, unit, number(a, spec), number(b, spec), number(difference, "+.3g")))
     # Both runs were loaded into the same Parameters model, so they have the same keys.

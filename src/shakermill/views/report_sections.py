@@ -3,13 +3,12 @@ of an engine of several, and the numerics."""
 
 from __future__ import annotations
 
-import math
-from collections.abc import Iterator, Mapping
-from typing import Any
+from collections.abc import Iterator
 
 from shakermill.analysis.regime import classify_impacts, settled_run_impacts
 from shakermill.analysis.stress_energy import StressSpectrum
 from shakermill.io.runs import RunData
+from shakermill.solvers.summary import unit_of
 from shakermill.views.figures.common import several_balls
 from shakermill.views.figures.impacts import TARGETS, impact_figures, run_stress_spectrum
 from shakermill.views.figures.run import impact_span
@@ -93,12 +92,8 @@ ENERGY_TERMS = (
     ("work_by_gravity", "work done by gravity"),
     ("work_by_stiffening", "energy the tangential springs gain as they stiffen (Hertz–Mindlin)"),
     ("heat_generated", "irreversible heat generated (η × dissipated)"),
-    ("heat_to_ball", "heat to the ball (λ × heat)"),
-    ("heat_to_vial", "heat to the vial ((1 − λ) × heat)"),
     ("not_converted_to_heat", "dissipated but not turned into heat"),
-    ("stored_ball", "stored in the ball"),
-    ("stored_vial", "stored in the vial"),
-    ("stored_air", "stored in the inner air"),
+    ("drive_heat", "heat the drive put into the holder, whatever the balls did"),
     ("heat_lost_to_surroundings", "lost to the surroundings"),
     ("projection_correction", "total |ΔE_kin| applied by the energy projection (outside the balance)"),
     ("mechanical_residual", "mechanical residual: work − Δkinetic − Δelastic − dissipated"),
@@ -110,25 +105,35 @@ ENERGY_TERMS = (
 RELATIVE_RESIDUAL_KEY = "relative_residual"
 
 
-def finite_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
-    """``summary`` with the nulls of ``summary.json`` (non-finite numbers) back as NaN."""
-    return {key: math.nan if value is None else value for key, value in summary.items()}
+# The audit's terms of each node ("balls" together, then the vial, the air and whatever further nodes the network has:
+# the holder, the powder), labelled from the node's name.
+NODE_TERMS = (("heat_into_", "heat from the contacts into the {}"), ("stored_", "stored in the {}"))
+
+
+def energy_label(key: str) -> str:
+    """What the audit's ``key`` means: its fixed label, one made from its node's name, or the key itself (terms a
+    newer audit may add are shown under their own names)."""
+    for prefix, label in NODE_TERMS:
+        if key.startswith(prefix):
+            return label.format(key.removeprefix(prefix))
+    return dict(ENERGY_TERMS).get(key, key)
 
 
 def energy_section(run: RunData) -> str:
     energy = run.energy
-    labels = dict(ENERGY_TERMS)
-    # Terms a newer audit may add are shown too, under their own names.
-    keys = [key for key, _ in ENERGY_TERMS if key in energy]
-    keys += [key for key in energy if key not in labels and key != RELATIVE_RESIDUAL_KEY]
-    rows = [(labels.get(key, key), key, number(energy[key], ".6g"), "J") for key in keys]
+    fixed = [key for key, _ in ENERGY_TERMS if key in energy]
+    nodes = [key for prefix, _ in NODE_TERMS for key in energy if key.startswith(prefix)]
+    others = [key for key in energy if key not in {*fixed, *nodes, RELATIVE_RESIDUAL_KEY}]
+    keys = [*fixed[: fixed.index("not_converted_to_heat")], *nodes, *fixed[fixed.index("not_converted_to_heat") :]]
+    rows = [(energy_label(key), key, number(energy[key], ".6g"), "J") for key in [*keys, *others]]
     if RELATIVE_RESIDUAL_KEY in energy:
         relative = ("relative residual: |residual| / largest flow", RELATIVE_RESIDUAL_KEY)
         rows.append((*relative, number(energy[RELATIVE_RESIDUAL_KEY], ".3e"), ""))
     supplied = "work by the vial + by gravity + stiffening" if several_balls(run.params) else "work by the vial"
     balances = (
         f"{supplied} = Δkinetic + Δelastic + dissipated; dissipated = heat generated + not converted to heat; "
-        "heat generated = stored (ball + vial + air) + lost to the surroundings. The residuals are what is left "
+        "heat generated (+ the drive's) = stored (in every node) + lost to the surroundings. The residuals are what "
+        "is left "
         "of these balances."
     )
     return section(
@@ -142,9 +147,9 @@ def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
     """(quantity, value, unit) rows of the impact table, with the summary's count and rate."""
     impacts = run.impacts
     summary = run.summary
-    rate = summary.get("impact_rate_hz")
+    rate = summary.impact_rate_hz
     rows = [
-        ("impacts in the run", number(summary.get("impacts"), "d"), ""),
+        ("impacts in the run", number(summary.impacts, "d"), ""),
         ("impacts in the impact table", str(len(impacts)), ""),
         ("impact rate", number(rate, ".4g"), "Hz"),
     ]
@@ -170,14 +175,14 @@ def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
 
 def wall_rows(run: RunData) -> list[tuple[str, str, str]]:
     """The regime of the settled motion and the impacts at each end face, of a 1-D run."""
-    impacts, rate = run.impacts, run.summary.get("impact_rate_hz")
+    impacts, rate = run.impacts, run.summary.impact_rate_hz
     regime, _ = classify_impacts(settled_run_impacts(run), run.params.omega, run.params.phase)
     rows = [("regime of the settled motion", regime, "")]
     for wall in ("left", "right"):
         count = int((impacts["wall"] == wall).sum())
         share = count / len(impacts)
         # The summary's rate covers the whole run (the averaged solver's table covers only its window).
-        wall_rate = rate * share if isinstance(rate, (int, float)) else None
+        wall_rate = rate * share
         rows.append((f"impacts at the {wall} end face", f"{count} ({share:.1%})", ""))
         rows.append((f"impact rate at the {wall} end face", number(wall_rate, ".4g"), "Hz"))
     return rows
@@ -185,12 +190,12 @@ def wall_rows(run: RunData) -> list[tuple[str, str, str]]:
 
 def target_rows(run: RunData) -> list[tuple[str, str, str]]:
     """The impacts on each wall and between balls, of a 'dem' run (whose several balls have no 1-D regime)."""
-    impacts, rate = run.impacts, run.summary.get("impact_rate_hz")
+    impacts, rate = run.impacts, run.summary.impact_rate_hz
     rows = []
     for target, label, _ in TARGETS:
         count = int((impacts["target"] == target).sum())
         share = count / len(impacts)
-        target_rate = rate * share if isinstance(rate, (int, float)) else None
+        target_rate = rate * share
         rows.append((f"impacts on {label}", f"{count} ({share:.1%})", ""))
         rows.append((f"impact rate on {label}", number(target_rate, ".4g"), "Hz"))
     return rows
@@ -199,7 +204,7 @@ def target_rows(run: RunData) -> list[tuple[str, str, str]]:
 def balls_section(run: RunData) -> str:
     """Each ball of a 'dem' run: radius, temperature at the end and steady state, impacts, heat received."""
     summary, impacts = run.summary, run.impacts
-    at_end, steady = summary.get("ball_temperatures_C") or [], summary.get("balls_steady_C") or []
+    at_end, steady = summary.ball_temperatures_C or [], summary.balls_steady_C or []
     series = run.timeseries
     seconds = float(series["time"].values[-1])
     heat = series["heat_into_balls"].transpose("time", "ball").values[-1] / seconds if seconds > 0 else None
@@ -238,11 +243,11 @@ def impacts_section(run: RunData, numbers: Iterator[int]) -> str:
     parts = [table(("quantity", "value", "unit"), impact_statistics(run), numeric=(1,))]
     if run.impacts.empty:
         parts.append(paragraph("No impacts were recorded.", "note"))
-    elif run.summary.get("impacts") != len(run.impacts):
+    elif run.summary.impacts != len(run.impacts):
         parts.append(
             paragraph(
                 "The averaged solver resolves impacts only while its averages converge "
-                f"({number(run.summary.get('averaging_window_s'), '.3g')} s); the count for the whole run is the "
+                f"({number(run.summary.averaging_window_s, '.3g')} s); the count for the whole run is the "
                 "mean rate times the duration, and the statistics are over the impacts of the table.",
                 "note",
             )
@@ -313,16 +318,18 @@ def numerics_section(run: RunData) -> str:
     summary = run.summary
     params = run.params
     rows = [
-        ("solver", str(summary.get("solver", "n/a")), ""),
+        ("solver", summary.solver, ""),
         ("relative tolerance rtol", number(params.rtol, ".3g"), ""),
-        ("accepted steps", number(summary.get("steps"), "d"), ""),
-        ("rejected steps", number(summary.get("rejected_steps"), "d"), ""),
-        ("right-hand-side evaluations", number(summary.get("rhs_evaluations"), "d"), ""),
-        ("wall time", number(summary.get("wall_time_s"), ".3g"), "s"),
+        ("accepted steps", number(summary.steps, "d"), ""),
+        ("rejected steps", number(summary.rejected_steps, "d"), ""),
+        ("right-hand-side evaluations", number(summary.rhs_evaluations, "d"), ""),
+        ("wall time", number(summary.wall_time_s, ".3g"), "s"),
         ("energy projection", "on" if params.energy_projection else "off", ""),
-        ("projection correction / dissipated energy", number(summary.get("energy_projection_relative"), ".3e"), ""),
-        ("energy audit relative residual", number(summary.get("energy_audit_residual"), ".3e"), ""),
+        ("projection correction / dissipated energy", number(summary.energy_projection_relative, ".3e"), ""),
+        ("energy audit relative residual", number(summary.energy_audit_residual, ".3e"), ""),
     ]
-    # The averaged solver adds its statistics (averaged_*, averaging_*) to the summary.
-    rows += [(key, number(value, ".4g"), "") for key, value in summary.items() if key.startswith("averag")]
+    # The averaged solver adds its statistics (averaged_*, averaging_*) to the summary, each with its unit.
+    rows += [
+        (key, number(value, ".4g"), unit_of(key)) for key, value in summary.flat().items() if key.startswith("averag")
+    ]
     return section("Numerics", table(("quantity", "value", "unit"), rows, numeric=(1,)))

@@ -18,6 +18,7 @@ if TYPE_CHECKING:
 
     from shakermill.studies.cross_prediction import CrossPrediction
     from shakermill.studies.held_out import HeldOutPrediction
+    from shakermill.studies.powder import PowderComparison
     from shakermill.studies.validation_matrix import StructureOutcome, ValidationMatrix
     from shakermill.studies.validation_report import ValidationReport
 
@@ -105,6 +106,35 @@ def held_out_rows(prediction: HeldOutPrediction) -> list[tuple[str, ...]]:
         (row.label, row.unit, f"{row.experiment:g}", f"{row.predicted:.3g}", f"{100 * row.relative_error:+.0f} %")
         for row in prediction.rows
     ]
+
+
+POWDER_HEADERS = ("quantity", "unit", "without powder", "with powder", "measured without", "measured with")
+
+
+def powder_rows(comparison: PowderComparison) -> list[tuple[str, ...]]:
+    """Each quantity predicted without and with the powder, beside what was measured ('' where nothing was)."""
+    return [
+        (
+            row.label,
+            row.unit,
+            *(f"{value:.3g}" if math.isfinite(value) else "—" for value in (row.without, row.with_powder)),
+            *(f"{value:g}" if math.isfinite(value) else "" for value in (row.measured_without, row.measured_with)),
+        )
+        for row in comparison.rows
+    ]
+
+
+def powder_statement(comparison: PowderComparison) -> str:
+    """What the comparison ran and whether the vial came out warmer with powder, as the published ordering has it."""
+    vial = comparison.vial_row
+    ordering = "warmer" if comparison.vial_warmer_with_powder else "NOT warmer"
+    measured = vial.measured_with - vial.measured_without
+    published = f" (measured: {measured:+.3g} K)" if math.isfinite(measured) and measured != 0 else ""
+    return (
+        f"{comparison.preset} with {1e3 * comparison.powder_kg:g} g of powder (the preset's assumed powder values: "
+        f"`shakermill keys powder`): the vial is {ordering} with powder than without, by "
+        f"{vial.with_powder - vial.without:+.3g} K{published}. Source: {comparison.source}."
+    )
 
 
 def structure_verdict(outcomes: Sequence[StructureOutcome]) -> str:
@@ -276,6 +306,14 @@ def render_validation_page(report: ValidationReport) -> str:
                 "Held out: five balls",
                 table(HELD_OUT_HEADERS, held_out_rows(prediction), numeric=(2, 3, 4)),
                 paragraph(prediction.statement, "statement"),
+            )
+        )
+    for comparison in report.powder:
+        sections.append(
+            section(
+                comparison.title,
+                table(POWDER_HEADERS, powder_rows(comparison), numeric=(2, 3, 4, 5)),
+                paragraph(powder_statement(comparison), "statement"),
             )
         )
     if report.cross is not None:

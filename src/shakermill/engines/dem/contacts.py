@@ -6,6 +6,7 @@ entries when the neighbour list is rebuilt."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -395,7 +396,8 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
     other = j if pair else k.n_balls
     s.totals[WORK_VIAL] += vial
     s.totals[HEAT_GENERATED] += heat
-    for node, part in ((i, share * heat), (other, (1.0 - share) * heat)):
+    kept = heat - _deposit(int(pair), channels, k, s)
+    for node, part in ((i, share * kept), (other, (1.0 - share) * kept)):
         s.pending_heat[node] += part
         s.heat_into[node] += part
     copy_into(w.normal_force[slot], c.normal_force[slot])
@@ -417,10 +419,38 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
         row[5 + channel] = c.dissipated[slot, channel]
     row[9], row[10], row[11] = c.peak_force[slot], c.max_overlap[slot], t - c.started[slot]
     total = k.eta * (c.dissipated[slot, 0] + c.dissipated[slot, 1] + c.dissipated[slot, 2] + c.dissipated[slot, 3])
-    row[12], row[13] = share * total, (1.0 - share) * total
+    deposited = _deposited(int(pair), c.dissipated[slot], k)
+    row[12], row[13] = share * (total - deposited), (1.0 - share) * (total - deposited)
     row[14] = _conduct(slot, i, j, wall, row[11], k, s)
+    row[15] = deposited
     c.spring[slot, :] = 0.0
     return count + 1
+
+
+@njit(cache=True, inline="always")
+def _deposited(kind: int, channels: Any, k: Constants) -> float:
+    """The heat (J) of ``channels``' dissipation (J, in HEAT_CHANNELS order) of a contact of ``kind`` (0: a wall, 1:
+    a pair) that goes to nodes other than its two bodies (``network.deposits``: the powder)."""
+    deposited = 0.0
+    for deposit in range(k.deposit_count):
+        for channel in range(4):
+            deposited += k.eta * channels[channel] * k.deposit_shares[kind, channel, deposit]
+    return deposited
+
+
+@njit(cache=True, inline="always")
+def _deposit(kind: int, channels: Any, k: Constants, s: State) -> float:
+    """Put the deposits' shares of a step's heat (:func:`_deposited`) into their nodes; their sum (J)."""
+    deposited = 0.0
+    for deposit in range(k.deposit_count):
+        part = 0.0
+        for channel in range(4):
+            part += k.eta * channels[channel] * k.deposit_shares[kind, channel, deposit]
+        node = k.deposit_nodes[deposit]
+        s.pending_heat[node] += part
+        s.heat_into[node] += part
+        deposited += part
+    return deposited
 
 
 @njit(cache=True, inline="always")

@@ -37,36 +37,12 @@ IMPACT_UNITS = {
     "heat_generated": "J",
     "heat_to_ball": "J",
     "heat_to_other": "J",
+    "heat_to_deposits": "J",
     "peak_force": "N",
     "max_overlap": "m",
     "duration": "s",
     "conduction": "J/K",
 }
-
-# Keys that enter only the thermal network, never a force, the heat a contact makes or the Whitaker term the
-# stepping measures (λ, η and the balls' effusivities split that heat inside the stepper; the air's density and
-# its viscosity at the ambient temperature set each ball's Reynolds number there, the materials' conductivities
-# each contact's conduction).
-THERMAL_ONLY_KEYS = (
-    "h_inner",
-    "h_outer",
-    "inner_area",
-    "outer_area",
-    "vial_mass",
-    "vial_heat_capacity",
-    "beta",
-    "initial_temperature",
-    "duration",
-    "output_interval",
-    "thermal_model",
-    "outer_diameter",
-    "outer_length",
-    "emissivity",
-    "clamp_heat_capacity",
-    "clamp_conductance",
-    "clamp_loss",
-    "drive_heat",
-)
 
 DESCRIPTION = EngineDescription(
     keys=THREE_DIMENSIONAL,
@@ -88,17 +64,16 @@ DESCRIPTION = EngineDescription(
         "work_vial",
         "heat_generated",
         "heat_into_balls",
-        "heat_into_vial",
+        "heat_into_nodes",
         "velocity_term_integrals",
         "velocity_term_integral",
         "contact_conduction",
     ),
-    heat_variables=("heat_into_balls", "heat_into_vial"),
+    heat_variables=("heat_into_balls", "heat_into_nodes"),
     term_variables=("velocity_term_integrals",),
     status_messages=STATUS_MESSAGES,
     averaging_error_key="dem_averaging_rel_error",
-    replicas_key="dem_replicas",
-    thermal_only_keys=THERMAL_ONLY_KEYS,
     attractor_starts=False,
     conduction_variables=("contact_conduction",),
+    contact_step_guard=True,
 )

@@ -10,15 +10,25 @@ from collections.abc import Mapping, Sequence
 from typing import ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from shakermill.engines.budget import RunBudget
 from shakermill.engines.calls import CALL_AGAIN, PAUSED, CompiledRun
 from shakermill.engines.dem import model, stepper
 from shakermill.engines.dem.description import CHANNELS, DESCRIPTION
-from shakermill.engines.interface import EngineDescription, Measured
+from shakermill.engines.interface import (
+    Averaging,
+    EngineDescription,
+    Measured,
+    MemoryBound,
+    Replicas,
+    ReplicatedEngine,
+    StepBound,
+)
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
-    CELSIUS_VARIABLES,
+    HEAT_INTO_NODES,
+    NODE_NAMES,
     EnergyAudit,
     StateHistory,
     attributes,
@@ -49,8 +59,9 @@ def marks(params: Parameters, samples: np.ndarray, end: float) -> tuple[np.ndarr
     return times, np.isin(times, samples), np.isin(times, window)
 
 
-class DemEngine(CompiledRun):
-    """The balls, the vial and the thermal network of one run, advanced by :meth:`advance`."""
+class DemEngine(CompiledRun, Averaging, Replicas, StepBound, MemoryBound):
+    """The balls, the vial and the thermal network of one run, advanced by :meth:`advance`: the engine core and every
+    capability (``engines/interface.py``)."""
 
     description: ClassVar[EngineDescription] = DESCRIPTION
     first_steps_per_call: ClassVar[int] = 2_000
@@ -60,7 +71,7 @@ class DemEngine(CompiledRun):
         self,
         params: Parameters,
         budget: RunBudget | None = None,
-        samples: Sequence[float] = (0.0,),
+        samples: Sequence[float] | np.ndarray = (0.0,),
         horizon: float = 0.0,
         replica: int = 0,
     ) -> None:
@@ -70,7 +81,7 @@ class DemEngine(CompiledRun):
         self.params = params
         self.budget = budget if budget is not None else RunBudget.of(params)
         self.network = self.network_for(params)
-        self.constants = model.constants_from(params)
+        self.constants = model.constants_from(params, self.network)
         self.state = model.initial_state(params, self.constants, self.network)
         if replica:
             model.kick_for_replica(self.state, replica)
@@ -218,13 +229,9 @@ class DemEngine(CompiledRun):
             elastic_energy_change=self.stored_contact_energy(),
             dissipated=dissipated,
             heat_generated=heat,
-            heat_to_ball=float(np.sum(s.heat_into[:n] - initial["heat_into"][:n])),
-            heat_to_vial=float(s.heat_into[n] - initial["heat_into"][n]),
+            heat_into=self.network.grouped(s.heat_into - initial["heat_into"]),
             not_converted_to_heat=dissipated - heat,
-            stored_ball=float(np.dot(capacity[:n], warming[:n])),
-            stored_vial=float(capacity[n] * warming[n]),
-            stored_air=float(capacity[n + 1] * warming[n + 1]),
-            stored_clamp=float(np.dot(capacity[n + 2 :], warming[n + 2 :])),
+            stored=self.network.grouped(capacity * warming),
             drive_heat=self.network.fixed_heat * (self.t - float(self.start[0, 0])),
             heat_lost_to_surroundings=float(totals[model.HEAT_LOST]),
             projection_correction=0.0,
@@ -247,21 +254,28 @@ class DemEngine(CompiledRun):
         n = self.params.n_balls
         return Measured(s.heat_into.copy(), s.drive_integrals[:n].copy(), dissipated, s.drive_integrals[n:].copy())
 
-    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
-        """The heat into each ball and the vial as measured (the stepper splits each contact's heat), none into the
-        air; the contacts' mean conductances."""
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: ArrayLike = ()) -> NetworkLoad:
+        """The heat into each node as measured (the stepper routes each contact's heat: ``network.split`` and
+        ``network.deposits``); the contacts' mean conductances."""
         heat = np.asarray(heat_rates, dtype=float)
         terms = np.asarray(term_means, dtype=float)
         mean_term = float(terms.mean()) if terms.size else math.nan  # an empty mill has no ball to convect
-        return NetworkLoad(
-            np.append(heat, 0.0), terms, float(heat.sum()), mean_term, np.asarray(conductances, dtype=float)
-        )
+        return NetworkLoad(heat, terms, float(heat.sum()), mean_term, np.asarray(conductances, dtype=float))
 
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
-        """Each ball's contacts, with the vial or another ball; the vial's; the air's none."""
+        """Each ball's contacts, with the vial or another ball; the vial's; each deposit's node every contact of the
+        kinds it takes a share of; the others none."""
         n = self.params.n_balls
         balls = [int(np.sum(impacts["ball"] == ball) + np.sum(impacts["other_ball"] == ball)) for ball in range(n)]
-        return np.array([*balls, int(np.sum(impacts["target"] != "ball")), 0])
+        hits = np.zeros(len(self.network.nodes), dtype=np.int64)
+        hits[:n] = balls
+        walls = int(np.sum(impacts["target"] != "ball"))
+        hits[self.network.vial] = walls
+        pairs = len(impacts["target"]) - walls
+        nodes, shares = self.network.deposit_arrays()
+        for index, node in enumerate(nodes):
+            hits[node] += walls * bool(shares[0, :, index].any()) + pairs * bool(shares[1, :, index].any())
+        return hits
 
     def averaged_history(
         self,
@@ -292,11 +306,18 @@ class DemEngine(CompiledRun):
             "angular_velocity": motion,
             "temperature": temperatures.T,
             "totals": totals,
-            "heat_into": np.outer(times, load.heat[: n + 1]),
+            "heat_into": np.outer(times, load.heat),
             "drive_integrals": np.outer(times, load.drives),
             "vial": vial,
         }
         return history_of(times, fields, k, network)
+
+
+# The engine contract, checked by mypy (pyproject.toml): the core with Averaging and Replicas, StepBound, MemoryBound.
+# One assignment each: mypy refuses a class that lacks a method of a capability it derives from only in a plain one.
+_CONTRACT: type[ReplicatedEngine] = DemEngine
+_STEPS: type[StepBound] = DemEngine
+_MEMORY: type[MemoryBound] = DemEngine
 
 
 def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.ndarray]:
@@ -309,6 +330,7 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
     other = records[:, column["other"]].astype(np.int64)
     channels = records[:, column["dissipated_normal"] : column["dissipated_rolling"] + 1]
     heat_to_ball, heat_to_other = records[:, column["heat_to_ball"]], records[:, column["heat_to_other"]]
+    heat_to_deposits = records[:, column["heat_to_deposits"]]
     return {
         "time": records[:, column["time"]],
         "ball": records[:, column["ball"]].astype(np.int64),
@@ -318,9 +340,10 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
         "tangential_speed": records[:, column["tangential_speed"]],
         **{f"dissipated_{name}": channels[:, index] for index, name in enumerate(CHANNELS)},
         "dissipated_energy": channels.sum(axis=1),
-        "heat_generated": heat_to_ball + heat_to_other,
+        "heat_generated": heat_to_ball + heat_to_other + heat_to_deposits,
         "heat_to_ball": heat_to_ball,
         "heat_to_other": heat_to_other,
+        "heat_to_deposits": heat_to_deposits,
         "peak_force": records[:, column["peak_force"]],
         "max_overlap": records[:, column["max_overlap"]],
         "duration": records[:, column["duration"]],
@@ -331,22 +354,21 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
 def history_of(
     times: np.ndarray, fields: dict[str, np.ndarray], k: model.Constants, network: ThermalNetwork
 ) -> StateHistory:
-    """The states with units: temperatures of each ball (and their mean, ``theta_ball``), vial and air (and any
-    further node of ``network``, ``theta_<name>``), the balls' motion in the lab frame (axis x, y, z; z up), the
-    vial's pose and the running totals."""
+    """The states with units: temperatures of each ball (and their mean, ``theta_ball``) and of every other node of
+    ``network`` (``theta_<name>``: the vial, the air, then the holder or the powder where the network has them), the
+    balls' motion in the lab frame (axis x, y, z; z up), the vial's pose, the running totals and the heat into each
+    node."""
     n = k.n_balls
     theta, totals, heat_into = fields["temperature"], fields["totals"], fields["heat_into"]
     terms, vial = fields["drive_integrals"][:, :n], fields["vial"]
     variables: dict[str, tuple[np.ndarray, dict[str, str]]] = {
         "theta_ball": (network.mean_ball(theta), attributes("K", "mean ball temperature")),
-        "theta_vial": (theta[:, n], attributes("K", "vial temperature")),
-        "theta_air": (theta[:, n + 1], attributes("K", "inner air temperature")),
         BALL_TEMPERATURES: (theta[:, :n], attributes("K", "temperature of each ball")),
     }
-    others = tuple(f"theta_{node.name}" for node in network.nodes[n + 2 :])
-    for index, name in enumerate(others, start=n + 2):
-        variables[name] = (theta[:, index], attributes("K", f"{network.nodes[index].name} temperature"))
-    with_celsius(variables, (*CELSIUS_VARIABLES, BALL_TEMPERATURES, *others))
+    others = tuple(f"theta_{node.name}" for node in network.others)
+    for index, (name, node) in enumerate(zip(others, network.others, strict=True), start=n):
+        variables[name] = (theta[:, index], attributes("K", f"{node.title} temperature"))
+    with_celsius(variables, ("theta_ball", BALL_TEMPERATURES, *others))
     for name, units, long_name in (
         ("position", "m", "ball centre, lab frame"),
         ("velocity", "m s-1", "ball velocity, lab frame"),
@@ -360,7 +382,13 @@ def history_of(
     dissipated = totals[:, model.DISSIPATED_NORMAL : model.DISSIPATED_ROLLING + 1].sum(axis=1)
     variables["dissipated"] = (dissipated, attributes("J", "cumulative energy dissipated in contacts"))
     variables["heat_into_balls"] = (heat_into[:, :n], attributes("J", "cumulative impact heat into each ball"))
-    variables["heat_into_vial"] = (heat_into[:, n], attributes("J", "cumulative impact heat into the vial"))
+    variables[HEAT_INTO_NODES] = (
+        heat_into[:, n:],
+        {
+            **attributes("J", "cumulative contact heat into each node but the balls"),
+            NODE_NAMES: ", ".join(node.name for node in network.others),
+        },
+    )
     variables["velocity_term_integrals"] = (
         terms,
         attributes("s", "time integral of each ball's Whitaker velocity term"),
@@ -375,11 +403,12 @@ def history_of(
             "J K-1", "heat per kelvin conducted by the contacts of each ball with the vial, then with the other balls"
         ),
     )
-    dimensions = {
+    dimensions: dict[str, tuple[str, ...]] = {
         name: _PER_BALL
         for name in (BALL_TEMPERATURES, f"{BALL_TEMPERATURES}_C", "heat_into_balls", "velocity_term_integrals")
     }
     dimensions["contact_conduction"] = ("time", "contact")
+    dimensions[HEAT_INTO_NODES] = ("time", "node")
     dimensions.update({name: _VECTORS for name in ("position", "velocity", "angular_velocity")})
     dimensions.update(vial_centre=("time", "axis"), vial_angles=("time", "angle"))
     return StateHistory(times, variables, dimensions)

@@ -15,7 +15,8 @@ import numpy as np
 
 from shakermill.engines.dem import neighbours as neighbour_list
 from shakermill.engines.thermal import kernel
-from shakermill.engines.thermal.network import ThermalNetwork, air_constants, build_network
+from shakermill.engines.thermal.air import air_constants
+from shakermill.engines.thermal.network import ThermalNetwork, build_network
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.kinematic_models import MOTION_COORDINATES, motion_terms
 from shakermill.physics import contact
@@ -82,6 +83,11 @@ class Constants(NamedTuple):
     rolling_friction: float
     eta: float
     lam: float
+    # Shares of each contact's heat deposited in nodes other than its two bodies (the powder; network.deposits):
+    # their count, their nodes (m,) and shares over (contact kind: wall, pair; channel; deposit).
+    deposit_count: int
+    deposit_nodes: np.ndarray
+    deposit_shares: np.ndarray
     # The vial
     half_length: float
     bore_radius: float
@@ -122,13 +128,13 @@ class State(NamedTuple):
     spin: np.ndarray  # (N, 3) rad/s, angular velocity
     force: np.ndarray  # (N, 3) N: contact forces of the last evaluation (gravity apart)
     torque: np.ndarray  # (N, 3) N·m
-    temperature: np.ndarray  # (nodes,) K: the balls, the vial, the air (and the clamp: the thermal network's nodes)
-    pending_heat: np.ndarray  # (nodes,) J from the contacts into the balls and the vial since the last thermal update
+    temperature: np.ndarray  # (nodes,) K: the thermal network's nodes (the balls, the vial, the air, then the others)
+    pending_heat: np.ndarray  # (nodes,) J from the contacts into each node since the last thermal update
     # The network's drives (engines.thermal.kernel): each ball's Whitaker term integral ∫w dt (s), then the heat per
     # kelvin of the contacts (J/K) of each ball with the vial and with the other balls, since the last thermal update...
     pending_drives: np.ndarray  # (D,)
     totals: np.ndarray  # (len(TOTAL_NAMES),) J
-    heat_into: np.ndarray  # (N + 1,) J: all heat into each ball and the vial so far
+    heat_into: np.ndarray  # (nodes,) J: all heat from the contacts into each node so far
     drive_integrals: np.ndarray  # (D,) ...and since the start
     contacts: Contacts
     neighbours: Neighbours
@@ -269,8 +275,11 @@ def network_of(params: Parameters) -> ThermalNetwork:
     return build_network(params, radius, capacity, names, share)
 
 
-def constants_from(params: Parameters) -> Constants:
-    """Everything the stepping needs but the thermal network (:func:`network_of`)."""
+def constants_from(params: Parameters, network: ThermalNetwork | None = None) -> Constants:
+    """Everything the stepping needs but the thermal network's compiled form: of ``network`` (:func:`network_of`
+    when None), where the contacts' heat goes and its fastest time constant."""
+    network = network if network is not None else network_of(params)
+    deposit_nodes, deposit_shares = network.deposit_arrays()
     n = params.n_balls
     radius = np.array(params.ball_values("ball_radius"))
     density = np.array(params.ball_values("ball_density"))
@@ -295,7 +304,10 @@ def constants_from(params: Parameters) -> Constants:
         default=params.max_flight_step / params.contact_step_fraction,
     )
     impact_fraction = params.contact_step_fraction * IMPACT_STEP_SCALE
-    fastest_node = min(value for value, _ in params.thermal_time_constants_at_rest.values())
+    network.check_not_stiff()
+    fastest_node = min(network.time_constants_at_rest().values(), default=math.inf)
+    # A node that coats the bodies in contact (the powder) sets their restitution.
+    wall_restitution, pair_restitution = network.coated_restitution or (params.restitution, params.pair_restitution)
     return Constants(
         relative_convection=params.relative_convection,
         air_density=params.air_density,
@@ -315,14 +327,17 @@ def constants_from(params: Parameters) -> Constants:
         conductivity=conductivity,
         vial_effusivity=vial_effusivity,
         vial_conductivity=params.vial_conductivity,
-        beta_e=contact.damping_ratio(params.restitution),
-        pair_beta_e=contact.damping_ratio(params.pair_restitution),
+        beta_e=contact.damping_ratio(wall_restitution),
+        pair_beta_e=contact.damping_ratio(pair_restitution),
         no_tension=params.no_tension,
         friction=params.friction,
         pair_friction=params.pair_friction,
         rolling_friction=params.rolling_friction,
         eta=params.eta,
-        lam=params.lam,
+        lam=network.split.wall_ball_share,
+        deposit_count=deposit_nodes.size,
+        deposit_nodes=deposit_nodes,
+        deposit_shares=deposit_shares,
         half_length=0.5 * params.vial_length,
         bore_radius=bore,
         omega=params.omega,
@@ -415,7 +430,7 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
         pending_heat=np.zeros(len(network.nodes)),
         pending_drives=np.zeros(drives),
         totals=np.zeros(len(TOTAL_NAMES)),
-        heat_into=np.zeros(n + 1),
+        heat_into=np.zeros(len(network.nodes)),
         drive_integrals=np.zeros(drives),
         contacts=empty_contacts(slot_count(n, capacity)),
         neighbours=neighbours,
@@ -494,7 +509,7 @@ def row_fields(n_balls: int, nodes: int) -> tuple[tuple[str, tuple[int, ...]], .
         ("angular_velocity", (n_balls, 3)),
         ("temperature", (nodes,)),
         ("totals", (len(TOTAL_NAMES),)),
-        ("heat_into", (n_balls + 1,)),
+        ("heat_into", (nodes,)),
         ("drive_integrals", (kernel.drive_count(n_balls),)),
         ("vial", (6,)),
     )

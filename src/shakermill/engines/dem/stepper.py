@@ -73,6 +73,7 @@ RECORD_COLUMNS = (
     "heat_to_ball",
     "heat_to_other",
     "conduction",
+    "heat_to_deposits",
 )
 COUNTER_NAMES = ("steps", "contact_steps", "flight_steps", "impacts", "thermal_updates", "neighbour_builds")
 STEPS, CONTACT_STEPS, FLIGHT_STEPS, IMPACTS, THERMAL_UPDATES, NEIGHBOUR_BUILDS, ROWS_WRITTEN = range(

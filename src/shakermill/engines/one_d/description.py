@@ -58,6 +58,5 @@ DESCRIPTION = EngineDescription(
     term_variables=("velocity_term_integral",),
     status_messages=STATUS_MESSAGES,
     averaging_error_key="averaging_rel_error",
-    thermal_only_keys=(),
     attractor_starts=True,
 )

@@ -9,14 +9,15 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from shakermill.engines.budget import RunBudget
-from shakermill.engines.interface import EngineDescription, Measured
+from shakermill.engines.interface import AveragedEngine, Averaging, EngineDescription, Measured
 from shakermill.engines.one_d import model
 from shakermill.engines.one_d.description import DESCRIPTION
 from shakermill.engines.one_d.integrator import COUNTER_NAMES, IMPACT_COLUMNS, Integrator, Tolerances
 from shakermill.engines.records import CELSIUS_VARIABLES, EnergyAudit, StateHistory, attributes, with_celsius
-from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork, build_network
+from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.keys import Parameters
 from shakermill.physics import contact
 
@@ -66,9 +67,15 @@ def tolerances_for(params: Parameters, constants: model.Constants) -> Tolerances
     )
 
 
-def integrator_for(params: Parameters, sample_times: np.ndarray, budget: RunBudget | None = None) -> Integrator:
-    """A compiled integrator set up for ``params`` from its initial state, within ``budget`` (a fresh one if None)."""
-    constants = model.constants_from(params)
+def integrator_for(
+    params: Parameters,
+    sample_times: np.ndarray,
+    budget: RunBudget | None = None,
+    network: ThermalNetwork | None = None,
+) -> Integrator:
+    """A compiled integrator set up for ``params`` from its initial state, within ``budget`` (a fresh one if None),
+    its thermal network written out from ``network`` (``model.network_of(params)`` if None)."""
+    constants = model.constants_from(params, network)
     windows = np.array([(start, start + length) for start, length in params.record_windows], dtype=float).reshape(-1, 2)
     return Integrator(
         constants=constants,
@@ -110,8 +117,9 @@ def state_history(
     return StateHistory(times, variables)
 
 
-class OneDimensionalEngine:
-    """One ball on the axis of an axially driven vial, integrated by :class:`Integrator`."""
+class OneDimensionalEngine(Averaging):
+    """One ball on the axis of an axially driven vial, integrated by :class:`Integrator`: the engine core and the
+    capability Averaging (``engines/interface.py``)."""
 
     description: ClassVar[EngineDescription] = DESCRIPTION
 
@@ -119,22 +127,21 @@ class OneDimensionalEngine:
         self,
         params: Parameters,
         budget: RunBudget | None = None,
-        samples: Sequence[float] = (0.0,),
+        samples: Sequence[float] | np.ndarray = (0.0,),
         horizon: float = 0.0,
     ) -> None:
         """See :class:`~shakermill.engines.interface.Engine`; the integrator keeps every step inside a record
         window as it takes it, so ``horizon`` asks nothing of it."""
         self.params = params
         self.budget = budget if budget is not None else RunBudget.of(params)
-        self.integrator = integrator_for(params, np.asarray(samples, dtype=float), self.budget)
+        self.network = self.network_for(params)
+        self.integrator = integrator_for(params, np.asarray(samples, dtype=float), self.budget, self.network)
         self.constants = self.integrator.constants
         self.start = self.integrator.y.copy()
-        self.network = self.network_for(params)
 
     @classmethod
     def network_for(cls, params: Parameters) -> ThermalNetwork:
-        capacity = params.ball_mass * params.ball_heat_capacity
-        return build_network(params, [params.ball_radius], [capacity], ("ball",), "λ of each impact's heat")
+        return model.network_of(params)
 
     @property
     def t(self) -> float:
@@ -175,21 +182,16 @@ class OneDimensionalEngine:
         heat = y1[model.HEAT_GENERATED] - y0[model.HEAT_GENERATED]
         dissipated = y1[model.DISSIPATED] - y0[model.DISSIPATED]
 
-        def stored(index: int, capacity: float) -> float:
-            return capacity * (y1[index] - y0[index])
-
+        warming = y1[model.THETA_BALL : model.THETA_AIR + 1] - y0[model.THETA_BALL : model.THETA_AIR + 1]
         return EnergyAudit(
             work_by_vial=y1[model.WORK_VIAL] - y0[model.WORK_VIAL],
             kinetic_energy_change=kinetic_change,
             elastic_energy_change=mechanical_change - kinetic_change,
             dissipated=dissipated,
             heat_generated=heat,
-            heat_to_ball=self.params.lam * heat,
-            heat_to_vial=(1.0 - self.params.lam) * heat,
+            heat_into=self.network.grouped(self.network.wall_contact_heat(heat)),
             not_converted_to_heat=dissipated - heat,
-            stored_ball=stored(model.THETA_BALL, k.capacity_ball),
-            stored_vial=stored(model.THETA_VIAL, k.capacity_vial),
-            stored_air=stored(model.THETA_AIR, k.capacity_air),
+            stored=self.network.grouped(self.network.arrays.capacity * warming),
             heat_lost_to_surroundings=y1[model.HEAT_LOST] - y0[model.HEAT_LOST],
             projection_correction=self.integrator.energy_correction,
         )
@@ -215,12 +217,11 @@ class OneDimensionalEngine:
             np.array([y[model.HEAT_GENERATED]]), np.array([y[model.VELOCITY_TERM]]), float(y[model.DISSIPATED])
         )
 
-    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: np.ndarray = ()) -> NetworkLoad:
+    def load(self, heat_rates: np.ndarray, term_means: np.ndarray, conductances: ArrayLike = ()) -> NetworkLoad:
         """The impacts' heat P splits λ : 1 − λ between the ball and the vial (MODEL.md §3); its network (the paper's)
         has no contact conduction."""
         power, term = float(heat_rates[0]), float(term_means[0])
-        lam = self.params.lam
-        return NetworkLoad(np.array([lam * power, (1.0 - lam) * power, 0.0]), np.array([term]), power, term)
+        return NetworkLoad(self.network.wall_contact_heat(power), np.array([term]), power, term)
 
     def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
         """Every impact heats the ball and the vial; the air only by convection."""
@@ -247,3 +248,7 @@ class OneDimensionalEngine:
         states[:, model.WORK_VIAL] = dissipated_power * times
         states[:, model.VELOCITY_TERM] = load.velocity_term * times
         return state_history(times, states, self.constants, self.params)
+
+
+# The engine contract, checked by mypy (pyproject.toml): the core and Averaging.
+_CONTRACT: type[AveragedEngine] = OneDimensionalEngine

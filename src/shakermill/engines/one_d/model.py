@@ -30,7 +30,9 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit
 
-from shakermill.engines.thermal.network import air_constants
+from shakermill.engines.thermal.air import air_constants
+from shakermill.engines.thermal.network import ThermalNetwork, build_network
+from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.physics import contact, kinematics, thermal
 
@@ -66,10 +68,8 @@ class Constants(NamedTuple):
     sutherland: float
     air_conductivity: float
     beta: float
-    h_inner: float
-    h_outer: float
-    inner_area: float
-    outer_area: float
+    inner_conductance: float  # W/K: the network's "vial → air"
+    outer_conductance: float  # W/K: its "vial → room"
     capacity_ball: float
     capacity_vial: float
     capacity_air: float
@@ -77,34 +77,48 @@ class Constants(NamedTuple):
     ball_only: bool
 
 
-def _network_constants(params: Parameters) -> dict[str, Any]:
-    """The three-node network's fields of :class:`Constants`, by name (MODEL.md §§4–6): the same values the
-    one network (``engines.thermal``) is built from, written out for the right-hand side."""
+def _network_constants(params: Parameters, network: ThermalNetwork) -> dict[str, Any]:
+    """The three-node network's fields of :class:`Constants`, by name (MODEL.md §§4–6), read from ``network``: the
+    one network (``engines.thermal``) written out for the right-hand side. A network it cannot write out (another
+    node, a path or a deposit beyond the paper's three nodes) is refused."""
+    paths = {path.name: path for path in network.paths}
+    if len(network.nodes) != 3 or network.deposits or set(paths) != {"ball → air", "vial → air", "vial → room"}:
+        raise ParameterError(
+            "engine: the 1-D engine writes out the paper's network of ball, vial and air alone; this run's has "
+            f"{', '.join(node.name for node in network.nodes)} (allowed: engine = 'dem' for another network)"
+        )
     return {
         **air_constants(params),
         "relative_convection": params.relative_convection,
         "air_density": params.air_density,
-        "mu_ref": params.air_viscosity_ref,
-        "t_ref": params.air_reference_temperature,
-        "sutherland": params.sutherland,
-        "air_conductivity": params.air_conductivity,
-        "beta": params.beta,
-        "h_inner": params.h_inner,
-        "h_outer": params.h_outer,
-        "inner_area": params.inner_area,
-        "outer_area": params.outer_area,
-        "capacity_vial": params.vial_mass * params.vial_heat_capacity,
-        "capacity_air": params.air_mass * params.air_heat_capacity,
-        "t_ambient": params.ambient_temperature,
+        "mu_ref": network.arrays.mu_ref,
+        "t_ref": network.arrays.t_ref,
+        "sutherland": network.arrays.sutherland,
+        "air_conductivity": network.arrays.air_conductivity,
+        "beta": network.arrays.beta,
+        "inner_conductance": paths["vial → air"].conductance,
+        "outer_conductance": paths["vial → room"].conductance,
+        "capacity_ball": network.nodes[0].capacity,
+        "capacity_vial": network.nodes[network.vial].capacity,
+        "capacity_air": network.nodes[network.air].capacity,
+        "lam": network.split.wall_ball_share,
+        "t_ambient": network.ambient,
     }
 
 
-def constants_from(params: Parameters) -> Constants:
+def network_of(params: Parameters) -> ThermalNetwork:
+    """The network of the one ball on the axis: the paper's (MODEL.md §§4–6)."""
+    capacity = params.ball_mass * params.ball_heat_capacity
+    return build_network(params, [params.ball_radius], [capacity], ("ball",), "λ of each impact's heat")
+
+
+def constants_from(params: Parameters, network: ThermalNetwork | None = None) -> Constants:
+    """Everything the right-hand side needs, its network's part from ``network`` (:func:`network_of` when None)."""
     e_star = contact.effective_modulus(
         params.ball_youngs_modulus, params.ball_poisson_ratio, params.vial_youngs_modulus, params.vial_poisson_ratio
     )
     return Constants(
-        **_network_constants(params),
+        **_network_constants(params, network if network is not None else network_of(params)),
         ball_mass=params.ball_mass,
         radius=params.ball_radius,
         half_length=0.5 * params.vial_length,
@@ -116,9 +130,7 @@ def constants_from(params: Parameters) -> Constants:
         beta_e=contact.damping_ratio(params.restitution),
         no_tension=params.no_tension,
         eta=params.eta,
-        lam=params.lam,
         paper_heat=params.heat_model == "paper",
-        capacity_ball=params.ball_mass * params.ball_heat_capacity,
         ball_only=params.model == "ball_only",
     )
 
@@ -187,8 +199,8 @@ def thermal_network(
         rate_ball = (k.lam * heat_generated - ball_to_ambient) / k.capacity_ball
         return rate_ball, 0.0, 0.0, ball_to_ambient + (1.0 - k.lam) * heat_generated
     ball_to_air = thermal.ball_air_heat_flow(k.radius, k.beta, h_ball, t_ball, t_air)
-    vial_to_air = thermal.newton_cooling(k.h_inner, k.inner_area, t_vial, t_air)
-    vial_to_outside = thermal.newton_cooling(k.h_outer, k.outer_area, t_vial, k.t_ambient)
+    vial_to_air = k.inner_conductance * (t_vial - t_air)
+    vial_to_outside = k.outer_conductance * (t_vial - k.t_ambient)
     rate_ball, rate_vial, rate_air = thermal.temperature_rates(
         k.lam * heat_generated,
         (1.0 - k.lam) * heat_generated,

@@ -1,48 +1,38 @@
-"""The thermal network of a run, built from its parameters: a node per ball, the vial and the air (and with
-``thermal_model = 'mill-head'`` the clamp and mill head), the named heat paths between them and to the room,
-and the heat each node receives from the contacts and the drive (MODEL.md sections 4-6, 11, 12.5, 13). Every
-engine builds its network here and evaluates it through :mod:`kernel`."""
+"""The thermal network of a run, built from its parameters: its nodes (a node per ball, the vessel, the gas inside,
+and those the extensions add: with ``thermal_model = 'mill-head'`` the holder, with powder the powder), the named
+heat paths between them and to the room, where each contact's heat goes, and the heat each node receives whatever
+the balls do (MODEL.md sections 4-6, 11, 12.5, 13). Every engine builds its network here and evaluates it through
+:mod:`kernel`; nodes, deposits and roles are data (:mod:`nodes`), so that the audits, summaries and figures loop over
+them."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from shakermill.engines.thermal import kernel
-from shakermill.engines.thermal.paths import (
-    HeatPath,
-    among_balls_conduction,
-    ball_convection,
-    contact_conduction,
-    fixed_conductance,
-    newton_cooling,
-    radiation,
+from shakermill.engines.thermal.air import air_constants
+from shakermill.engines.thermal.mill_head import add_mill_head
+from shakermill.engines.thermal.nodes import (
+    BALL,
+    BALL_WALL,
+    BALLS_GROUP,
+    GAS,
+    VESSEL,
+    BodySplit,
+    Deposit,
+    NetworkDraft,
+    Node,
+    deposit_arrays,
 )
+from shakermill.engines.thermal.paths import PAPER_PATHS, HeatPath, ball_convection, newton_cooling
+from shakermill.engines.thermal.powder import add_powder
+from shakermill.parameters.consistency import MIN_THERMAL_TIME_CONSTANT_S
+from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
-from shakermill.parameters.kinematic_models import KINEMATIC_MODELS, MOTION_COORDINATES, motion_terms
-from shakermill.physics import heat_paths, thermal
-
-PAPER_PATHS = "Son 2025 (Mathematics 13, 446)"
-
-
-@dataclass(frozen=True)
-class Node:
-    """A lumped heat capacity (J/K); a ``held`` node stays at the ambient temperature (a reservoir)."""
-
-    name: str
-    capacity: float
-    held: bool = False
-
-
-@dataclass(frozen=True)
-class HeatSource:
-    """Heat the contacts put into a node: of the η·dissipation of every channel (MODEL.md §§3, 12.4), ``share``."""
-
-    node: int
-    share: str
 
 
 @dataclass(frozen=True)
@@ -63,25 +53,97 @@ class NetworkLoad:
         """The ``drives`` the network's paths read (:mod:`kernel`)."""
         return np.concatenate([self.terms, self.conductances])
 
+    def moved(self, source: ThermalNetwork, target: ThermalNetwork) -> NetworkLoad:
+        """This load, measured on the nodes of ``source``, on those of ``target`` by the nodes' names: a network of
+        other thermal-only keys may add a node (the holder) before another (the powder). A node ``source`` has not
+        receives nothing."""
+        names = [node.name for node in source.nodes]
+        if names == [node.name for node in target.nodes]:
+            return self
+        measured = dict(zip(names, self.heat, strict=False))
+        heat = np.array([measured.get(node.name, 0.0) for node in target.nodes])
+        return replace(self, heat=heat)
+
 
 @dataclass(frozen=True)
 class ThermalNetwork:
-    """Nodes, heat paths and heat sources; ``arrays`` is the compiled form. Node order: the balls, the vial, the
-    air, then any others (the clamp)."""
+    """Nodes, heat paths, where the contacts' heat goes (``split`` between the bodies in contact, ``deposits`` into
+    other nodes) and the compiled form (``arrays``). Node order: the balls, the vessel, the gas, then the nodes the
+    extensions add."""
 
     n_balls: int
     nodes: tuple[Node, ...]
     paths: tuple[HeatPath, ...]
-    sources: tuple[HeatSource, ...]
+    split: BodySplit
+    deposits: tuple[Deposit, ...]
     arrays: kernel.NetworkArrays = field(repr=False)
+    # The restitution of a ball on the vessel and of two balls where a node coats them (NetworkDraft); None: uncoated.
+    coated_restitution: tuple[float, float] | None = None
 
     @property
     def vial(self) -> int:
-        return self.n_balls
+        return self.index_of_role(VESSEL)
 
     @property
     def air(self) -> int:
-        return self.n_balls + 1
+        return self.index_of_role(GAS)
+
+    def index_of_role(self, role: str) -> int:
+        """The one node of ``role`` (the vessel, the gas, the holder, the powder)."""
+        (index,) = (index for index, node in enumerate(self.nodes) if node.role == role)
+        return index
+
+    @property
+    def others(self) -> tuple[Node, ...]:
+        """Every node but the balls, in order: what a table or figure shows one line of each."""
+        return self.nodes[self.n_balls :]
+
+    def grouped(self, values: np.ndarray) -> dict[str, float]:
+        """Per-node ``values`` (J, W) as an audit shows them: the balls summed (:data:`nodes.BALLS_GROUP`), then each
+        other node by name."""
+        values = np.asarray(values, dtype=float)
+        return {BALLS_GROUP: float(values[: self.n_balls].sum())} | {
+            node.name: float(values[index]) for index, node in enumerate(self.nodes) if index >= self.n_balls
+        }
+
+    def time_constants_at_rest(self) -> dict[int, float]:
+        """Each free node's heat capacity over the conductance of its paths with the balls at rest (s), by index: no
+        motion in the convection, no contact conducting. The motion only shortens them."""
+        conductances = self.node_conductances(np.zeros(kernel.drive_count(self.n_balls)))
+        return {
+            int(node): self.nodes[node].capacity / conductances[node] if conductances[node] > 0 else math.inf
+            for node in self.free
+        }
+
+    def check_not_stiff(self) -> None:
+        """Refuse a node whose time constant at rest is below :data:`MIN_THERMAL_TIME_CONSTANT_S`, naming the keys
+        that set it: the stepping's thermal steps would shrink with it. The nodes :mod:`consistency` cannot see
+        (those of the extensions) are checked here."""
+        for node, constant in self.time_constants_at_rest().items():
+            keys = self.nodes[node].keys
+            if keys and constant < MIN_THERMAL_TIME_CONSTANT_S:
+                raise ParameterError(
+                    f"{', '.join(keys)}: the {self.nodes[node].title}'s thermal time constant is {constant:.3g} s with "
+                    f"these values; allowed >= {MIN_THERMAL_TIME_CONSTANT_S:g} s (a larger mass or a weaker coupling)"
+                )
+
+    def deposit_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """The deposits as compiled stepping reads them (:func:`nodes.deposit_arrays`)."""
+        return deposit_arrays(self.deposits)
+
+    def wall_contact_heat(self, heat: float, channel: str = "normal") -> np.ndarray:
+        """Heat (W or J) of a ball's contacts with the vessel, all in ``channel``, into each node: the deposits'
+        shares, of the rest ``split.wall_ball_share`` to the ball (the first) and the remainder to the vessel. An
+        engine of one ball on the vessel's axis loads its network this way."""
+        into = np.zeros(len(self.nodes))
+        kept = heat
+        for deposit in self.deposits:
+            part = deposit.share(BALL_WALL, channel) * heat
+            into[deposit.node] += part
+            kept -= part
+        into[0] += self.split.wall_ball_share * kept
+        into[self.vial] += (1.0 - self.split.wall_ball_share) * kept
+        return into
 
     @property
     def ambient(self) -> float:
@@ -160,15 +222,10 @@ class ThermalNetwork:
         return conductances
 
 
-def air_constants(params: Parameters) -> dict[str, float]:
-    """The air's viscosity at the ambient temperature (Pa·s) and its Prandtl number: Re and Nu of MODEL.md §4."""
-    viscosity = thermal.sutherland_viscosity(
-        params.ambient_temperature, params.air_viscosity_ref, params.air_reference_temperature, params.sutherland
-    )
-    return {
-        "viscosity_ambient": viscosity,
-        "prandtl": thermal.prandtl_number(params.air_cp, viscosity, params.air_conductivity),
-    }
+# The nodes beyond the balls, the vessel and the gas: each extension adds its node, paths and deposits to the draft
+# where the run's parameters ask for it. A new node is a module and an entry here (docs/ARCHITECTURE.md).
+NodeExtension = Callable[[NetworkDraft], None]
+NODE_EXTENSIONS: list[NodeExtension] = [add_mill_head, add_powder]
 
 
 def build_network(
@@ -176,22 +233,20 @@ def build_network(
     radii: Sequence[float],
     capacities: Sequence[float],
     ball_names: Sequence[str],
-    contact_share: str,
+    split_description: str,
 ) -> ThermalNetwork:
     """The network of ``params`` for balls of ``radii`` (m) and heat ``capacities`` (J/K): each ball convects to
-    the air (Whitaker), the vial exchanges heat with the air inside and the room outside. ``thermal_model``
-    'paper': the outside at a constant h·A, and in the ``ball_only`` model the vial and the air held at the ambient
-    (the paper's 2023 predecessor); 'mill-head': :func:`mill_head_paths` as well. ``contact_share`` says which part
-    of the contacts' heat a ball receives."""
-    n = len(radii)
-    vial, air = n, n + 1
+    the gas (Whitaker), the vessel exchanges heat with the gas inside and, under ``thermal_model = 'paper'``, with
+    the room outside at a constant h·A; in the ``ball_only`` model the vessel and the gas are held at the ambient
+    (the paper's 2023 predecessor). Then each of :data:`NODE_EXTENSIONS`. ``split_description`` says how the
+    engine splits a contact's heat between the bodies in contact."""
     held = params.model == "ball_only"
-    nodes = [
-        *(Node(name, capacity) for name, capacity in zip(ball_names, capacities, strict=True)),
-        Node("vial", params.vial_mass * params.vial_heat_capacity, held),
-        Node("air", params.air_mass * params.air_heat_capacity, held),
-    ]
-    paths = [
+    draft = NetworkDraft(params, tuple(radii))
+    for name, capacity in zip(ball_names, capacities, strict=True):
+        draft.add(Node(name, BALL, capacity, name))
+    vial = draft.add(Node("vial", VESSEL, params.vial_mass * params.vial_heat_capacity, "vial", held))
+    air = draft.add(Node("air", GAS, params.air_mass * params.air_heat_capacity, "inner air", held))
+    draft.paths += [
         *(ball_convection(f"{ball_names[i]} → air", i, air, i, radius) for i, radius in enumerate(radii)),
         newton_cooling(
             "vial → air",
@@ -202,19 +257,8 @@ def build_network(
             f"h_inner, inner_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)",
         ),
     ]
-    sources = [
-        *(HeatSource(i, contact_share) for i in range(n)),
-        HeatSource(vial, "1 − λ of the heat of each contact with the vial"),
-    ]
-    fixed_heat = np.zeros(len(nodes))
-    if params.thermal_model == "mill-head":
-        clamp = len(nodes)
-        nodes.append(Node("clamp", params.clamp_heat_capacity))
-        paths += mill_head_paths(params, ball_names, vial, clamp)
-        sources.append(HeatSource(clamp, "drive_heat: the motor's and bearings' losses, whatever the balls do"))
-        fixed_heat = np.append(fixed_heat, params.drive_heat)
-    else:
-        paths.append(
+    if params.thermal_model == "paper":
+        draft.paths.append(
             newton_cooling(
                 "vial → room",
                 vial,
@@ -224,165 +268,17 @@ def build_network(
                 f"h_outer, outer_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)",
             )
         )
-    return ThermalNetwork(n, tuple(nodes), tuple(paths), tuple(sources), _arrays(params, nodes, paths, fixed_heat))
-
-
-def mill_head_paths(params: Parameters, ball_names: Sequence[str], vial: int, clamp: int) -> list[HeatPath]:
-    """The paths of a real mill beyond the paper's (MODEL.md §13.1): the vial's outside to the room by convection
-    at its own speed and by radiation, conduction through the contacts of each ball with the vial and with the
-    other balls, the vial to the clamp and the clamp to the room."""
-    n = len(ball_names)
-    outer = vial_outer_convection(params)
-    return [
-        newton_cooling(
-            "vial → room, convection", vial, kernel.ROOM, outer.coefficient, outer.area, outer.source, outer.validity
-        ),
-        radiation("vial → room, radiation", vial, kernel.ROOM, params.emissivity, outer.area),
-        *(
-            contact_conduction(f"{ball_names[i]} → vial, contacts", i, vial, kernel.contact_drive(i, -1, n))
-            for i in range(n)
-        ),
-        *(
-            among_balls_conduction(f"{ball_names[i]} → other balls, contacts", i, kernel.contact_drive(i, i, n))
-            for i in range(n)
-            if n > 1
-        ),
-        fixed_conductance(
-            "vial → clamp",
-            vial,
-            clamp,
-            params.clamp_conductance,
-            "clamp_conductance (see its source)",
-            "a steady joint: the vial's and the clamp's own conduction are fast beside it",
-        ),
-        fixed_conductance(
-            "clamp → room",
-            clamp,
-            kernel.ROOM,
-            params.clamp_loss,
-            "clamp_loss (see its source)",
-            "the clamp and mill head lumped at one temperature",
-        ),
-    ]
-
-
-@dataclass(frozen=True)
-class OuterConvection:
-    """The vial's outside to the room: the mean coefficient over its faces (W/(m²·K)), their area (m²), the speed it
-    is taken at (m/s) and what it rests on."""
-
-    coefficient: float
-    area: float
-    speed: float
-    source: str
-    validity: str
-
-
-# Natural convection depends on the vial's rise itself (as ΔT^1/4): it is taken at a rise typical of a milling
-# hour. Beside forced convection at metres per second it changes the outer coefficient by under 1 %.
-NATURAL_CONVECTION_RISE_K = 20.0
-
-
-def vial_outer_convection(params: Parameters) -> OuterConvection:
-    """Convection from the vial's outside (a cylinder of ``outer_diameter`` × ``outer_length``) at the rms speed of
-    its motion, each face combined with natural convection (Churchill's rule); air properties at the ambient
-    temperature. A shaken vial meets the air along its axis (:func:`_along_the_axis`), a planetary jar across it
-    (:func:`_across_the_axis`)."""
-    constants = air_constants(params)
-    viscosity, prandtl = constants["viscosity_ambient"], constants["prandtl"]
-    speed = vial_rms_speed(params)
-    diameter, length, k_air = params.outer_diameter, params.outer_length, params.air_conductivity
-    side_area, end_area = math.pi * diameter * length, 2.0 * math.pi * diameter**2 / 4.0
-    rayleigh = heat_paths.rayleigh_number(
-        diameter,
-        NATURAL_CONVECTION_RISE_K,
-        params.ambient_temperature + NATURAL_CONVECTION_RISE_K / 2,
-        viscosity,
-        params.air_density,
-        k_air,
-        params.air_cp,
+    for extend in NODE_EXTENSIONS:
+        extend(draft)
+    return ThermalNetwork(
+        len(radii),
+        tuple(draft.nodes),
+        tuple(draft.paths),
+        BodySplit(params.lam, split_description),
+        tuple(draft.deposits),
+        _arrays(params, draft.nodes, draft.paths, np.array(draft.fixed_heat, dtype=float)),
+        draft.coated_restitution,
     )
-    natural = heat_paths.churchill_chu_cylinder_nusselt(rayleigh, prandtl) * k_air / diameter
-    faces = _across_the_axis if KINEMATIC_MODELS[params.kinematics].axis_upright else _along_the_axis
-    h_side, h_end, correlations, validity = faces(params, speed, viscosity, prandtl)
-    area = side_area + end_area
-    return OuterConvection(
-        coefficient=(
-            heat_paths.mixed_convection_coefficient(h_side, natural) * side_area
-            + heat_paths.mixed_convection_coefficient(h_end, natural) * end_area
-        )
-        / area,
-        area=area,
-        speed=speed,
-        source=(
-            f"{correlations}; each with natural convection (Churchill & Chu 1975, horizontal cylinder, at a "
-            f"{NATURAL_CONVECTION_RISE_K:g} K rise) by Churchill's rule; at the vial's rms speed {speed:.3g} m/s"
-        ),
-        validity=validity,
-    )
-
-
-def _reynolds(length: float, params: Parameters, speed: float, viscosity: float) -> float:
-    return thermal.reynolds_number(length, params.air_density, speed, viscosity)
-
-
-def _along_the_axis(
-    params: Parameters, speed: float, viscosity: float, prandtl: float
-) -> tuple[float, float, str, str]:
-    """The forced coefficients (W/(m²·K)) of a vial shaken along its axis: the side a plate along the flow, each end
-    a disk facing it; what they rest on and where they hold."""
-    diameter, length, k_air = params.outer_diameter, params.outer_length, params.air_conductivity
-    side = heat_paths.flat_plate_nusselt(_reynolds(length / 2, params, speed, viscosity), prandtl) * k_air / length
-    end = heat_paths.disk_nusselt(_reynolds(diameter / 2, params, speed, viscosity), prandtl) * k_air / diameter
-    return (
-        side,
-        end,
-        (
-            "side: laminar flat plate, Nu = 0.664 Re_L^1/2 Pr^1/3 (Incropera & DeWitt Eq. 7.30); ends: disk facing the "
-            "flow, Nu = 1.05 Re_D^1/2 Pr^0.36 (Sparrow & Geiger 1985, recalled, not re-read)"
-        ),
-        (
-            "quasi-steady flow: the vial's stroke is ~3 diameters (Keulegan-Carpenter number ~3), so steady "
-            "correlations at the rms speed are a ±30 % estimate; Re_L < 5e5 (laminar), the disk measured for "
-            "5e3 < Re_D < 5e4"
-        ),
-    )
-
-
-def _across_the_axis(
-    params: Parameters, speed: float, viscosity: float, prandtl: float
-) -> tuple[float, float, str, str]:
-    """The forced coefficients (W/(m²·K)) of a jar carried across its axis: the side a cylinder in cross flow, each
-    end a plate along the flow, as long as the jar is wide; what they rest on and where they hold."""
-    diameter, k_air = params.outer_diameter, params.air_conductivity
-    reynolds = _reynolds(diameter, params, speed, viscosity)
-    side = heat_paths.churchill_bernstein_nusselt(reynolds, prandtl) * k_air / diameter
-    end = heat_paths.flat_plate_nusselt(reynolds, prandtl) * k_air / diameter
-    return (
-        side,
-        end,
-        (
-            "side: cylinder in cross flow, Churchill & Bernstein 1977 (Incropera & DeWitt Eq. 7.54); ends: laminar "
-            "flat "
-            "plate along the flow, Nu = 0.664 Re_D^1/2 Pr^1/3 (Eq. 7.30)"
-        ),
-        (
-            "the jar's speed round the sun wheel taken as the air's speed past it: the air inside a mill's housing "
-            "turns "
-            "with the wheel and the jar's own spin adds (1 + k)·ω·D_o/2 at its surface, so this is a ±50 % estimate; "
-            "Re_D·Pr > 0.2"
-        ),
-    )
-
-
-def vial_rms_speed(params: Parameters) -> float:
-    """The rms speed (m/s) of the vial's centre over a drive cycle, from the Fourier terms of its motion."""
-    amplitudes: dict[tuple[str, int], np.ndarray] = {}
-    for coordinate, k, cosine, sine in motion_terms(params.kinematics, params):
-        if coordinate in MOTION_COORDINATES[:3]:
-            amplitudes[(coordinate, k)] = amplitudes.get((coordinate, k), np.zeros(2)) + (cosine, sine)
-    mean_square = sum(0.5 * (k * params.omega) ** 2 * float(np.sum(pair**2)) for (_, k), pair in amplitudes.items())
-    return math.sqrt(mean_square)
 
 
 def _arrays(

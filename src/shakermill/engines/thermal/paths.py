@@ -10,6 +10,9 @@ from dataclasses import dataclass
 from shakermill.engines.thermal.kernel import AMONG_BALLS, BALLS, CONSTANT, CONTACT, RADIATION, WHITAKER
 from shakermill.physics.heat_paths import STEFAN_BOLTZMANN
 
+# The paper whose Tables 1 and 3 give the constant coefficients of the vessel's paths.
+PAPER_PATHS = "Son 2025 (Mathematics 13, 446)"
+
 WHITAKER_CORRELATION = (
     "Q = 4πR²·β·h·(θ_b − θ_a), h = Nu·k_a/(2R), Nu = 2 + (0.4 Re^1/2 + 0.06 Re^2/3)·Pr^0.4·(μ(θ_b)/μ_r)^(−1/4), "
     "Re = 2R·ρ_a·|u|/μ_∞ at the ball's mean velocity term"

@@ -17,7 +17,6 @@ import pandas as pd
 import xarray as xr
 
 from shakermill.analysis.fit import ExponentialFit
-from shakermill.engines.registry import describe
 from shakermill.parameters.defaults import FIGURE_FORMATS, PNG_DPI
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
@@ -25,6 +24,9 @@ from shakermill.support.atomic import remove_abandoned_writes, write_files_atomi
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
+
+    from shakermill.engines.interface import EngineDescription
+    from shakermill.solvers.summary import Summary
 
 
 KELVIN_OFFSET = 273.15
@@ -56,13 +58,16 @@ class RunLike(Protocol):
     def ball_fit(self) -> ExponentialFit: ...
 
     @property
-    def summary(self) -> dict[str, Any]: ...
+    def summary(self) -> Summary: ...
+
+    @property
+    def description(self) -> EngineDescription: ...
 
 
 def several_balls(params: Parameters) -> bool:
     """Whether a run's engine moves several balls (the 'dem' engine, MODEL.md §12): its figures differ from the
     paper's."""
-    return describe(params.engine).several_balls
+    return params.engine_keys.several_balls
 
 
 def check_window(params: Parameters, window: int) -> None:
@@ -78,14 +83,14 @@ def run_context(run: RunLike) -> str:
 
     The preset is known for a stored run (:class:`shakermill.io.runs.RunData`), not for a bare Result.
     """
-    minutes = run.summary.get("simulated_s", run.params.duration) / 60.0
+    minutes = run.summary.simulated_s / 60.0
     parts = [getattr(run, "preset", None), f"{minutes:.3g} min", f"{run.params.solver} solver"]
     return ", ".join(part for part in parts if part)
 
 
 def averaging_window_note(run: RunLike) -> str:
     """For the averaged solver, which keeps the impacts of its averaging window only: that window; else empty."""
-    window = run.summary.get("averaging_window_s")
+    window = run.summary.averaging_window_s
     if run.params.solver != "averaged" or window is None:
         return ""
     return f"impacts of the {window:.3g} s averaging window only"

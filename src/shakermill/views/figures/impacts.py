@@ -119,14 +119,14 @@ SPECTRUM_CURVES = (
 def run_stress_spectrum(run: RunLike) -> StressSpectrum | None:
     """The stress-energy spectrum of ``run``'s impacts as its summary measured it; None for a run folder written
     before the spectrum was reported."""
-    window = run.summary.get("stress_window_s")
-    if not window:
+    window = run.summary.stress_window_s
+    if not window > 0.0:
         return None
     return stress_spectrum(
         run.impacts,
         window,
         run.params.stress_energy_thresholds,
-        run.summary.get("dissipated_power_W", math.nan),
+        run.summary.dissipated_power_W,
         run.params.ball_masses(),
     )
 

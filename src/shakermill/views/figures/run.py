@@ -19,7 +19,6 @@ wall and the other balls apart.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -27,8 +26,7 @@ import numpy as np
 import xarray as xr
 
 from shakermill.analysis.fit import ExponentialFit
-from shakermill.engines.records import BALL_TEMPERATURES
-from shakermill.engines.registry import describe
+from shakermill.engines.records import BALL_TEMPERATURES, HEAT_INTO_NODES, NODE_NAMES
 from shakermill.parameters.defaults import ANIMATION_FRAMES, PNG_DPI
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
@@ -54,10 +52,14 @@ from shakermill.views.trajectories import ANIMATION_DPI, animation_gif, ball_col
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+    from shakermill.solvers.summary import Summary
+
 # Figure names (file stems): the paper's Figs. 5a, 4, 5b, and this package's impact statistics.
 PAPER_FIGURES = ("temperatures", "ball_motion", "ball_heating_zoom")
 # The same for the 'dem' engine: Fig. 5a and 5b with a line per ball, the paths in the vial frame, the heat by channel.
 SEVERAL_BALL_FIGURES = ("temperatures", "trajectories", "heat_by_channel", "ball_heating_zoom")
+# The colours of the nodes other than the balls, in the network's order (the vial, the air, then any others).
+NODE_COLOURS = ("tab:blue", "tab:green", "tab:purple", "tab:brown", "tab:olive")
 # The paper's Fig. 5b zooms into the heating at 10 min; the window starting nearest to it is shown.
 HEATING_ZOOM_TIME = 600.0
 DRIVE_CURVE_POINTS = 2000
@@ -152,19 +154,18 @@ def temperature_figure(run: RunLike) -> Figure:
     balls = several_balls(run.params)
     fit = run.ball_fit
     window = f"0–{minutes[-1]:.3g} min"
-    # A summary written before the key existed drew the fit wherever it was finite.
-    describes = run.summary.get("exponential_fit_describes_run", True)
+    describes = run.summary.exponential_fit_describes_run
     if describes and math.isfinite(fit.theta_inf) and math.isfinite(fit.tau):
         fitted = "balls' mean, exponential fitted" if balls else f"ball, exponential fitted over {window}"
         axis.plot(minutes, to_celsius(fit.evaluate(series["time"].values)), "k--", lw=1, label=fitted)
-    steady = run.summary.get("ball_steady_C")
+    steady = run.summary.ball_steady_C
     if steady is not None and math.isfinite(steady):
         # The fit's θ∞ is a property of the window; the steady state is where the ball really settles.
         axis.axhline(steady, color="tab:red", ls=":", lw=1, label=steady_label(run.summary, balls))
         low, high = axis.get_ylim()
         axis.set_ylim(low, max(high, steady + 0.05 * (steady - low)))
     if run.params.n_balls:
-        slowest = run.summary.get("slowest_time_constant_min", math.nan)
+        slowest = run.summary.slowest_time_constant_min or math.nan
         said = (
             f"exponential fitted over {window}:\n{_fit_text(fit)}"
             if describes
@@ -198,12 +199,12 @@ def temperature_figure(run: RunLike) -> Figure:
     return figure
 
 
-def steady_label(summary: Mapping[str, Any], balls: bool) -> str:
+def steady_label(summary: Summary, balls: bool) -> str:
     """The legend of the steady-state line: the ball's, or the balls' mean with the range of the balls'."""
-    steady = summary["ball_steady_C"]
+    steady = summary.ball_steady_C
     if not balls:
         return f"ball steady state {steady:.1f} °C (MODEL.md §11)"
-    each = [value for value in summary.get("balls_steady_C") or () if value is not None]
+    each = [value for value in summary.balls_steady_C or () if math.isfinite(value)]
     spread = f" (each {min(each):.1f}–{max(each):.1f} °C)" if each else ""
     return f"balls' mean steady state {steady:.1f} °C{spread}"
 
@@ -223,14 +224,23 @@ def temperature_curves(params: Parameters) -> tuple[tuple[str, str, str], ...]:
 
 def temperature_lines(params: Parameters, series: xr.Dataset) -> list[tuple[np.ndarray, str, Any]]:
     """(temperatures in K, legend label, colour) of each line of the temperature figure: the ball, vial and
-    air of :func:`temperature_curves`, or for a 'dem' run each ball (numbered as in the run's files), vial and air."""
+    air of :func:`temperature_curves`, or for a 'dem' run each ball (numbered as in the run's files) and every other
+    node of its network (the vial, the air, then the holder or the powder where it has them)."""
     if not several_balls(params):
         return [(series[name].values, label, colour) for name, label, colour in temperature_curves(params)]
     balls = series[BALL_TEMPERATURES].transpose("time", "ball").values
     lines: list[tuple[np.ndarray, str, Any]] = [
         (balls[:, ball], f"ball {ball}", colour) for ball, colour in enumerate(ball_colours(balls.shape[1]))
     ]
-    return lines + [(series["theta_vial"].values, "vial", "tab:blue"), (series["theta_air"].values, "air", "tab:green")]
+    nodes = [name.strip() for name in series[HEAT_INTO_NODES].attrs[NODE_NAMES].split(",")]
+    return lines + [
+        (
+            series[f"theta_{name}"].values,
+            series[f"theta_{name}"].attrs["long_name"].removesuffix(" temperature"),
+            colour,
+        )
+        for name, colour in zip(nodes, NODE_COLOURS, strict=False)
+    ]
 
 
 def _fit_text(fit: ExponentialFit) -> str:
@@ -318,9 +328,9 @@ def impact_span(run: RunLike) -> float:
 
     The summary's impact rate is the table's impacts over that span, whichever solver wrote it.
     """
-    rate = run.summary.get("impact_rate_hz")
-    if rate is None or not rate > 0.0:
-        return float(run.summary.get("simulated_s", run.params.duration))
+    rate = run.summary.impact_rate_hz
+    if not rate > 0.0:
+        return float(run.summary.simulated_s)
     return len(run.impacts) / float(rate)
 
 
@@ -328,7 +338,7 @@ def heat_by_channel_figure(run: RunLike) -> Figure:
     """The heat of a run of several balls as mean power (W): made in each dissipation channel of its engine
     (MODEL.md §12.4), stacked by what was hit (left, from the impact table), and received by each ball and the
     vial (right, from the sampled history)."""
-    channels = describe(run.params.engine).channels
+    channels = run.description.channels
     figure, (made, received) = new_figure(height=4.2, columns=2, width=11.0)
     impacts = run.impacts
     kinds, categories = impact_kinds(impacts)
@@ -361,17 +371,25 @@ def heat_by_channel_figure(run: RunLike) -> Figure:
 
 
 def _heat_received(axis: object, run: RunLike) -> None:
-    """Bars of the mean heat power into each ball (numbered as in the run's files) and into the vial."""
+    """Bars of the mean heat power into each ball (numbered as in the run's files) and into each other node the
+    contacts heat (the vial, the powder): the nodes as the run's files name them."""
     series = run.timeseries
     seconds = float(series["time"].values[-1]) or math.nan
     balls = series["heat_into_balls"].transpose("time", "ball").values[-1] / seconds
-    powers = [*balls, float(series["heat_into_vial"].values[-1]) / seconds]
-    names = [str(ball) for ball in range(balls.size)] + ["vial"]
-    axis.bar(range(len(powers)), powers, color=[*ball_colours(balls.size), "tab:blue"])  # type: ignore[attr-defined]
+    nodes = series[HEAT_INTO_NODES]
+    heated = [
+        (name.strip(), float(value) / seconds)
+        for name, value in zip(nodes.attrs[NODE_NAMES].split(","), nodes.transpose("time", "node").values[-1])
+        if value > 0.0
+    ]
+    powers = [*balls, *(power for _, power in heated)]
+    names = [str(ball) for ball in range(balls.size)] + [name for name, _ in heated]
+    colours = [*ball_colours(balls.size), *NODE_COLOURS[: len(heated)]]
+    axis.bar(range(len(powers)), powers, color=colours)  # type: ignore[attr-defined]
     axis.set_xticks(range(len(powers)), names)  # type: ignore[attr-defined]
-    axis.set_xlabel("ball (numbered as in the run's files), and the vial")  # type: ignore[attr-defined]
+    axis.set_xlabel(f"ball (numbered as in the run's files), and {', '.join(names[balls.size :])}")  # type: ignore[attr-defined]
     axis.set_ylabel("heat received, mean power (W)")  # type: ignore[attr-defined]
-    axis.set_title(f"received by each ball and the vial: {sum(powers):.3g} W")  # type: ignore[attr-defined]
+    axis.set_title(f"received by each node: {sum(powers):.3g} W")  # type: ignore[attr-defined]
 
 
 def comparison_temperature_figure(runs: dict[str, RunLike]) -> Figure:

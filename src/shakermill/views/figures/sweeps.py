@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from shakermill.solvers.summary import SummaryKeyError, declared_names, unit_of
 from shakermill.views.figures.common import add_context, new_figure
 from shakermill.views.figures.impacts import _radian_ticks
 from shakermill.views.notebook import rpm
@@ -31,6 +32,8 @@ SWEEP_QUANTITIES = (
     ("stress_energy_median_J", "median stress energy (dissipated per impact)", "J"),
     ("stress_energy_p90_J", "90th percentile of the stress energy", "J"),
 )
+# Columns of the sweep table that are summary keys: their names checked against the schema (solvers/summary.py).
+declared_names(column for column, _, _ in SWEEP_QUANTITIES)
 
 
 # Lengths read better in mm: a vial is a few centimetres long.
@@ -86,8 +89,15 @@ MISSING_STYLE = {"marker": "x", "color": "tab:red", "s": 40, "zorder": 3}
 
 def contour_label(column: str, level: float) -> str:
     """``("theta_inf_C", 60)`` -> ``"ball θ∞ = 60 °C"``: the quantity's name and unit, not the column's."""
-    unit = next((unit for suffix, unit in SUFFIX_UNITS if column.endswith(suffix)), "")
-    return f"{SHORT_NAMES.get(column, column)} = {level:g} {unit}".rstrip()
+    return f"{SHORT_NAMES.get(column, column)} = {level:g} {column_unit(column)}".rstrip()
+
+
+def column_unit(column: str) -> str:
+    """The unit of a sweep table's column: a summary key's as its schema declares it, else by its name's suffix."""
+    try:
+        return unit_of(column)
+    except SummaryKeyError:
+        return next((unit for suffix, unit in SUFFIX_UNITS if column.endswith(suffix)), "")
 
 
 def rpm_axis(axis: object, key: str, which: str = "x") -> None:
