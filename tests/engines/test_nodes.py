@@ -150,9 +150,11 @@ def test_the_extensions_are_listed_once_and_the_kinds_and_channels_are_those_the
 
 
 # The files outside the powder's own code whose code names it (comments and docstrings aside): its keys, its default
-# values with their sources, the keys the engines read, its place among the extensions (and materials.toml, data, its
-# material). A new file here means the powder has leaked into code that should loop over the nodes.
+# values with their sources, the keys the engines read, the keys a lone impact does not (its heat), its place among
+# the extensions (and materials.toml, data, its material). A new file here means the powder has leaked into code that
+# should loop over the nodes.
 POWDER_FILES = {
+    "solvers/impact.py",
     "parameters/keys.py",
     "parameters/presets.py",
     "parameters/engine_keys.py",

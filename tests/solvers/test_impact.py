@@ -345,8 +345,11 @@ def test_the_keys_a_lone_impact_does_not_read_are_keys_and_refused_with_why():
     for key in ("ball_materials", "fill", "n_balls", "engine", "gravity", "motion", "yaw_amplitude", "solver"):
         assert key in UNREAD_KEYS
     assert set(UNREAD_KEYS) <= set(FIELD_NAMES)
-    # What the contact law reads stays readable.
+    # What the contact law reads stays readable; of the powder, its mass and the restitution of the contacts it coats.
     assert not {"ball_radius", "ball_material", "restitution", "friction", "contact_step_fraction"} & set(UNREAD_KEYS)
+    assert not {"powder_mass", "powder_restitution"} & set(UNREAD_KEYS)
+    with pytest.raises(ParameterError, match="^powder_heat_share: a lone impact reports mechanics"):
+        check_keys_read(["powder_mass", "powder_heat_share"], "wall")
     with pytest.raises(ParameterError, match="^ball_materials: a lone impact takes the scalar ball keys"):
         check_keys_read(["restitution", "ball_materials", "fill"], "wall")
     check_keys_read(["restitution", "ball_material"], "wall")

@@ -18,6 +18,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from shakermill.parameters.engine_keys import MILL_HEAD_ONLY
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import PER_BALL_KEYS, Parameters
 
@@ -126,13 +127,12 @@ _UNREAD_GROUPS = (
             "inner_area",
             "outer_area",
             "thermal_model",
-            "outer_diameter",
-            "outer_length",
-            "emissivity",
-            "clamp_heat_capacity",
-            "clamp_conductance",
-            "clamp_loss",
-            "drive_heat",
+            *sorted(MILL_HEAD_ONLY),
+            # The powder's heat: its mass and the restitution of the contacts it coats are read, as the mechanics'.
+            "powder_material",
+            "powder_heat_capacity",
+            "powder_heat_share",
+            "powder_contact_coefficient",
             "eta",
             "lam",
             "beta",

@@ -148,8 +148,9 @@ def planetary_ordering(overrides: Mapping[str, Any] | None = None) -> PowderComp
     )
 
 
+POWDER_STUDIES = (five_balls_with_powder, planetary_ordering)
 # The steps :func:`powder_studies` counts for a progress bar.
-POWDER_STEPS = 2
+POWDER_STEPS = len(POWDER_STUDIES)
 
 
 def powder_studies(
@@ -157,7 +158,7 @@ def powder_studies(
 ) -> tuple[PowderComparison, ...]:
     """Both comparisons, ``progress(done, total)`` after each."""
     studies = []
-    for done, study in enumerate((five_balls_with_powder, planetary_ordering), start=1):
+    for done, study in enumerate(POWDER_STUDIES, start=1):
         studies.append(study(overrides))
         if progress is not None:
             progress(done, POWDER_STEPS)

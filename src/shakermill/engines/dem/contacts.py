@@ -428,24 +428,30 @@ def settle(slot: int, t: float, dt: float, k: Constants, s: State, w: Scratch, r
 
 
 @njit(cache=True, inline="always")
-def _deposited(kind: int, channels: Any, k: Constants) -> float:
+def _deposit_share(kind: int, channels: Any, deposit: int, k: Constants) -> float:
     """The heat (J) of ``channels``' dissipation (J, in HEAT_CHANNELS order) of a contact of ``kind`` (0: a wall, 1:
-    a pair) that goes to nodes other than its two bodies (``network.deposits``: the powder)."""
+    a pair) that ``deposit`` takes for its node, neither of the two bodies (``network.deposits``: the powder)."""
+    part = 0.0
+    for channel in range(4):
+        part += k.eta * channels[channel] * k.deposit_shares[kind, channel, deposit]
+    return part
+
+
+@njit(cache=True, inline="always")
+def _deposited(kind: int, channels: Any, k: Constants) -> float:
+    """What all deposits take of a contact's heat (J, :func:`_deposit_share`)."""
     deposited = 0.0
     for deposit in range(k.deposit_count):
-        for channel in range(4):
-            deposited += k.eta * channels[channel] * k.deposit_shares[kind, channel, deposit]
+        deposited += _deposit_share(kind, channels, deposit, k)
     return deposited
 
 
 @njit(cache=True, inline="always")
 def _deposit(kind: int, channels: Any, k: Constants, s: State) -> float:
-    """Put the deposits' shares of a step's heat (:func:`_deposited`) into their nodes; their sum (J)."""
+    """Put each deposit's share of a step's heat (:func:`_deposit_share`) into its node; their sum (J)."""
     deposited = 0.0
     for deposit in range(k.deposit_count):
-        part = 0.0
-        for channel in range(4):
-            part += k.eta * channels[channel] * k.deposit_shares[kind, channel, deposit]
+        part = _deposit_share(kind, channels, deposit, k)
         node = k.deposit_nodes[deposit]
         s.pending_heat[node] += part
         s.heat_into[node] += part

@@ -108,8 +108,10 @@ class DemEngine(CompiledRun, Averaging, Replicas, StepBound, MemoryBound):
         (:func:`model.contact_memory`: ~40 MB for 2000 balls)."""
         windows = sum(max(0.0, min(length, params.duration - start)) for start, length in params.record_windows)
         rows = samples + windows / WINDOW_INTERVAL
-        row_bytes = rows * model.row_width(params.n_balls, len(cls.network_for(params).nodes)) * 8
-        return int(row_bytes + model.contact_memory(model.constants_from(params), len(stepper.RECORD_COLUMNS)))
+        network = cls.network_for(params)
+        row_bytes = rows * model.row_width(params.n_balls, len(network.nodes)) * 8
+        constants = model.constants_from(params, network)
+        return int(row_bytes + model.contact_memory(constants, len(stepper.RECORD_COLUMNS)))
 
     @classmethod
     def least_steps(cls, params: Parameters, simulated: float) -> float:
@@ -272,9 +274,10 @@ class DemEngine(CompiledRun, Averaging, Replicas, StepBound, MemoryBound):
         walls = int(np.sum(impacts["target"] != "ball"))
         hits[self.network.vial] = walls
         pairs = len(impacts["target"]) - walls
-        nodes, shares = self.network.deposit_arrays()
-        for index, node in enumerate(nodes):
-            hits[node] += walls * bool(shares[0, :, index].any()) + pairs * bool(shares[1, :, index].any())
+        k = self.constants
+        for index, node in enumerate(k.deposit_nodes):
+            shares = k.deposit_shares[:, :, index]
+            hits[node] += walls * bool(shares[0].any()) + pairs * bool(shares[1].any())
         return hits
 
     def averaged_history(

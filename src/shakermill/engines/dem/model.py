@@ -275,6 +275,14 @@ def network_of(params: Parameters) -> ThermalNetwork:
     return build_network(params, radius, capacity, names, share)
 
 
+def thermal_step(network: ThermalNetwork) -> float:
+    """The clock the stepping advances ``network`` on (s): THERMAL_STEP, or a tenth of its fastest node's time
+    constant at rest where that is shorter; a node too stiff to step is refused (``check_not_stiff``)."""
+    time_constants = network.time_constants_at_rest()
+    network.check_not_stiff(time_constants)
+    return min(THERMAL_STEP, THERMAL_STEP_FRACTION * min(time_constants.values(), default=math.inf))
+
+
 def constants_from(params: Parameters, network: ThermalNetwork | None = None) -> Constants:
     """Everything the stepping needs but the thermal network's compiled form: of ``network`` (:func:`network_of`
     when None), where the contacts' heat goes and its fastest time constant."""
@@ -304,8 +312,6 @@ def constants_from(params: Parameters, network: ThermalNetwork | None = None) ->
         default=params.max_flight_step / params.contact_step_fraction,
     )
     impact_fraction = params.contact_step_fraction * IMPACT_STEP_SCALE
-    network.check_not_stiff()
-    fastest_node = min(network.time_constants_at_rest().values(), default=math.inf)
     # A node that coats the bodies in contact (the powder) sets their restitution.
     wall_restitution, pair_restitution = network.coated_restitution or (params.restitution, params.pair_restitution)
     return Constants(
@@ -352,7 +358,7 @@ def constants_from(params: Parameters, network: ThermalNetwork | None = None) ->
         longest_contact_step=0.9 * rayleigh,
         max_flight_step=params.max_flight_step,
         max_overlap=MAX_OVERLAP_FRACTION * float(radius.min(initial=math.inf)),
-        thermal_step=min(THERMAL_STEP, THERMAL_STEP_FRACTION * fastest_node),
+        thermal_step=thermal_step(network),
         skin=skin,
         cell_size=cell_size,
         cells_per_side=cells_per_side,

@@ -8,7 +8,7 @@ them."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -82,11 +82,13 @@ class ThermalNetwork:
 
     @property
     def vial(self) -> int:
-        return self.index_of_role(VESSEL)
+        """The vessel: :func:`build_network` adds it after the balls."""
+        return self.n_balls
 
     @property
     def air(self) -> int:
-        return self.index_of_role(GAS)
+        """The gas: :func:`build_network` adds it after the vessel."""
+        return self.n_balls + 1
 
     def index_of_role(self, role: str) -> int:
         """The one node of ``role`` (the vessel, the gas, the holder, the powder)."""
@@ -115,11 +117,11 @@ class ThermalNetwork:
             for node in self.free
         }
 
-    def check_not_stiff(self) -> None:
-        """Refuse a node whose time constant at rest is below :data:`MIN_THERMAL_TIME_CONSTANT_S`, naming the keys
-        that set it: the stepping's thermal steps would shrink with it. The nodes :mod:`consistency` cannot see
-        (those of the extensions) are checked here."""
-        for node, constant in self.time_constants_at_rest().items():
+    def check_not_stiff(self, time_constants: Mapping[int, float]) -> None:
+        """Refuse a node whose time constant at rest (``time_constants``, :meth:`time_constants_at_rest`) is below
+        :data:`MIN_THERMAL_TIME_CONSTANT_S`, naming the keys that set it: the stepping's thermal steps would shrink
+        with it. The nodes :mod:`consistency` cannot see (those of the extensions) are checked here."""
+        for node, constant in time_constants.items():
             keys = self.nodes[node].keys
             if keys and constant < MIN_THERMAL_TIME_CONSTANT_S:
                 raise ParameterError(
@@ -212,13 +214,13 @@ class ThermalNetwork:
         """The conductance (W/K) of all paths at each node: its heat flows when it alone is 1 K above the
         ambient, every other node at the ambient."""
         conductances = np.zeros(len(self.nodes))
+        theta = np.full(len(self.nodes), self.ambient)
         for node in range(len(self.nodes)):
-            theta = np.full(len(self.nodes), self.ambient)
             theta[node] += 1.0
             flows = self.flows(theta, drives)
-            for path, flow in zip(self.paths, flows, strict=True):
-                if node in (path.hot, path.cold):
-                    conductances[node] += abs(flow)
+            theta[node] = self.ambient
+            # Vectorised over the paths: a charge of thousands has thousands of nodes and paths.
+            conductances[node] = np.abs(flows[(self.arrays.hot == node) | (self.arrays.cold == node)]).sum()
         return conductances
 
 
