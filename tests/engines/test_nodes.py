@@ -4,9 +4,9 @@ the stepping, the audit, the history and the steady state without an edit anywhe
 
 from __future__ import annotations
 
-import ast
 import math
-from pathlib import Path
+import sys
+import types
 
 import numpy as np
 import pytest
@@ -25,7 +25,6 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.physics import contact
 from shakermill.solvers.averaged import integrate_network
 
-SRC = Path(__file__).resolve().parents[2] / "src" / "shakermill"
 # Five balls in the SPEX vial, a fraction of a second: enough impacts of both kinds for the routing to show.
 FIVE_BALLS = {"n_balls": 5, "duration": 0.3, "solver": "full", "record_windows": ()}
 
@@ -119,7 +118,11 @@ def add_lid(draft: network.NetworkDraft) -> None:
 
 @pytest.fixture(name="lid")
 def lid_fixture(monkeypatch):
-    monkeypatch.setattr(network, "NODE_EXTENSIONS", [*network.NODE_EXTENSIONS, add_lid])
+    """The lid as a module of engines/thermal/ would be, named among the extensions."""
+    module = types.ModuleType("shakermill.engines.thermal.lid")
+    module.add_node = add_lid
+    monkeypatch.setitem(sys.modules, module.__name__, module)
+    monkeypatch.setattr(network, "NODE_EXTENSIONS", (*network.NODE_EXTENSIONS, "lid"))
 
 
 @pytest.mark.slow
@@ -149,70 +152,12 @@ def test_the_extensions_are_listed_once_and_the_kinds_and_channels_are_those_the
     assert [node.role for node in built.nodes[5:]] == ["vessel", "gas", "holder", "powder"]
 
 
-# The files outside the powder's own code whose code names it (comments and docstrings aside): its keys, its default
-# values with their sources, the keys the engines read, the keys a lone impact does not (its heat), its place among
-# the extensions (and materials.toml, data, its material). A new file here means the powder has leaked into code that
-# should loop over the nodes.
-POWDER_FILES = {
-    "solvers/impact.py",
-    "parameters/keys.py",
-    "parameters/presets.py",
-    "parameters/engine_keys.py",
-    "engines/thermal/network.py",
-}
-# Its own code: the node, and the study of it with its rows in `validate` and on the validation page.
-POWDER_OWN = {
-    "engines/thermal/powder.py",
-    "studies/powder.py",
-    "studies/validation_report.py",
-    "cli/validating.py",
-    "views/validation_page.py",
-}
-
-
-def names_in_code(source: str, word: str) -> bool:
-    """Whether ``word`` is in a name, an attribute, an argument, an import or a string of ``source`` that is not
-    prose."""
-    tree = ast.parse(source)
-    # Prose: a string that is a statement of its own (a docstring) or holds a space (a message, a source).
-    prose = {id(node.value) for node in ast.walk(tree) if isinstance(node, ast.Expr)}
-    for node in ast.walk(tree):
-        text = (
-            node.id
-            if isinstance(node, ast.Name)
-            else node.attr
-            if isinstance(node, ast.Attribute)
-            else node.arg
-            if isinstance(node, ast.arg)
-            else node.value
-            if isinstance(node, ast.Constant)
-            and isinstance(node.value, str)
-            and id(node) not in prose
-            and " " not in node.value
-            else " ".join([node.module or "", *(alias.name for alias in node.names)])
-            if isinstance(node, ast.ImportFrom)
-            else ""
-        )
-        if word in text.lower():
-            return True
-    return False
-
-
-def test_names_in_code_sees_code_and_not_prose() -> None:
-    assert names_in_code("x = params.powder_mass", "powder")
-    assert names_in_code("from a.powder import add", "powder")
-    assert names_in_code("KEYS = ('powder_mass',)", "powder")
-    assert not names_in_code('"""The powder."""\n# the powder\nx = "no powder here"', "powder")
-
-
-def test_the_powder_is_named_in_its_own_code_and_a_few_declared_places_only() -> None:
-    naming = {
-        str(path.relative_to(SRC))
-        for path in SRC.rglob("*.py")
-        if names_in_code(path.read_text(encoding="utf-8"), "powder")
-    }
-    assert POWDER_OWN <= naming
-    assert naming - POWDER_OWN == POWDER_FILES
+@pytest.mark.parametrize("name", ["Lid", "lid 2", "top_lid", ""])
+def test_a_node_beyond_the_balls_whose_name_the_summary_cannot_take_is_refused_where_it_is_made(name):
+    with pytest.raises(ValueError, match=r"a node's name is one word of lower-case letters \(\[a-z\]\+\)"):
+        Node(name, "lid", 40.0, "lid")
+    assert Node("lid", "lid", 40.0, "lid").name == "lid"
+    assert Node("ball 3", "ball", 1.0, "ball 3").role == "ball"  # the balls are no summary key of their own
 
 
 def test_a_powder_too_light_to_step_is_refused_naming_its_keys() -> None:

@@ -29,13 +29,8 @@ from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork, air_constants, build_network
 from shakermill.io.runs import load_run, write_run
 from shakermill.parameters.config import load_config
-from shakermill.parameters.engine_keys import (
-    AVERAGED_SOLVER,
-    GEOMETRY_AND_DRIVE,
-    PAPER_THERMAL,
-    RUN_CONTROL,
-    EngineKeys,
-)
+from shakermill.parameters.engine_keys import EngineKeys, reads_of
+from shakermill.parameters.groups import AveragedSolver, Drive, PaperNetwork, RoomLoss, RunControl, Stroke, Vial
 from shakermill.parameters.keys import FIELD_NAMES, Parameters
 from shakermill.physics import thermal
 from shakermill.views.figures.run import temperature_figure
@@ -61,11 +56,9 @@ DESCRIPTION = EngineDescription(
         networks=("paper",),
         air_moves_with_vial=False,
         # It keeps no record windows, and its ball starts at the gap's end whatever the drive's phase.
-        reads=(RUN_CONTROL - {"record_windows"})
-        | AVERAGED_SOLVER
-        | (GEOMETRY_AND_DRIVE - {"phase"})
-        | PAPER_THERMAL
-        | {"averaging_rel_error", "restitution", "ball_density", "ball_material", "vial_material"},
+        reads=reads_of(RunControl, AveragedSolver, Vial, Drive, Stroke, PaperNetwork, RoomLoss)
+        - {"record_windows", "phase"}
+        | {"averaging_rel_error", "ball_radius", "restitution", "ball_density", "ball_material", "vial_material"},
     ),
     channels=("normal",),
     impact_units=IMPACT_UNITS,

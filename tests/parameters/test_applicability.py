@@ -12,15 +12,10 @@ from shakermill.engines.dem import model
 from shakermill.engines.dem.engine import WINDOW_INTERVAL, DemEngine
 from shakermill.engines.dem.stepper import RECORD_COLUMNS
 from shakermill.parameters.config import load_config, write_config_toml
-from shakermill.parameters.engine_keys import (
-    AVERAGED_ONLY,
-    ENGINE_KEYS,
-    MILL_HEAD_ONLY,
-    MOTION_KEYS,
-    NETWORK_ONLY,
-    Reader,
-)
+from shakermill.parameters.engine_keys import ENGINE_KEYS, SOLVER_KEYS, Reader, keys_decided_by
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.groups import keys_of_role
+from shakermill.parameters.key_group import VIAL_MOTION
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.solvers import simulate as simulate_module
 from shakermill.studies.calibrate import LONGEST_FULL_RESOLUTION_FIT_S, check_full_resolution_work
@@ -28,7 +23,7 @@ from shakermill.studies.sweep_plan import check_keys_read, plan_sweep
 
 
 def test_a_reader_names_where_a_key_applies():
-    one_d = Reader("1d", "full", "paper", "axial")
+    one_d = Reader(engine="1d", solver="full", thermal_model="paper", kinematics="axial")
     assert (
         one_d.not_read("ball_materials")
         == "the 1-D engine (engine = '1d') does not read it; it applies to engine = 'dem'"
@@ -38,29 +33,41 @@ def test_a_reader_names_where_a_key_applies():
     )
     assert (
         one_d.not_read("omega") is None
-        and Reader("1d", "averaged", "paper", "axial").not_read("averaging_max_time") is None
+        and Reader(engine="1d", solver="averaged", thermal_model="paper", kinematics="axial").not_read(
+            "averaging_max_time"
+        )
+        is None
     )
-    dem = Reader("dem", "averaged", "paper", "axial")
+    dem = Reader(engine="dem", solver="averaged", thermal_model="paper", kinematics="axial")
     assert "it applies to engine = '1d'" in dem.not_read("heat_model")
     assert (
         dem.not_read("drive_heat") == "the 'paper' network does not read it; it applies to thermal_model = 'mill-head'"
     )
-    assert Reader("dem", "averaged", "mill-head", "axial").not_read("drive_heat") is None
+    assert (
+        Reader(engine="dem", solver="averaged", thermal_model="mill-head", kinematics="axial").not_read("drive_heat")
+        is None
+    )
     # The powder's keys apply with powder, and then it coats every contact: the bare restitutions give way.
     assert dem.not_read("powder_heat_share") == (
         "a run without powder (powder_mass = 0) does not read it; it applies to powder_mass > 0"
     )
-    coated = Reader("dem", "averaged", "paper", "axial", 0.004)
+    coated = Reader(engine="dem", solver="averaged", thermal_model="paper", kinematics="axial", powder_mass=0.004)
     assert coated.not_read("powder_heat_share") is None and dem.not_read("restitution") is None
     assert "powder_restitution applies instead" in coated.not_read("pair_restitution")
-    assert "engine = 'dem'" in Reader("1d", "full", "paper", "axial", 0.004).not_read("powder_heat_share")
+    assert "engine = 'dem'" in Reader(
+        engine="1d", solver="full", thermal_model="paper", kinematics="axial", powder_mass=0.004
+    ).not_read("powder_heat_share")
     # Every key of these sets is one some run reads: none is dead.
     readers = [
-        Reader("1d", "averaged", "paper", "axial"),
-        *(Reader("dem", "averaged", "mill-head", motion) for motion in KINEMATIC_MODELS),
-        Reader("dem", "averaged", "paper", "axial", 0.004),
+        Reader(engine="1d", solver="averaged", thermal_model="paper", kinematics="axial"),
+        *(
+            Reader(engine="dem", solver="averaged", thermal_model="mill-head", kinematics=motion)
+            for motion in KINEMATIC_MODELS
+        ),
+        Reader(engine="dem", solver="averaged", thermal_model="paper", kinematics="axial", powder_mass=0.004),
     ]
-    for key in AVERAGED_ONLY | MILL_HEAD_ONLY | MOTION_KEYS | ENGINE_KEYS["1d"].reads | ENGINE_KEYS["dem"].reads:
+    mill_head, motions = keys_decided_by("thermal_model", "mill-head"), keys_of_role(VIAL_MOTION)
+    for key in SOLVER_KEYS | mill_head | motions | ENGINE_KEYS["1d"].reads | ENGINE_KEYS["dem"].reads:
         assert any(reader.not_read(key) is None for reader in readers), key
 
 
@@ -93,13 +100,15 @@ def test_a_file_written_by_hand_is_explicit_a_runs_own_configuration_is_not(tmp_
 @pytest.mark.parametrize("network, other", [("paper", "mill-head"), ("mill-head", "paper")])
 def test_a_key_of_one_network_is_refused_on_a_run_of_the_other_both_ways(network, other):
     """Issue 35: with thermal_model = 'mill-head', h_outer and outer_area changed nothing and were accepted."""
-    reader = Reader("dem", "averaged", other, "spex8000m")
-    for key in NETWORK_ONLY[network]:
+    reader = Reader(engine="dem", solver="averaged", thermal_model=other, kinematics="spex8000m")
+    for key in keys_decided_by("thermal_model", network):
         assert (
             reader.not_read(key) == f"the {other!r} network does not read it; it applies to thermal_model = {network!r}"
         )
-        assert Reader("dem", "averaged", network, "spex8000m").not_read(key) is None
-    key = sorted(NETWORK_ONLY[network])[0]
+        assert (
+            Reader(engine="dem", solver="averaged", thermal_model=network, kinematics="spex8000m").not_read(key) is None
+        )
+    key = sorted(keys_decided_by("thermal_model", network))[0]
     preset = "spex8000m-3d-calibrated" if other == "mill-head" else "spex8000m-3d"
     with pytest.raises(ParameterError) as raised:
         load_config(preset=preset, overrides=[f"{key}=1"])
@@ -126,14 +135,14 @@ def test_the_keys_a_preset_sets_and_the_run_does_not_read_are_said_in_a_note():
 
 
 def test_a_key_of_the_vial_motion_is_read_only_by_the_kinematic_models_that_take_it():
-    spex = Reader("dem", "full", "paper", "spex8000m")
+    spex = Reader(engine="dem", solver="full", thermal_model="paper", kinematics="spex8000m")
     assert spex.not_read("lateral_amplitude") is None and spex.not_read("amplitude") is None
     assert (
         spex.not_read("swing_radius")
         == "kinematics = 'spex8000m' does not read it; it applies to kinematics = 'mixer-mill-arc'"
     )
-    assert Reader("dem", "full", "paper", "fourier").not_read("amplitude") == (
-        "kinematics = 'fourier' does not read it; it applies to kinematics = 'axial' or 'spex8000m' or 'mixer-mill-arc'"
+    assert Reader(engine="dem", solver="full", thermal_model="paper", kinematics="fourier").not_read("amplitude") == (
+        "kinematics = 'fourier' does not read it; it applies to kinematics = 'axial' or 'mixer-mill-arc' or 'spex8000m'"
     )
     with pytest.raises(ParameterError, match="motion: set explicitly, but kinematics = 'spex8000m' does not read it"):
         load_config(preset="spex8000m-3d", overrides=["motion=x:1:0.001:0"])

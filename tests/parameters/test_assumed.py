@@ -22,7 +22,7 @@ CONTACT = {"friction", "pair_friction", "restitution", "pair_restitution", "roll
 HEAD = {"emissivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss"}
 BOWL = {"vial_diameter", "vial_length", "outer_diameter", "outer_length"}
 TABLE = {"low": 0.1, "high": 0.6, "distribution": "uniform", "reason": "assumed"}
-SPEX_3D = Reader("dem", "averaged", "paper", "spex8000m")
+SPEX_3D = Reader(engine="dem", solver="averaged", thermal_model="paper", kinematics="spex8000m")
 
 
 @pytest.mark.parametrize(
@@ -102,7 +102,8 @@ def test_a_users_range_from_the_command_line():
     assert (narrowed.low, narrowed.high, narrowed.distribution) == (0.4, 0.5, "uniform")
     assert (
         parse_assumption(
-            "clamp_loss=1:10:log-uniform", Reader("dem", "averaged", "mill-head", "spex8000m")
+            "clamp_loss=1:10:log-uniform",
+            Reader(engine="dem", solver="averaged", thermal_model="mill-head", kinematics="spex8000m"),
         ).distribution
         == "log-uniform"
     )

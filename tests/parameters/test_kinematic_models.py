@@ -1,9 +1,9 @@
-"""Named motions of the vial (MODEL.md §12.2; parameters/kinematic_models.py) and the presets that use them."""
+"""Named motions of the vial (MODEL.md §12.2; parameters/motions/, found by parameters/kinematic_models.py) and the
+presets that use them."""
 
 from __future__ import annotations
 
 import math
-import typing
 
 import numpy as np
 import pytest
@@ -12,8 +12,9 @@ import shakermill as sm
 from shakermill.engines.dem.model import harmonics_of
 from shakermill.parameters import kinematic_models as models
 from shakermill.parameters.errors import ParameterError
-from shakermill.parameters.keys import Parameters, unit_slip_warnings
-from shakermill.parameters.kinematic_models import MOTION_COORDINATES
+from shakermill.parameters.keys import choices_of, unit_slip_warnings
+from shakermill.parameters.motions import MAX_MOTION_HARMONIC, MOTION_COORDINATES
+from shakermill.parameters.motions.mixer_mill_arc import MAX_SWING_ANGLE, arc_terms
 from shakermill.parameters.presets import PRESETS
 from shakermill.physics import kinematics as drive
 
@@ -27,7 +28,10 @@ def _coordinates(harmonics: np.ndarray, t: float, omega: float, phase: float) ->
 
 
 def test_every_named_motion_is_a_choice_of_the_kinematics_key():
-    assert set(typing.get_args(Parameters.model_fields["kinematics"].annotation)) == set(models.KINEMATIC_MODELS)
+    assert set(choices_of("kinematics")) == set(models.KINEMATIC_MODELS)
+    assert {"axial", "fourier", "spex8000m", "mixer-mill-arc", "planetary"} <= set(models.KINEMATIC_MODELS)
+    with pytest.raises(ParameterError, match="^kinematics: input should be 'axial' or 'fourier' or "):
+        sm.default_parameters(engine="dem", kinematics="orbital")
 
 
 @pytest.mark.parametrize("t", [0.0, 0.0123, 0.5, 7.77])
@@ -49,12 +53,12 @@ def test_the_spex_motion_without_lateral_motion_and_yaw_is_axial():
     assert np.array_equal(harmonics_of(figure_of_eight), harmonics_of(axial))
 
 
-@pytest.mark.parametrize("alpha", [1e-3, 0.1, 0.5, models.MAX_SWING_ANGLE])
+@pytest.mark.parametrize("alpha", [1e-3, 0.1, 0.5, MAX_SWING_ANGLE])
 def test_the_arcs_fourier_series_is_its_closed_form(alpha):
     radius = 0.1
-    terms = models.arc_terms(alpha * radius, radius)
-    assert max(k for _, k, _, _ in terms) <= models.MAX_MOTION_HARMONIC
-    harmonics = np.zeros((6, models.MAX_MOTION_HARMONIC + 1, 2))
+    terms = arc_terms(alpha * radius, radius)
+    assert max(k for _, k, _, _ in terms) <= MAX_MOTION_HARMONIC
+    harmonics = np.zeros((6, MAX_MOTION_HARMONIC + 1, 2))
     for coordinate, k, cosine, sine in terms:
         harmonics[MOTION_COORDINATES.index(coordinate), k] += (cosine, sine)
     for theta in THETAS:
@@ -111,7 +115,7 @@ def test_every_value_a_preset_sets_names_its_source(name):
         ({"kinematics": "spex8000m", "yaw_amplitude": "100 deg"}, ("yaw_amplitude:", "allowed [0, 1.570796] rad")),
         ({"kinematics": "mixer-mill-arc", "swing_radius": 0}, ("swing_radius:", "allowed [0.001, 1] m")),
         ({"kinematics": "mixer-mill-arc", "swing_radius": "10 mm"}, ("amplitude:", "swing_radius·π/2 = 0.01571 m")),
-        ({"kinematics": "figure8"}, ("kinematics:", "'spex8000m', 'mixer-mill-arc'")),
+        ({"kinematics": "figure8"}, ("kinematics:", "'mixer-mill-arc', 'planetary', 'spex8000m'")),
         ({"engine": "1d", "kinematics": "spex8000m"}, ("kinematics:", "allowed 'axial' with engine = '1d'")),
     ],
 )

@@ -7,10 +7,13 @@ import math
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 import shakermill as sm
+from shakermill.cli.commands import app
 from shakermill.engines.registry import describe
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.groups.powder import PowderHeat
 from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.physics.contact import (
     effective_modulus,
@@ -18,7 +21,7 @@ from shakermill.physics.contact import (
     hertz_force,
     hertz_max_overlap,
 )
-from shakermill.solvers.impact import UNREAD_KEYS, check_keys_read, restitution_warning, single_impact
+from shakermill.solvers.impact import IMPACT_READS, check_keys_read, restitution_warning, single_impact
 
 # A contact step of 2 % of the Rayleigh time: an impact at 1/125 of its period, restitution within 6e-4 of e, contact
 # time within one contact step. The default 0.025 (1/100 of the period) leaves restitution errors up to ~8e-4.
@@ -341,16 +344,21 @@ def test_a_near_grazing_impact_is_refused_by_its_normal_speed():
         single_impact(sm.default_parameters(), 1.0, 89.9999999999)
 
 
-def test_the_keys_a_lone_impact_does_not_read_are_keys_and_refused_with_why():
-    for key in ("ball_materials", "fill", "n_balls", "engine", "gravity", "motion", "yaw_amplitude", "solver"):
-        assert key in UNREAD_KEYS
-    assert set(UNREAD_KEYS) <= set(FIELD_NAMES)
-    # What the contact law reads stays readable; of the powder, its mass and the restitution of the contacts it coats.
-    assert not {"ball_radius", "ball_material", "restitution", "friction", "contact_step_fraction"} & set(UNREAD_KEYS)
-    assert not {"powder_mass", "powder_restitution"} & set(UNREAD_KEYS)
-    with pytest.raises(ParameterError, match="^powder_heat_share: a lone impact reports mechanics"):
+def test_a_lone_impact_reads_the_contact_law_and_refuses_every_other_key_with_why():
+    """What it reads is derived from the key groups (issue 48): the balls, the vial's wall, the contacts' damping,
+    friction and rolling, the 'dem' engine's steps and every coating of the contacts (the powder's); any other key,
+    a new one included, is refused without a list naming it."""
+    assert IMPACT_READS <= set(FIELD_NAMES)
+    assert {"ball_radius", "ball_material", "restitution", "friction", "contact_step_fraction"} <= IMPACT_READS
+    assert {"powder_mass", "powder_restitution"} <= IMPACT_READS
+    unread = set(FIELD_NAMES) - IMPACT_READS
+    assert {"ball_materials", "fill", "n_balls", "engine", "gravity", "motion", "yaw_amplitude", "solver"} <= unread
+    assert {"powder_heat_share", "powder_heat_capacity", "powder_material", "stress_energy_thresholds"} <= unread
+    with pytest.raises(
+        ParameterError, match="^powder_heat_share: a lone impact does not read it: it reads the contact "
+    ):
         check_keys_read(["powder_mass", "powder_heat_share"], "wall")
-    with pytest.raises(ParameterError, match="^ball_materials: a lone impact takes the scalar ball keys"):
+    with pytest.raises(ParameterError, match="^ball_materials: a lone impact does not read it.*several balls applies"):
         check_keys_read(["restitution", "ball_materials", "fill"], "wall")
     check_keys_read(["restitution", "ball_material"], "wall")
     check_keys_read(["pair_restitution", "pair_friction", "ball_material"], "ball")
@@ -359,6 +367,14 @@ def test_the_keys_a_lone_impact_does_not_read_are_keys_and_refused_with_why():
         check_keys_read(["pair_friction"], "wall")
     with pytest.raises(ParameterError, match="^restitution: an impact on a ball does not read it.*pair_restitution"):
         check_keys_read(["restitution"], "ball")
+
+
+@pytest.mark.parametrize("key", sorted(PowderHeat.keys()))
+def test_a_lone_impact_refuses_every_key_of_the_powders_thermal_group_in_one_line(key):
+    result = CliRunner().invoke(app, ["impact", "--speed", "1", "--set", f"{key}=0.5"])
+    assert result.exit_code == 2
+    (line,) = result.stderr.strip().splitlines()
+    assert line.startswith(f"error: {key}: a lone impact does not read it") and "the powder's heat applies" in line
 
 
 def test_a_coarse_contact_step_is_warned_of_and_the_default_one_is_not():

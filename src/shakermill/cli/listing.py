@@ -135,19 +135,21 @@ def keys(
         str | None, typer.Option("--engine", metavar="NAME", help="Only the keys this engine reads: '1d' or 'dem'.")
     ] = None,
 ) -> None:
-    """List the canonical parameter keys with unit, allowed values, default and description."""
+    """List the canonical parameter keys, component by component, with unit, allowed values, default and
+    description."""
     from shakermill.parameters.engine_keys import ENGINE_KEYS, reads
+    from shakermill.parameters.groups import GROUPS
     from shakermill.parameters.keys import FIELD_NAMES, allowed_range, field_description
     from shakermill.parameters.presets import PRESETS, preset_values
 
     if engine is not None and engine not in ENGINE_KEYS:
         fail(f"--engine: {engine!r} is no engine; allowed {', '.join(map(repr, ENGINE_KEYS))}")
-    chosen = [
+    chosen = {
         key
         for key in FIELD_NAMES
         if (engine is None or reads(engine, key))
         and (pattern is None or _matches(pattern, key, field_description(key)))
-    ]
+    }
     narrowed = [f"matching {pattern!r}"] if pattern is not None else []
     if engine is not None:
         narrowed.append(f"read by {ENGINE_KEYS[engine].title}")
@@ -156,12 +158,23 @@ def keys(
         typer.echo(f"no parameter key {which}; `shakermill keys` lists all {len(FIELD_NAMES)}")
         return
     defaults = preset_values(DEFAULT_PRESET)
-    title = f"parameter keys {which}: {len(chosen)} of {len(FIELD_NAMES)}" if which else "parameter keys"
-    table = Table("key", "allowed (SI)", f"default ({DEFAULT_PRESET})", "description", title=title)
-    for key in chosen:
-        default = format_value(key, defaults[key]) if key in defaults else ""
-        add_plain_row(table, key, allowed_range(key), default, field_description(key) + _assumed_note(key, PRESETS))
-    stdout_console().print(table)
+    console = stdout_console()
+    console.print(Text(f"parameter keys {which}: {len(chosen)} of {len(FIELD_NAMES)}" if which else "parameter keys"))
+    header = ("key", "allowed (SI)", f"default ({DEFAULT_PRESET})", "description")
+    for group in GROUPS:
+        listed = [key for key in group.keys() if key in chosen]
+        if not listed:
+            continue
+        table = Table(*header, title=f"{group.title[:1].upper()}{group.title[1:]}", title_justify="left")
+        for key in listed:
+            add_plain_row(
+                table,
+                key,
+                allowed_range(key),
+                format_value(key, defaults[key]),
+                field_description(key) + _assumed_note(key, PRESETS),
+            )
+        console.print(table)
 
 
 def _assumed_note(key: str, presets: Mapping[str, Any]) -> str:

@@ -25,7 +25,7 @@ import tomli_w
 from shakermill.parameters import guards
 from shakermill.parameters.assumed import inherited_assumed
 from shakermill.parameters.defaults import DEFAULT_PRESET
-from shakermill.parameters.engine_keys import READER_FIELDS, Reader, reader_of
+from shakermill.parameters.engine_keys import reader_for, reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import (
     Parameters,
@@ -105,7 +105,7 @@ def load_config(
         raise ParameterError(problem)
     inherited = {key: value for key, value in preset_layer.items() if key not in explicit}
     defaults = preset_values(DEFAULT_PRESET)
-    preset_reader = Reader(*(preset_layer.get(field, defaults[field]) for field in READER_FIELDS))
+    preset_reader = reader_for(preset_layer)
     notes = [run.ignored_note(inherited, defaults, preset_reader)]
     if file_preset is not None and chosen_preset != file_preset:
         notes.append(f"The preset is {chosen_preset!r} (--preset), not the {file_preset!r} that {source} names.")

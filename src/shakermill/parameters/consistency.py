@@ -10,15 +10,10 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from shakermill.parameters.engine_keys import MAX_BALLS, engine_problem
+from shakermill.parameters.engine_keys import engine_problem
 from shakermill.parameters.geometry import ball_volume, balls_for_fill
-from shakermill.parameters.kinematic_models import (
-    MAX_MOTION_TRANSLATION,
-    MAX_SWING_ANGLE,
-    MOTION_COORDINATES,
-    arc_angle,
-)
-from shakermill.support.limits import MAX_FULL_RESOLUTION_PERIODS, MAX_RECORDED_SECONDS, MAX_SAMPLES
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
+from shakermill.support.limits import MAX_BALLS, MAX_FULL_RESOLUTION_PERIODS, MAX_RECORDED_SECONDS, MAX_SAMPLES
 
 # The explicit integrator's steps follow the fastest thermal time constant: ~0.7 steps per time constant
 # and simulated second, so 0.1 ms costs ~25 million steps a simulated hour, ten times the mechanics'
@@ -117,43 +112,9 @@ def engine_takes_the_keys(params: Any) -> None:
 
 
 def motion_is_well_formed(params: Any) -> None:
-    """A Fourier motion has terms, no coordinate moves too far, and a mixer mill's arc turns the jar at most a
-    quarter turn."""
-    if params.kinematics == "fourier" and not params.motion:
-        raise ValueError(
-            "motion: kinematics = 'fourier' needs at least one harmonic; allowed (coordinate, k, cos, sin) terms"
-        )
-    _check_motion(params.motion)
-    if params.kinematics == "mixer-mill-arc" and arc_angle(params.amplitude, params.swing_radius) > MAX_SWING_ANGLE:
-        raise ValueError(
-            f"amplitude: an arc of {params.amplitude * 1e3:g} mm on a swing radius of {params.swing_radius * 1e3:g} mm "
-            f"turns the jar by {arc_angle(params.amplitude, params.swing_radius):.3g} rad; allowed amplitude <= "
-            f"swing_radius·π/2 = {params.swing_radius * MAX_SWING_ANGLE:.4g} m with kinematics = 'mixer-mill-arc'"
-        )
-
-
-# A steady turn of more than five radians per radian of the drive's phase describes no mill (planetary jars turn
-# at most ~3 times their sun wheel's speed), as speed_ratio's bounds say.
-MAX_STEADY_RATE = 5.0
-
-
-def _check_motion(motion: tuple[tuple[str, int, float, float], ...]) -> None:
-    """The summed harmonic amplitudes of each coordinate stay within a metre's half and a half turn; only angles
-    turn steadily (a k = 0 sine), and at most MAX_STEADY_RATE."""
-    for name, k, _, steady in motion:
-        if k == 0 and steady != 0.0 and (name in MOTION_COORDINATES[:3] or abs(steady) > MAX_STEADY_RATE):
-            raise ValueError(
-                f"motion: a steady rate {steady:g} of {name} (its sin at k = 0); allowed only for roll, pitch and yaw, "
-                f"at most {MAX_STEADY_RATE:g} rad per radian of ωt + φ"
-            )
-    for coordinate in MOTION_COORDINATES:
-        amplitude = sum(abs(a) + abs(b) * (k > 0) for name, k, a, b in motion if name == coordinate)
-        limit, unit = (math.pi, "rad") if coordinate in ("roll", "pitch", "yaw") else (MAX_MOTION_TRANSLATION, "m")
-        if amplitude > limit:
-            raise ValueError(
-                f"motion: the harmonics of {coordinate} add up to {amplitude:g} {unit}; allowed at most {limit:g} "
-                f"{unit}"
-            )
+    """The run's vial motion checks its keys across what their bounds say (its module's ``check``: a Fourier motion
+    has terms within a metre's half and a half turn, a mixer mill's arc turns the jar at most a quarter turn)."""
+    KINEMATIC_MODELS[params.kinematics].check(params)
 
 
 def balls_fit_side_by_side(params: Any) -> None:
@@ -238,7 +199,9 @@ def thermal_time_constants_at_rest(params: Any) -> dict[str, tuple[float, tuple[
     """
     ball_conductance = 4.0 * math.pi * params.ball_radius * params.beta * params.air_conductivity
     ball = params.ball_mass * params.ball_heat_capacity / ball_conductance if ball_conductance > 0 else math.inf
-    constants = {"ball": (ball, ("ball_density", "ball_radius", "ball_heat_capacity", "beta", "air_conductivity"))}
+    constants: dict[str, tuple[float, tuple[str, ...]]] = {
+        "ball": (ball, ("ball_density", "ball_radius", "ball_heat_capacity", "beta", "air_conductivity"))
+    }
     if params.model == "ball_only":
         return constants
     inner, outer = params.h_inner * params.inner_area, params.h_outer * params.outer_area

@@ -9,31 +9,15 @@ from typing import TYPE_CHECKING
 
 from shakermill.parameters.engine_keys import ENGINE_KEYS, EngineKeys
 from shakermill.parameters.geometry import ball_volume, end_faces_area, vial_volume
+from shakermill.parameters.groups import CoreKeys
 
 if TYPE_CHECKING:
     import numpy
 
 
-class DerivedQuantities:
+class DerivedQuantities(CoreKeys):
     """Periods, masses, areas and volumes of a run, where its balls start and how its convection takes their speed,
-    from the keys of the ``Parameters`` that inherit them."""
-
-    if TYPE_CHECKING:
-        omega: float
-        engine: str
-        ball_radius: float
-        ball_density: float
-        vial_length: float
-        vial_diameter: float
-        air_density: float
-        air_cp: float
-        air_heat_capacity_ratio: float
-
-        n_balls: int
-        ball_position: float
-        convection_velocity: str
-
-        def ball_values(self, scalar_key: str) -> tuple[float, ...]: ...
+    from the core keys of the ``Parameters`` that inherit them."""
 
     @property
     def engine_keys(self) -> EngineKeys:

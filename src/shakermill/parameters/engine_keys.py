@@ -1,5 +1,6 @@
 """What each engine takes, by name: the vial motions, how many balls, the thermal models, how the air moves and the
-keys it reads (listed from groups of keys stated once here).
+keys it reads (the key groups it names and the components it takes, ``parameters/groups/``), and what decides whether
+a run reads a key (:class:`Reader`).
 
 ``Parameters`` checks a run's keys against the engine it names (key ``engine``), so these declarations live
 in this layer, below the engines; each engine carries its own as part of its description
@@ -12,139 +13,57 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from shakermill.parameters.groups import (
+    GROUP_OF,
+    GROUPS,
+    AveragedSolver,
+    Balls,
+    ContactDamping,
+    DemAveraging,
+    DemContacts,
+    DemStepping,
+    Drive,
+    EnduringContacts,
+    HeatSplit,
+    LabFrame,
+    NetworkChoice,
+    OneBallStart,
+    OneDAveraging,
+    OneDIntegrator,
+    PaperNetwork,
+    RoomLoss,
+    RunControl,
+    SeveralBalls,
+    Stroke,
+    Vial,
+    VialWall,
+    default_of,
+    keys_of,
+    keys_of_role,
+    marked,
+)
+from shakermill.parameters.key_group import CONTACT_COATING, NETWORK_NODE, VIAL_MOTION, KeyGroup
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
-
-# The most balls any engine moves: the 'dem' engine's contact search (a neighbour list, engines/dem/neighbours.py) and
-# its memory grow linearly with them; a run's preflight refuses what the machine cannot hold or finish.
-MAX_BALLS = 2000
+from shakermill.support.limits import MAX_BALLS
 
 
-# Keys only one thermal network reads (engines/thermal/network.py), stated once for both directions: 'paper' loses
-# the vial's heat to the room through a constant h_outer·outer_area; 'mill-head' computes that loss from the vial's
-# outside and its speed instead, and adds the clamp. A key of one network set on a run of the other changes nothing.
-NETWORK_ONLY: dict[str, frozenset[str]] = {
-    "paper": frozenset({"h_outer", "outer_area"}),
-    "mill-head": frozenset(
-        {
-            "outer_diameter",
-            "outer_length",
-            "emissivity",
-            "clamp_heat_capacity",
-            "clamp_conductance",
-            "clamp_loss",
-            "drive_heat",
-        }
-    ),
-}
-MILL_HEAD_ONLY = NETWORK_ONLY["mill-head"]
-
-# The keys an engine reads (``EngineKeys.reads``) are listed from these groups, each stated once, and its own keys: a
-# key every engine reads joins its group, not each engine's list. A key set explicitly that the run's engine does not
-# read is refused (:class:`Reader`); ``Parameters`` has no key that no engine reads (tests/parameters).
-
-# Every run, whatever its engine: which engine and solver, for how long, what is kept, its budget and its bounds.
-# (``attractor_starts`` too: its 1, "no probe", is what an engine without the probe does anyway.)
-RUN_CONTROL = frozenset(
-    {
-        "engine",
-        "solver",
-        "duration",
-        "output_interval",
-        "record_windows",
-        "max_wall_time",
-        "max_steps",
-        "stress_energy_thresholds",
-        "ball_temperature_limit",
-        "attractor_starts",
-    }
-)
-# The averaged solver of any engine (each engine adds the key of its own target error, ``averaging_error_key``).
-AVERAGED_SOLVER = frozenset(
-    {"averaging_batch_periods", "averaging_min_batches", "averaging_max_time", "averaging_fallback"}
-)
-# The vial, the ball in it and the vial's drive: its amplitude, its frequency and its phase at t = 0.
-GEOMETRY_AND_DRIVE = frozenset({"ball_radius", "vial_length", "vial_diameter", "amplitude", "omega", "phase"})
-# Where one ball on the axis starts: its position and momentum.
-ONE_BALL_START = frozenset({"ball_position", "ball_momentum"})
-# A ball on the vial as a Hertz contact with damping (MODEL.md §2): the bodies' materials (a material name fills
-# them), elastic constants and densities, the restitution it is damped to and whether it may pull.
-CONTACT_LAW = frozenset(
-    {
-        "ball_material",
-        "vial_material",
-        "ball_density",
-        "vial_density",
-        "ball_youngs_modulus",
-        "vial_youngs_modulus",
-        "ball_poisson_ratio",
-        "vial_poisson_ratio",
-        "restitution",
-        "no_tension",
-    }
-)
-# The paper's thermal model (MODEL.md §§3-6): the share η of the dissipated energy that is heat and the share λ of it
-# that goes to the ball, the network of ball, vial and air that takes it (capacities, convection, exchange and the
-# loss to the room through h_outer·outer_area, the 'paper' network's own keys) and its temperatures at the start.
-PAPER_THERMAL = frozenset(
-    {
-        "eta",
-        "lam",
-        "model",
-        "ball_heat_capacity",
-        "vial_heat_capacity",
-        "vial_mass",
-        "air_density",
-        "air_viscosity_ref",
-        "air_reference_temperature",
-        "air_conductivity",
-        "air_cp",
-        "air_heat_capacity_ratio",
-        "sutherland",
-        "beta",
-        "convection_velocity",
-        "h_inner",
-        "inner_area",
-        *NETWORK_ONLY["paper"],
-        "ambient_temperature",
-        "initial_temperature",
-    }
-)
-# The network of a real mill (thermal_model = 'mill-head', MODEL.md §13): the choice of network and its own keys.
-MILL_HEAD_THERMAL = frozenset({"thermal_model", *MILL_HEAD_ONLY})
-# Powder in the vial (MODEL.md §13, engines/thermal/powder.py): its node, the share of the contacts' heat it takes
-# and what it does to the contacts it coats.
-POWDER = frozenset(
-    {
-        "powder_mass",
-        "powder_material",
-        "powder_heat_capacity",
-        "powder_heat_share",
-        "powder_restitution",
-        "powder_contact_coefficient",
-    }
-)
-# Balls of their own (an engine of several): how many, or the fill that makes them, and each ball's values.
-SEVERAL_BALLS = frozenset(
-    {
-        "n_balls",
-        "fill",
-        "ball_radii",
-        "ball_densities",
-        "ball_youngs_moduli",
-        "ball_poisson_ratios",
-        "ball_heat_capacities",
-        "ball_conductivities",
-        "ball_materials",
-    }
-)
+def reads_of(*groups: type[KeyGroup], roles: Iterable[str] = (), kinematics: Iterable[str] = ()) -> frozenset[str]:
+    """The keys a reader reads: those of the core ``groups`` it names, of every component group of ``roles``, and of
+    the vial-motion groups that the motions ``kinematics`` take (with ``kinematics`` itself where there is a choice,
+    whose group the reader names)."""
+    motion_keys = {key for name in kinematics for key in KINEMATIC_MODELS[name].keys}
+    return (
+        keys_of(*groups)
+        | frozenset().union(*(keys_of_role(role) for role in roles))
+        | (keys_of_role(VIAL_MOTION) & motion_keys)
+    )
 
 
-def motion_keys(kinematics: Iterable[str]) -> frozenset[str]:
-    """The keys of the named vial motions ``kinematics`` (``KINEMATIC_MODELS``), with the choice among them where there
-    is more than one: what an engine that moves the vial so reads of its motion."""
-    names = tuple(kinematics)
-    keys = {key for name in names for key in KINEMATIC_MODELS[name].keys}
-    return frozenset(keys | ({"kinematics"} if len(names) > 1 else set()))
+def thermal_only_of(reads: Iterable[str]) -> tuple[str, ...]:
+    """The keys of ``reads`` that enter the thermal network alone (their fields' ``thermal_only``), in the groups'
+    order."""
+    chosen = set(reads)
+    return tuple(key for key in GROUP_OF if key in chosen and marked(key, "thermal_only"))
 
 
 @dataclass(frozen=True)
@@ -161,13 +80,13 @@ class EngineKeys:
     # Whether the air moves with the vial, so that convection takes the ball's speed relative to it by default
     # (``convection_velocity = 'auto'``, MODEL.md §§4, 12.5).
     air_moves_with_vial: bool
-    # Every key of ``Parameters`` a run of the engine reads (the groups above and its own): a key set explicitly that
-    # it does not read is refused, `shakermill keys --engine` and a run's report leave the others out. A key it takes
-    # only at one value (n_balls = 1) is not read.
+    # Every key of ``Parameters`` a run of the engine reads (:func:`reads_of`: the core groups it names and the
+    # components it takes): a key set explicitly that it does not read is refused, `shakermill keys --engine` and a
+    # run's report leave the others out. A key it takes only at one value (n_balls = 1) is not read.
     reads: frozenset[str]
-    # Keys that enter its thermal network alone, never its mechanics: runs that differ in these share one
-    # measured mechanics (solvers.simulate.thermal_variants). Empty where the temperatures share the mechanics'
-    # error control, as in the 1-D engine.
+    # Keys that enter its thermal network alone, never its mechanics (:func:`thermal_only_of`): runs that differ in
+    # these share one measured mechanics (solvers.simulate.thermal_variants). Empty where the temperatures share the
+    # mechanics' error control, as in the 1-D engine.
     thermal_only_keys: tuple[str, ...] = ()
     # The key of how many independent replicas of its mechanics the averaged solver runs and pools, if it takes any:
     # its engine then has the capability ``engines.interface.Replicas``.
@@ -178,6 +97,21 @@ class EngineKeys:
         return self.most_balls > 1
 
 
+# The groups every built-in engine reads: the run and its averaged solver, the vial, its drive and stroke, the balls,
+# where one ball starts, the vial's wall and the contacts' damping, the paper's network and its loss to the room.
+EVERY_ENGINE = (
+    RunControl,
+    AveragedSolver,
+    Vial,
+    Drive,
+    Stroke,
+    Balls,
+    OneBallStart,
+    VialWall,
+    ContactDamping,
+    PaperNetwork,
+    RoomLoss,
+)
 ONE_DIMENSIONAL = EngineKeys(
     name="1d",
     title="the 1-D engine",
@@ -185,25 +119,28 @@ ONE_DIMENSIONAL = EngineKeys(
     kinematics=("axial",),
     most_balls=1,
     thermal_models=("three_node", "ball_only"),
-    # Its right-hand side writes the paper's three nodes out for speed (engines/one_d/model.py).
+    # Its right-hand side writes the paper's three nodes out for speed (engines/one_d/model.py): it takes no node of
+    # the network's extensions.
     networks=("paper",),
     air_moves_with_vial=False,
     # It integrates with error control (rtol, atol_*), projects each contact's energy and makes heat either way.
-    reads=RUN_CONTROL
-    | AVERAGED_SOLVER
-    | GEOMETRY_AND_DRIVE
-    | ONE_BALL_START
-    | CONTACT_LAW
-    | PAPER_THERMAL
-    | {
-        "averaging_rel_error",
-        "rtol",
-        "atol_position",
-        "atol_momentum",
-        "atol_temperature",
-        "energy_projection",
-        "heat_model",
-    },
+    reads=reads_of(*EVERY_ENGINE, OneDIntegrator, OneDAveraging),
+)
+# It steps by velocity Verlet at its own contact step, and its heat is η times what each contact dissipates, split
+# by the bodies' effusivities (their conductivities); gravity, friction, rolling and the pair's own contact law; its
+# network takes every node of the extensions, its contacts every coating, its vial every motion.
+_DEM_READS = reads_of(
+    *EVERY_ENGINE,
+    NetworkChoice,
+    SeveralBalls,
+    DemContacts,
+    HeatSplit,
+    LabFrame,
+    DemStepping,
+    EnduringContacts,
+    DemAveraging,
+    roles=(NETWORK_NODE, CONTACT_COATING),
+    kinematics=KINEMATIC_MODELS,
 )
 THREE_DIMENSIONAL = EngineKeys(
     name="dem",
@@ -214,54 +151,10 @@ THREE_DIMENSIONAL = EngineKeys(
     thermal_models=("three_node",),
     networks=("paper", "mill-head"),
     air_moves_with_vial=True,
-    # It steps by velocity Verlet at its own contact step, and its heat is η times what each contact dissipates, split
-    # by the bodies' effusivities (their conductivities); gravity, friction, rolling and the pair's own contact law.
-    reads=RUN_CONTROL
-    | AVERAGED_SOLVER
-    | GEOMETRY_AND_DRIVE
-    | ONE_BALL_START
-    | CONTACT_LAW
-    | PAPER_THERMAL
-    | MILL_HEAD_THERMAL
-    | POWDER
-    | SEVERAL_BALLS
-    | motion_keys(KINEMATIC_MODELS)
-    | {
-        "dem_averaging_rel_error",
-        "dem_replicas",
-        "ball_conductivity",
-        "vial_conductivity",
-        "gravity",
-        "friction",
-        "pair_friction",
-        "pair_restitution",
-        "rolling_friction",
-        "contact_step_fraction",
-        "enduring_step_fraction",
-        "max_flight_step",
-    },
-    # Keys that enter only the thermal network, never a force, the heat a contact makes or the Whitaker term the
-    # stepping measures (λ, η and the balls' effusivities split that heat inside the stepper; the air's density and
-    # its viscosity at the ambient temperature set each ball's Reynolds number there, the materials' conductivities
-    # each contact's conduction).
-    thermal_only_keys=(
-        "h_inner",
-        "h_outer",
-        "inner_area",
-        "outer_area",
-        "vial_mass",
-        "vial_heat_capacity",
-        "beta",
-        "initial_temperature",
-        "duration",
-        "output_interval",
-        "thermal_model",
-        *sorted(MILL_HEAD_ONLY),
-        # The powder's heat capacity and its layer's coupling: the stepping routes its share of the heat but never
-        # reads its temperature.
-        "powder_heat_capacity",
-        "powder_contact_coefficient",
-    ),
+    reads=_DEM_READS,
+    # λ, η and the balls' effusivities split a contact's heat inside the stepper, and the air's density and its
+    # viscosity at the ambient temperature set each ball's Reynolds number there: those are not thermal-only.
+    thermal_only_keys=thermal_only_of(_DEM_READS),
     replicas_key="dem_replicas",
 )
 
@@ -274,54 +167,58 @@ def reads(engine: str, key: str) -> bool:
     return key in ENGINE_KEYS[engine].reads
 
 
-# Keys only the averaged solver reads: a full-resolution run integrates every impact. (``attractor_starts`` too, but
-# its 1, "no probe", is what a full run does anyway, and scripts set it for either solver.)
-AVERAGED_ONLY = AVERAGED_SOLVER | {"averaging_rel_error", "dem_averaging_rel_error", "dem_replicas"}
+# The keys whose values decide whether a run reads a key: its engine, and those the groups' rules read.
+DECIDING: tuple[str, ...] = tuple(dict.fromkeys(("engine", *(key for group in GROUPS for key in group.rule.deciding))))
+# A solver's own numerical settings: they say nothing of the answer of a run that chose another solver.
+SOLVER_KEYS = frozenset(key for group in GROUPS if group.rule.deciding == ("solver",) for key in group.keys())
 
 
-# Keys of the vial's motion each kinematic model reads (its ``keys``): the others are read by none of its runs.
-MOTION_KEYS = frozenset(key for model in KINEMATIC_MODELS.values() for key in model.keys)
-READER_FIELDS = ("engine", "solver", "thermal_model", "kinematics", "powder_mass")
-# Where a run has powder (powder_mass > 0), it coats every contact: these keys give way to powder_restitution.
-COATED_AWAY = frozenset({"restitution", "pair_restitution"})
+def keys_decided_by(deciding: str, value: Any) -> frozenset[str]:
+    """The keys a run reads only where its ``deciding`` key has ``value`` (and a run with another value not): a
+    network's own keys (``keys_decided_by("thermal_model", "mill-head")``), a solver's."""
+    return frozenset(
+        key
+        for group in GROUPS
+        if group.rule.deciding == (deciding,)
+        for key in group.keys()
+        if key != deciding and group.rule.refusal(key, {deciding: value}) is None
+    )
 
 
-@dataclass(frozen=True)
 class Reader:
-    """What decides whether a run reads a key: its engine, its solver, its thermal network, its vial motion and
-    whether it has powder."""
+    """What decides whether a run reads a key: the values of the keys of :data:`DECIDING` (its engine, its solver,
+    its thermal network, its vial motion, whether it has powder), those not given at the paper's preset's."""
 
-    engine: str
-    solver: str
-    thermal_model: str
-    kinematics: str
-    powder_mass: float = 0.0
+    def __init__(self, **values: Any) -> None:
+        unknown = sorted(set(values) - set(DECIDING))
+        if unknown:
+            raise TypeError(f"Reader: {', '.join(unknown)} decide nothing a run reads; those that do: {DECIDING}")
+        self.values: dict[str, Any] = {key: values.get(key, default_of(key)) for key in DECIDING}
+
+    def __repr__(self) -> str:
+        return f"Reader({', '.join(f'{key}={value!r}' for key, value in self.values.items())})"
+
+    @property
+    def engine(self) -> EngineKeys:
+        return ENGINE_KEYS[self.values["engine"]]
 
     def not_read(self, key: str) -> str | None:
         """Why a run would not read ``key`` (a phrase naming where it applies), or None."""
-        if not reads(self.engine, key):
+        engine = self.engine
+        if key not in engine.reads:
             readers = [name for name in ENGINE_KEYS if reads(name, key)]
             where = f"engine = {readers[0]!r}" if len(readers) == 1 else "another engine" if readers else "no engine"
-            return (
-                f"{ENGINE_KEYS[self.engine].title} (engine = {self.engine!r}) does not read it; it applies to {where}"
-            )
-        if self.solver != "averaged" and key in AVERAGED_ONLY:
-            return f"the {self.solver!r} solver does not read it; it applies to solver = 'averaged'"
-        for network, keys in NETWORK_ONLY.items():
-            if key in keys and self.thermal_model != network:
-                return f"the {self.thermal_model!r} network does not read it; it applies to thermal_model = {network!r}"
-        if key in MOTION_KEYS and key not in KINEMATIC_MODELS[self.kinematics].keys:
-            readers = " or ".join(repr(name) for name, model in KINEMATIC_MODELS.items() if key in model.keys)
-            return f"kinematics = {self.kinematics!r} does not read it; it applies to kinematics = {readers}"
-        return self._powder_problem(key)
+            return f"{engine.title} (engine = {engine.name!r}) does not read it; it applies to {where}"
+        why = GROUP_OF[key].rule.refusal(key, self.values)
+        if why is not None:
+            return why
+        return next(
+            (group.superseded_because for group in GROUPS if key in group.supersedes and self._takes(group)), None
+        )
 
-    def _powder_problem(self, key: str) -> str | None:
-        has_powder = float(self.powder_mass) > 0.0
-        if not has_powder and key in POWDER - {"powder_mass"}:
-            return "a run without powder (powder_mass = 0) does not read it; it applies to powder_mass > 0"
-        if has_powder and key in COATED_AWAY and reads(self.engine, "powder_restitution"):
-            return "the powder coats every contact (powder_mass > 0): powder_restitution applies instead"
-        return None
+    def _takes(self, group: type[KeyGroup]) -> bool:
+        """Whether the run reads ``group``: its engine does and its rule lets it."""
+        return bool(set(group.keys()) & self.engine.reads) and group.rule.active(self.values)
 
     def unread_problem(self, keys: Iterable[str], how: str = "set explicitly") -> str | None:
         """One line for the first of ``keys``, given as ``how`` says, that the run would ignore, or None: a key set
@@ -347,7 +244,7 @@ class Reader:
             and value != defaults[key]
             and self.not_read(key) is not None
             and (preset is None or preset.not_read(key) is None)
-            and key not in AVERAGED_ONLY
+            and key not in SOLVER_KEYS
         ]
         if not ignored:
             return None
@@ -356,7 +253,14 @@ class Reader:
 
 def reader_of(params: Any, solver: str | None = None) -> Reader:
     """The :class:`Reader` of a run of ``params`` (a ``Parameters``), with ``solver`` instead of its own if given."""
-    return Reader(params.engine, solver or params.solver, params.thermal_model, params.kinematics, params.powder_mass)
+    values = {key: getattr(params, key) for key in DECIDING}
+    return Reader(**{**values, **({"solver": solver} if solver else {})})
+
+
+def reader_for(values: Mapping[str, Any]) -> Reader:
+    """The :class:`Reader` of a run of the plain ``values`` (a preset's, a sweep point's): its deciding keys among
+    them, the others at the paper's preset's."""
+    return Reader(**{key: values[key] for key in DECIDING if key in values})
 
 
 def declare(keys: EngineKeys) -> None:

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from shakermill.parameters.errors import ParameterError
-from shakermill.parameters.kinematic_models import MOTION_COORDINATES
+from shakermill.parameters.motions import MOTION_COORDINATES
 from shakermill.parameters.units import UnitError, to_si
 from shakermill.support.limits import MAX_RECORD_WINDOWS, quoted
 

@@ -145,11 +145,16 @@ def allowed_for(key: str) -> str:
     )
 
 
+def name_in(key: str, value: Any) -> str:
+    """The canonical material name of a name or alias of a key naming one material ('' or None: none)."""
+    return "" if value is None or not str(value).strip() else _named(key, value)
+
+
 def names_in(key: str, value: Any) -> str | tuple[str, ...]:
     """Canonical material names from a name or alias ('' or None: none), or for ``ball_materials`` from
     "wc, zirconia" (the command line) or a list (TOML, Python); :class:`ParameterError` naming ``key`` otherwise."""
     if key != "ball_materials":
-        return "" if value is None or not str(value).strip() else _named(key, value)
+        return name_in(key, value)
     items = [item for item in value.split(",") if item.strip()] if isinstance(value, str) else value
     if not isinstance(items, (list, tuple)):
         raise ParameterError(
@@ -174,7 +179,7 @@ def filled_keys(
     filled: dict[str, tuple[Any, str]] = {}
     for key in material_keys:
         prefix = key.removesuffix("material")
-        name = names_in(key, layer.get(key, ""))
+        name = name_in(key, layer.get(key, ""))
         if name:
             found = material(name)
             for prop in FILLED:

@@ -26,7 +26,7 @@ class UnitError(ValueError):
 def _registry() -> pint.UnitRegistry:
     import pint  # 0.3 s: only when a value carries a unit
 
-    registry = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
+    registry: pint.UnitRegistry = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
     return registry
 
 
@@ -165,7 +165,7 @@ def _quantity_to_si(text: str, value: str, unit: str, key: str) -> float:
 
     registry = _registry()
     try:
-        quantity = registry.Quantity(text)
+        quantity: pint.Quantity = registry.Quantity(text)
     except pint.UndefinedUnitError as exc:
         unknown = ", ".join(map(repr, exc.unit_names))
         raise UnitError(

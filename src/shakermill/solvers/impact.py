@@ -18,8 +18,10 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from shakermill.parameters.engine_keys import MILL_HEAD_ONLY
+from shakermill.parameters.engine_keys import reads_of
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.groups import GROUP_OF, GROUPS, Balls, ContactDamping, DemContacts, DemStepping, VialWall
+from shakermill.parameters.key_group import CONTACT_COATING
 from shakermill.parameters.keys import PER_BALL_KEYS, Parameters
 
 if TYPE_CHECKING:
@@ -47,107 +49,12 @@ MIN_OVERLAP_POSITIONS = 2e4
 GUARD_SPEEDS = (0.1, 20.0)  # m/s
 RESTITUTION_TOLERANCE = 0.01  # relative
 
-# What a lone impact does not read, each group with why: impact_parameters sets these keys itself, or the
-# impact has no use for them. A key set explicitly would otherwise be ignored without a word.
-_UNREAD_GROUPS = (
-    (
-        (*PER_BALL_KEYS, "ball_materials"),
-        "a lone impact takes the scalar ball keys (ball_material, ball_radius, ...); per-ball lists apply to runs "
-        "of several balls",
-    ),
-    (("n_balls", "fill"), "a lone impact is one ball against its --target; the number of balls applies to runs"),
-    (("engine",), "a lone impact always runs the 'dem' engine's contact law"),
-    (
-        (
-            "gravity",
-            "kinematics",
-            "motion",
-            "amplitude",
-            "omega",
-            "phase",
-            "lateral_amplitude",
-            "yaw_amplitude",
-            "swing_radius",
-            "revolution_radius",
-            "speed_ratio",
-            "jar_tilt",
-        ),
-        "a lone impact happens in a vial at rest without gravity; the vial's motion applies to runs",
-    ),
-    (
-        ("vial_length", "vial_diameter"),
-        "the vial's size plays no part in a lone impact, only its material (vial_material, vial_youngs_modulus, ...)",
-    ),
-    (
-        ("ball_position", "ball_momentum"),
-        "a lone impact starts the ball at its target with --speed, --angle and --spin",
-    ),
-    (
-        (
-            "solver",
-            "duration",
-            "output_interval",
-            "record_windows",
-            "max_wall_time",
-            "max_steps",
-            "rtol",
-            "atol_position",
-            "atol_momentum",
-            "atol_temperature",
-            "energy_projection",
-            "averaging_rel_error",
-            "dem_averaging_rel_error",
-            "dem_replicas",
-            "averaging_batch_periods",
-            "averaging_min_batches",
-            "averaging_max_time",
-            "averaging_fallback",
-            "attractor_starts",
-            "enduring_step_fraction",
-        ),
-        "a lone impact lasts one contact; how long and how a run is integrated applies to runs",
-    ),
-    (
-        (
-            "ball_heat_capacity",
-            "vial_heat_capacity",
-            "vial_mass",
-            "vial_density",
-            "ball_conductivity",
-            "vial_conductivity",
-            "air_density",
-            "air_viscosity_ref",
-            "air_reference_temperature",
-            "air_conductivity",
-            "air_cp",
-            "air_heat_capacity_ratio",
-            "sutherland",
-            "h_inner",
-            "h_outer",
-            "inner_area",
-            "outer_area",
-            "thermal_model",
-            *sorted(MILL_HEAD_ONLY),
-            # The powder's heat: its mass and the restitution of the contacts it coats are read, as the mechanics'.
-            "powder_material",
-            "powder_heat_capacity",
-            "powder_heat_share",
-            "powder_contact_coefficient",
-            "eta",
-            "lam",
-            "beta",
-            "ambient_temperature",
-            "initial_temperature",
-            "ball_temperature_limit",
-            "model",
-            "heat_model",
-            "convection_velocity",
-        ),
-        "a lone impact reports mechanics and dissipated energy, no heat or temperatures",
-    ),
-)
-UNREAD_KEYS: dict[str, str] = {key: why for keys, why in _UNREAD_GROUPS for key in keys}
-
+# What a lone impact reads: the 'dem' engine's contact law at its contact step (the balls and the vial's wall, the
+# contacts' damping, friction and rolling, the coatings of contacts) and nothing of a run: it sets the rest itself
+# (impact_parameters). A key of any other group, a new one included, is refused without anyone's edit.
+READ_GROUPS = (Balls, VialWall, ContactDamping, DemContacts, DemStepping)
+IMPACT_READS = reads_of(*READ_GROUPS, roles=(CONTACT_COATING,))
+READ_TITLES = ", ".join(group.title for group in GROUPS if set(group.keys()) & IMPACT_READS)
 
 # A ball on the end face touches the vial alone, a ball on a ball the other ball alone: each reads its own pair's
 # restitution and friction (MODEL.md §14.1).
@@ -162,8 +69,11 @@ def check_keys_read(keys: Iterable[str], target: str) -> None:
     does not read (a target that is none of them is refused by :func:`check_inputs`)."""
     other, applies = OTHER_PAIR_KEYS.get(target, ((), ""))
     for key in keys:
-        if key in UNREAD_KEYS:
-            raise ParameterError(f"{key}: {UNREAD_KEYS[key]}")
+        if key not in IMPACT_READS:
+            raise ParameterError(
+                f"{key}: a lone impact does not read it: it reads the contact law alone ({READ_TITLES}); "
+                f"{GROUP_OF[key].title} applies to runs"
+            )
         if key in other:
             raise ParameterError(f"{key}: an impact on a {target} does not read it; it applies to {applies}")
 

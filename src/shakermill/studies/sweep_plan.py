@@ -18,7 +18,7 @@ import numpy as np
 from shakermill.io.runs import to_jsonable
 from shakermill.parameters.config import RunConfig, load_config, parse_overrides, read_config_file
 from shakermill.parameters.csvinput import read_csv_rows
-from shakermill.parameters.engine_keys import READER_FIELDS, Reader
+from shakermill.parameters.engine_keys import DECIDING, reader_for
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.guards import whole_number
 from shakermill.parameters.keys import Parameters, check_known_keys, checked_name, field_unit, takes_names
@@ -244,7 +244,7 @@ def check_keys_read(base: Parameters, plan: SweepPlan) -> None:
     """Refuse, in one line, a swept key that a point's run would not read (its engine, or its solver): every point
     would give the same numbers under different labels."""
     for point in plan.points:
-        run = Reader(*(point.get(key, getattr(base, key)) for key in READER_FIELDS))
+        run = reader_for({key: point.get(key, getattr(base, key)) for key in DECIDING})
         problem = run.unread_problem(plan.keys, "swept")
         if problem is not None:
             raise ParameterError(problem)

@@ -32,6 +32,9 @@ MAX_SWEEP_POINTS = 100_000
 MAX_BIFURCATION_VALUES = 10_000
 # A measured temperature curve: a point a second for a day is 86 400.
 MAX_CURVE_POINTS = 100_000
+# The most balls a run moves: the 'dem' engine's contact search (a neighbour list, engines/dem/neighbours.py) and
+# its memory grow linearly with them; a run's preflight refuses what the machine cannot hold or finish.
+MAX_BALLS = 2000
 # A configuration file holds about sixty keys, a few kilobytes.
 MAX_CONFIG_BYTES = 1_000_000
 # How much of an over-long or odd input an error line quotes.

@@ -18,7 +18,8 @@ from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.air import air_constants
 from shakermill.engines.thermal.network import ThermalNetwork, build_network
 from shakermill.parameters.keys import Parameters
-from shakermill.parameters.kinematic_models import MOTION_COORDINATES, motion_terms
+from shakermill.parameters.kinematic_models import motion_terms
+from shakermill.parameters.motions import MOTION_COORDINATES
 from shakermill.physics import contact
 from shakermill.physics.kinematics import angular_velocity, fourier_coordinates, rotation_matrix
 

@@ -19,15 +19,17 @@ from shakermill.engines.thermal.paths import (
     newton_cooling,
     radiation,
 )
+from shakermill.parameters.groups.mill_head import MillHead
 from shakermill.parameters.keys import Parameters
-from shakermill.parameters.kinematic_models import KINEMATIC_MODELS, MOTION_COORDINATES, motion_terms
+from shakermill.parameters.kinematic_models import KINEMATIC_MODELS, motion_terms
+from shakermill.parameters.motions import MOTION_COORDINATES
 from shakermill.physics import heat_paths, thermal
 
 # The role of the node it adds (engines/thermal/nodes.py): what holds the vessel.
 HOLDER = "holder"
 
 
-def add_mill_head(draft: NetworkDraft) -> None:
+def add_node(draft: NetworkDraft) -> None:
     """Under ``thermal_model = 'mill-head'``, the paths of a real mill beyond the paper's (MODEL.md §13.1): the
     vessel's outside to the room by convection at its own speed and by radiation, conduction through the contacts of
     each ball with the vessel and with the other balls, and the holder (a shaker's clamp and mill head, a planetary
@@ -35,16 +37,17 @@ def add_mill_head(draft: NetworkDraft) -> None:
     params = draft.params
     if params.thermal_model != "mill-head":
         return
+    head = MillHead.of(params)
     vial, balls = draft.one_of_role(VESSEL), draft.of_role(BALL)
     names, n = [draft.nodes[ball].name for ball in balls], len(balls)
     title = "jar holder" if KINEMATIC_MODELS[params.kinematics].axis_upright else "clamp and mill head"
-    holder = draft.add(Node("holder", HOLDER, params.clamp_heat_capacity, title), fixed_heat=params.drive_heat)
+    holder = draft.add(Node("holder", HOLDER, head.clamp_heat_capacity, title), fixed_heat=head.drive_heat)
     outer = vial_outer_convection(params)
     draft.paths += [
         newton_cooling(
             "vial → room, convection", vial, kernel.ROOM, outer.coefficient, outer.area, outer.source, outer.validity
         ),
-        radiation("vial → room, radiation", vial, kernel.ROOM, params.emissivity, outer.area),
+        radiation("vial → room, radiation", vial, kernel.ROOM, head.emissivity, outer.area),
         *(
             contact_conduction(f"{names[i]} → vial, contacts", i, vial, kernel.contact_drive(i, -1, n))
             for i in range(n)
@@ -58,7 +61,7 @@ def add_mill_head(draft: NetworkDraft) -> None:
             "vial → holder",
             vial,
             holder,
-            params.clamp_conductance,
+            head.clamp_conductance,
             "clamp_conductance (see its source)",
             "a steady joint: the vial's and the holder's own conduction are fast beside it",
         ),
@@ -66,7 +69,7 @@ def add_mill_head(draft: NetworkDraft) -> None:
             "holder → room",
             holder,
             kernel.ROOM,
-            params.clamp_loss,
+            head.clamp_loss,
             "clamp_loss (see its source)",
             f"the {title} lumped at one temperature",
         ),
@@ -98,7 +101,8 @@ def vial_outer_convection(params: Parameters) -> OuterConvection:
     constants = air_constants(params)
     viscosity, prandtl = constants["viscosity_ambient"], constants["prandtl"]
     speed = vial_rms_speed(params)
-    diameter, length, k_air = params.outer_diameter, params.outer_length, params.air_conductivity
+    head = MillHead.of(params)
+    diameter, length, k_air = head.outer_diameter, head.outer_length, params.air_conductivity
     side_area, end_area = math.pi * diameter * length, 2.0 * math.pi * diameter**2 / 4.0
     rayleigh = heat_paths.rayleigh_number(
         diameter,
@@ -138,7 +142,8 @@ def _along_the_axis(
 ) -> tuple[float, float, str, str]:
     """The forced coefficients (W/(m²·K)) of a vial shaken along its axis: the side a plate along the flow, each end
     a disk facing it; what they rest on and where they hold."""
-    diameter, length, k_air = params.outer_diameter, params.outer_length, params.air_conductivity
+    head = MillHead.of(params)
+    diameter, length, k_air = head.outer_diameter, head.outer_length, params.air_conductivity
     side = heat_paths.flat_plate_nusselt(_reynolds(length / 2, params, speed, viscosity), prandtl) * k_air / length
     end = heat_paths.disk_nusselt(_reynolds(diameter / 2, params, speed, viscosity), prandtl) * k_air / diameter
     return (
@@ -161,7 +166,7 @@ def _across_the_axis(
 ) -> tuple[float, float, str, str]:
     """The forced coefficients (W/(m²·K)) of a jar carried across its axis: the side a cylinder in cross flow, each
     end a plate along the flow, as long as the jar is wide; what they rest on and where they hold."""
-    diameter, k_air = params.outer_diameter, params.air_conductivity
+    diameter, k_air = MillHead.of(params).outer_diameter, params.air_conductivity
     reynolds = _reynolds(diameter, params, speed, viscosity)
     side = heat_paths.churchill_bernstein_nusselt(reynolds, prandtl) * k_air / diameter
     end = heat_paths.flat_plate_nusselt(reynolds, prandtl) * k_air / diameter

@@ -10,12 +10,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from importlib import import_module
 
 import numpy as np
 
 from shakermill.engines.thermal import kernel
 from shakermill.engines.thermal.air import air_constants
-from shakermill.engines.thermal.mill_head import add_mill_head
 from shakermill.engines.thermal.nodes import (
     BALL,
     BALL_WALL,
@@ -29,7 +29,6 @@ from shakermill.engines.thermal.nodes import (
     deposit_arrays,
 )
 from shakermill.engines.thermal.paths import PAPER_PATHS, HeatPath, ball_convection, newton_cooling
-from shakermill.engines.thermal.powder import add_powder
 from shakermill.parameters.consistency import MIN_THERMAL_TIME_CONSTANT_S
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
@@ -224,10 +223,17 @@ class ThermalNetwork:
         return conductances
 
 
-# The nodes beyond the balls, the vessel and the gas: each extension adds its node, paths and deposits to the draft
-# where the run's parameters ask for it. A new node is a module and an entry here (docs/ARCHITECTURE.md).
+# The nodes beyond the balls, the vessel and the gas: the modules of this folder that add one, in the order they add
+# it; each has ``add_node(draft)``, which adds its node, paths and deposits where the run's parameters ask for it. A
+# new node is a module, its key group (parameters/groups/) and its name here (docs/ARCHITECTURE.md).
+NODE_EXTENSIONS: tuple[str, ...] = ("mill_head", "powder")
 NodeExtension = Callable[[NetworkDraft], None]
-NODE_EXTENSIONS: list[NodeExtension] = [add_mill_head, add_powder]
+
+
+def node_extension(name: str) -> NodeExtension:
+    """The ``add_node`` of the extension module ``name`` of :data:`NODE_EXTENSIONS`."""
+    add_node: NodeExtension = import_module(f"{__package__}.{name}").add_node
+    return add_node
 
 
 def build_network(
@@ -270,7 +276,7 @@ def build_network(
                 f"h_outer, outer_area ({PAPER_PATHS}, Table 3 and Table 1 for the SPEX preset)",
             )
         )
-    for extend in NODE_EXTENSIONS:
+    for extend in map(node_extension, NODE_EXTENSIONS):
         extend(draft)
     return ThermalNetwork(
         len(radii),

@@ -5,6 +5,7 @@ its name: audits, summaries, tables and figures loop over the nodes and their ro
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -28,6 +29,9 @@ HEAT_CHANNELS = ("normal", "tangential", "sliding", "rolling")
 
 # The audit's name for the balls together: a charge of thousands has one line, not one per ball.
 BALLS_GROUP = "balls"
+# A node's name beyond the balls: one word of lower-case letters (``lid``), as its keys in a run's summary take it
+# (``lid_C``, ``lid_steady_C``), so that no other key reads as a node's.
+NODE_NAME = "[a-z]+"
 
 
 @dataclass(frozen=True)
@@ -42,6 +46,14 @@ class Node:
     title: str
     held: bool = False
     keys: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        # Checked where the node is made: a name the summary cannot take would fail every run at its end.
+        if self.role != BALL and not re.fullmatch(NODE_NAME, self.name):
+            raise ValueError(
+                f"node {self.name!r}: a node's name is one word of lower-case letters ({NODE_NAME}), as the run's "
+                "summary names its temperature (<name>_C)"
+            )
 
 
 @dataclass(frozen=True)

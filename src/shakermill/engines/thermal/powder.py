@@ -21,6 +21,7 @@ from shakermill.engines.thermal.nodes import (
     Node,
 )
 from shakermill.engines.thermal.paths import newton_cooling
+from shakermill.parameters.groups.powder import PowderCoating, PowderHeat
 
 # The role of the node (engines/thermal/nodes.py).
 POWDER = "powder"
@@ -31,17 +32,18 @@ LAYER_VALIDITY = (
 )
 
 
-def add_powder(draft: NetworkDraft) -> None:
+def add_node(draft: NetworkDraft) -> None:
     """The powder node, its paths to the vessel, the balls and the gas, and its share of each contact's heat."""
     params = draft.params
-    if params.powder_mass <= 0.0:
+    coating, heat = PowderCoating.of(params), PowderHeat.of(params)
+    if coating.powder_mass <= 0.0:
         return
     vial, air = draft.one_of_role(VESSEL), draft.one_of_role(GAS)
     keys = ("powder_mass", "powder_heat_capacity", "powder_contact_coefficient")
-    capacity = params.powder_mass * params.powder_heat_capacity
+    capacity = coating.powder_mass * heat.powder_heat_capacity
     powder = draft.add(Node("powder", POWDER, capacity, "powder", keys=keys))
     wall = wall_area(params.vial_diameter, params.vial_length)
-    coefficient = params.powder_contact_coefficient
+    coefficient = heat.powder_contact_coefficient
     draft.paths += [
         newton_cooling("powder → vial", powder, vial, coefficient, wall, LAYER_SOURCE, LAYER_VALIDITY),
         *(
@@ -65,8 +67,8 @@ def add_powder(draft: NetworkDraft) -> None:
             "h_inner, inner_area: the layer's free surface meets the gas where the bare wall does (vial → air)",
         ),
     ]
-    draft.coated_restitution = (params.powder_restitution, params.powder_restitution)
-    share = params.powder_heat_share
+    draft.coated_restitution = (coating.powder_restitution, coating.powder_restitution)
+    share = heat.powder_heat_share
     draft.deposits.append(
         Deposit(
             powder,
