@@ -106,11 +106,11 @@ def test_bad_input_exits_2_with_one_line_naming_the_option(args, fragments):
     "setting, fragments",
     [
         # Issue 25: computed steel (578 N for 1007 N) and made 9154 balls for the impact's own vial.
-        ("ball_materials=wc", ("ball_materials:", "scalar ball keys", "per-ball lists apply to runs")),
-        ("fill=0.3", ("fill:", "one ball against its --target")),
-        ("engine=1d", ("engine:", "'dem' engine's contact law")),
-        ("yaw_amplitude=0.1", ("yaw_amplitude:", "vial at rest")),
-        ("duration=5", ("duration:", "one contact")),
+        ("ball_materials=wc", ("ball_materials: a lone impact does not read it", "several balls applies to runs")),
+        ("fill=0.3", ("fill: a lone impact does not read it", "it reads the contact law alone (the balls,")),
+        ("engine=1d", ("engine: a lone impact does not read it", "the run applies to runs")),
+        ("yaw_amplitude=0.1", ("yaw_amplitude:", "the SPEX 8000M clamp applies to runs")),
+        ("duration=5", ("duration:", "the run applies to runs")),
     ],
 )
 def test_keys_a_lone_impact_does_not_read_are_refused_with_why(setting, fragments):
