@@ -497,9 +497,9 @@ def impact(
     config: ConfigArgument = None,
     preset: PresetOption = None,
     settings: SettingsOption = None,
-    speed: Annotated[
-        float, typer.Option("--speed", help="Speed of the incoming ball relative to its target, m/s.")
-    ] = ...,
+    *,
+    # Required: an option without a default (keyword-only, after the arguments that have one).
+    speed: Annotated[float, typer.Option("--speed", help="Speed of the incoming ball relative to its target, m/s.")],
     angle: Annotated[
         float, typer.Option("--angle", help="Angle between the incoming velocity and the normal, degrees (0: head-on).")
     ] = 0.0,

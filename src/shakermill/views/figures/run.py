@@ -109,7 +109,7 @@ def _paper_figures(run: RunLike, window: int) -> dict[str, Figure]:
         figures["heat_by_channel"] = heat_by_channel_figure(run)
     zoom_index = heating_zoom_window(params)
     zoom = window_data(run, zoom_index) if zoom_index is not None else None
-    if zoom is not None:
+    if zoom is not None and zoom_index is not None:
         zoom_start = params.record_windows[zoom_index][0]
         figures["ball_heating_zoom"] = heating_zoom_figure(run, zoom, zoom_start)
     return figures
