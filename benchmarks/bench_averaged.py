@@ -65,7 +65,13 @@ def main() -> None:
         d_temp = max(abs(a.value(key) - f.value(key)) for key in ("ball_C", "vial_C", "air_C"))
         ratios.append(full_time / averaged_time)
         probed_ratios.append(full_time / probed_time)
-        note = "fell back to full resolution" if averaged.solver == "full" else a.averaging_message
+        note = (
+            "fell back to full resolution"
+            if averaged.solver == "full"
+            else a.averaging.message
+            if a.averaging is not None
+            else "no averaging"
+        )
         print(
             f"{omega:6.0f} {amplitude * 1e3:5.0f} | {f.theta_inf_C:8.2f} {d_inf:7.3f} | {f.tau_min:7.2f} "
             f"{d_tau:7.3f} | "

@@ -58,7 +58,7 @@ def _run(omega: float, amplitude: float, rtol: float) -> tuple[float, float, flo
     wall = time.perf_counter() - started
     if not result.success:
         raise RuntimeError(f"ω={omega} X={amplitude} rtol={rtol}: {result.message}")
-    return result.summary.heat_power_W, result.summary.impact_rate_hz, wall
+    return result.summary.heat_power_W, result.summary.impacts.rate_hz, wall
 
 
 def _point(point: tuple[float, float]) -> list[tuple[float, float, float]]:
@@ -126,8 +126,8 @@ def study() -> None:
         summary = sm.simulate(base.replace(rtol=rtol)).summary
         wall = time.perf_counter() - started
         print(
-            f"{rtol:5.0e} | {summary.heat_power_W:.4f} | {summary.impact_rate_hz:7.2f} | "
-            f"{summary.energy_projection_relative:21.1e} | {summary.steps / summary.impacts:12.1f} | "
+            f"{rtol:5.0e} | {summary.heat_power_W:.4f} | {summary.impacts.rate_hz:7.2f} | "
+            f"{summary.energy_projection_relative:21.1e} | {summary.steps / summary.impacts.count:12.1f} | "
             f"{60 * wall:15.1f} | {_worst_restitution_error(rtol):.1e}"
         )
     print("\nreferences against tighter runs (20 s from the default start):")

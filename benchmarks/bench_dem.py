@@ -148,7 +148,7 @@ def full_run(plan: Plan) -> None:
         "CPU second "
         f"({1e6 * timing.cpu_median / c['steps']:.2f} µs a step)"
     )
-    print(f"heat power {s.heat_power_W:.3f} W, impact rate {s.impact_rate_hz:.1f} Hz (transient included)")
+    print(f"heat power {s.heat_power_W:.3f} W, impact rate {s.impacts.rate_hz:.1f} Hz (transient included)")
 
 
 def averaged_run() -> None:
@@ -226,7 +226,7 @@ def limit_convergence(plan: Plan, repeats: int) -> None:
             f"{fraction:8g} | {heat:8.5f} {percent(heat, whole):+9.3f} "
             f"{percent(heat, finest.summary.heat_power_W):+11.3f} | "
             f"{later:10.5f} {percent(later, half):+9.3f} {percent(later, settled_heat(finest)):+11.3f} | "
-            f"{result.summary.impact_rate_hz:7.2f} | {timing.median:6.2f} {timing.cpu_median:6.2f}"
+            f"{result.summary.impacts.rate_hz:7.2f} | {timing.median:6.2f} {timing.cpu_median:6.2f}"
         )
     print(repeat_note(repeats))
 
@@ -313,7 +313,7 @@ def flight_step_convergence(plan: Plan, repeats: int) -> None:
         print(
             f"{step:17g} | {heat:8.5f} {percent(heat, reference.summary.heat_power_W):+9.4f} "
             f"{percent(settled_heat(result), settled_heat(reference)):+10.4f} | "
-            f"{result.summary.impact_rate_hz:7.2f} | "
+            f"{result.summary.impacts.rate_hz:7.2f} | "
             f"{timing.median:6.2f} {timing.cpu_median:6.2f}"
         )
 
@@ -331,12 +331,12 @@ def converged_means(plan: Plan) -> None:
     }
     finest, _ = runs[plan.fractions[-1]]
     for fraction, (result, timing) in runs.items():
-        a, rate, reference = result.averages, result.summary.impact_rate_hz, finest.averages
+        a, rate, reference = result.averages, result.summary.impacts.rate_hz, finest.averages
         sigma = 100 * np.hypot(a.heat_power_stderr, reference.heat_power_stderr) / reference.heat_power
         print(
             f"{fraction:8g} | {a.heat_power:7.3f} {a.heat_power_stderr:6.3f} "
             f"{percent(a.heat_power, reference.heat_power):+11.2f} "
-            f"{sigma:5.2f} | {rate:7.1f} {percent(rate, finest.summary.impact_rate_hz):+11.2f} | "
+            f"{sigma:5.2f} | {rate:7.1f} {percent(rate, finest.summary.impacts.rate_hz):+11.2f} | "
             f"{a.transient + a.window:11.1f} | {timing.median:6.2f} {timing.cpu_median:6.2f}"
         )
     print("±σ: standard error of the difference from the finest fraction")
@@ -369,7 +369,7 @@ def one_d_limit(plan: Plan, repeats: int) -> None:
         loose = simulate(engine="1d", omega=omega, duration=seconds)
         tight = simulate(**TIGHT_1D, omega=omega, duration=seconds)
         heat = [run.summary.heat_power_W for run in (dem, loose, tight)]
-        rate = [run.summary.impact_rate_hz for run in (dem, loose, tight)]
+        rate = [run.summary.impacts.rate_hz for run in (dem, loose, tight)]
         met = abs(heat[0] / heat[2] - 1) <= HEAT_TARGET and abs(rate[0] / rate[2] - 1) <= RATE_TARGET
         print(
             f"{omega:5.0f} | {heat[0]:8.5f} {heat[1]:8.5f} {heat[2]:9.5f} | "

@@ -76,7 +76,7 @@ def main() -> None:
                 cpu, summary = one_second(preset, settings, fraction)
                 print(
                     f"    enduring_step_fraction {fraction:<5g}  {cpu:6.2f} CPU-s  {summary.steps:>9,} steps  "
-                    f"{summary.impacts:>5} impacts"
+                    f"{summary.impacts.count:>5} impacts"
                 )
         if options.no_averaged:
             continue
@@ -84,12 +84,12 @@ def main() -> None:
         reference = None
         for fraction in options.fractions:
             cpu, summary = averaged(preset, {**settings, **tighter, "dem_replicas": options.replicas}, fraction)
-            power, error = summary.averaged_heat_power_W, summary.averaged_heat_power_stderr_W
-            rate, speed = summary.impact_rate_hz, summary.mean_impact_speed_m_s
+            power, error = summary.averaging.heat_power_W, summary.averaging.heat_power_stderr_W
+            rate, speed = summary.impacts.rate_hz, summary.impacts.mean_speed_m_s
             line = (
                 f"    enduring_step_fraction {fraction:<5g}  {cpu:6.1f} CPU-s  heat {power:.4g} ± {error:.2g} W  "
                 f"impacts {rate:.4g} /s  mean impact speed {speed:.4g} m/s  mechanics "
-                f"{summary.averaging_window_s:.3g} s"
+                f"{summary.averaging.window_s:.3g} s"
             )
             if reference is None:
                 reference = (power, error, rate, speed)

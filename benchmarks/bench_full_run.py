@@ -57,7 +57,7 @@ def main() -> None:
     summary = result.summary
     print(
         f"default 60-min run, warm: median {median:.2f} s over {args.repeats} "
-        f"(min {min(times):.2f}, max {max(times):.2f}); {summary.impacts} impacts, {summary.steps} steps, "
+        f"(min {min(times):.2f}, max {max(times):.2f}); {summary.impacts.count} impacts, {summary.steps} steps, "
         f"{summary.rhs_evaluations} RHS evaluations ({1e9 * median / summary.rhs_evaluations:.0f} ns each, all "
         "included)"
     )

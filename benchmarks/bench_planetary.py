@@ -81,7 +81,7 @@ def second_part() -> None:
         print(
             f"{LABELS[preset]}: {seconds:g} simulated s in {cpu:.1f} CPU-s ({wall:.1f} wall-s), {cpu / seconds:.3g} "
             "CPU-s "
-            f"per simulated s; {result.counters['steps']} steps, {summary.impact_rate_hz:.4g} impacts/s, heat "
+            f"per simulated s; {result.counters['steps']} steps, {summary.impacts.rate_hz:.4g} impacts/s, heat "
             f"{summary.heat_power_W:.3g} W, audit residual {summary.energy_audit_residual:.1e}"
         )
         print(f"  {spectrum_line(summary)}")
@@ -103,10 +103,10 @@ def hour_part(presets: list[str], batch_periods: int | None) -> None:
             f"status {result.status}: {result.message}"
         )
         print(
-            f"  balls {summary.ball_C:.1f} °C (mean; hottest {summary.hottest_ball_C:.1f} °C), jar "
+            f"  balls {summary.ball_C:.1f} °C (mean; hottest {summary.temperatures.hottest_ball_C:.1f} °C), jar "
             f"{summary.vial_C:.1f} °C, air {summary.air_C:.1f} °C, holder "
             f"{summary.number('holder_C'):.1f} °C; "
-            f"heat {summary.heat_power_W:.3g} W at {summary.impact_rate_hz:.4g} impacts/s"
+            f"heat {summary.heat_power_W:.3g} W at {summary.impacts.rate_hz:.4g} impacts/s"
         )
         print(f"  {spectrum_line(summary)}")
         print("  largest heat paths: " + "; ".join(f"{name} {flow:.3g} W" for name, flow in paths))

@@ -17,7 +17,7 @@ print(result)
 # %%
 # How the heat is made, by dissipation channel, and how hard the balls hit: the spectrum of the energy each impact
 # dissipates (Kwade's stress energy), which decides whether a reaction can be activated.
-print(f"heat power {result.summary.heat_power_W:.3g} W; impacts per second {result.summary.impact_rate_hz:.0f}")
+print(f"heat power {result.summary.heat_power_W:.3g} W; impacts per second {result.summary.impacts.rate_hz:.0f}")
 
 import matplotlib.pyplot as plt  # noqa: E402
 

@@ -118,7 +118,7 @@ def test_a_probe_that_uses_up_the_budget_stops_an_averaged_run_that_finished() -
     result = sm.simulate(base.replace(attractor_starts=4, max_steps=mechanics_steps + 1000))
     assert result.status == BUDGET_EXCEEDED
     assert "probing attractors (4 of 4 starts not settled); the run itself finished" in result.message
-    assert result.t_end == 600.0 and result.summary.attractor_failed_starts == 4
+    assert result.t_end == 600.0 and result.summary.attractors.failed_starts == 4
     probe_lines = [line for line in result.warnings if line.startswith("attractor probe")]
     assert len(probe_lines) == 1 and probe_lines[0].startswith("attractor probe: starts 0, 1, 2, 3 did not settle")
 

@@ -103,7 +103,7 @@ def test_the_neighbour_list_finds_the_contacts_of_the_search_over_every_pair(mon
     pairs = {
         engine.constants.skin: sorted(
             (int(engine.state.neighbours.first_ball[e]), int(engine.state.neighbours.second_ball[e]))
-            for e in range(int(engine.state.neighbours.count[0]))
+            for e in range(int(engine.state.neighbours.entries[0]))
             if engine.state.contacts.active[3 * N_BALLS + e]
         )
         for engine in runs
@@ -128,7 +128,7 @@ def test_a_rebuild_carries_each_touching_contact_to_its_new_entry_whole(monkeypa
                 *s.contacts.dissipated[walls + e],
                 s.contacts.peak_force[walls + e],
             )
-            for e in range(int(nb.count[0]))
+            for e in range(int(nb.entries[0]))
             if s.contacts.active[walls + e]
         }
 
@@ -136,17 +136,20 @@ def test_a_rebuild_carries_each_touching_contact_to_its_new_entry_whole(monkeypa
     assert rebuild_neighbours(k, s, engine.scratch.coordinates[:3])  # the list of the balls where they are now
     assert touching() == before
     entries_before = (
-        s.neighbours.first_ball[: s.neighbours.count[0]].copy(),
-        s.neighbours.second_ball[: s.neighbours.count[0]].copy(),
+        s.neighbours.first_ball[: s.neighbours.entries[0]].copy(),
+        s.neighbours.second_ball[: s.neighbours.entries[0]].copy(),
     )
     # The grid moved by 0.4 of a cell: every ball in other cells, so the pairs are listed in another order.
     assert rebuild_neighbours(k, s, engine.scratch.coordinates[:3] + 0.4 * k.cell_size)
-    entries_after = s.neighbours.first_ball[: s.neighbours.count[0]], s.neighbours.second_ball[: s.neighbours.count[0]]
+    entries_after = (
+        s.neighbours.first_ball[: s.neighbours.entries[0]],
+        s.neighbours.second_ball[: s.neighbours.entries[0]],
+    )
     assert before and touching() == before
     # Which pairs are listed depends on their distances alone, not on the cells.
     assert set(zip(*map(list, entries_before))) == set(zip(*map(list, entries_after)))
     assert not all(np.array_equal(a, b) for a, b in zip(entries_before, entries_after))
-    assert s.contacts.active[walls + int(s.neighbours.count[0]) :].sum() == 0
+    assert s.contacts.active[walls + int(s.neighbours.entries[0]) :].sum() == 0
 
 
 def test_packing_a_thousand_balls_places_them_apart_and_inside_the_bowl():

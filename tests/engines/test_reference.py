@@ -39,7 +39,7 @@ def test_compiled_and_scipy_paths_agree(settled_parameters: sm.Parameters) -> No
     reference = simulate_scipy(settled_parameters)
     assert compiled.success and reference.status == 0
     assert reference.t_end == pytest.approx(COMPARISON_TIME)
-    assert reference.impact_rate == pytest.approx(compiled.summary.impact_rate_hz, rel=0.01)
+    assert reference.impact_rate == pytest.approx(compiled.summary.impacts.rate_hz, rel=0.01)
     assert reference.heat_power == pytest.approx(compiled.summary.heat_power_W, rel=0.01)
     # The impacts happen at the same times, not only at the same rate.
     first_impacts = compiled.impacts["time"].to_numpy()[:20]

@@ -299,8 +299,8 @@ def test_a_registered_engine_runs_through_simulate_storage_the_summary_and_a_fig
     engine = ToyEngine(toy)
     # A hit every crossing of the free gap, the first after half of one.
     assert hits == math.floor((600.0 - engine.gap / engine.speed) * engine.speed / (2 * engine.gap)) + 1
-    assert result.summary.impact_rate_hz == pytest.approx(hits / 600.0)
-    assert result.summary.mean_impact_speed_m_s == pytest.approx(toy.amplitude * toy.omega)
+    assert result.summary.impacts.rate_hz == pytest.approx(hits / 600.0)
+    assert result.summary.impacts.mean_speed_m_s == pytest.approx(toy.amplitude * toy.omega)
     assert result.summary.heat_power_W == pytest.approx(engine.heat_power, rel=1e-12)
     # The steady state of the shared network: all the heat leaves through h_o·A_o.
     assert result.summary.vial_steady_C == pytest.approx(

@@ -670,11 +670,11 @@ def test_a_dem_run_draws_its_figures_and_its_table_tells_the_balls_apart(dem_run
         assert (out / "figures" / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     summary = load_run(out).summary
     rows = table_rows(outcome.stdout)
-    assert rows["engine; balls; fill of the vial"] == (f"dem; 3; {summary.fill_fraction:.3f}", "")
-    each = "; ".join(f"{value:.2f}" for value in summary.ball_temperatures_C)
+    assert rows["engine; balls; fill of the vial"] == (f"dem; 3; {summary.charge.fill_fraction:.3f}", "")
+    each = "; ".join(f"{value:.2f}" for value in summary.temperatures.each_ball_C)
     assert rows["each ball at the end (ball 0; 1; …)"] == (each, "°C")
     assert rows["impacts on the walls; between balls"] == (
-        f"{summary.wall_impacts}; {summary.ball_ball_impacts}",
+        f"{summary.impacts.on_walls}; {summary.impacts.between_balls}",
         "",
     )
     heat = "; ".join(
@@ -1105,7 +1105,7 @@ def test_a_run_of_a_calibrated_preset_reports_intervals_and_where_its_heat_goes(
     assert f"Caveat (spex8000m-calibrated): {PRESETS['spex8000m-calibrated'].caveat}" in " ".join(result.stdout.split())
     for key in ("ball_C", "vial_C", "ball_steady_C", "vial_steady_C"):
         assert summary.value(f"{key}_low") < summary.value(key) < summary.value(f"{key}_high"), key
-    assert "covariance" in summary.interval_note and "averaging error" in summary.interval_note
+    assert "covariance" in summary.intervals.note and "averaging error" in summary.intervals.note
     assert "90 % interval, ball at the end" in result.stdout
     paths = summary.heat_paths_W
     assert set(paths) == {"ball → air", "vial → air", "vial → room"}

@@ -113,7 +113,7 @@ def test_load_run_returns_what_was_written(run_folder, short_result):
     assert run.ball_fit == short_result.ball_fit
     assert run.impact_units == IMPACT_UNITS
     assert run.counters == short_result.counters
-    assert run.summary.impacts == short_result.summary.impacts
+    assert run.summary.impacts.count == short_result.summary.impacts.count
     xr.testing.assert_identical(run.timeseries.drop_attrs(), short_result.timeseries.drop_attrs())
     pd.testing.assert_frame_equal(run.impacts, short_result.impacts, check_dtype=False)
 
@@ -287,11 +287,11 @@ def test_an_old_run_folder_is_read_with_its_keys_brought_forward(run_folder):
 
     as_version_1(run_folder, older)
     summary = load_run(run_folder).summary
-    assert (summary.holder_C, summary.holder_steady_C) == (25.5, 31.0)
+    assert (summary.temperatures.holder, summary.steady.holder) == (25.5, 31.0)
     # As the readers of version 1 assumed: the fit's rows shown; a key it lacked is NaN (shown "n/a").
     assert summary.exponential_fit_describes_run is True
-    assert math.isnan(summary.stress_window_s) and math.isnan(summary.fast_impact_rate_hz)
-    assert summary.impacts > 0
+    assert math.isnan(summary.stress_window_s) and math.isnan(summary.impacts.fast_rate_hz)
+    assert summary.impacts.count > 0
 
 
 def test_an_old_run_folder_that_does_not_fit_is_refused_in_one_line_that_says_to_re_run_it(run_folder):

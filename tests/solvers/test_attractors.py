@@ -66,7 +66,7 @@ def test_every_start_reaches_an_attractor_at_the_default_stroke():
     assert sum(attractor.basin_fraction for attractor in scan.attractors) == pytest.approx(1.0)
     assert scan.failed == ()
     assert scan.configured is scan.attractors[0]
-    assert scan.as_summary()["n_attractors"] == len(scan.attractors)
+    assert scan.as_summary().count == len(scan.attractors)
 
 
 def test_starts_are_deterministic_inside_the_gap_and_begin_with_the_configured_one():
@@ -225,7 +225,7 @@ def test_a_start_that_fails_is_reported_not_grouped(monkeypatch):
     assert [start.start for start in scan.failed] == [2]
     assert all(2 not in attractor.starts for attractor in scan.attractors)
     assert sum(attractor.basin_fraction for attractor in scan.attractors) == pytest.approx(0.75)
-    assert scan.as_summary()["attractor_failed_starts"] == 1
+    assert scan.as_summary().failed_starts == 1
     assert any("start 2" in line and "step size too small" in line for line in scan.warnings())
 
 
@@ -241,8 +241,8 @@ def test_averaged_run_follows_the_configured_start_and_warns_of_the_other_attrac
     probed = sm.simulate(base)
     assert probed.summary.heat_power_W == alone.summary.heat_power_W
     assert probed.summary.theta_inf_C == alone.summary.theta_inf_C
-    assert alone.summary.n_attractors is None and alone.warnings == []
-    assert probed.summary.n_attractors == len(scan.attractors) == 2
+    assert alone.summary.attractors is None and alone.warnings == []
+    assert probed.summary.attractors.count == len(scan.attractors) == 2
     other = scan.attractors[1]
     (warning,) = probed.warnings
     assert f"basin fraction {other.basin_fraction:.2f}" in warning and f"{other.heat_power_W:.4g} W" in warning
@@ -252,8 +252,8 @@ def test_averaged_run_follows_the_configured_start_and_warns_of_the_other_attrac
 @pytest.mark.slow
 def test_one_attractor_at_the_default_stroke_and_no_warning():
     result = sm.simulate(sm.default_parameters(solver="averaged", duration=10800.0, omega=110.0, record_windows=()))
-    assert result.summary.n_attractors == len(result.attractors.attractors) == 1
-    assert result.summary.heat_power_spread_W == 0.0
+    assert result.summary.attractors.count == len(result.attractors.attractors) == 1
+    assert result.summary.attractors.heat_power_spread_W == 0.0
     assert result.warnings == []
 
 
@@ -263,7 +263,7 @@ def test_a_resting_ball_never_reached_is_warned_of_the_moving_starts():
     assert scan.configured.regime == NO_IMPACTS and scan.configured.heat_power_W == 0.0
     assert len(scan.differing()) == len(scan.attractors) - 1 >= 1
     assert all("with 0 W" in line and "%" not in line for line in scan.warnings())
-    assert math.isnan(scan.as_summary()["heat_power_spread_relative"])
+    assert math.isnan(scan.as_summary().heat_power_spread_relative)
 
 
 def test_only_a_heat_power_more_than_one_percent_away_is_worth_a_warning():

@@ -47,9 +47,9 @@ def test_both_solvers_give_each_ball_its_own_temperature_and_a_steady_state(pair
         temperatures = result.history[BALL_TEMPERATURES]
         assert temperatures.shape == (result.history.times.size, 5)
         assert np.allclose(temperatures.mean(axis=1), result.history["theta_ball"])
-        assert len(result.summary.balls_steady_C) == 5
+        assert len(result.summary.steady.each_ball_C) == 5
         assert result.steady.solved and len(result.steady.time_constants) == 7  # five balls, vial, air
-        assert result.summary.ball_steady_C == pytest.approx(np.mean(result.summary.balls_steady_C))
+        assert result.summary.ball_steady_C == pytest.approx(np.mean(result.summary.steady.each_ball_C))
 
 
 @pytest.mark.slow

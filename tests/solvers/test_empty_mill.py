@@ -26,10 +26,10 @@ def test_the_drive_alone_warms_an_empty_mill_and_its_heat_is_accounted_for(solve
     params = default_parameters("spex8000m-3d-calibrated", n_balls=0, duration=60.0, solver=solver)
     result = simulate(params)
     summary = result.summary
-    assert result.success and summary.impacts == 0 and summary.heat_power_W == 0.0
-    assert math.isnan(summary.ball_C) and math.isnan(summary.ball_steady_C) and summary.ball_temperatures_C == []
+    assert result.success and summary.impacts.count == 0 and summary.heat_power_W == 0.0
+    assert math.isnan(summary.ball_C) and math.isnan(summary.ball_steady_C) and summary.temperatures.each_ball_C == []
     assert summary.drive_heat_W == pytest.approx(params.drive_heat)
-    assert 20.0 < summary.vial_C < summary.holder_C < summary.vial_steady_C
+    assert 20.0 < summary.vial_C < summary.temperatures.holder < summary.vial_steady_C
     # The drive's heat is the only flow of the balance, and all of it is accounted for.
     assert abs(result.energy.thermal_residual) < 1e-9 * result.energy.drive_heat
     assert summary.energy_audit_residual == pytest.approx(abs(result.energy.residual) / result.energy.drive_heat)

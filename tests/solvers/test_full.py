@@ -35,10 +35,10 @@ def test_energy_audit_of_default_run_closes(default_run_20s: sm.Result) -> None:
 def test_summary_is_consistent_with_the_records(default_run_20s: sm.Result) -> None:
     summary = default_run_20s.summary
     impacts = default_run_20s.impacts
-    assert summary.impacts == len(impacts)
-    assert summary.impact_rate_hz == pytest.approx(len(impacts) / 20.0)
+    assert summary.impacts.count == len(impacts)
+    assert summary.impacts.rate_hz == pytest.approx(len(impacts) / 20.0)
     assert summary.heat_power_W == pytest.approx(default_run_20s.energy.heat_generated / 20.0)
-    assert summary.mean_impact_speed_m_s == pytest.approx(impacts["impact_speed"].mean())
+    assert summary.impacts.mean_speed_m_s == pytest.approx(impacts["impact_speed"].mean())
     assert set(impacts["wall"]) == {"left", "right"}
     assert (impacts["rebound_speed"] > 0).all() and (impacts["duration"] > 0).all()
     last = default_run_20s.timeseries.isel(time=-1)
@@ -60,7 +60,7 @@ def test_default_tolerance_finds_the_converged_motion_at_90_rad_s() -> None:
     base = sm.default_parameters(omega=90.0, duration=20.0, record_windows=())
     default = sm.simulate(base).summary
     converged = sm.simulate(base.replace(rtol=1e-6, atol_position=1e-9, atol_momentum=1e-9)).summary
-    assert default.impact_rate_hz == pytest.approx(converged.impact_rate_hz, rel=0.03)
+    assert default.impacts.rate_hz == pytest.approx(converged.impacts.rate_hz, rel=0.03)
     assert default.heat_power_W == pytest.approx(converged.heat_power_W, rel=0.01)
 
 

@@ -1,11 +1,17 @@
-"""The run summary's schema (solvers/summary.py, its versions solvers/summary_versions.py; issue 39): every key a
-run of each engine and solver summarizes is declared with a unit and a meaning, summary.json round-trips, a misspelt
-key fails loudly, and an old summary.json is read where it can be or refused in one line."""
+"""The run summary's schema (solvers/summary.py, its sections, its versions solvers/summary_versions.py; issues 39
+and 48): every key a run of each engine and solver summarizes is declared with a unit and a meaning, summary.json
+round-trips, a misspelt key fails loudly, the summary reads as a mapping of its flat keys, mypy refuses a writer of a
+wrongly typed section, and an old summary.json is read where it can be or refused in one line."""
 
 from __future__ import annotations
 
 import json
 import math
+import os
+import subprocess
+import sys
+import textwrap
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +21,7 @@ from typer.testing import CliRunner
 
 import shakermill as sm
 from shakermill import cli
+from shakermill.analysis.sections import further_nodes
 from shakermill.engines.records import StateHistory, attributes
 from shakermill.io.runs import load_run, to_jsonable, write_run
 from shakermill.solvers.result import end_temperatures
@@ -96,8 +103,8 @@ def test_every_key_a_run_summarizes_is_declared_with_its_unit_and_meaning(run):
         assert summary.solver == "averaged"
     # What each engine's run leaves out is absent, not null: a one-ball engine has no balls' keys or channels.
     if name in ("1-D", "averaged"):
-        assert summary.n_balls is None and "n_balls" not in flat and summary.dissipated_by_channel_W == {}
-    assert (summary.holder_C is None) == (name != "mill-head")
+        assert summary.charge is None and "n_balls" not in flat and summary.dissipated_by_channel_W == {}
+    assert (summary.temperatures.holder is None) == (name != "mill-head")
 
 
 @pytest.mark.slow
@@ -115,7 +122,7 @@ def test_summary_json_round_trips(run, tmp_path):
 
 def test_every_declared_key_has_a_meaning_and_the_unit_its_name_says():
     keys = summary_keys()
-    assert len(keys) == len(Summary.model_fields) > 100
+    assert len(keys) == len({key.name for key in keys}) > 100
     for key in keys:
         assert len(key.meaning) > 10, key.name
         name = key.name.replace("{channel}", "x").replace("{threshold}", "x")
@@ -141,11 +148,10 @@ def test_a_misspelt_key_fails_loudly_with_the_nearest_one(default_run_20s):
         declared_name("impact_rate_per_s")
     with pytest.raises(SummaryKeyError):
         summary.updated(ball_c=20.0)
-    # By name only through the schema: a subscript or a membership test says how to read it instead.
-    with pytest.raises(TypeError, match=r"summary\.ball_C"):
-        summary["ball_C"]  # noqa: B018
-    with pytest.raises(TypeError, match="summary.has"):
-        "ball_C" in summary  # noqa: B015
+    # As a mapping too, a misspelt key is no key (with the nearest one in its message).
+    with pytest.raises(KeyError, match="did you mean 'ball_steady_C'"):
+        summary["ball_steady_c"]  # noqa: B018
+    assert "ball_steady_c" not in summary and summary.get("ball_steady_c") is None
     assert summary.value("ball_C") == summary.ball_C and summary.number("ball_C") == summary.ball_C
     # Declared but not of this run: an optional key is None (NaN as a number); a family's members are the run's own,
     # so a channel a one-ball engine has not is no key of its summary.
@@ -165,6 +171,129 @@ def test_the_summary_is_frozen_and_an_update_is_checked(default_run_20s):
         summary.updated(impacts="many")
 
 
+def test_the_summary_is_a_read_only_mapping_of_its_flat_keys(default_run_20s):
+    """For a notebook: ``summary["key"]`` beside the attributes, over the keys summary.json has (issue 48)."""
+    summary = default_run_20s.summary
+    flat = summary.flat()
+    assert isinstance(summary, Mapping)
+    assert summary["ball_steady_C"] == summary.ball_steady_C and summary["impacts"] == summary.impacts.count
+    assert summary["heat_paths_W"] == summary.heat_paths_W and summary["tau_min"] == summary.tau_min
+    assert list(summary) == list(summary.keys()) == list(flat) and len(summary) == len(flat)
+    assert same(dict(summary.items()), flat)
+    assert "ball_C" in summary and "stress_events_above_0.001J_hz" in summary
+    # A key of no value in this run is declared, but no key of its mapping: None through get and value.
+    assert "holder_C" not in summary and summary.get("holder_C") is None and summary.value("holder_C") is None
+    with pytest.raises(KeyError, match="'holder_C': this run's summary has no value"):
+        summary["holder_C"]  # noqa: B018
+    with pytest.raises(TypeError):
+        summary["ball_C"] = 30.0  # type: ignore[index]
+    # What it gives is a copy: the frozen summary does not change through it.
+    summary["warnings"].append("said here")
+    summary["heat_paths_W"]["a path"] = 1.0
+    assert "said here" not in summary.warnings and "a path" not in summary.heat_paths_W
+
+
+def test_the_sections_are_nested_where_clearer_and_flat_on_disk(run):
+    """The temperatures by node, the steady state, the impacts, the averaging and the balls are sections of their
+    own in Python; summary.json has their fields under the keys of version 2."""
+    name, result = run
+    summary = result.summary
+    flat = summary.flat()
+    assert summary.temperatures.by_node()["vial"] == summary.vial_C == flat["vial_C"]
+    assert summary.steady is not None and summary.steady.ball == flat["ball_steady_C"]
+    assert summary.steady.slowest_time_constant_min == flat["slowest_time_constant_min"]
+    assert (summary.impacts.count, summary.impacts.rate_hz) == (flat["impacts"], flat["impact_rate_hz"])
+    assert "count" not in flat and "temperatures" not in flat and "impacts" in flat
+    if name == "averaged":
+        assert summary.averaging is not None and summary.averaging.window_s == flat["averaging_window_s"]
+        assert summary.attractors is not None and summary.attractors.count == flat["n_attractors"]
+    else:
+        assert summary.averaging is None and not any(key.startswith("averag") for key in flat)
+    if name.startswith("dem"):
+        assert summary.charge is not None and summary.charge.n_balls == flat["n_balls"] == 3
+        assert summary.impacts.on_walls == flat["wall_impacts"]
+    if name == "mill-head":
+        assert summary.further_nodes() == {"holder": (flat["holder_C"], flat["holder_steady_C"])}
+
+
+# A writer of each kind mypy refuses: a section of the wrong type returned, a field of the wrong type, a misspelt
+# field, and a section given to the summary in the place of another.
+WRONG_WRITERS = """
+from shakermill.analysis.attractors import AttractorSection
+from shakermill.analysis.fit import FitSection
+from shakermill.analysis.steady import SteadySection
+from shakermill.analysis.stress_energy import StressSection
+from shakermill.solvers.summary import Summary
+from shakermill.solvers.summary_sections import (
+    EndTemperatures, Heat, Impacts, Inputs, Numerics, Outcome, PredictionIntervals,
+)
+
+
+def attractors(impacts: Impacts) -> AttractorSection:
+    return impacts
+
+
+def averaging(window: float) -> PredictionIntervals:
+    return PredictionIntervals(
+        ball_C_low="low", ball_C_high=1.0, vial_C_low=1.0, vial_C_high=1.0, ball_steady_C_low=1.0,
+        ball_steady_C_high=1.0, vial_steady_C_low=1.0, vial_steady_C_high=1.0, note="",
+    )
+
+
+def numerics() -> Numerics:
+    return Numerics(
+        step=1, rejected_steps=0, rhs_evaluations=1, wall_time_s=1.0, energy_audit_residual=0.0,
+        energy_projection_relative=0.0,
+    )
+
+
+def composed(
+    outcome: Outcome, fit: FitSection, temperatures: EndTemperatures, steady: SteadySection, impacts: Impacts,
+    heat: Heat, numerics: Numerics, inputs: Inputs, stress: StressSection,
+) -> Summary:
+    return Summary.compose(
+        outcome=outcome, fit=stress, temperatures=temperatures, steady=steady, impacts=impacts, heat=heat,
+        charge=None, numerics=numerics, inputs=inputs, stress=stress, averaging=None, attractors=None, warnings=[],
+        notes=[],
+    )
+"""
+
+
+@pytest.mark.slow
+def test_mypy_refuses_a_writer_of_a_wrongly_typed_section(tmp_path):
+    """The sections are checked where they are built (``make test`` runs mypy over the package's writers); here the
+    same check on writers made wrong on purpose, each refused on its line."""
+    root = Path(__file__).resolve().parents[2]
+    snippet = tmp_path / "wrong_writers.py"
+    snippet.write_text(textwrap.dedent(WRONG_WRITERS), encoding="utf-8")
+    checked = subprocess.run(
+        [sys.executable, "-m", "mypy", "--config-file", str(root / "pyproject.toml"), str(snippet)],
+        cwd=root,
+        # The package's source, as make test checks it (the editable install carries no py.typed marker).
+        env={**os.environ, "MYPYPATH": str(root / "src")},
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert checked.returncode == 1, checked.stdout + checked.stderr
+    lines = textwrap.dedent(WRONG_WRITERS).splitlines()
+
+    def line_of(text: str) -> int:
+        return next(number for number, line in enumerate(lines, 1) if text in line)
+
+    found = {
+        (int(line.split(":")[1]), line.rsplit("[", 1)[-1].rstrip("]"))
+        for line in checked.stdout.splitlines()
+        if ": error: " in line
+    }
+    assert found == {
+        (line_of("    return impacts"), "return-value"),
+        (line_of('ball_C_low="low"'), "arg-type"),
+        (line_of("    return Numerics("), "call-arg"),
+        (line_of("fit=stress"), "arg-type"),
+    }, checked.stdout
+
+
 def history_of(**nodes: float) -> StateHistory:
     """A history of the nodes ``theta_<node>`` (K) at two samples, with the balls' own and the °C copies."""
     variables = {f"theta_{node}": (np.array([293.15, kelvin]), attributes("K", node)) for node, kelvin in nodes.items()}
@@ -175,19 +304,25 @@ def history_of(**nodes: float) -> StateHistory:
 
 def test_the_temperature_of_every_node_at_the_end_comes_from_its_history_variable():
     found = end_temperatures(history_of(ball=303.15, vial=298.15, air=294.15, holder=295.15, powder=310.15))
-    assert found == pytest.approx(
-        {"ball_C": 30.0, "vial_C": 25.0, "air_C": 21.0, "holder_C": 22.0, "powder_C": 37.0}, abs=1e-12
-    )
-    # An engine that still calls the holder the clamp: its key is the holder's.
-    assert end_temperatures(history_of(clamp=300.15)) == {"holder_C": pytest.approx(27.0)}
+    assert found == pytest.approx({"ball": 30.0, "vial": 25.0, "air": 21.0, "holder": 22.0, "powder": 37.0}, abs=1e-12)
+    # An engine that still calls the holder the clamp: its temperature is the holder's.
+    assert further_nodes({"clamp": 27.0, "powder": 30.0}) == (27.0, {"powder": 30.0})
     # A node no key names (one an extension adds) is of the family {node}_C; a key of no declared form fails loudly.
     flat = sm.simulate(sm.default_parameters(duration=0.1)).summary.flat()
     with_lid = Summary.from_flat({**flat, "lid_C": 20.0, "lid_steady_C": 21.0})
-    assert with_lid.other_nodes_C == {"lid": 20.0} and with_lid.value("lid_steady_C") == 21.0
+    assert with_lid.temperatures.others == {"lid": 20.0} and with_lid.value("lid_steady_C") == 21.0
+    assert with_lid.steady is not None and with_lid.steady.by_node()["lid"] == 21.0
     assert "lid_C" in with_lid.flat() and unit_of("lid_C") == "°C"
     assert with_lid.further_nodes() == {"lid": (20.0, 21.0)}
     with pytest.raises(ValueError, match="'lid_temperature_K' is not a summary key"):
         Summary.from_flat({**flat, "lid_temperature_K": 293.0})
+    # Built as a section, a node of no such name (or one of the named nodes' names) is refused: its key would not read
+    # back, or would be another's.
+    fields = {name: getattr(with_lid, name) for name in Summary.model_fields}
+    for others in ({"jar_lid": 20.0}, {"vial": 20.0}):
+        temperatures = with_lid.temperatures.model_copy(update={"others": others})
+        with pytest.raises(ValueError, match=f"the member '{next(iter(others))}'"):
+            Summary(**{**fields, "temperatures": temperatures})
 
 
 def version_1(summary: Summary, **changes) -> dict:
@@ -209,9 +344,50 @@ def test_a_version_1_summary_is_brought_forward_where_it_can_be(default_run_20s)
     summary = default_run_20s.summary
     old = version_1(summary, clamp_C=24.0, exponential_fit_describes_run=None, stress_window_s=None, gone_key=1.0)
     read = summary_from_document(old, None)
-    assert read.holder_C == 24.0 and read.exponential_fit_describes_run is True
+    assert read.temperatures.holder == 24.0 and read.exponential_fit_describes_run is True
     assert math.isnan(read.stress_window_s) and read.ball_C == summary.ball_C
     assert summary_from_document(version_1(summary), 1).flat().keys() == summary.flat().keys()
+
+
+# Summaries as shakermill wrote them at version 2 (issue 39; spex8000m-3d-mill-head, 3 balls, 0.2 s; the averaged 1-D
+# default with its attractor probe; spex8000m-calibrated with its intervals; spex8000m-3d, 5 balls, averaged).
+VERSION_2 = Path(__file__).resolve().parents[1] / "data" / "summary-v2"
+
+
+@pytest.mark.parametrize("name", ["mill-head", "oned-averaged", "calibrated", "dem-averaged"])
+def test_a_version_2_summary_is_read_into_the_sections_with_every_key_as_it_was(name):
+    document = json.loads((VERSION_2 / f"{name}.json").read_text(encoding="utf-8"))
+    assert document["schema_version"] == 2
+    stored = document["summary"]
+    read = summary_from_document(stored, 2)
+    # Flat again, the same keys and values, null read as NaN.
+    assert same(read.flat(), {key: math.nan if value is None else value for key, value in stored.items()})
+    assert read.ball_C == stored["ball_C"] and read.impacts.count == stored["impacts"]
+    if name == "mill-head":
+        assert read.temperatures.holder == stored["holder_C"] and read.charge is not None
+        assert read.impacts.between_balls == stored["ball_ball_impacts"]
+        assert read.heat_by_channel_W["sliding"] == stored["heat_sliding_W"]
+    if name in ("oned-averaged", "dem-averaged"):
+        assert read.averaging is not None and read.averaging.replicas == stored["averaging_replicas"]
+    if name == "oned-averaged":
+        assert read.attractors is not None and read.attractors.count == stored["n_attractors"]
+    if name == "calibrated":
+        assert read.intervals is not None and read.intervals.ball_steady_C_high == stored["ball_steady_C_high"]
+        assert read.intervals.note == stored["interval_note"]
+        assert read.validation_caveat == stored["validation_caveat"]
+
+
+def test_a_version_1_averaged_summary_gets_the_keys_its_sections_added_since():
+    """A version-1 averaged run predates the replicas and the grouped batches: one replica, the batches NaN."""
+    stored = json.loads((VERSION_2 / "oned-averaged.json").read_text(encoding="utf-8"))["summary"]
+    for added_since in ("averaging_replicas", "averaging_batch_s", "averaging_batch_autocorrelation"):
+        del stored[added_since]
+    read = summary_from_document(stored, None)
+    assert read.averaging is not None and read.averaging.replicas == 1
+    assert math.isnan(read.averaging.batch_s) and math.isnan(read.averaging.batch_autocorrelation)
+    assert read.averaging.window_s == stored["averaging_window_s"]
+    # A section of which the older document has nothing is not made up.
+    assert read.charge is None and read.intervals is None
 
 
 def test_a_summary_of_a_version_this_one_cannot_read_is_refused_in_one_line(default_run_20s):

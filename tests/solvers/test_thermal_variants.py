@@ -72,8 +72,8 @@ def test_hits_leave_out_contacts_slower_than_the_hit_speed(base):
     speeds = np.asarray(result.impact_columns["impact_speed"])
     hits = speeds[speeds >= HIT_SPEED]
     assert 0 < hits.size < speeds.size  # resting balls chatter; flying ones hit
-    assert result.summary.hit_rate_hz == pytest.approx(hits.size / 2.0)
-    assert result.summary.mean_hit_speed_m_s == pytest.approx(hits.mean())
+    assert result.summary.impacts.hit_rate_hz == pytest.approx(hits.size / 2.0)
+    assert result.summary.impacts.mean_hit_speed_m_s == pytest.approx(hits.mean())
     fast = speeds[speeds >= FAST_IMPACT_SPEED]
     assert 0 < fast.size < hits.size
-    assert result.summary.fast_impact_rate_hz == pytest.approx(fast.size / 2.0)
+    assert result.summary.impacts.fast_rate_hz == pytest.approx(fast.size / 2.0)

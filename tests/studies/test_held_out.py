@@ -43,7 +43,7 @@ def test_the_held_out_preset_was_fitted_to_one_ball_and_runs_five_unrefitted():
 @pytest.mark.slow
 def test_the_prediction_says_what_was_fitted_and_that_the_rest_is_predicted():
     prediction = five_ball_prediction(QUICK)
-    assert prediction.summary.n_balls == FIVE_BALLS
+    assert prediction.summary.charge.n_balls == FIVE_BALLS
     assert all(math.isfinite(row.predicted) for row in prediction.rows)
     assert prediction.rows[0].predicted == pytest.approx(prediction.summary.ball_C - 20.0)
     assert "nothing was refitted" in prediction.statement

@@ -585,7 +585,7 @@ def test_keep_runs_writes_each_point_run_folder(base, tmp_path):
         folder = Path(row["output_dir"])
         assert folder == tmp_path / "kept" / "runs" / row["point_id"]
         run = load_run(folder)
-        assert run.summary.impacts == row["impacts"]
+        assert run.summary.impacts.count == row["impacts"]
         assert run.params.amplitude == row["amplitude"]
 
 

@@ -31,7 +31,7 @@ def test_intervals_hold_the_run_and_scale_with_the_covariance(full_run):
         )  # linear: symmetric
         # A full run has no averaging error: the spread is the calibration's alone, linear in its standard deviations.
         assert four.high[key] - four.low[key] == pytest.approx(2.0 * (high - low), rel=1e-9)
-    assert one.as_summary()["ball_C_high"] == one.bounds("ball_C")[1]
+    assert one.as_summary().ball_C_high == one.bounds("ball_C")[1]
     assert intervals(full_run, Uncertainty(("beta",))) is None  # nothing uncertain
 
 

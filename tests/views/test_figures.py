@@ -636,7 +636,7 @@ def test_run_figures_name_the_run_and_averaged_impact_figures_their_window(tmp_p
     params = sm.default_parameters(solver="averaged", duration=600.0)
     run = load_run(write_run(sm.simulate(params), tmp_path / "run", preset="spex8000m"))
     figures = run_figures(run, impacts=True)
-    window = f"impacts of the {run.summary.averaging_window_s:.3g} s averaging window only"
+    window = f"impacts of the {run.summary.averaging.window_s:.3g} s averaging window only"
     for name, figure in figures.items():
         title = figure.get_suptitle() or figure.axes[0].get_title()
         assert "spex8000m, 10 min, averaged solver" in title, name

@@ -82,7 +82,9 @@ def test_the_answer_says_when_an_uncalibrated_steady_state_is_far_above_the_expe
 
 
 def test_a_3d_run_far_above_the_experiment_is_pointed_to_the_3d_calibrated_preset(default_run_20s):
-    summary = default_run_20s.summary.updated(ball_steady_C=124.6, initial_temperature_C=20.0, engine="dem")
+    # One ball of the 'dem' engine: its charge is a section of its own, whole.
+    charge = {"engine": "dem", "n_balls": 1, "fill_fraction": 0.01, "work_gravity_J": 0.0, "work_stiffening_J": 0.0}
+    summary = default_run_20s.summary.updated(ball_steady_C=124.6, initial_temperature_C=20.0, **charge)
     (far_above,) = (sentence for sentence in answer_sentences(summary, "spex8000m-3d") if "far above" in sentence)
     assert "Preset spex8000m-3d-calibrated is fitted to that experiment" in far_above
 

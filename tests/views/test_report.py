@@ -175,7 +175,7 @@ def test_report_shows_the_energy_audit_with_its_residual(run_folder, report_html
 def test_report_shows_impact_statistics_and_numerics(run_folder, report_html):
     run = load_run(run_folder)
     impacts = "\n".join(rows_of_table_after(report_html, "Impacts"))
-    assert f">{run.summary.impacts}<" in impacts
+    assert f">{run.summary.impacts.count}<" in impacts
     for wall in ("left", "right"):
         count = int((run.impacts["wall"] == wall).sum())
         assert f'impacts at the {wall} end face</td><td class="num">{count} (' in impacts
@@ -354,7 +354,7 @@ def test_report_opens_with_the_answer_and_points_the_default_preset_to_the_calib
     assert report_html.index(answer) < report_html.index("<table>")
     assert f"the ball would settle at {summary.ball_steady_C:.1f} °C" in answer
     assert f"slowest time constant of the thermal network is {summary.slowest_time_constant_min:.1f} min" in answer
-    assert f"{summary.heat_power_W:.3g} W of heat at {summary.impact_rate_hz:.3g} impacts per second" in answer
+    assert f"{summary.heat_power_W:.3g} W of heat at {summary.impacts.rate_hz:.3g} impacts per second" in answer
     assert "far above the experiment" in answer and CALIBRATED_PRESET in answer
 
 

@@ -188,7 +188,7 @@ def test_an_animation_is_refused_for_a_window_without_motion_and_for_a_1d_run(st
 def test_the_report_has_a_table_per_ball_and_leaves_out_what_is_one_dimensional(stored):
     document = render_report(stored)
     assert "<h2>Balls</h2>" in document
-    temperatures = stored.summary.ball_temperatures_C
+    temperatures = stored.summary.temperatures.each_ball_C
     for ball, value in enumerate(temperatures):
         assert f'<td>{ball}</td><td class="num">6.35</td><td class="num">{value:.2f}</td>' in document
     assert "regime of the settled motion" not in document

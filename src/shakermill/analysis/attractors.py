@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 
@@ -37,6 +37,7 @@ from shakermill.analysis.regime import (
     period_signatures,
     signatures_match,
 )
+from shakermill.analysis.sections import Key, Section, Watts
 from shakermill.parameters.keys import Parameters
 
 if TYPE_CHECKING:
@@ -104,6 +105,19 @@ class Attractor:
     starts: tuple[int, ...]
 
 
+class AttractorSection(Section):
+    """The summary's section of the attractor probe (``summary.attractors``; ``solvers/attractors.py``)."""
+
+    count: Annotated[int, Key("n_attractors")]
+    """Settled motions reached from the probed starts."""
+    heat_power_spread_W: Watts
+    """Largest minus smallest heat power across those attractors."""
+    heat_power_spread_relative: float
+    """That spread over the configured start's heat power."""
+    failed_starts: Annotated[int, Key("attractor_failed_starts")]
+    """Probed starts that did not settle."""
+
+
 @dataclass(frozen=True)
 class AttractorScan:
     """All starts of one parameter set, and the attractors they reached (attractor 0: the configured start's)."""
@@ -137,19 +151,25 @@ class AttractorScan:
             if _relative_difference(attractor.heat_power_W, configured.heat_power_W) > HEAT_POWER_TOLERANCE
         ]
 
-    def as_summary(self) -> dict[str, Any]:
+    def as_summary(self) -> AttractorSection:
         configured = self.configured
         reference = configured.heat_power_W if configured is not None else math.nan
-        return {
-            "n_attractors": len(self.attractors),
-            "heat_power_spread_W": self.heat_power_spread_W,
-            "heat_power_spread_relative": self.heat_power_spread_W / reference if reference > 0 else math.nan,
-            "attractor_failed_starts": len(self.failed),
-        }
+        return AttractorSection(
+            count=len(self.attractors),
+            heat_power_spread_W=self.heat_power_spread_W,
+            heat_power_spread_relative=self.heat_power_spread_W / reference if reference > 0 else math.nan,
+            failed_starts=len(self.failed),
+        )
 
     def warnings(self) -> list[str]:
         """One line per other attractor with a different heat power, and one per failed start."""
-        lines = [_difference_warning(attractor, self.configured, len(self.settled)) for attractor in self.differing()]
+        configured = self.configured
+        # Without the configured start's attractor nothing differs from it (differing() is empty).
+        lines = (
+            []
+            if configured is None
+            else [_difference_warning(attractor, configured, len(self.settled)) for attractor in self.differing()]
+        )
         # One line per reason: once a run's budget is spent, every start left fails for it.
         failed_for: dict[str, list[str]] = {}
         for start in self.failed:

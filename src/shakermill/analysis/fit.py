@@ -8,6 +8,29 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from shakermill.analysis.sections import Celsius, CelsiusPerMinute, Kelvin, Minutes, Section
+
+
+class FitSection(Section):
+    """The summary's keys of the exponential fitted to the ball temperature (:meth:`ExponentialFit.as_summary`)."""
+
+    theta_inf_C: Celsius
+    """θ∞ of the exponential θ∞ − (θ∞ − θ₀)·exp(−t/τ) fitted to the ball temperature (the balls' mean) over the run
+    (MODEL.md §8): a property of the run's window, not the steady state; NaN where the fit failed."""
+    theta_inf_stderr_K: Kelvin
+    """Standard error of ``theta_inf_C``."""
+    tau_min: Minutes
+    """τ of that fit."""
+    tau_stderr_min: Minutes
+    """Standard error of ``tau_min``."""
+    rate0_C_per_min: CelsiusPerMinute
+    """The fit's initial heating rate θ̇₀ = (θ∞ − θ₀)/τ."""
+    fit_rms_residual_K: Kelvin
+    """RMS residual of that fit."""
+    exponential_fit_describes_run: bool
+    """Whether the exponential is worth reading: fitted, over a run no shorter than the network's slowest time
+    constant."""
+
 
 @dataclass(frozen=True)
 class ExponentialFit:
@@ -32,6 +55,19 @@ class ExponentialFit:
 
     def as_dict(self) -> dict[str, float | bool | str]:
         return {**asdict(self), "initial_rate": self.initial_rate}
+
+    def as_summary(self, describes_run: bool) -> FitSection:
+        """The summary's section of this fit, in °C and minutes; ``describes_run``: whether the run was no shorter than
+        its network's slowest time constant, so that an exponential was to be expected."""
+        return FitSection(
+            theta_inf_C=self.theta_inf - 273.15,
+            theta_inf_stderr_K=self.theta_inf_stderr,
+            tau_min=self.tau / 60.0,
+            tau_stderr_min=self.tau_stderr / 60.0,
+            rate0_C_per_min=self.initial_rate * 60.0,
+            fit_rms_residual_K=self.rms_residual,
+            exponential_fit_describes_run=bool(self.success) and describes_run,
+        )
 
 
 def exponential_approach(t: np.ndarray, theta_0: float, theta_inf: float, tau: float) -> np.ndarray:

@@ -16,17 +16,39 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
 from scipy.differentiate import jacobian
 from scipy.optimize import root
 
+from shakermill.analysis.sections import Celsius, Key, Minutes, NodeTemperatures, Watts, further_nodes
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 
 # A run shorter than this many slowest time constants has not settled: its fit is not the steady state.
 SETTLED_TIME_CONSTANTS = 3.0
 # Residual of the root (K/s) below which the steady state counts as solved; ~1e-9 K per second.
 ROOT_TOLERANCE = 1e-9
+
+
+class SteadySection(NodeTemperatures):
+    """The summary's section of the steady state (MODEL.md §11; ``summary.steady``): every node's steady temperature,
+    keys ``{node}_steady_C``, and what it was computed for."""
+
+    node_key = "{node}_steady_C"
+    node_meaning = (
+        "its steady temperature, the root of the thermal network under the run's mean load, where a longer run "
+        "would settle (absent where the run stopped before it was computed)."
+    )
+
+    each_ball_C: Annotated[list[Celsius] | None, Key("balls_steady_C")] = None
+    """Each ball's steady temperature, ball 0 first (an engine of several balls)."""
+    slowest_time_constant_min: Minutes
+    """The thermal network's slowest time constant at the steady state: a run of several of them has settled."""
+    heat_power_W: Annotated[Watts, Key("steady_state_heat_power_W")]
+    """The mean heat power the steady state was computed for."""
+    message: Annotated[str, Key("steady_state_message")]
+    """``solved``, or why the steady state was not found."""
 
 
 @dataclass(frozen=True)
@@ -48,16 +70,21 @@ class SteadyState:
     def slowest_time_constant(self) -> float:
         return self.time_constants[0] if self.time_constants else math.nan
 
-    def as_summary(self) -> dict[str, float | str]:
-        return {
-            "ball_steady_C": self.ball - 273.15,
-            "vial_steady_C": self.vial - 273.15,
-            "air_steady_C": self.air - 273.15,
-            "slowest_time_constant_min": self.slowest_time_constant / 60.0,
-            "steady_state_heat_power_W": self.heat_power,
-            "steady_state_message": self.message,
-            **{f"{name}_steady_C": value - 273.15 for name, value in self.others},
-        }
+    def as_summary(self, each_ball: bool = False) -> SteadySection:
+        """The summary's section of this steady state, in °C and minutes; ``each_ball``: with each ball's steady
+        temperature (an engine of several balls)."""
+        holder, others = further_nodes({name: value - 273.15 for name, value in self.others})
+        return SteadySection(
+            ball=self.ball - 273.15,
+            vial=self.vial - 273.15,
+            air=self.air - 273.15,
+            holder=holder,
+            others=others,
+            each_ball_C=[value - 273.15 for value in self.balls] if each_ball and self.balls else None,
+            slowest_time_constant_min=self.slowest_time_constant / 60.0,
+            heat_power_W=self.heat_power,
+            message=self.message,
+        )
 
 
 def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:

@@ -26,14 +26,20 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
+from numpy.typing import ArrayLike
+from pydantic import Field
+
+from shakermill.analysis.sections import Joules, Key, PerSecond, Seconds, Section, Watts
 
 # The energy dissipated per impact (total, its normal and tangential parts) and Kwade's stress energy ½·m*·v_n².
 COMPONENTS = ("total", "normal", "tangential", "kinetic")
 # What was hit: the vial (its end faces or, in three dimensions, its side) or another ball.
 TARGETS = ("all", "wall", "ball")
-PERCENTILES = (("median", 50.0), ("p90", 90.0))
+# The percentiles of the stress energies the summary reports.
+MEDIAN, P90 = 50.0, 90.0
 # A Hertz impact of steel balls of 5-40 mm lasts 20-600 µs from 10 m/s down to 1 mm/s (its duration grows as R·v^-1/5):
 # a contact of more than a millisecond rolls, slides or rests.
 LASTING_CONTACT_S = 1e-3
@@ -46,6 +52,52 @@ def threshold_name(threshold: float) -> str:
     from every other number (0.0010000001 -> '0.0010000001J'), so that distinct thresholds never share a key."""
     digits = next(digits for digits in range(6, 18) if float(f"{threshold:.{digits}g}") == threshold)
     return f"{threshold:.{digits}g}J"
+
+
+class StressSection(Section):
+    """The summary's keys of the stress-energy spectrum (:meth:`StressSpectrum.as_summary`; guide: planetary)."""
+
+    stress_window_s: Seconds
+    """The seconds over which the impacts were resolved (the averaged solver: its mechanics)."""
+    stress_lasting_power_W: Watts
+    """The power the contacts lasting over 1 ms dissipated (rolling, sliding, resting under load)."""
+    stress_lasting_share: float
+    """The share of the dissipated power in those lasting contacts, which no median below describes."""
+    stress_lasting_contacts_hz: PerSecond
+    """Contacts per second that lasted over 1 ms."""
+    stress_energy_median_J: Joules
+    """Median stress energy of the impacts (the energy each dissipated); NaN without impacts."""
+    stress_energy_p90_J: Joules
+    """90th percentile of the impacts' stress energy."""
+    stress_energy_normal_median_J: Joules
+    """Median of the normal part (damping of the normal force)."""
+    stress_energy_normal_p90_J: Joules
+    """90th percentile of the normal part."""
+    stress_energy_tangential_median_J: Joules
+    """Median of the tangential part (tangential damping, sliding, rolling resistance)."""
+    stress_energy_tangential_p90_J: Joules
+    """90th percentile of the tangential part."""
+    stress_energy_kinetic_median_J: Joules
+    """Median of Kwade's stress energy ½·m*·v_n² at first touch."""
+    stress_energy_kinetic_p90_J: Joules
+    """90th percentile of Kwade's stress energy."""
+    stress_energy_wall_median_J: Joules
+    """Median stress energy of the impacts on the vial; NaN without any."""
+    stress_energy_wall_p90_J: Joules
+    """90th percentile of the impacts on the vial."""
+    stress_energy_ball_median_J: Joules
+    """Median stress energy of the impacts between balls; NaN without any."""
+    stress_energy_ball_p90_J: Joules
+    """90th percentile of the impacts between balls."""
+    stress_events_above_hz: Annotated[dict[str, PerSecond], Key("stress_events_above_{threshold}_hz")] = Field(
+        default_factory=dict
+    )
+    """Impacts per second at or above each threshold of ``stress_energy_thresholds``, by the threshold's name
+    (``0.001J``)."""
+    stress_power_above_W: Annotated[dict[str, Watts], Key("stress_power_above_{threshold}_W")] = Field(
+        default_factory=dict
+    )
+    """The power of those impacts, by threshold."""
 
 
 @dataclass(frozen=True)
@@ -103,28 +155,32 @@ class StressSpectrum:
         energies = self.of(component, target)
         return self._per_second(float(energies[energies >= above].sum()))
 
-    def as_summary(self) -> dict[str, float]:
-        """The summary's keys: the median and 90th percentile of the total, of each part and for each target, and
+    def as_summary(self) -> StressSection:
+        """The summary's section: the median and 90th percentile of the total, of each part and for each target, and
         per threshold the events per second and their power."""
-        keys: dict[str, float] = {
-            "stress_window_s": self.window,
-            "stress_lasting_power_W": self.lasting_power(),
-            "stress_lasting_share": self.lasting_share(),
-            "stress_lasting_contacts_hz": self.lasting_per_second(),
-        }
-        for name, q in PERCENTILES:
-            keys[f"stress_energy_{name}_J"] = self.percentile(q)
-            for part in COMPONENTS[1:]:
-                keys[f"stress_energy_{part}_{name}_J"] = self.percentile(q, part)
-            for target in TARGETS[1:]:
-                keys[f"stress_energy_{target}_{name}_J"] = self.percentile(q, target=target)
-        for threshold in self.thresholds:
-            keys[f"stress_events_above_{threshold_name(threshold)}_hz"] = self.events_per_second(threshold)
-            keys[f"stress_power_above_{threshold_name(threshold)}_W"] = self.power(threshold)
-        return keys
+        return StressSection(
+            stress_window_s=self.window,
+            stress_lasting_power_W=self.lasting_power(),
+            stress_lasting_share=self.lasting_share(),
+            stress_lasting_contacts_hz=self.lasting_per_second(),
+            stress_energy_median_J=self.percentile(MEDIAN),
+            stress_energy_p90_J=self.percentile(P90),
+            stress_energy_normal_median_J=self.percentile(MEDIAN, "normal"),
+            stress_energy_normal_p90_J=self.percentile(P90, "normal"),
+            stress_energy_tangential_median_J=self.percentile(MEDIAN, "tangential"),
+            stress_energy_tangential_p90_J=self.percentile(P90, "tangential"),
+            stress_energy_kinetic_median_J=self.percentile(MEDIAN, "kinetic"),
+            stress_energy_kinetic_p90_J=self.percentile(P90, "kinetic"),
+            stress_energy_wall_median_J=self.percentile(MEDIAN, target="wall"),
+            stress_energy_wall_p90_J=self.percentile(P90, target="wall"),
+            stress_energy_ball_median_J=self.percentile(MEDIAN, target="ball"),
+            stress_energy_ball_p90_J=self.percentile(P90, target="ball"),
+            stress_events_above_hz={threshold_name(above): self.events_per_second(above) for above in self.thresholds},
+            stress_power_above_W={threshold_name(above): self.power(above) for above in self.thresholds},
+        )
 
 
-def collision_energy(impacts: Mapping[str, Sequence], masses: Sequence[float]) -> np.ndarray:
+def collision_energy(impacts: Mapping[str, ArrayLike], masses: Sequence[float]) -> np.ndarray:
     """Kwade's stress energy of each impact (J): ½·m*·v_n² of the pair at first touch, m* the reduced mass of two balls
     (``other_ball`` ≥ 0) or the ball's mass on the vial; ``masses`` (kg) by ball index (a one-ball engine has no
     ``ball`` column: ball 0)."""
@@ -139,7 +195,7 @@ def collision_energy(impacts: Mapping[str, Sequence], masses: Sequence[float]) -
 
 
 def stress_spectrum(
-    impacts: Mapping[str, Sequence],
+    impacts: Mapping[str, ArrayLike],
     window: float,
     thresholds: Sequence[float] = (),
     dissipated_power: float = math.nan,

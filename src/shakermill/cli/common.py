@@ -58,12 +58,20 @@ class OneLineUsageErrors(TyperGroup):
     wrong type or outside an option's range) as one ``error:`` line and exit code 2, like every other
     bad input: typer draws them in a box over several lines, which scripts and logs read badly."""
 
-    def main(self, args: Sequence[str] | None = None, *rest: Any, standalone_mode: bool = True, **extra: Any) -> Any:
+    def main(
+        self,
+        args: Sequence[str] | None = None,
+        prog_name: str | None = None,
+        complete_var: str | None = None,
+        standalone_mode: bool = True,
+        windows_expand_args: bool = True,
+        **extra: Any,
+    ) -> Any:
         arguments = sys.argv[1:] if args is None else list(args)
         if not standalone_mode or not arguments:  # no arguments: typer shows the help, as it should
-            return super().main(args, *rest, standalone_mode=standalone_mode, **extra)
+            return super().main(args, prog_name, complete_var, standalone_mode, windows_expand_args, **extra)
         try:
-            outcome = super().main(arguments, *rest, standalone_mode=False, **extra)
+            outcome = super().main(arguments, prog_name, complete_var, False, windows_expand_args, **extra)
         except typer.Abort:
             # Outside Click's handling now: typer.Exit (what fail raises) would not be caught.
             echo_error("aborted")

@@ -179,12 +179,11 @@ def with_preset_findings(result: Result, preset: str | None, refitted: Sequence[
 
     known = PRESETS.get(preset) if preset is not None else None
     caveat = known.caveat_for(result.params.model_dump(), refitted) if known is not None else None
-    if caveat:
-        result.summary = result.summary.updated(validation_caveat=caveat)
     uncertainty = uncertainty_of(known) if known is not None else None
     found = intervals(result, uncertainty) if uncertainty is not None else None
-    if found is not None:
-        result.summary = result.summary.updated(**found.as_summary())
+    result.summary = result.summary.with_findings(
+        validation_caveat=caveat or None, intervals=found.as_summary() if found is not None else None
+    )
 
 
 def answer_text(summary: Summary, preset: str | None, said: Sequence[str] = ()) -> str:
@@ -288,12 +287,12 @@ def summary_table(result: Result, target: Path) -> Table:
         *interval_rows(s),
         *(several_ball_rows(s, description.channels) if description.several_balls else ()),
         *heat_path_rows(s),
-        ("impacts", number(s.impacts, "d"), ""),
-        ("impact rate", number(s.impact_rate_hz, ".2f"), "Hz"),
-        ("mean impact speed", number(s.mean_impact_speed_m_s, ".3f"), "m/s"),
+        ("impacts", number(s.impacts.count, "d"), ""),
+        ("impact rate", number(s.impacts.rate_hz, ".2f"), "Hz"),
+        ("mean impact speed", number(s.impacts.mean_speed_m_s, ".3f"), "m/s"),
         (
             f"hits ≥ {HIT_SPEED:g} m/s: rate; mean speed",
-            f"{number(s.hit_rate_hz, '.2f')} Hz; {number(s.mean_hit_speed_m_s, '.3f')}",
+            f"{number(s.impacts.hit_rate_hz, '.2f')} Hz; {number(s.impacts.mean_hit_speed_m_s, '.3f')}",
             "m/s",
         ),
         ("heat generated", number(s.heat_power_W, ".3f"), "W"),
@@ -346,14 +345,16 @@ def interval_rows(s: Summary) -> list[tuple[str, str, str]]:
         (f"{node} at the end; steady state", f"{number(end, '.2f')}; {number(steady, '.2f')}", "°C")
         for node, (end, steady) in s.further_nodes().items()
     ]
+    found = s.intervals
+    if found is None:
+        return rows
     for label, low, high in (
-        ("ball at the end", s.ball_C_low, s.ball_C_high),
-        ("vial at the end", s.vial_C_low, s.vial_C_high),
-        ("ball steady state", s.ball_steady_C_low, s.ball_steady_C_high),
-        ("vial steady state", s.vial_steady_C_low, s.vial_steady_C_high),
+        ("ball at the end", found.ball_C_low, found.ball_C_high),
+        ("vial at the end", found.vial_C_low, found.vial_C_high),
+        ("ball steady state", found.ball_steady_C_low, found.ball_steady_C_high),
+        ("vial steady state", found.vial_steady_C_low, found.vial_steady_C_high),
     ):
-        if low is not None:
-            rows.append((f"  90 % interval, {label}", f"{number(low, '.1f')} to {number(high, '.1f')}", "°C"))
+        rows.append((f"  90 % interval, {label}", f"{number(low, '.1f')} to {number(high, '.1f')}", "°C"))
     return rows
 
 
@@ -361,8 +362,9 @@ def heat_path_rows(s: Summary) -> list[tuple[str, str, str]]:
     """Each heat path's mean flow over the run, the balls' like paths summed (``ball 2 → air`` counts in
     ``balls → air``)."""
     totals: dict[str, float] = {}
+    several = s.charge is not None and s.charge.n_balls > 1
     for name, value in s.heat_paths_W.items():
-        general = re.sub(r"ball \d+", "balls", name) if (s.n_balls or 1) > 1 else name
+        general = re.sub(r"ball \d+", "balls", name) if several else name
         totals[general] = totals.get(general, 0.0) + (0.0 if math.isnan(value) else value)
     rows = [(f"heat path {name}", number(value, ".3g"), "W") for name, value in totals.items()]
     if s.drive_heat_W:
@@ -376,15 +378,19 @@ EACH_BALL_UP_TO = 6
 
 def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, str, str]]:
     """The run table's rows of an engine of several balls: balls, their temperatures at the end and steady states,
-    impacts on the walls and between balls, heat by dissipation channel (``channels``)."""
+    impacts on the walls and between balls, heat by dissipation channel (``channels``); none for an engine of one."""
+    charge = s.charge
+    if charge is None:
+        return []
     rows = [
         (
             "engine; balls; fill of the vial",
-            f"{s.engine}; {s.n_balls}; {number(s.fill_fraction, '.3f')}",
+            f"{charge.engine}; {charge.n_balls}; {number(charge.fill_fraction, '.3f')}",
             "",
         )
     ]
-    for each, what in ((s.ball_temperatures_C, "at the end"), (s.balls_steady_C, "steady state")):
+    steady = s.steady.each_ball_C if s.steady is not None else None
+    for each, what in ((s.temperatures.each_ball_C, "at the end"), (steady, "steady state")):
         values = [value for value in each or () if not math.isnan(value)]
         if not values:
             continue
@@ -394,7 +400,7 @@ def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, st
             rows.append(
                 (f"balls {what}: coolest; hottest", f"{number(min(values), '.2f')}; {number(max(values), '.2f')}", "°C")
             )
-    rows.append(("impacts on the walls; between balls", f"{s.wall_impacts}; {s.ball_ball_impacts}", ""))
+    rows.append(("impacts on the walls; between balls", f"{s.impacts.on_walls}; {s.impacts.between_balls}", ""))
     # Kwade's ½·m*·v_n² beside the energy dissipated, and how much of the dissipation neither describes.
     rows.append(
         (
@@ -418,11 +424,11 @@ def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, st
             "%",
         )
     )
-    if s.charge_regime is not None:
+    if charge.regime is not None:
         rows.append(
             (
                 "motion (pack: lasting contacts, under one impact > 1 m/s a ball and turn; else active)",
-                f"{s.charge_regime}, {number(s.fast_impact_rate_hz, '.4g')} impacts > 1 m/s a second",
+                f"{charge.regime}, {number(s.impacts.fast_rate_hz, '.4g')} impacts > 1 m/s a second",
                 "",
             )
         )
@@ -491,9 +497,9 @@ def impact(
     config: ConfigArgument = None,
     preset: PresetOption = None,
     settings: SettingsOption = None,
-    speed: Annotated[
-        float, typer.Option("--speed", help="Speed of the incoming ball relative to its target, m/s.")
-    ] = ...,
+    *,
+    # Required: an option without a default (keyword-only, after the arguments that have one).
+    speed: Annotated[float, typer.Option("--speed", help="Speed of the incoming ball relative to its target, m/s.")],
     angle: Annotated[
         float, typer.Option("--angle", help="Angle between the incoming velocity and the normal, degrees (0: head-on).")
     ] = 0.0,

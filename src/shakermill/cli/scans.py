@@ -279,7 +279,9 @@ def bifurcation(
         nothing_written_when_a_run_is_stopped("the scan"),
         progress_bar("scanning", "{task.completed}/{task.total} runs", len(values)) as update,
     ):
-        scan = regime_scan(run_config.params, values, key, progress=lambda done, _total: update(done))
+        scan = regime_scan(
+            run_config.params, [float(value) for value in values], key, progress=lambda done, _total: update(done)
+        )
 
     def fill(folder: Path) -> None:
         write_bifurcation(scan, folder)

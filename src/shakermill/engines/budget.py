@@ -17,6 +17,7 @@ import time
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from types import FrameType
 from typing import TYPE_CHECKING
 
 from shakermill.engines.status import BUDGET_EXCEEDED
@@ -134,7 +135,7 @@ def _hours_or_minutes(seconds: float) -> str:
 
 
 @contextmanager
-def interrupts_held(deliver: bool = True) -> Iterator[list[object]]:
+def interrupts_held(deliver: bool = True) -> Iterator[list[FrameType | None]]:
     """Hold a SIGINT that arrives inside the block; deliver it to the previous handler afterwards (``deliver``), or
     leave it in the list the block is given, for the caller to act on.
 
@@ -144,7 +145,7 @@ def interrupts_held(deliver: bool = True) -> Iterator[list[object]]:
     (sweep workers) or default, nothing is held.
     """
     previous = signal.getsignal(signal.SIGINT)
-    received: list[object] = []
+    received: list[FrameType | None] = []
     if threading.current_thread() is not threading.main_thread() or not callable(previous):
         yield received
         return

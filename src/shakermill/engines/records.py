@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 
@@ -152,5 +152,14 @@ class EnergyAudit:
         return values
 
 
-def kelvin_to_celsius(kelvin: float) -> float:
+@overload
+def kelvin_to_celsius(kelvin: float) -> float: ...
+
+
+@overload
+def kelvin_to_celsius(kelvin: np.ndarray) -> np.ndarray: ...
+
+
+def kelvin_to_celsius(kelvin: float | np.ndarray) -> float | np.ndarray:
+    """A temperature (K), or an array of them, in °C."""
     return kelvin - 273.15

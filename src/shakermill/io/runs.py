@@ -26,7 +26,7 @@ import math
 import os
 import shutil
 from collections.abc import Callable, Container, Iterable, Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -461,7 +461,7 @@ def _read_impact_table(path: Path, description: EngineDescription) -> tuple[pd.D
     return impacts, units
 
 
-def _require(names: Iterable[str], present: Container[str], kind: str) -> None:
+def _require(names: Iterable[str], present: Container[object], kind: str) -> None:
     """A file of the right format but not written by a run (another tool's, an empty one) lacks what plot and report
     read."""
     missing = [name for name in names if name not in present]
@@ -495,9 +495,19 @@ def read_impacts(path: Path) -> tuple[pd.DataFrame, dict[str, str]]:
 
 
 def _fit_from_dict(values: Mapping[str, Any]) -> ExponentialFit:
-    # summary.json stores NaN as null; the fit's fields are floats again here.
-    arguments = {
-        field.name: math.nan if values.get(field.name) is None else values[field.name]
-        for field in fields(ExponentialFit)
-    }
-    return ExponentialFit(**arguments)
+    """The fit ``summary.json`` stores under ``ball_fit``: null where a number was not finite, NaN again here."""
+
+    def number(name: str) -> float:
+        value = values.get(name)
+        return math.nan if value is None else float(value)
+
+    return ExponentialFit(
+        theta_0=number("theta_0"),
+        theta_inf=number("theta_inf"),
+        tau=number("tau"),
+        theta_inf_stderr=number("theta_inf_stderr"),
+        tau_stderr=number("tau_stderr"),
+        rms_residual=number("rms_residual"),
+        success=bool(values.get("success")),
+        message=str(values.get("message", "")),
+    )

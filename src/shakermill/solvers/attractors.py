@@ -130,9 +130,11 @@ def probe_attractors(result: Result, budget: RunBudget, progress: ProgressCallba
 
 def probed(result: Result) -> AttractorScan:
     """The attractors at ``result``'s parameters: those its solver probed, or found now and attached."""
-    if result.attractors is None:
-        attach(result, find_attractors(result.params))
-    return result.attractors
+    scan = result.attractors
+    if scan is None:
+        scan = find_attractors(result.params)
+        attach(result, scan)
+    return scan
 
 
 def attach(result: Result, scan: AttractorScan) -> None:

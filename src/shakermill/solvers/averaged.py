@@ -46,7 +46,15 @@ from shakermill.solvers.attractors import probe_attractors
 from shakermill.solvers.driver import Means, least_rounds, measure_means, sample_times
 from shakermill.solvers.full import concluded, simulate_full
 from shakermill.solvers.replicas import replicas_of
-from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages, Result, conclude, summarize
+from shakermill.solvers.result import (
+    INTERRUPTED,
+    INTERRUPTED_MESSAGE,
+    MechanicsAverages,
+    Result,
+    RunOutput,
+    conclude,
+    summarize,
+)
 
 # The thermal time constant of each impact-heated node must exceed the mean time between the impacts that heat it
 # by this factor, or its temperature follows single impacts and the average is not what drives it.
@@ -235,7 +243,7 @@ def _averaged_result(
     )
     impacts = engine.impact_columns(since=averages.transient)
     note = "" if math.isfinite(averages.impact_interval) else engine.no_impact_note()
-    result = Result(
+    output = RunOutput(
         params=params,
         status=REACHED_STOP,
         message=f"Averaged solver: {averages.message}; thermal network integrated to {params.duration:g} s." + note,
@@ -252,7 +260,7 @@ def _averaged_result(
         impact_window=averages.window,
         averages=averages,
     )
-    return conclude(result, network, load)
+    return conclude(output, network, load)
 
 
 def time_scale_problem(engine: AveragedEngine, network: ThermalNetwork, means: Means) -> str | None:

@@ -15,7 +15,7 @@ from shakermill.engines.records import StateHistory
 from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.driver import run_until, sample_times, stop_message
-from shakermill.solvers.result import MechanicsAverages, Result, conclude
+from shakermill.solvers.result import MechanicsAverages, Result, RunOutput, conclude
 
 
 def simulate_full(
@@ -48,22 +48,22 @@ def concluded(
 ) -> Result:
     """The result of what ``engine`` has integrated, concluded with the steady state of its settled means; ``solver``
     and ``averages`` say what ran it (the averaged solver's mechanics, stopped)."""
-    result = result_of(engine, status, message, wall_time, solver, averages)
-    return conclude(result, engine.network, settled_load(engine, result.history))
+    output = output_of(engine, status, message, wall_time, solver, averages)
+    return conclude(output, engine.network, settled_load(engine, output.history))
 
 
-def result_of(
+def output_of(
     engine: Engine,
     status: int,
     message: str,
     wall_time: float,
     solver: str = "full",
     averages: MechanicsAverages | None = None,
-) -> Result:
-    """``engine``'s history, windows, impacts, counters and energy audit as a :class:`Result` (not concluded)."""
+) -> RunOutput:
+    """``engine``'s history, windows, impacts, counters and energy audit, for :func:`conclude`."""
     history = engine.history()
     impacts = engine.impact_columns()
-    return Result(
+    return RunOutput(
         params=engine.params,
         status=status,
         message=message + ("" if impacts["time"].size else engine.no_impact_note()),

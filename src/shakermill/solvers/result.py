@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
@@ -15,8 +15,9 @@ import numpy as np
 from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
 from shakermill.analysis.regime import charge_regime
+from shakermill.analysis.sections import further_nodes
 from shakermill.analysis.steady import SteadyState, fits_no_exponential, run_length_note, steady_state
-from shakermill.analysis.stress_energy import stress_spectrum
+from shakermill.analysis.stress_energy import StressSpectrum, stress_spectrum
 from shakermill.engines.interface import EngineDescription
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
@@ -28,7 +29,17 @@ from shakermill.engines.status import REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.defaults import FAST_IMPACT_SPEED, HIT_SPEED
 from shakermill.parameters.keys import Parameters, unit_slip_warnings
-from shakermill.solvers.summary import Summary, node_key
+from shakermill.solvers.summary import Summary
+from shakermill.solvers.summary_sections import (
+    Averaging,
+    Charge,
+    EndTemperatures,
+    Heat,
+    Impacts,
+    Inputs,
+    Numerics,
+    Outcome,
+)
 from shakermill.support.presenters import present
 
 if TYPE_CHECKING:
@@ -72,23 +83,23 @@ class MechanicsAverages:
     batch_autocorrelation: float = math.nan
     transient_heat_power: float = math.nan
 
-    def as_summary(self) -> dict[str, float | int | bool | str]:
-        return {
-            "averaged_heat_power_W": self.heat_power,
-            "averaged_heat_power_stderr_W": self.heat_power_stderr,
-            "averaged_dissipated_power_W": self.dissipated_power,
-            "averaged_velocity_term": self.velocity_term,
-            "averaged_velocity_term_stderr": self.velocity_term_stderr,
-            "averaging_transient_s": self.transient,
-            "averaging_window_s": self.window,
-            "averaging_batches": self.batches,
-            "averaging_replicas": self.replicas,
-            "averaging_batch_s": self.batch_length,
-            "averaging_batch_autocorrelation": self.batch_autocorrelation,
-            "averaging_transient_heat_power_W": self.transient_heat_power,
-            "averaging_converged": self.converged,
-            "averaging_message": self.message,
-        }
+    def as_summary(self) -> Averaging:
+        return Averaging(
+            heat_power_W=self.heat_power,
+            heat_power_stderr_W=self.heat_power_stderr,
+            dissipated_power_W=self.dissipated_power,
+            velocity_term=self.velocity_term,
+            velocity_term_stderr=self.velocity_term_stderr,
+            transient_s=self.transient,
+            window_s=self.window,
+            batches=self.batches,
+            replicas=self.replicas,
+            batch_s=self.batch_length,
+            batch_autocorrelation=self.batch_autocorrelation,
+            transient_heat_power_W=self.transient_heat_power,
+            converged=self.converged,
+            message=self.message,
+        )
 
 
 # What ``repr(result)`` shows of its summary, and the longest message it prints whole.
@@ -102,9 +113,10 @@ REPR_HEADLINES = {
 REPR_MESSAGE = 160
 
 
-@dataclass(repr=False)
-class Result:
-    """Everything a run produced. ``success`` is False when the integrator stopped early."""
+@dataclass
+class RunOutput:
+    """What a solver gathered of a run from its engine, before the conclusions every run gets (:func:`conclude` makes
+    the :class:`Result`). ``success`` is False when the integrator stopped early."""
 
     params: Parameters
     status: int
@@ -122,38 +134,54 @@ class Result:
     solver: str = "full"
     impact_window: float | None = None  # s covered by ``impacts``; None means the whole run
     averages: MechanicsAverages | None = None
-    steady: SteadyState | None = None
-    # Each heat path's mean flow over the run (W, from its hot end to its cold end; MODEL.md §13.1), and the mean
-    # load of the network they were computed with (of the settled second half, for a full run)
+
+    @property
+    def success(self) -> bool:
+        return self.status == REACHED_STOP
+
+    @property
+    def impact_count(self) -> int:
+        return int(self.impact_columns["time"].size)
+
+
+@dataclass(repr=False, kw_only=True)
+class Result(RunOutput):
+    """Everything a run produced, concluded (:func:`conclude`): its steady state, heat paths, warnings, notes and
+    summary. The summary is made from the rest when the result is; a solver that changes a result after (a fall-back,
+    the attractor probe) makes it again (:func:`summarize`)."""
+
+    steady: SteadyState
+    # The mean load of the network the steady state and the heat paths were computed with (of the settled second
+    # half, for a full run), and each heat path's mean flow over the run (W, from its hot end to its cold end;
+    # MODEL.md §13.1).
+    load: NetworkLoad
     heat_paths: dict[str, float] = field(default_factory=dict)
-    load: NetworkLoad | None = None
     attractors: AttractorScan | None = None  # the settled motions of other starts, where they were probed
     # One line each, for things a user should know that do not stop the run (stderr and summary.json).
     warnings: list[str] = field(default_factory=list)
     # Sentences of advice that is not a problem (how the solver was chosen, a run shorter than its time to steady
     # state): they belong to the run's answer, not to its warnings.
     notes: list[str] = field(default_factory=list)
-    # Every number of the run by key, with its unit (solvers/summary.py); None until the run is concluded.
-    summary: Summary | None = None
+    # Every number of the run by key, with its unit (solvers/summary.py).
+    summary: Summary = field(init=False)
 
-    @property
-    def success(self) -> bool:
-        return self.status == REACHED_STOP
+    def __post_init__(self) -> None:
+        self.summary = summarize(self)
 
     def __repr__(self) -> str:
         """A few lines, as xarray and pandas objects print: what ran and how it ended, its headline numbers and the
         sizes of its data; the data themselves are ``timeseries``, ``impacts``, ``windows`` and ``summary``."""
         summary = self.summary
-        shown = [f"{label} {summary.number(key):.4g}" for key, label in REPR_HEADLINES.items() if summary is not None]
+        shown = [f"{label} {summary.number(key):.4g}" for key, label in REPR_HEADLINES.items()]
         impacts = next(iter(self.impact_columns.values()), np.zeros(0)).size
         lines = [
             f"<shakermill.Result: engine {self.params.engine!r}, solver {self.solver!r}, "
             f"{'success' if self.success else f'status {self.status}'}, {self.t_end:g} s simulated in "
             f"{self.wall_time:.3g} s>",
             f"  {self.message if len(self.message) <= REPR_MESSAGE else self.message[: REPR_MESSAGE - 1] + '…'}",
-            *([f"  {', '.join(shown)}"] if shown else []),
+            f"  {', '.join(shown)}",
             f"  data: {self.history.times.size} samples of {len(self.history.variables)} series, {impacts} impacts, "
-            f"{self.window_history.times.size} window samples, {len(summary) if summary else 0} summary keys",
+            f"{self.window_history.times.size} window samples, {len(summary)} summary keys",
             *(
                 [f"  {len(self.warnings)} warning{'s' if len(self.warnings) != 1 else ''} (.warnings)"]
                 if self.warnings
@@ -170,10 +198,6 @@ class Result:
     def note(self, *lines: str | None, first: bool = False) -> None:
         """Add each of ``lines`` (None is skipped) to the notes once, as :meth:`warn` does the warnings."""
         _add_once(self.notes, lines, first)
-
-    @property
-    def impact_count(self) -> int:
-        return int(self.impact_columns["time"].size)
 
     @cached_property
     def timeseries(self) -> xr.Dataset:
@@ -202,27 +226,37 @@ class Result:
 
 
 def _add_once(said: list[str], lines: Sequence[str | None], first: bool) -> None:
-    new = [line for line in dict.fromkeys(lines) if line is not None and line not in said]
+    new = [line for line in _once(lines) if line not in said]
     position = 0 if first else len(said)
     said[position:position] = new
 
 
-def conclude(result: Result, network: ThermalNetwork, load: NetworkLoad) -> Result:
-    """The steady state of ``network`` under ``load`` (MODEL.md §11), the mean flow of each heat path over the run,
-    physical bounds, energy audit and warnings of a finished run, then its summary."""
-    params = result.params
-    result.steady = steady_state(network, load)
-    result.load = load
-    result.heat_paths = mean_path_flows(network, result.history, load.drives)
-    result.warn(*unit_slip_warnings(params), steady_state_bound_warning(result), fit_warning(result))
-    result.note(run_length_note(result.t_end, result.steady))
+def _once(lines: Sequence[str | None]) -> list[str]:
+    """``lines`` in order, each once, without the None."""
+    return [line for line in dict.fromkeys(lines) if line is not None]
+
+
+def conclude(output: RunOutput, network: ThermalNetwork, load: NetworkLoad) -> Result:
+    """The result of ``output``: the steady state of ``network`` under ``load`` (MODEL.md §11), the mean flow of each
+    heat path over the run, physical bounds, energy audit and warnings of a finished run, then its summary."""
+    params = output.params
+    steady = steady_state(network, load)
+    status, message = output.status, output.message
     checks = ((OUT_OF_PHYSICAL_BOUNDS, physical_bounds_problem), (ENERGY_AUDIT_FAILED, energy_audit_problem))
-    for status, problem_of in checks:
-        problem = problem_of(result) if result.status == REACHED_STOP else None
+    for code, problem_of in checks:
+        problem = problem_of(output) if status == REACHED_STOP else None
         if problem is not None:
-            result.status, result.message = status, problem
-    result.summary = summarize(result)
-    return result
+            status, message = code, problem
+    gathered = {item.name: getattr(output, item.name) for item in fields(RunOutput)}
+    warnings = [*unit_slip_warnings(params), steady_state_bound_warning(params, steady), fit_warning(output, steady)]
+    return Result(
+        **{**gathered, "status": status, "message": message},
+        steady=steady,
+        load=load,
+        heat_paths=mean_path_flows(network, output.history, load.drives),
+        warnings=_once(warnings),
+        notes=_once([run_length_note(output.t_end, steady)]),
+    )
 
 
 def node_temperatures(network: ThermalNetwork, history: StateHistory) -> np.ndarray:
@@ -245,7 +279,7 @@ def mean_path_flows(network: ThermalNetwork, history: StateHistory, drives: np.n
     return {path.name: float(value) for path, value in zip(network.paths, means, strict=True)}
 
 
-def physical_bounds_problem(result: Result) -> str | None:
+def physical_bounds_problem(result: RunOutput) -> str | None:
     """Why the temperatures of a run cannot be physical, or None."""
     series = result.history
     balls = series[BALL_TEMPERATURES if BALL_TEMPERATURES in series.variables else "theta_ball"]
@@ -264,7 +298,7 @@ def physical_bounds_problem(result: Result) -> str | None:
     return None
 
 
-def energy_audit_problem(result: Result) -> str | None:
+def energy_audit_problem(result: RunOutput) -> str | None:
     """Why the energy audit of a run says its heat cannot be trusted, or None."""
     residual = result.energy.relative_residual
     if residual <= ENERGY_AUDIT_TOLERANCE:
@@ -280,15 +314,15 @@ def energy_audit_problem(result: Result) -> str | None:
 def shorter_than_its_network(result: Result) -> bool:
     """Whether the run ended before its network's slowest time constant, so that no exponential was to be expected
     (:func:`~shakermill.analysis.steady.fits_no_exponential`)."""
-    return result.steady is not None and fits_no_exponential(result.t_end, result.steady)
+    return fits_no_exponential(result.t_end, result.steady)
 
 
-def fit_warning(result: Result) -> str | None:
+def fit_warning(output: RunOutput, steady: SteadyState) -> str | None:
     """A line when the exponential fit of the ball temperature failed: the summary's θ∞, τ and θ̇₀ then mean nothing."""
-    fit = result.ball_fit
-    if fit.success or result.params.n_balls == 0:  # an empty mill has no ball to fit
+    fit = output.ball_fit
+    if fit.success or output.params.n_balls == 0:  # an empty mill has no ball to fit
         return None
-    if shorter_than_its_network(result):
+    if fits_no_exponential(output.t_end, steady):
         return None  # no exponential was to be expected: run_length_note says why
     return (
         f"the exponential fit of the ball temperature failed ({fit.message}): theta_inf_C, tau_min and "
@@ -296,12 +330,11 @@ def fit_warning(result: Result) -> str | None:
     )
 
 
-def steady_state_bound_warning(result: Result) -> str | None:
+def steady_state_bound_warning(params: Parameters, steady: SteadyState) -> str | None:
     """A line when the run stays in range but its steady state would not."""
-    steady = result.steady
-    limit = result.params.ball_temperature_limit
+    limit = params.ball_temperature_limit
     # Written as "not above" so that the NaN ball of an empty mill gives no warning.
-    if steady is None or not steady.solved or not steady.ball > limit:
+    if not steady.solved or not steady.ball > limit:
         return None
     return (
         f"the ball's steady state ({kelvin_to_celsius(steady.ball):.4g} °C) is above ball_temperature_limit "
@@ -309,111 +342,123 @@ def steady_state_bound_warning(result: Result) -> str | None:
     )
 
 
-def understood_inputs(params: Parameters) -> dict[str, float]:
+def understood_inputs(params: Parameters) -> Inputs:
     """The inputs people most often give in other units, echoed in those units (guards against unit slips)."""
     cycles_per_second = params.frequency
-    return {
-        "omega_rad_s": params.omega,
-        "omega_hz": cycles_per_second,
-        "omega_rpm": 60.0 * cycles_per_second,
-        "amplitude_mm": params.amplitude * 1e3,
-        "ball_radius_mm": params.ball_radius * 1e3,
-        "vial_length_mm": params.vial_length * 1e3,
-        "vial_diameter_mm": params.vial_diameter * 1e3,
-        "ambient_temperature_C": kelvin_to_celsius(params.ambient_temperature),
-        "initial_temperature_C": kelvin_to_celsius(params.initial_temperature),
-    }
+    return Inputs(
+        omega_rad_s=params.omega,
+        omega_hz=cycles_per_second,
+        omega_rpm=60.0 * cycles_per_second,
+        amplitude_mm=params.amplitude * 1e3,
+        ball_radius_mm=params.ball_radius * 1e3,
+        vial_length_mm=params.vial_length * 1e3,
+        vial_diameter_mm=params.vial_diameter * 1e3,
+        ambient_temperature_C=kelvin_to_celsius(params.ambient_temperature),
+        initial_temperature_C=kelvin_to_celsius(params.initial_temperature),
+    )
 
 
 def summarize(result: Result) -> Summary:
     """The run's :class:`~shakermill.solvers.summary.Summary` (``Result.summary``), printed by ``run --json`` and
-    stored in ``summary.json``: every key is declared in ``solvers/summary.py`` with its unit and meaning."""
+    stored in ``summary.json``: each section built here or by what computed it, its keys declared with their units
+    and meanings."""
     params = result.params
-    series = result.history
-    fit = result.ball_fit
-    theta_0 = params.initial_temperature
-    impacts = result.impact_columns
-    count = result.impact_count
     duration = max(result.t_end, 1e-300)
     impact_window = result.impact_window if result.impact_window else duration
-    impact_rate = count / impact_window if impact_window > 0 else math.nan
     dissipated_power = result.energy.dissipated / duration
-    hit_rate, mean_hit_speed, fast_rate = _hits(impacts["impact_speed"], impact_window)
     spectrum = stress_spectrum(
-        impacts, impact_window, params.stress_energy_thresholds, dissipated_power, params.ball_masses()
+        result.impact_columns, impact_window, params.stress_energy_thresholds, dissipated_power, params.ball_masses()
     )
-    values: dict[str, Any] = {
-        "status": result.status,
-        "success": result.success,
-        "message": result.message,
-        "simulated_s": result.t_end,
-        "theta_inf_C": kelvin_to_celsius(fit.theta_inf),
-        "theta_inf_stderr_K": fit.theta_inf_stderr,
-        "tau_min": fit.tau / 60.0,
-        "tau_stderr_min": fit.tau_stderr / 60.0,
-        "rate0_C_per_min": fit.initial_rate * 60.0,
-        "fit_rms_residual_K": fit.rms_residual,
-        # Whether the exponential is worth reading: fitted, over a run no shorter than the slowest time constant.
-        "exponential_fit_describes_run": bool(fit.success) and not shorter_than_its_network(result),
-        **end_temperatures(series),
-        "vial_ball_ratio": increment_ratio(float(series["theta_vial"][-1]), float(series["theta_ball"][-1]), theta_0),
-        "solver": result.solver,
-        "impacts": count if result.impact_window is None else int(round(impact_rate * duration)),
-        "impact_rate_hz": impact_rate,
-        "heat_power_W": result.energy.heat_generated / duration,
-        "dissipated_power_W": dissipated_power,
-        "mean_impact_speed_m_s": float(impacts["impact_speed"].mean()) if count else math.nan,
-        "hit_rate_hz": hit_rate,
-        "mean_hit_speed_m_s": mean_hit_speed,
-        "fast_impact_rate_hz": fast_rate,
-        "max_impact_speed_m_s": float(impacts["impact_speed"].max()) if count else math.nan,
-        "mean_dissipated_per_impact_J": float(impacts["dissipated_energy"].mean()) if count else math.nan,
-        "steps": result.counters["steps"],
-        "rejected_steps": result.counters.get("rejected_steps", 0),
-        "rhs_evaluations": result.counters.get("rhs_evaluations", result.counters["steps"]),
-        "wall_time_s": result.wall_time,
-        "energy_audit_residual": result.energy.relative_residual,
-        "energy_projection_relative": (
-            result.energy.projection_correction / result.energy.dissipated if result.energy.dissipated > 0 else 0.0
+    impacts = impacts_section(result, impact_window)
+    several = result.description.several_balls
+    return Summary.compose(
+        outcome=Outcome(
+            status=result.status,
+            success=result.success,
+            message=result.message,
+            solver=result.solver,
+            simulated_s=result.t_end,
         ),
-        **understood_inputs(params),
-        **spectrum.as_summary(),
-        **several_ball_summary(result),
-        **(steady_summary(result.steady) if result.steady is not None else {}),
-        "heat_paths_W": dict(result.heat_paths),
-        "drive_heat_W": result.energy.drive_heat / duration,
-        **(result.averages.as_summary() if result.averages is not None else {}),
-        **(result.attractors.as_summary() if result.attractors is not None else {}),
-        "warnings": list(result.warnings),
-        "notes": list(result.notes),
-    }
-    if result.description.several_balls and math.isfinite(spectrum.lasting_share()):
-        values["charge_regime"] = charge_regime(
-            spectrum.lasting_share(), fast_rate, params.n_balls, params.omega / (2.0 * math.pi)
-        )
-    return Summary.of(values)
+        fit=result.ball_fit.as_summary(describes_run=not shorter_than_its_network(result)),
+        temperatures=end_temperatures_section(result),
+        steady=result.steady.as_summary(each_ball=several),
+        impacts=impacts,
+        heat=heat_section(result, dissipated_power),
+        charge=charge_section(result, spectrum, impacts.fast_rate_hz) if several else None,
+        numerics=numerics_section(result),
+        inputs=understood_inputs(params),
+        stress=spectrum.as_summary(),
+        averaging=result.averages.as_summary() if result.averages is not None else None,
+        attractors=result.attractors.as_summary() if result.attractors is not None else None,
+        warnings=result.warnings,
+        notes=result.notes,
+    )
 
 
 def end_temperatures(history: StateHistory) -> dict[str, float]:
-    """The temperature (°C) at the end of every node ``history`` holds as ``theta_<node>`` (K, over time alone), as
-    the key ``<node>_C``: the ball (the balls' mean), the vial, the air and any further node of the network (the
-    holder, ..., and one no key names: the family ``{node}_C``). A name of no declared form fails the summary."""
+    """The temperature (°C) at the end of every node ``history`` holds as ``theta_<node>`` (K, over time alone), by the
+    node's name: the ball (the balls' mean), the vial, the air and any further node of the network."""
     found = {}
     for name, (values, attributes) in history.variables.items():
         node = name.removeprefix("theta_")
         if node != name and attributes.get("units") == "K" and history.dims(name) == ("time",):
-            found[f"{node_key(node)}_C"] = kelvin_to_celsius(float(values[-1]))
+            found[node] = kelvin_to_celsius(float(values[-1]))
     return found
 
 
-def steady_summary(steady: SteadyState) -> dict[str, Any]:
-    """The steady state's keys (MODEL.md §11): each node's steady temperature (a further node under its summary name,
-    ``holder_steady_C``), the slowest time constant, the heat power it was computed for."""
-    values: dict[str, Any] = {}
-    for key, value in steady.as_summary().items():
-        node = key.removesuffix("_steady_C")
-        values[f"{node_key(node)}_steady_C" if node != key else key] = value
-    return values
+def end_temperatures_section(result: RunOutput) -> EndTemperatures:
+    """Every node's temperature at the end of the run (a further node under its name in the summary: the holder for
+    a clamp; one of no such name fails the summary), the vial's rise over the ball's, each ball's with several."""
+    series = result.history
+    ends = end_temperatures(series)
+    main = ("ball", "vial", "air")
+    holder, others = further_nodes({node: value for node, value in ends.items() if node not in main})
+    balls = series[BALL_TEMPERATURES][-1] if result.description.several_balls else None
+    return EndTemperatures(
+        ball=ends["ball"],
+        vial=ends["vial"],
+        air=ends["air"],
+        holder=holder,
+        others=others,
+        vial_ball_ratio=increment_ratio(
+            float(series["theta_vial"][-1]), float(series["theta_ball"][-1]), result.params.initial_temperature
+        ),
+        each_ball_C=None if balls is None else [kelvin_to_celsius(float(value)) for value in balls],
+        hottest_ball_C=None if balls is None else _hottest(balls),
+    )
+
+
+def _hottest(temperatures: np.ndarray) -> float:
+    """The hottest of the balls' temperatures (K) in °C; NaN without balls."""
+    return kelvin_to_celsius(float(np.nanmax(temperatures))) if temperatures.size else math.nan
+
+
+def impacts_section(result: RunOutput, window: float) -> Impacts:
+    """The impacts of the table, which covers ``window`` seconds (the whole run, or the averaging window): their
+    count over the whole run, rates, speeds, energy, and by kind with several balls."""
+    impacts = result.impact_columns
+    count = result.impact_count
+    duration = max(result.t_end, 1e-300)
+    rate = count / window if window > 0 else math.nan
+    hit_rate, mean_hit_speed, fast_rate = _hits(impacts["impact_speed"], window)
+    on_walls = between_balls = None
+    description = result.description
+    if description.several_balls:
+        scale = duration / window if window > 0 else math.nan
+        wall = int(np.sum(impacts[description.impact_target] != "ball"))
+        on_walls, between_balls = int(round(wall * scale)), int(round((count - wall) * scale))
+    return Impacts(
+        count=count if result.impact_window is None else int(round(rate * duration)),
+        rate_hz=rate,
+        hit_rate_hz=hit_rate,
+        mean_hit_speed_m_s=mean_hit_speed,
+        fast_rate_hz=fast_rate,
+        mean_speed_m_s=float(impacts["impact_speed"].mean()) if count else math.nan,
+        max_speed_m_s=float(impacts["impact_speed"].max()) if count else math.nan,
+        mean_dissipated_J=float(impacts["dissipated_energy"].mean()) if count else math.nan,
+        on_walls=on_walls,
+        between_balls=between_balls,
+    )
 
 
 def _hits(speeds: np.ndarray, window: float) -> tuple[float, float, float]:
@@ -429,32 +474,50 @@ def _hits(speeds: np.ndarray, window: float) -> tuple[float, float, float]:
     )
 
 
-def several_ball_summary(result: Result) -> dict[str, Any]:
-    """The keys of an engine that moves several balls: impacts by kind, each ball's temperature and steady state, the
-    heat by channel (none for an engine of one ball)."""
-    description = result.description
-    if not description.several_balls:
-        return {}
-    impacts = result.impact_columns
+def heat_section(result: Result, dissipated_power: float) -> Heat:
+    """The mean heat and power of the contacts, the drive's heat, the heat paths' flows, and by dissipation channel
+    (an engine that moves several balls splits its dissipation)."""
     duration = max(result.t_end, 1e-300)
-    window = result.impact_window if result.impact_window else duration
-    scale = duration / window if window > 0 else math.nan
-    wall = int(np.sum(impacts[description.impact_target] != "ball"))
-    temperatures = result.history[BALL_TEMPERATURES][-1]
-    keys: dict[str, Any] = {
-        "engine": description.name,
-        "n_balls": result.params.n_balls,
-        "fill_fraction": result.params.fill_fraction,
-        "wall_impacts": int(round(wall * scale)),
-        "ball_ball_impacts": int(round((result.impact_count - wall) * scale)),
-        "ball_temperatures_C": [kelvin_to_celsius(float(value)) for value in temperatures],
-        "hottest_ball_C": kelvin_to_celsius(float(np.nanmax(temperatures))) if temperatures.size else math.nan,
-        "work_gravity_J": result.energy.work_by_gravity,
-        "work_stiffening_J": result.energy.work_by_stiffening,
-    }
-    if result.steady is not None and result.steady.balls:
-        keys["balls_steady_C"] = [kelvin_to_celsius(value) for value in result.steady.balls]
-    by_channel = {channel: dissipated / duration for channel, dissipated in result.energy.dissipated_by_channel.items()}
-    keys["dissipated_by_channel_W"] = by_channel
-    keys["heat_by_channel_W"] = {channel: result.params.eta * power for channel, power in by_channel.items()}
-    return keys
+    energy = result.energy
+    by_channel = (
+        {channel: dissipated / duration for channel, dissipated in energy.dissipated_by_channel.items()}
+        if result.description.several_balls
+        else {}
+    )
+    return Heat(
+        heat_power_W=energy.heat_generated / duration,
+        dissipated_power_W=dissipated_power,
+        drive_heat_W=energy.drive_heat / duration,
+        heat_paths_W=dict(result.heat_paths),
+        dissipated_by_channel_W=by_channel,
+        heat_by_channel_W={channel: result.params.eta * power for channel, power in by_channel.items()},
+    )
+
+
+def charge_section(result: RunOutput, spectrum: StressSpectrum, fast_rate: float) -> Charge:
+    """The balls of an engine that moves several: how many, how full the vial, the work of gravity and of the
+    stiffening springs, and the regime of the charge where the share of lasting contacts is known."""
+    params = result.params
+    share = spectrum.lasting_share()
+    frequency = params.omega / (2.0 * math.pi)
+    return Charge(
+        engine=result.description.name,
+        n_balls=params.n_balls,
+        fill_fraction=params.fill_fraction,
+        work_gravity_J=result.energy.work_by_gravity,
+        work_stiffening_J=result.energy.work_by_stiffening,
+        regime=charge_regime(share, fast_rate, params.n_balls, frequency) if math.isfinite(share) else None,
+    )
+
+
+def numerics_section(result: RunOutput) -> Numerics:
+    """What the integration took (steps, rejected steps, evaluations, wall time) and how its energy audit closed."""
+    counters, energy = result.counters, result.energy
+    return Numerics(
+        steps=counters["steps"],
+        rejected_steps=counters.get("rejected_steps", 0),
+        rhs_evaluations=counters.get("rhs_evaluations", counters["steps"]),
+        wall_time_s=result.wall_time,
+        energy_audit_residual=energy.relative_residual,
+        energy_projection_relative=(energy.projection_correction / energy.dissipated if energy.dissipated > 0 else 0.0),
+    )

@@ -1,22 +1,28 @@
-"""The run summary's schema: every key a run's summary can hold, with its unit and meaning.
+"""The run summary: :class:`Summary`, composed of the typed sections that the code computing each part builds
+(:mod:`shakermill.analysis.sections`), and every key it has in its flat form, with its unit and meaning.
 
-:class:`Summary` is what :func:`~shakermill.solvers.result.summarize` makes (``Result.summary``), what ``summary.json``
-stores under ``"summary"`` (with ``"schema_version"`` beside it), what ``shakermill run --json`` prints and what a sweep
-table has as columns. Read it by attribute (``result.summary.ball_C``); where a key is chosen by name at run time (a
-calibration target, a compared quantity, a table column), through :meth:`Summary.value`, :meth:`Summary.number` or
-:func:`declared_name`, which refuse a name that is not declared here (``SummaryKeyError``, with the nearest key). No
-module but this one reads a summary by a string key (``tests/test_architecture.py``).
+:class:`Summary` is what :func:`~shakermill.solvers.result.summarize` makes (``Result.summary``). Its sections are
+nested where that is clearer (``summary.temperatures`` and ``summary.steady``, each node's temperature at the end and
+at steady state; ``summary.impacts``; ``summary.averaging``; the balls of an engine of several, ``summary.charge``;
+the attractor probe's ``summary.attractors``; a calibrated preset's ``summary.intervals``) and their fields are the
+summary's own where they are not (``summary.heat_power_W``, ``summary.steps``, ...); the headline temperatures are
+attributes too (``summary.ball_C``, ``summary.ball_steady_C``). Flat, as ``summary.json`` stores it under
+``"summary"`` (with ``"schema_version"`` beside it), as ``shakermill run --json`` prints it and as a sweep table has
+it as columns, every number is one key: :meth:`Summary.flat`, and the summary itself is a read-only mapping over those
+keys (``summary["ball_steady_C"]``, ``"holder_C" in summary``, ``list(summary)``) for a notebook.
 
-Every field below is one key, in the unit its annotation names (``Celsius``: °C, ``PerSecond``: 1/s, ...; a bare
-``float`` or ``int`` has none). A key that only some runs have (an engine of several balls, a ``mill-head`` network,
-the averaged solver, the attractor probe, a calibrated preset's intervals) is optional: ``None`` when the run has
-none, and then absent from ``summary.json``. The keys whose names depend on the run are *families*: in the summary a
-mapping by member (a dissipation channel, a stress-energy threshold), in ``summary.json`` one flat key per member
-after a declared pattern (:data:`FAMILIES`: ``dissipated_{channel}_W``, ``heat_{channel}_W``,
-``stress_events_above_{threshold}_hz``, ``stress_power_above_{threshold}_W``, and ``{node}_C``, ``{node}_steady_C`` for
-a node of the thermal network that no key names, as the powder: the ball, vial, air and holder have keys of their
-own). A
-number that is not finite is ``null`` in JSON and NaN here once read back.
+In the package a summary is read by attribute; where a key is chosen by name at run time (a calibration target, a
+compared quantity, a table column), through :meth:`Summary.value`, :meth:`Summary.number` or :func:`declared_name`,
+which refuse a name that is not declared (``SummaryKeyError``, with the nearest key). No module but this one reads a
+summary by a string key (``tests/test_architecture.py``).
+
+A key that only some runs have (a section of an engine of several balls, a ``mill-head`` network's holder, the
+averaged solver, the attractor probe, a calibrated preset's intervals) is absent from the flat summary when the run has
+none, and None read by :meth:`Summary.value`. The keys whose names depend on the run are *families*: a mapping by
+member in their section, one flat key per member after a declared pattern (``dissipated_{channel}_W``,
+``heat_{channel}_W``, ``stress_events_above_{threshold}_hz``, ``stress_power_above_{threshold}_W``, and ``{node}_C``,
+``{node}_steady_C`` for a node of the thermal network that no key names, as the powder). A number that is not finite is
+``null`` in JSON and NaN here once read back.
 
 The version of ``summary.json`` and the reading of older ones: ``solvers/summary_versions.py``.
 """
@@ -27,361 +33,189 @@ import difflib
 import math
 import re
 import typing
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
 from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 
-# The thermal network's nodes renamed since version 1 of the summary: the clamp and mill head is the holder. An engine
-# that still names the node so has its keys under the new name.
-RENAMED_NODES = {"clamp": "holder"}
-
-
-@dataclass(frozen=True)
-class Unit:
-    """The unit of a summary key, as its annotation carries it (``Annotated[float, Unit("°C")]``)."""
-
-    symbol: str
-
-
-Celsius = Annotated[float, Unit("°C")]
-Kelvin = Annotated[float, Unit("K")]
-Minutes = Annotated[float, Unit("min")]
-Seconds = Annotated[float, Unit("s")]
-Watts = Annotated[float, Unit("W")]
-Joules = Annotated[float, Unit("J")]
-PerSecond = Annotated[float, Unit("1/s")]
-MetresPerSecond = Annotated[float, Unit("m/s")]
-Millimetres = Annotated[float, Unit("mm")]
-CelsiusPerMinute = Annotated[float, Unit("°C/min")]
-RadiansPerSecond = Annotated[float, Unit("rad/s")]
-Hertz = Annotated[float, Unit("Hz")]
-PerMinute = Annotated[float, Unit("rpm")]
+from shakermill.analysis.attractors import AttractorSection
+from shakermill.analysis.fit import FitSection
+from shakermill.analysis.sections import Section, Unit
+from shakermill.analysis.steady import SteadySection
+from shakermill.analysis.stress_energy import StressSection
+from shakermill.solvers.summary_sections import (
+    Averaging,
+    Charge,
+    EndTemperatures,
+    Heat,
+    Impacts,
+    Inputs,
+    Numerics,
+    Outcome,
+    PredictionIntervals,
+)
 
 
 class SummaryKeyError(KeyError):
-    """A name that is not a declared summary key (a misspelling, or a key of another program)."""
+    """A name that is not a declared summary key (a misspelling, or a key of another program), or a key this run's
+    summary has no value for."""
 
     def __str__(self) -> str:
         return str(self.args[0]) if self.args else ""
 
 
-class Summary(BaseModel):
-    """The summary of one run (``Result.summary``, ``RunData.summary``): one attribute per key, in the unit its
-    annotation names. Frozen: :meth:`updated` gives a copy with keys added or changed, checked against the schema."""
+# The sections whose fields are the summary's own: they are flat in Python too.
+INLINED = (Outcome, FitSection, Heat, Numerics, Inputs, StressSection)
 
-    model_config = ConfigDict(frozen=True, extra="forbid", use_attribute_docstrings=True)
 
-    # ------------------------------------------------------------------ the run
-    status: int
-    """0 when the run reached its end; 1 interrupted (Ctrl-C); negative: stopped early or failed a check
-    (``engines/status.py``; -5 a temperature out of the model's range, -6 an energy audit that does not close)."""
-    success: bool
-    """Whether ``status`` is 0."""
-    message: str
-    """How the run ended, in a sentence."""
-    solver: str
-    """The solver that made these numbers: ``full``, or ``averaged`` (an averaged run that fell back to full resolution
-    says ``full``)."""
-    simulated_s: Seconds
-    """The simulated time."""
+class Summary(Outcome, FitSection, Heat, Numerics, Inputs, StressSection, Mapping[str, Any]):
+    """The summary of one run (``Result.summary``, ``RunData.summary``): the sections' keys, in the units their
+    annotations name. Frozen: :meth:`updated` gives a copy with flat keys added or changed, checked against the schema.
+    A read-only mapping over its flat keys as well (``summary["ball_C"]``)."""
 
-    # ------------------------------------------------------------------ the exponential fitted to the ball
-    theta_inf_C: Celsius
-    """θ∞ of the exponential θ∞ − (θ∞ − θ₀)·exp(−t/τ) fitted to the ball temperature (the balls' mean) over the run
-    (MODEL.md §8): a property of the run's window, not the steady state; NaN where the fit failed."""
-    theta_inf_stderr_K: Kelvin
-    """Standard error of ``theta_inf_C``."""
-    tau_min: Minutes
-    """τ of that fit."""
-    tau_stderr_min: Minutes
-    """Standard error of ``tau_min``."""
-    rate0_C_per_min: CelsiusPerMinute
-    """The fit's initial heating rate θ̇₀ = (θ∞ − θ₀)/τ."""
-    fit_rms_residual_K: Kelvin
-    """RMS residual of that fit."""
-    exponential_fit_describes_run: bool
-    """Whether the exponential is worth reading: fitted, over a run no shorter than the network's slowest time
-    constant."""
-
-    # ------------------------------------------------------------------ temperatures at the end
-    ball_C: Celsius
-    """The ball's temperature at the end of the run (with several balls, their mean)."""
-    vial_C: Celsius
-    """The vial's temperature at the end of the run."""
-    air_C: Celsius
-    """The inner air's temperature at the end of the run."""
-    holder_C: Celsius | None = None
-    """The holder's temperature at the end of the run (``thermal_model = 'mill-head'``: the clamp and mill head; the
-    key was ``clamp_C`` in version 1); None without a holder node."""
-    other_nodes_C: dict[str, Celsius] = Field(default_factory=dict)
-    """The temperature at the end of each further node of the thermal network that no key above names (one an
-    extension of ``engines/thermal/network.py`` adds: the powder), by the node's name; flat keys ``{node}_C``."""
-    vial_ball_ratio: float
-    """(θ_vial − θ₀)/(θ_ball − θ₀) at the end: the vial's temperature rise over the ball's (MODEL.md §8)."""
-    ball_temperatures_C: list[Celsius] | None = None
-    """Each ball's temperature at the end, ball 0 first (an engine of several balls)."""
-    hottest_ball_C: Celsius | None = None
-    """The hottest ball's temperature at the end (an engine of several balls)."""
-
-    # ------------------------------------------------------------------ the steady state (MODEL.md §11)
-    ball_steady_C: Celsius | None = None
-    """The ball's steady temperature (the balls' mean): the root of the thermal network under the run's mean load,
-    where a longer run would settle; None where the run stopped before it was computed."""
-    vial_steady_C: Celsius | None = None
-    """The vial's steady temperature."""
-    air_steady_C: Celsius | None = None
-    """The inner air's steady temperature."""
-    holder_steady_C: Celsius | None = None
-    """The holder's steady temperature (``clamp_steady_C`` in version 1); None without a holder node."""
-    other_nodes_steady_C: dict[str, Celsius] = Field(default_factory=dict)
-    """The steady temperature of each further node that no key above names, by name; flat keys
-    ``{node}_steady_C``."""
-    balls_steady_C: list[Celsius] | None = None
-    """Each ball's steady temperature, ball 0 first (an engine of several balls)."""
-    slowest_time_constant_min: Minutes | None = None
-    """The thermal network's slowest time constant at the steady state: a run of several of them has settled."""
-    steady_state_heat_power_W: Watts | None = None
-    """The mean heat power the steady state was computed for."""
-    steady_state_message: str | None = None
-    """``solved``, or why the steady state was not found."""
-
-    # ------------------------------------------------------------------ impacts
-    impacts: int
-    """Impacts in the run (the averaged solver: its window's rate times the duration)."""
-    impact_rate_hz: PerSecond
-    """Impacts per second, over the impact table's span (the whole run, or the averaging window)."""
-    hit_rate_hz: PerSecond
-    """Impacts per second at or above 0.1 m/s (``HIT_SPEED``): the hits that count, without the chatter."""
-    mean_hit_speed_m_s: MetresPerSecond
-    """Mean speed of those hits; NaN without any."""
-    fast_impact_rate_hz: PerSecond
-    """Impacts per second at or above 1 m/s (``FAST_IMPACT_SPEED``)."""
-    mean_impact_speed_m_s: MetresPerSecond
-    """Mean normal impact speed; NaN without impacts."""
-    max_impact_speed_m_s: MetresPerSecond
-    """Fastest impact; NaN without impacts."""
-    mean_dissipated_per_impact_J: Joules
-    """Mean energy dissipated per impact; NaN without impacts."""
-
-    # ------------------------------------------------------------------ heat and power
-    heat_power_W: Watts
-    """Mean irreversible heat generation of the contacts, η times the dissipated power."""
-    dissipated_power_W: Watts
-    """Mean power dissipated in the contacts."""
-    drive_heat_W: Watts
-    """Mean heat the drive puts into the holder whatever the balls do (``drive_heat``; 0 without a holder)."""
-    heat_paths_W: dict[str, Watts] = Field(default_factory=dict)
-    """Each heat path's mean flow over the run, from its hot end to its cold end, by the path's name (``ball → air``,
-    ``vial → room, convection``, ...; MODEL.md §13.1)."""
-    dissipated_by_channel_W: dict[str, Watts] = Field(default_factory=dict)
-    """Mean power dissipated in each channel of the engine (``normal``, ``tangential``, ``sliding``, ``rolling`` for
-    the 'dem' engine; MODEL.md §12.4), by channel; flat keys ``dissipated_{channel}_W``. Empty for an engine that does
-    not split its dissipation."""
-    heat_by_channel_W: dict[str, Watts] = Field(default_factory=dict)
-    """η times ``dissipated_by_channel_W``: the heat made in each channel; flat keys ``heat_{channel}_W``."""
-
-    # ------------------------------------------------------------------ an engine of several balls
-    engine: str | None = None
-    """The engine (``dem``); None for the one-ball engine."""
-    n_balls: int | None = None
-    """The number of balls (an engine of several balls)."""
-    fill_fraction: float | None = None
-    """The share of the vial's inner volume the balls take."""
-    wall_impacts: int | None = None
-    """Impacts on the vial's walls in the run."""
-    ball_ball_impacts: int | None = None
-    """Impacts between balls in the run."""
-    work_gravity_J: Joules | None = None
-    """Work done by gravity on the balls over the run."""
-    work_stiffening_J: Joules | None = None
-    """Energy the tangential springs gained by stiffening with the load (``work_by_stiffening``)."""
-    charge_regime: str | None = None
-    """``pack`` (lasting contacts, under one impact above 1 m/s per ball and turn) or ``active`` (MODEL.md §14.2)."""
-
-    # ------------------------------------------------------------------ numerics
-    steps: int
-    """Accepted integrator steps."""
-    rejected_steps: int
-    """Rejected integrator steps."""
-    rhs_evaluations: int
-    """Evaluations of the equations' right-hand side."""
-    wall_time_s: Seconds
-    """Wall-clock time of the run."""
-    energy_audit_residual: float
-    """Relative residual of the energy audit (|residual| over the largest flow); above 1e-2 the run fails."""
-    energy_projection_relative: float
-    """The kinetic energy the energy projection corrected, over the energy dissipated."""
-
-    # ------------------------------------------------------------------ inputs echoed in the units people quote
-    omega_rad_s: RadiansPerSecond
-    """The drive's angular frequency ω."""
-    omega_hz: Hertz
-    """The drive frequency, ω/2π."""
-    omega_rpm: PerMinute
-    """The drive frequency in cycles per minute."""
-    amplitude_mm: Millimetres
-    """The vial's amplitude."""
-    ball_radius_mm: Millimetres
-    """The ball radius."""
-    vial_length_mm: Millimetres
-    """The vial's inner length."""
-    vial_diameter_mm: Millimetres
-    """The vial's inner diameter."""
-    ambient_temperature_C: Celsius
-    """The room's temperature."""
-    initial_temperature_C: Celsius
-    """The temperature every node starts at (θ₀)."""
-
-    # ------------------------------------------------------------------ the stress-energy spectrum (guide: planetary)
-    stress_window_s: Seconds
-    """The seconds over which the impacts were resolved (the averaged solver: its mechanics)."""
-    stress_lasting_power_W: Watts
-    """The power the contacts lasting over 1 ms dissipated (rolling, sliding, resting under load)."""
-    stress_lasting_share: float
-    """The share of the dissipated power in those lasting contacts, which no median below describes."""
-    stress_lasting_contacts_hz: PerSecond
-    """Contacts per second that lasted over 1 ms."""
-    stress_energy_median_J: Joules
-    """Median stress energy of the impacts (the energy each dissipated); NaN without impacts."""
-    stress_energy_p90_J: Joules
-    """90th percentile of the impacts' stress energy."""
-    stress_energy_normal_median_J: Joules
-    """Median of the normal part (damping of the normal force)."""
-    stress_energy_normal_p90_J: Joules
-    """90th percentile of the normal part."""
-    stress_energy_tangential_median_J: Joules
-    """Median of the tangential part (tangential damping, sliding, rolling resistance)."""
-    stress_energy_tangential_p90_J: Joules
-    """90th percentile of the tangential part."""
-    stress_energy_kinetic_median_J: Joules
-    """Median of Kwade's stress energy ½·m*·v_n² at first touch."""
-    stress_energy_kinetic_p90_J: Joules
-    """90th percentile of Kwade's stress energy."""
-    stress_energy_wall_median_J: Joules
-    """Median stress energy of the impacts on the vial; NaN without any."""
-    stress_energy_wall_p90_J: Joules
-    """90th percentile of the impacts on the vial."""
-    stress_energy_ball_median_J: Joules
-    """Median stress energy of the impacts between balls; NaN without any."""
-    stress_energy_ball_p90_J: Joules
-    """90th percentile of the impacts between balls."""
-    stress_events_above_hz: dict[str, PerSecond] = Field(default_factory=dict)
-    """Impacts per second at or above each threshold of ``stress_energy_thresholds``, by the threshold's name
-    (``0.001J``); flat keys ``stress_events_above_{threshold}_hz``."""
-    stress_power_above_W: dict[str, Watts] = Field(default_factory=dict)
-    """The power of those impacts, by threshold; flat keys ``stress_power_above_{threshold}_W``."""
-
-    # ------------------------------------------------------------------ the averaged solver (MODEL.md §14)
-    averaged_heat_power_W: Watts | None = None
-    """Mean heat power of the settled motion (averaged solver)."""
-    averaged_heat_power_stderr_W: Watts | None = None
-    """Its standard error, from batch means."""
-    averaged_dissipated_power_W: Watts | None = None
-    """Mean dissipated power of the settled motion."""
-    averaged_velocity_term: float | None = None
-    """Mean Whitaker velocity term 0.4·Re^½ + 0.06·Re^⅔ of the settled motion."""
-    averaged_velocity_term_stderr: float | None = None
-    """Its standard error."""
-    averaging_transient_s: Seconds | None = None
-    """The start-up transient cut before averaging."""
-    averaging_window_s: Seconds | None = None
-    """The seconds averaged over."""
-    averaging_batches: int | None = None
-    """Batches of the batch means."""
-    averaging_replicas: int | None = None
-    """Independent replicas of the mechanics pooled."""
-    averaging_batch_s: Seconds | None = None
-    """Length of a batch after grouping to uncorrelated means."""
-    averaging_batch_autocorrelation: float | None = None
-    """The largest |lag-1 autocorrelation| of the batches' heat and velocity term."""
-    averaging_transient_heat_power_W: Watts | None = None
-    """Mean heat power of the transient cut."""
-    averaging_converged: bool | None = None
-    """Whether the averages converged to their tolerance."""
-    averaging_message: str | None = None
-    """How the averaging ended, in words."""
-
-    # ------------------------------------------------------------------ the attractor probe (solvers/attractors.py)
-    n_attractors: int | None = None
-    """Settled motions reached from the probed starts."""
-    heat_power_spread_W: Watts | None = None
-    """Largest minus smallest heat power across those attractors."""
-    heat_power_spread_relative: float | None = None
-    """That spread over the configured start's heat power."""
-    attractor_failed_starts: int | None = None
-    """Probed starts that did not settle."""
-
-    # ------------------------------------------------------------------ a preset's findings (shakermill run)
+    temperatures: EndTemperatures
+    """Every node's temperature at the end of the run, and each ball's."""
+    steady: SteadySection | None = None
+    """The steady state (MODEL.md §11): every node's steady temperature and what it was computed for; None where the
+    run stopped before it was computed."""
+    impacts: Impacts
+    """The impacts: how many, how often, how fast."""
+    charge: Charge | None = None
+    """The balls of an engine that moves several; None for an engine of one ball."""
+    averaging: Averaging | None = None
+    """What the averaged solver measured of the settled motion; None for a run at full resolution."""
+    attractors: AttractorSection | None = None
+    """The attractor probe's findings (``solvers/attractors.py``); None where it did not run."""
     validation_caveat: str | None = None
-    """What the preset's validation found where it failed or is missing."""
-    ball_C_low: Celsius | None = None
-    """Lower end of the 90 % interval of ``ball_C`` (a calibrated preset's run; ``studies/uncertainty.py``)."""
-    ball_C_high: Celsius | None = None
-    """Upper end of that interval."""
-    vial_C_low: Celsius | None = None
-    """Lower end of the 90 % interval of ``vial_C``."""
-    vial_C_high: Celsius | None = None
-    """Upper end of that interval."""
-    ball_steady_C_low: Celsius | None = None
-    """Lower end of the 90 % interval of ``ball_steady_C``."""
-    ball_steady_C_high: Celsius | None = None
-    """Upper end of that interval."""
-    vial_steady_C_low: Celsius | None = None
-    """Lower end of the 90 % interval of ``vial_steady_C``."""
-    vial_steady_C_high: Celsius | None = None
-    """Upper end of that interval."""
-    interval_note: str | None = None
-    """What the intervals carry (the calibration's uncertainty, the averaging error)."""
-
-    # ------------------------------------------------------------------ what a user should know
+    """What the preset's validation found where it failed or is missing (``shakermill run``)."""
+    intervals: PredictionIntervals | None = None
+    """The 90 % intervals of a calibrated preset's run (``studies/uncertainty.py``)."""
     warnings: list[str] = Field(default_factory=list)
     """One line each: what a user should know that did not stop the run."""
     notes: list[str] = Field(default_factory=list)
     """Sentences of advice that is not a problem (how the solver was chosen, a run shorter than its steady state)."""
 
-    @model_validator(mode="before")
-    @classmethod
-    def _families_gathered(cls, data: Any) -> Any:
-        """Flat keys (as :meth:`flat` gives them) into the model: each family's keys into its mapping."""
-        if not isinstance(data, Mapping):
-            return data
-        values: dict[str, Any] = {}
-        for name, value in data.items():
-            family = _family_of(name) if name not in cls.model_fields else None
-            if family is None:
-                values[name] = value
-            else:
-                values.setdefault(family.field, {})[family.member(name)] = value
-        return values
-
     @model_validator(mode="after")
     def _members_named_apart(self) -> Summary:
-        for family in FAMILIES:
-            for member in getattr(self, family.field):
-                if family.name(member) in type(self).model_fields or not member:
+        for slot in _FAMILY_SLOTS:
+            family = slot.family
+            assert family is not None  # a family's slot
+            for member in self._at(slot.path) or {}:
+                if family.name(member) in _EXACT or not member:
                     raise ValueError(f"{family.pattern}: the member {member!r} would name another key")
+                if not family.regex.fullmatch(family.name(member)):
+                    raise ValueError(f"{family.pattern}: the member {member!r} is not {family.member_pattern}")
         return self
 
-    # ------------------------------------------------------------------ reading
+    @classmethod
+    def compose(
+        cls,
+        *,
+        outcome: Outcome,
+        fit: FitSection,
+        temperatures: EndTemperatures,
+        steady: SteadySection | None,
+        impacts: Impacts,
+        heat: Heat,
+        charge: Charge | None,
+        numerics: Numerics,
+        inputs: Inputs,
+        stress: StressSection,
+        averaging: Averaging | None,
+        attractors: AttractorSection | None,
+        warnings: Sequence[str],
+        notes: Sequence[str],
+    ) -> Summary:
+        """The summary of a run's sections, each built by the code that computes it."""
+        inlined = (outcome, fit, heat, numerics, inputs, stress)
+        own = {name: getattr(section, name) for section in inlined for name in type(section).model_fields}
+        return cls(
+            **own,
+            temperatures=temperatures,
+            steady=steady,
+            impacts=impacts,
+            charge=charge,
+            averaging=averaging,
+            attractors=attractors,
+            warnings=list(warnings),
+            notes=list(notes),
+        )
+
+    def with_findings(
+        self, *, validation_caveat: str | None = None, intervals: PredictionIntervals | None = None
+    ) -> Summary:
+        """A copy with what a preset's validation found and the 90 % intervals of a calibrated preset's run, those
+        given (``shakermill run``)."""
+        found = {"validation_caveat": validation_caveat, "intervals": intervals}
+        return self.model_copy(update={name: value for name, value in found.items() if value is not None})
+
+    # ------------------------------------------------------------------ the headline temperatures
+    @property
+    def ball_C(self) -> float:
+        """The ball's temperature at the end of the run (°C; with several balls, their mean)."""
+        return self.temperatures.ball
+
+    @property
+    def vial_C(self) -> float:
+        """The vial's temperature at the end of the run (°C)."""
+        return self.temperatures.vial
+
+    @property
+    def air_C(self) -> float:
+        """The inner air's temperature at the end of the run (°C)."""
+        return self.temperatures.air
+
+    @property
+    def vial_ball_ratio(self) -> float:
+        """The vial's temperature rise over the ball's at the end."""
+        return self.temperatures.vial_ball_ratio
+
+    @property
+    def ball_steady_C(self) -> float | None:
+        """The ball's steady temperature (°C; the balls' mean); None where it was not computed."""
+        return self.steady.ball if self.steady is not None else None
+
+    @property
+    def vial_steady_C(self) -> float | None:
+        """The vial's steady temperature (°C); None where it was not computed."""
+        return self.steady.vial if self.steady is not None else None
+
+    @property
+    def air_steady_C(self) -> float | None:
+        """The inner air's steady temperature (°C); None where it was not computed."""
+        return self.steady.air if self.steady is not None else None
+
+    @property
+    def slowest_time_constant_min(self) -> float | None:
+        """The thermal network's slowest time constant at the steady state (min); None where it was not computed."""
+        return self.steady.slowest_time_constant_min if self.steady is not None else None
+
+    # ------------------------------------------------------------------ reading by name
+    def _at(self, path: tuple[str, ...]) -> Any:
+        """The value at ``path`` of attributes; None where a section on the way is absent."""
+        found: Any = self
+        for name in path:
+            found = getattr(found, name)
+            if found is None:
+                return None
+        return found
+
     def value(self, name: str) -> Any:
         """The value of the key ``name`` (a flat name, as in ``summary.json``: ``ball_C``, ``heat_normal_W``); None
         where this run has no such optional key. Raises :class:`SummaryKeyError` for a name that is not declared, and
         for a family's key that this run has no member of (``heat_normall_W``): a family's members are the run's."""
-        declared(name)
-        if name in type(self).model_fields:
-            return getattr(self, name)
-        family = _family_of(name)
-        assert family is not None  # declared() found it
-        members = getattr(self, family.field)
-        member = family.member(name)
+        slot, member = _slot_of(name)
+        found = self._at(slot.path)
+        if slot.family is None:
+            return found
+        members = found or {}
         if member not in members:
             close = difflib.get_close_matches(name, list(self.flat()), n=1)
             hint = f"; did you mean {close[0]!r}?" if close else ""
             raise SummaryKeyError(
-                f"{name!r} is no key of this run's summary (its {family.placeholder}s: "
+                f"{name!r} is no key of this run's summary (its {slot.family.placeholder}s: "
                 f"{', '.join(members) or 'none'}){hint}"
             )
         return members[member]
@@ -409,21 +243,25 @@ class Summary(BaseModel):
         """The nodes of this run's thermal network beyond the balls, the vial and the air (the holder, and those of the
         family ``{node}_C``: the powder), each with its temperature at the end and its steady temperature (°C; None
         where the steady state was not computed), by name: for readers that loop over the nodes."""
-        named = {"holder": (self.holder_C, self.holder_steady_C)}
-        named.update({node: (end, self.other_nodes_steady_C.get(node)) for node, end in self.other_nodes_C.items()})
-        return {node: (end, steady) for node, (end, steady) in named.items() if end is not None}
+        steady = self.steady.by_node() if self.steady is not None else {}
+        return {
+            node: (end, steady.get(node))
+            for node, end in self.temperatures.by_node().items()
+            if node not in ("ball", "vial", "air")
+        }
 
     def flat(self) -> dict[str, Any]:
         """Every key this run has, flat as ``summary.json`` stores it (the families spread, optional keys left out
         where None), in the order declared."""
         values: dict[str, Any] = {}
-        families = {family.field: family for family in FAMILIES}
-        for name in type(self).model_fields:
-            value = getattr(self, name)
-            if name in families:
-                values.update({families[name].name(member): item for member, item in value.items()})
-            elif value is not None:
-                values[name] = type(value)(value) if isinstance(value, (list, dict)) else value
+        for slot in _SLOTS:
+            value = self._at(slot.path)
+            if value is None:
+                continue
+            if slot.family is not None:
+                values.update({slot.family.name(member): item for member, item in value.items()})
+            else:
+                values[slot.key] = _copied(value)
         return values
 
     def updated(self, **values: Any) -> Summary:
@@ -432,56 +270,70 @@ class Summary(BaseModel):
 
     @classmethod
     def of(cls, values: Mapping[str, Any]) -> Summary:
-        """The summary of flat ``values`` (a family's keys spread, None for a key the run does not have). Raises
-        :class:`SummaryKeyError` for a key that is not declared and ``ValueError`` for a value of the wrong kind,
-        each in one line."""
+        """The summary of flat ``values`` (a family's keys spread, None for a key the run does not have), each put into
+        its section. Raises :class:`SummaryKeyError` for a key that is not declared and ``ValueError`` for a value of
+        the wrong kind or a key missing, each in one line."""
+        nested: dict[str, Any] = {}
+        for name, value in values.items():
+            slot, member = _slot_of(name)
+            if value is None:
+                continue
+            *sections, last = slot.path
+            into = nested
+            for section in sections:
+                into = into.setdefault(section, {})
+            if slot.family is not None:
+                into.setdefault(last, {})[member] = value
+            else:
+                into[last] = value
         try:
-            return cls.model_validate(dict(values))
+            return cls.model_validate(nested)
         except ValidationError as exc:
-            first = exc.errors()[0]
-            if first["type"] == "extra_forbidden":
-                raise SummaryKeyError(_unknown(".".join(str(part) for part in first["loc"]))) from None
             raise ValueError(_first_problem(exc)) from None
-
-    def __getitem__(self, name: str) -> Any:
-        raise TypeError(
-            f"a Summary is read by attribute (summary.{name}) or, for a name chosen at run time, with "
-            f"summary.value({name!r}); summary.flat() is the flat dict of summary.json"
-        )
-
-    def __contains__(self, name: object) -> bool:
-        raise TypeError(
-            f"a Summary holds every declared key: summary.has({name!r}) says whether this run has a value for it"
-        )
-
-    def __len__(self) -> int:
-        return len(self.flat())
 
     @classmethod
     def from_flat(cls, values: Mapping[str, Any]) -> Summary:
         """The summary of flat ``values`` as ``summary.json`` stores them: a null where a number is declared (a
         number that was not finite) is NaN. Raises ``ValueError`` in one line for a key that is not declared or a
         value of the wrong kind."""
-        numbers = number_fields()
-        read = {}
-        for name, value in values.items():
-            family = _family_of(name) if name not in cls.model_fields else None
-            read[name] = _nan_for_null(value) if (family.field if family else name) in numbers else value
         try:
+            read = {name: _nan_for_null(value) if holds_numbers(name) else value for name, value in values.items()}
             return cls.of(read)
         except SummaryKeyError as exc:
             raise ValueError(str(exc)) from None
 
+    # ------------------------------------------------------------------ a read-only mapping over the flat keys
+    def __getitem__(self, name: str) -> Any:
+        """The value of the flat key ``name`` (a copy of a list or mapping). Raises :class:`SummaryKeyError` (a
+        ``KeyError``) for a name that is not declared and for a key this run has no value for."""
+        value = self.value(name)
+        if value is None:
+            raise SummaryKeyError(f"{name!r}: this run's summary has no value for it (summary.value gives None)")
+        return _copied(value)
 
-# ---------------------------------------------------------------------- families
+    # A Mapping iterates over its keys, where a pydantic model iterates over (field, value) pairs: the flat keys win.
+    def __iter__(self) -> Iterator[str]:  # type: ignore[override]
+        return iter(self.flat())
+
+    def __len__(self) -> int:
+        return len(self.flat())
+
+
+def _copied(value: Any) -> Any:
+    """A list or mapping copied, so that no reader changes a frozen summary through it."""
+    return type(value)(value) if isinstance(value, (list, dict)) else value
+
+
+# ---------------------------------------------------------------------- the flat keys
 
 
 @dataclass(frozen=True)
 class KeyFamily:
     """Keys named after a member that depends on the run: ``pattern`` with ``{placeholder}``, the members held by the
-    :class:`Summary` mapping ``field``; a member's name matches ``member_pattern`` (a regular expression)."""
+    mapping at ``path`` of attributes (``("heat_by_channel_W",)``, ``("temperatures", "others")``); a member's name
+    matches ``member_pattern`` (a regular expression)."""
 
-    field: str
+    path: tuple[str, ...]
     pattern: str
     placeholder: str
     member_pattern: str = ".+"
@@ -502,41 +354,89 @@ class KeyFamily:
         return match.group(1)
 
 
-# A node's name in its keys: one word of lower-case letters (``lid``), so that no other key reads as a node's.
-NODE_NAME = "[a-z]+"
-FAMILIES = (
-    KeyFamily("dissipated_by_channel_W", "dissipated_{channel}_W", "channel"),
-    KeyFamily("heat_by_channel_W", "heat_{channel}_W", "channel"),
-    KeyFamily("stress_events_above_hz", "stress_events_above_{threshold}_hz", "threshold"),
-    KeyFamily("stress_power_above_W", "stress_power_above_{threshold}_W", "threshold"),
-    KeyFamily("other_nodes_C", "{node}_C", "node", NODE_NAME),
-    KeyFamily("other_nodes_steady_C", "{node}_steady_C", "node", NODE_NAME),
-)
-
-
-def _family_of(name: str) -> KeyFamily | None:
-    return next((family for family in FAMILIES if family.regex.fullmatch(name)), None)
-
-
-# ---------------------------------------------------------------------- the declarations
-
-
 @dataclass(frozen=True)
-class SummaryKey:
-    """One declared key: its flat name (a family's pattern), unit ("" for none), meaning, and whether every run has
-    it."""
+class _Slot:
+    """Where one flat key (or a family's keys) lives: its key (a family's pattern), the path of attributes to its value
+    (a family's mapping) from the summary, and its declaration."""
 
-    name: str
+    key: str
+    path: tuple[str, ...]
+    family: KeyFamily | None
     unit: str
     meaning: str
     required: bool
+    in_section: bool
+    numbers: bool
+
+
+def _section_in(annotation: Any) -> tuple[type[Section] | None, bool]:
+    """The section type a field holds (None for a value), and whether it may be None."""
+    arguments = typing.get_args(annotation) or (annotation,)
+    sections = [arg for arg in arguments if isinstance(arg, type) and issubclass(arg, Section)]
+    return (sections[0] if sections else None), type(None) in arguments
+
+
+def _slots_of(section: type[Section], names: Iterable[str], path: tuple[str, ...], required: bool) -> list[_Slot]:
+    slots = []
+    for name in names:
+        field = section.model_fields[name]
+        key = section.key_of(name)
+        placeholder = re.search(r"\{(\w+)\}", key.pattern)
+        family = KeyFamily((*path, name), key.pattern, placeholder.group(1), key.member) if placeholder else None
+        unit = next((item.symbol for item in field.metadata if isinstance(item, Unit)), None)
+        slots.append(
+            _Slot(
+                key.pattern,
+                (*path, name),
+                family,
+                unit or _unit_in(field.annotation) or "",
+                section.meaning_of(name),
+                required and field.is_required(),
+                field.is_required(),
+                _is_number(field.annotation),
+            )
+        )
+    return slots
+
+
+def _summary_slots() -> tuple[_Slot, ...]:
+    """Every flat key in order: the inlined sections' fields and the summary's own where they are declared, each
+    nested section's fields at its place."""
+    layout = [
+        *Outcome.model_fields,
+        *FitSection.model_fields,
+        "temperatures",
+        "steady",
+        "impacts",
+        *Heat.model_fields,
+        "charge",
+        *Numerics.model_fields,
+        *Inputs.model_fields,
+        *StressSection.model_fields,
+        "averaging",
+        "attractors",
+        "validation_caveat",
+        "intervals",
+        "warnings",
+        "notes",
+    ]
+    assert sorted(layout) == sorted(Summary.model_fields), "every field of Summary has its place"
+    slots: list[_Slot] = []
+    for name in layout:
+        field = Summary.model_fields[name]
+        section, optional = _section_in(field.annotation)
+        if section is None:
+            slots += _slots_of(Summary, [name], (), True)
+        else:
+            slots += _slots_of(section, section.model_fields, (name,), not optional)
+    return tuple(slots)
 
 
 def _unit_in(annotation: Any) -> str | None:
     if typing.get_origin(annotation) is Annotated:
         unit = next((item for item in annotation.__metadata__ if isinstance(item, Unit)), None)
         if unit is not None:
-            return unit.symbol
+            return str(unit.symbol)
     return next((found for arg in typing.get_args(annotation) if (found := _unit_in(arg)) is not None), None)
 
 
@@ -546,50 +446,74 @@ def _is_number(annotation: Any) -> bool:
     return any(_is_number(arg) for arg in typing.get_args(annotation) if arg is not str)
 
 
-@cache
-def _annotations() -> dict[str, Any]:
-    return typing.get_type_hints(Summary, include_extras=True)
+_SLOTS = _summary_slots()
+_EXACT = {slot.key: slot for slot in _SLOTS if slot.family is None}
+_FAMILY_SLOTS = tuple(slot for slot in _SLOTS if slot.family is not None)
+FAMILIES = tuple(slot.family for slot in _FAMILY_SLOTS if slot.family is not None)
 
 
-@cache
-def _fixed_fields() -> frozenset[str]:
-    return frozenset(Summary.model_fields) - {family.field for family in FAMILIES}
+def _slot_of(name: str) -> tuple[_Slot, str]:
+    """The slot of the flat key ``name``, and its member where it is a family's (else ""). Raises
+    :class:`SummaryKeyError`, with the nearest declared key, for a name that is not one."""
+    exact = _EXACT.get(name)
+    if exact is not None:
+        return exact, ""
+    for slot in _FAMILY_SLOTS:
+        assert slot.family is not None  # a family's slot
+        if slot.family.regex.fullmatch(name):
+            return slot, slot.family.member(name)
+    close = difflib.get_close_matches(name, [slot.key for slot in _SLOTS], n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    raise SummaryKeyError(f"{name!r} is not a summary key (solvers/summary.py){hint}")
 
 
-@cache
-def number_fields() -> frozenset[str]:
-    """The fields that hold numbers (alone, in a list or by member): JSON's null in them is a number not finite."""
-    return frozenset(name for name, annotation in _annotations().items() if _is_number(annotation))
+# ---------------------------------------------------------------------- the declarations
+
+
+@dataclass(frozen=True)
+class SummaryKey:
+    """One declared key: its flat name (a family's pattern), unit ("" for none), meaning, whether every run has it,
+    the nested section it is in ("" for the summary's own keys) and whether every summary with that section has it."""
+
+    name: str
+    unit: str
+    meaning: str
+    required: bool
+    section: str = ""
+    in_every_section: bool = False
 
 
 @cache
 def summary_keys() -> tuple[SummaryKey, ...]:
-    """Every declared key in the order of :class:`Summary`, a family by its pattern."""
-    families = {family.field: family for family in FAMILIES}
-    keys = []
-    for name, field in Summary.model_fields.items():
-        shown = families[name].pattern if name in families else name
-        meaning = " ".join((field.description or "").split())
-        keys.append(SummaryKey(shown, _unit_in(_annotations()[name]) or "", meaning, field.is_required()))
-    return tuple(keys)
-
-
-def declared(name: str) -> SummaryKey:
-    """The declaration of the key ``name`` (a flat name; a family's member by its pattern). Raises
-    :class:`SummaryKeyError`, with the nearest declared key, for a name that is not one."""
-    if name in _fixed_fields():
-        return _by_name()[name]
-    family = next((family for family in FAMILIES if family.field == name), None) or _family_of(name)
-    if family is not None:
-        return _by_name()[family.pattern]
-    close = difflib.get_close_matches(name, list(_by_name()), n=1)
-    hint = f"; did you mean {close[0]!r}?" if close else ""
-    raise SummaryKeyError(f"{name!r} is not a summary key (solvers/summary.py){hint}")
+    """Every declared key in the order of the flat summary, a family by its pattern."""
+    return tuple(
+        SummaryKey(
+            slot.key,
+            slot.unit,
+            slot.meaning,
+            slot.required,
+            slot.path[0] if len(slot.path) > 1 else "",
+            slot.in_section,
+        )
+        for slot in _SLOTS
+    )
 
 
 @cache
 def _by_name() -> dict[str, SummaryKey]:
     return {key.name: key for key in summary_keys()}
+
+
+def declared(name: str) -> SummaryKey:
+    """The declaration of the key ``name`` (a flat name; a family's member by its pattern). Raises
+    :class:`SummaryKeyError`, with the nearest declared key, for a name that is not one."""
+    return _by_name()[_slot_of(name)[0].key]
+
+
+def holds_numbers(name: str) -> bool:
+    """Whether the key ``name`` holds numbers (alone, in a list or by member): JSON's null in it is a number not
+    finite. Raises :class:`SummaryKeyError` for a name that is not declared."""
+    return _slot_of(name)[0].numbers
 
 
 def declared_name(name: str) -> str:
@@ -618,11 +542,6 @@ def family_members(names: Iterable[str], pattern: str) -> dict[str, str]:
     return {name: family.member(name) for name in names if family.regex.fullmatch(name)}
 
 
-def node_key(node: str) -> str:
-    """The name a thermal network's node has in the summary's keys (``holder`` for an engine's ``clamp``)."""
-    return RENAMED_NODES.get(node, node)
-
-
 def _nan_for_null(value: Any) -> Any:
     """A null where a number is declared, as the value or inside a list or mapping of numbers: NaN."""
     if value is None:
@@ -634,20 +553,22 @@ def _nan_for_null(value: Any) -> Any:
     return value
 
 
+def _flat_name(location: tuple[int | str, ...]) -> str:
+    """The flat key at a pydantic error's ``location`` (a path of attributes, a family's member at its end); for a
+    section missing whole, its first key every run has."""
+    parts = tuple(str(part) for part in location)
+    for slot in _SLOTS:
+        if parts[: len(slot.path)] == slot.path:
+            beyond = parts[len(slot.path) :]
+            return slot.family.name(beyond[0]) if slot.family is not None and beyond else slot.key
+    within = [slot.key for slot in _SLOTS if slot.path[: len(parts)] == parts and slot.required]
+    return within[0] if within and parts else ".".join(parts) or "summary"
+
+
 def _first_problem(error: ValidationError) -> str:
     """The first problem pydantic found, in one line: ``summary key 'impacts': Input should be a valid integer``."""
     first = error.errors()[0]
-    where = ".".join(str(part) for part in first["loc"]) or "summary"
-    if first["type"] == "extra_forbidden":
-        return str(SummaryKeyError(_unknown(where)))
+    where = _flat_name(first["loc"])
     if first["type"] == "missing":
         return f"no summary key {where!r}"
     return f"summary key {where!r}: {first['msg']}"
-
-
-def _unknown(name: str) -> str:
-    try:
-        declared(name)
-    except SummaryKeyError as exc:
-        return str(exc)
-    return f"{name!r} is not a summary key"

@@ -3,23 +3,28 @@ into the schema of ``solvers/summary.py``.
 
 Version 1 has no ``"schema_version"`` (shakermill up to issue 39); it is read where possible
 (:func:`summary_from_document`): ``clamp_C``/``clamp_steady_C`` become ``holder_C``/``holder_steady_C``
-(:data:`~shakermill.solvers.summary.RENAMED_NODES`), keys a later version added are NaN
+(:data:`~shakermill.analysis.sections.RENAMED_NODES`), keys a later version added are NaN
 (``exponential_fit_describes_run`` true, as the readers of version 1 assumed) and keys since removed are dropped; a
-document that still does not fit is refused in one line (:class:`SummaryVersionError`). Version 2: the schema of
-``solvers/summary.py``, with ``"schema_version": 2``.
+document that still does not fit is refused in one line (:class:`SummaryVersionError`). Version 2 (issue 39): the
+flat keys of the schema, with ``"schema_version": 2``. Version 3 (issue 48): the same flat keys, each now the field of
+a typed section that the code computing it builds; a version-2 document is read as it is.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
-from shakermill.solvers.summary import RENAMED_NODES, Summary, SummaryKeyError, declared, number_fields
+from shakermill.analysis.sections import RENAMED_NODES
+from shakermill.solvers.summary import Summary, SummaryKeyError, declared, holds_numbers, summary_keys
 
 # The version ``summary.json`` carries as "schema_version"; a document without one is version 1.
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 VERSION_KEY = "schema_version"
+# What a version-1 summary that lacks them meant: the readers of version 1 showed the fit's rows, and an averaged run
+# had one replica before there were several.
+VERSION_1_MEANT = {"exponential_fit_describes_run": True, "averaging_replicas": 1}
 
 
 class SummaryVersionError(Exception):
@@ -50,7 +55,7 @@ def summary_from_document(values: Any, version: Any) -> Summary:
     if version == SCHEMA_VERSION:
         return Summary.from_flat(values)
     try:
-        return Summary.from_flat(_brought_forward(values))
+        return Summary.from_flat(brought_forward(values, version))
     except ValueError as exc:
         raise SummaryVersionError(
             f"written by an older shakermill (summary schema {version}) and not readable as schema {SCHEMA_VERSION} "
@@ -59,9 +64,17 @@ def summary_from_document(values: Any, version: Any) -> Summary:
         ) from None
 
 
-def _brought_forward(values: Mapping[str, Any]) -> dict[str, Any]:
-    """A version-1 summary in this schema: the renamed nodes' keys renamed, the keys since removed dropped, the keys
-    added since set to NaN (``exponential_fit_describes_run`` to true, as the readers of version 1 assumed)."""
+def brought_forward(values: Mapping[str, Any], version: int) -> dict[str, Any]:
+    """The flat summary of an older ``version`` in this one's keys: each version's step to the next in turn."""
+    for step in MIGRATIONS[version - 1 :]:
+        values = step(values)
+    return dict(values)
+
+
+def _from_version_1(values: Mapping[str, Any]) -> dict[str, Any]:
+    """A version-1 summary in version 2's keys: the renamed nodes' keys renamed, the keys since removed dropped, the
+    keys added since, those every run has and those of every section the document has (the averaging's, ...), set to
+    NaN, or to what version 1 meant (:data:`VERSION_1_MEANT`)."""
     renamed = {}
     for name, value in values.items():
         for old, new in RENAMED_NODES.items():
@@ -69,13 +82,25 @@ def _brought_forward(values: Mapping[str, Any]) -> dict[str, Any]:
                 name = name.replace(old, new, 1)
         renamed[name] = value
     kept = {name: value for name, value in renamed.items() if _is_declared(name)}
-    for name, field in Summary.model_fields.items():
-        if field.is_required() and name not in kept:
-            if name == "exponential_fit_describes_run":
-                kept[name] = True
-            elif name in number_fields():
-                kept[name] = math.nan
+    sections = {declared(name).section for name in kept}
+    for key in summary_keys():
+        due = key.required or (key.section in sections and key.in_every_section)
+        if not due or key.name in kept or "{" in key.name:
+            continue
+        if key.name in VERSION_1_MEANT:
+            kept[key.name] = VERSION_1_MEANT[key.name]
+        elif holds_numbers(key.name):
+            kept[key.name] = math.nan
     return kept
+
+
+def _from_version_2(values: Mapping[str, Any]) -> dict[str, Any]:
+    """A version-2 summary in version 3's keys: the same (version 3 types the sections that hold them)."""
+    return dict(values)
+
+
+# The step from each version to the next, version 1's first.
+MIGRATIONS: tuple[Callable[[Mapping[str, Any]], dict[str, Any]], ...] = (_from_version_1, _from_version_2)
 
 
 def _is_declared(name: str) -> bool:

@@ -28,6 +28,7 @@ from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.averaged import integrate_network
 from shakermill.solvers.result import Result
+from shakermill.solvers.summary_sections import PredictionIntervals
 
 LEVEL = 0.90
 # Step of the finite differences in the logarithm of a key (and of the heat): small beside a fit's relative errors
@@ -55,12 +56,19 @@ class Intervals:
     def bounds(self, key: str) -> tuple[float, float]:
         return self.low[key], self.high[key]
 
-    def as_summary(self) -> dict[str, float | str]:
-        values: dict[str, float | str] = {}
-        for key in self.centre:
-            values[f"{key}_low"], values[f"{key}_high"] = self.bounds(key)
-        values["interval_note"] = f"{100 * LEVEL:g} % intervals from {' and '.join(self.sources)}"
-        return values
+    def as_summary(self) -> PredictionIntervals:
+        """The summary's section of the intervals of the :data:`HEADLINE` temperatures."""
+        return PredictionIntervals(
+            ball_C_low=self.low["ball_C"],
+            ball_C_high=self.high["ball_C"],
+            vial_C_low=self.low["vial_C"],
+            vial_C_high=self.high["vial_C"],
+            ball_steady_C_low=self.low["ball_steady_C"],
+            ball_steady_C_high=self.high["ball_steady_C"],
+            vial_steady_C_low=self.low["vial_steady_C"],
+            vial_steady_C_high=self.high["vial_steady_C"],
+            note=f"{100 * LEVEL:g} % intervals from {' and '.join(self.sources)}",
+        )
 
 
 @dataclass(frozen=True)

@@ -90,9 +90,10 @@ def answer_sentences(summary: Summary, preset: str | None = None, fitted: bool =
     v = {key: number(summary.value(key), spec) for key, _, _, spec in ANSWER_KEYS}
     minutes = number(_number(summary.simulated_s) / 60.0, ".3g")
     notes = list(summary.notes)
-    if summary.n_balls == 0:
+    charge = summary.charge
+    if charge is not None and charge.n_balls == 0:
         return empty_mill_sentences(summary, v, minutes) + notes
-    if _number(summary.n_balls) > 1:
+    if charge is not None and charge.n_balls > 1:
         # The experiment had one ball: several balls are not compared with it.
         return several_ball_sentences(summary, v, minutes) + notes
     sentences = [
@@ -126,12 +127,14 @@ def empty_mill_sentences(summary: Summary, v: Mapping[str, str], minutes: str) -
 
 def several_ball_sentences(summary: Summary, v: Mapping[str, str], minutes: str) -> list[str]:
     """The answer of a 'dem' run with several balls: the range of their temperatures and their mean."""
-    walls, between = _number(summary.wall_impacts), _number(summary.ball_ball_impacts)
+    walls, between = _number(summary.impacts.on_walls), _number(summary.impacts.between_balls)
     share = walls / (walls + between) if walls + between > 0 else math.nan
+    balls = summary.charge.n_balls if summary.charge is not None else None
+    steady = summary.steady.each_ball_C if summary.steady is not None else None
     return [
-        f"After {minutes} min the {summary.n_balls} balls are at {_spread(summary.ball_temperatures_C)} °C "
+        f"After {minutes} min the {balls} balls are at {_spread(summary.temperatures.each_ball_C)} °C "
         f"(mean {v['ball_C']} °C), the vial at {v['vial_C']} °C and the air at {v['air_C']} °C.",
-        f"Run on, the balls would settle at {_spread(summary.balls_steady_C)} °C (mean {v['ball_steady_C']} °C; "
+        f"Run on, the balls would settle at {_spread(steady)} °C (mean {v['ball_steady_C']} °C; "
         f"vial {v['vial_steady_C']} °C, air {v['air_steady_C']} °C); the slowest time constant of the thermal "
         f"network is {v['slowest_time_constant_min']} min.",
         f"The impacts generate {v['heat_power_W']} W of heat at {v['impact_rate_hz']} impacts per second, "
@@ -152,7 +155,7 @@ def _number(value: Any) -> float:
 def _averaging_note(summary: Summary) -> str:
     if summary.solver != "averaged":
         return ""
-    window = number(summary.averaging_window_s, ".3g")
+    window = number(summary.averaging.window_s if summary.averaging is not None else None, ".3g")
     return f" (impacts resolved over the {window} s averaging window, the rate holding for the whole run)"
 
 
@@ -165,12 +168,13 @@ def experiment_comparison(summary: Summary, preset: str) -> str:
     ratio = (steady - start) / (EXPERIMENT_BALL_C - start)
     if ratio < FAR_ABOVE_RATIO:
         return ""
+    charge = summary.charge
+    calibrated = CALIBRATED_PRESETS.get(charge.engine, CALIBRATED_PRESET) if charge is not None else CALIBRATED_PRESET
     return (
         f"With preset {preset}, which uses the published parameters and fits nothing, this is far above the "
         f"experiment: the ball's temperature rise is {ratio:.1f} times the experiment's, which approached "
         f"{EXPERIMENT_BALL_C:g} °C within the hour (Takacs & McHenry 2006). Preset "
-        f"{CALIBRATED_PRESETS.get(str(summary.engine), CALIBRATED_PRESET)} is fitted to that experiment; use it "
-        "for predictions near it."
+        f"{calibrated} is fitted to that experiment; use it for predictions near it."
     )
 
 

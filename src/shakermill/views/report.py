@@ -446,7 +446,7 @@ def assumptions_section(run: RunData, preset: Preset | None) -> str:
             if cited.source.lower().startswith("assumption")
         ]
         assumed = paragraph(f"Values the paper does not print, as cited in preset {preset.name}:") + bullet_list(items)
-    keys = ("model", "heat_model", "convection_velocity", "no_tension")
+    keys: tuple[str, ...] = ("model", "heat_model", "convection_velocity", "no_tension")
     if several_balls(run.params):
         keys += ("engine", "n_balls", "kinematics", "gravity", "friction", "rolling_friction")
     options = ", ".join(f"{key} = {format_parameter(params[key])}" for key in keys if key in params)

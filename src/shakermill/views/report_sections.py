@@ -147,9 +147,9 @@ def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
     """(quantity, value, unit) rows of the impact table, with the summary's count and rate."""
     impacts = run.impacts
     summary = run.summary
-    rate = summary.impact_rate_hz
+    rate = summary.impacts.rate_hz
     rows = [
-        ("impacts in the run", number(summary.impacts, "d"), ""),
+        ("impacts in the run", number(summary.impacts.count, "d"), ""),
         ("impacts in the impact table", str(len(impacts)), ""),
         ("impact rate", number(rate, ".4g"), "Hz"),
     ]
@@ -175,7 +175,7 @@ def impact_statistics(run: RunData) -> list[tuple[str, str, str]]:
 
 def wall_rows(run: RunData) -> list[tuple[str, str, str]]:
     """The regime of the settled motion and the impacts at each end face, of a 1-D run."""
-    impacts, rate = run.impacts, run.summary.impact_rate_hz
+    impacts, rate = run.impacts, run.summary.impacts.rate_hz
     regime, _ = classify_impacts(settled_run_impacts(run), run.params.omega, run.params.phase)
     rows = [("regime of the settled motion", regime, "")]
     for wall in ("left", "right"):
@@ -190,7 +190,7 @@ def wall_rows(run: RunData) -> list[tuple[str, str, str]]:
 
 def target_rows(run: RunData) -> list[tuple[str, str, str]]:
     """The impacts on each wall and between balls, of a 'dem' run (whose several balls have no 1-D regime)."""
-    impacts, rate = run.impacts, run.summary.impact_rate_hz
+    impacts, rate = run.impacts, run.summary.impacts.rate_hz
     rows = []
     for target, label, _ in TARGETS:
         count = int((impacts["target"] == target).sum())
@@ -204,7 +204,8 @@ def target_rows(run: RunData) -> list[tuple[str, str, str]]:
 def balls_section(run: RunData) -> str:
     """Each ball of a 'dem' run: radius, temperature at the end and steady state, impacts, heat received."""
     summary, impacts = run.summary, run.impacts
-    at_end, steady = summary.ball_temperatures_C or [], summary.balls_steady_C or []
+    at_end = summary.temperatures.each_ball_C or []
+    steady = (summary.steady.each_ball_C if summary.steady is not None else None) or []
     series = run.timeseries
     seconds = float(series["time"].values[-1])
     heat = series["heat_into_balls"].transpose("time", "ball").values[-1] / seconds if seconds > 0 else None
@@ -243,12 +244,14 @@ def impacts_section(run: RunData, numbers: Iterator[int]) -> str:
     parts = [table(("quantity", "value", "unit"), impact_statistics(run), numeric=(1,))]
     if run.impacts.empty:
         parts.append(paragraph("No impacts were recorded.", "note"))
-    elif run.summary.impacts != len(run.impacts):
+    elif run.summary.impacts.count != len(run.impacts):
+        averaging = run.summary.averaging
+        window = number(averaging.window_s if averaging is not None else None, ".3g")
         parts.append(
             paragraph(
-                "The averaged solver resolves impacts only while its averages converge "
-                f"({number(run.summary.averaging_window_s, '.3g')} s); the count for the whole run is the "
-                "mean rate times the duration, and the statistics are over the impacts of the table.",
+                f"The averaged solver resolves impacts only while its averages converge ({window} s); the count for "
+                "the whole run is the mean rate times the duration, and the statistics are over the impacts of the "
+                "table.",
                 "note",
             )
         )

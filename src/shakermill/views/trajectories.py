@@ -24,7 +24,9 @@ from shakermill.physics import kinematics
 if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.axes import Axes
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+    from PIL.Image import Image as PillowImage
 
 # Neither blue nor green: the temperature figures draw the vial and the air in those.
 BALL_COLOURS = ("tab:red", "tab:orange", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:gray")
@@ -109,11 +111,12 @@ def draw_vial(axis: Axes, across: str, up: str, params: Parameters) -> None:
     from matplotlib.patches import Circle, Rectangle
 
     length, bore = params.vial_length * MM, params.vial_diameter * MM
-    style = {"fill": False, "edgecolor": "0.2", "lw": 1.2, "label": "vial, inner wall"}
-    if across == "x":
-        axis.add_patch(Rectangle((-length / 2, -bore / 2), length, bore, **style))
-    else:
-        axis.add_patch(Circle((0.0, 0.0), bore / 2, **style))
+    wall = Rectangle((-length / 2, -bore / 2), length, bore) if across == "x" else Circle((0.0, 0.0), bore / 2)
+    wall.set_fill(False)
+    wall.set_edgecolor("0.2")
+    wall.set_linewidth(1.2)
+    wall.set_label("vial, inner wall")
+    axis.add_patch(wall)
     # Room for the wall's line and the balls touching it.
     reach = (length if across == "x" else bore) / 2 * 1.04, bore / 2 * 1.04
     axis.set_xlim(-reach[0], reach[0])
@@ -177,6 +180,7 @@ def animation_gif(
     for 120 frames); here the still parts are drawn once and only the balls onto them (2 s), and the GIF is
     built in memory, for the caller to write atomically.
     """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.patches import Circle
 
     local = window_in_vial_frame(window)
@@ -190,13 +194,17 @@ def animation_gif(
     axis.set_title(f"Balls in the vial frame, {view_name(params, 'side view')}", loc="left")
     # Animated artists are left out of the full draw: it makes the still background they are drawn onto.
     discs = [
-        axis.add_patch(Circle((0.0, 0.0), radius, facecolor=colour, edgecolor="black", lw=0.5, animated=True))
+        Circle((0.0, 0.0), radius, facecolor=colour, edgecolor="black", lw=0.5, animated=True)
         for radius, colour in zip(radii, ball_colours(radii.size))
     ]
+    for disc in discs:
+        axis.add_patch(disc)
     # Opaque: the GIF's palette holds the balls' colours, not their blends with the background.
     trails = [axis.plot([], [], color=colour, lw=0.8, animated=True)[0] for colour in ball_colours(radii.size)]
     clock = axis.text(1.0, 1.01, "", transform=axis.transAxes, ha="right", va="bottom", animated=True)
     canvas = figure.canvas
+    if not isinstance(canvas, FigureCanvasAgg):  # new_figure's: the frames are copied from its pixels
+        raise TypeError(f"animation_gif draws on Agg's canvas, not on {type(canvas).__name__}")
     canvas.draw()
     background = canvas.copy_from_bbox(figure.bbox)
     images = []
@@ -213,15 +221,15 @@ def animation_gif(
     return gif_bytes(images, fps)
 
 
-def _frame_image(canvas: object) -> object:
+def _frame_image(canvas: FigureCanvasAgg) -> PillowImage:
     """What ``canvas`` shows now, as an RGB image of its own (the canvas's buffer is drawn over next frame)."""
     from PIL import Image
 
-    size = canvas.get_width_height()  # type: ignore[attr-defined]
-    return Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")  # type: ignore[attr-defined]
+    size = canvas.get_width_height()
+    return Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")
 
 
-def gif_bytes(images: Sequence[object], fps: int) -> bytes:
+def gif_bytes(images: Sequence[PillowImage], fps: int) -> bytes:
     """``images`` as a looping GIF at ``fps`` frames per second, in memory.
 
     One palette for all frames, from the first (every ball is in it): Pillow's own choice per frame
@@ -229,8 +237,8 @@ def gif_bytes(images: Sequence[object], fps: int) -> bytes:
     """
     from PIL import Image
 
-    palette = images[0].quantize(colors=GIF_COLOURS, method=Image.Quantize.FASTOCTREE)  # type: ignore[attr-defined]
-    frames = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in images]  # type: ignore[attr-defined]
+    palette = images[0].quantize(colors=GIF_COLOURS, method=Image.Quantize.FASTOCTREE)
+    frames = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in images]
     buffer = io.BytesIO()
     frames[0].save(buffer, format="GIF", save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0)
     return buffer.getvalue()

@@ -251,7 +251,7 @@ def pair_contacts(t: float, dt: float, k: Constants, s: State, w: Scratch, live:
     nb = s.neighbours
     walls = N_WALLS * k.n_balls
     deepest = 0.0
-    for entry in range(nb.count[0]):
+    for entry in range(nb.entries[0]):
         i, j = nb.first_ball[entry], nb.second_ball[entry]
         slot = walls + entry
         centres = distance(s.position[i], s.position[j])
@@ -544,7 +544,7 @@ def rebuild_neighbours(k: Constants, s: State, centre: np.ndarray) -> bool:
     nb, c = s.neighbours, s.contacts
     walls = N_WALLS * k.n_balls
     carried = 0
-    for entry in range(nb.count[0]):
+    for entry in range(nb.entries[0]):
         if c.active[walls + entry]:
             _copy_slot(c, walls + entry, nb.carried, carried)
             nb.carried_first[carried], nb.carried_second[carried] = nb.first_ball[entry], nb.second_ball[entry]

@@ -179,7 +179,7 @@ class Neighbours(NamedTuple):
     first_ball: np.ndarray  # (P,) int64
     second_ball: np.ndarray  # (P,) int64
     first: np.ndarray  # (N + 1,) int64
-    count: np.ndarray  # (1,) int64: entries in use
+    entries: np.ndarray  # (1,) int64: entries in use (a field named count would hide tuple.count)
     reference: np.ndarray  # (N, 3) m: each ball's centre relative to the vial's at the last build
     cell_head: np.ndarray  # (cells,) int64: a ball in each cell (−1: none), the others chained by cell_next
     cell_next: np.ndarray  # (N,) int64
@@ -411,7 +411,10 @@ def initial_state(params: Parameters, k: Constants, network: ThermalNetwork) -> 
     fourier_coordinates(0.0, k.omega, k.phase, k.harmonics, centre, rates)
     orientation = np.empty((3, 3))
     rotation_matrix(centre[3], centre[4], centre[5], orientation)
-    position = centre[:3] + params.initial_positions() @ orientation.T
+    placed = params.initial_positions()
+    if placed is None:  # parameters/consistency.py refuses a charge that does not fit before a run is built
+        raise ValueError(f"n_balls: {n} balls do not fit side by side in the vial")
+    position = centre[:3] + placed @ orientation.T
     velocity = np.zeros((n, 3))
     spin = np.zeros((n, 3))
     if np.any(k.harmonics[3:, 0, 1] != 0.0):
@@ -494,7 +497,7 @@ def neighbours_of(k: Constants, position: np.ndarray, centre: np.ndarray) -> Nei
         first_ball=np.zeros(capacity, dtype=np.int64),
         second_ball=np.zeros(capacity, dtype=np.int64),
         first=np.zeros(n + 1, dtype=np.int64),
-        count=np.zeros(1, dtype=np.int64),
+        entries=np.zeros(1, dtype=np.int64),
         reference=np.zeros((n, 3)),
         cell_head=np.zeros(k.cells_per_side**3, dtype=np.int64),
         cell_next=np.zeros(n, dtype=np.int64),

@@ -60,7 +60,7 @@ def build(k, position: np.ndarray, centre: np.ndarray, nb) -> bool:
                             count += 1
                         j = nb.cell_next[j]
     nb.first[n] = count
-    nb.count[0] = count
+    nb.entries[0] = count
     return True
 
 

@@ -23,6 +23,7 @@ clock with the heat and Whitaker velocity terms gathered meanwhile (MODEL.md §1
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -205,7 +206,7 @@ def _flight_step(cap: float, k: Constants, s: State, w: Scratch) -> float:
         if listed:
             margin = 0.5 * k.skin - moved_since_build(i, s.position, w.coordinates, nb)
             step = _shortened(step, margin, relative_speed, falling + pushed)
-    for entry in range(nb.count[0]):
+    for entry in range(nb.entries[0]):
         if active[walls + entry]:
             continue
         i, j = nb.first_ball[entry], nb.second_ball[entry]
@@ -337,8 +338,12 @@ def write_row(k: Constants, net: NetworkArrays, s: State, w: Scratch, row: np.nd
 # reference counting of the arrays inside the loop, which took three quarters of a step (each view and each array
 # taken from the tuples counted in and out with an atomic add; benchmarks/README.md, "The per-step cost"). The loop
 # allocates nothing, so it needs none of Numba's runtime. The option is Numba's own (``numba.core.options``),
-# private by its underscore: a Numba without it would refuse to compile this loop, which every 3-D test runs.
-@njit(cache=True, nogil=True, _nrt=False)
+# private by its underscore: a Numba without it would refuse to compile this loop, which every 3-D test runs. Private,
+# it is not among the options Numba's type stubs declare, so it is passed as a mapping the stubs do not hold it to.
+WITHOUT_REFERENCE_COUNTING: dict[str, Any] = {"_nrt": False}
+
+
+@njit(cache=True, nogil=True, **WITHOUT_REFERENCE_COUNTING)
 def advance(
     t_stop: float,
     max_steps: int,

@@ -52,13 +52,18 @@ class ScipyRun:
         return self.impacts / self.t_end
 
 
-def _wall_event(wall: int, k: model.Constants, direction: float):
-    def event(t: float, y: np.ndarray) -> float:
-        return model.gap(t, y[model.X], wall, k)
+@dataclass(frozen=True)
+class _WallEvent:
+    """The gap to ``wall`` as an event of ``solve_ivp``, which reads ``terminal`` and ``direction`` off it: the
+    integration stops where the gap crosses zero going ``direction`` (−1 the ball reaching the wall, +1 leaving it)."""
 
-    event.terminal = True
-    event.direction = direction
-    return event
+    wall: int
+    k: model.Constants
+    direction: float
+    terminal: bool = True
+
+    def __call__(self, t: float, y: np.ndarray) -> float:
+        return model.gap(t, y[model.X], self.wall, self.k)
 
 
 def simulate_scipy(params: Parameters, t_end: float | None = None, method: str = "RK23") -> ScipyRun:
@@ -70,8 +75,8 @@ def simulate_scipy(params: Parameters, t_end: float | None = None, method: str =
     atol[: model.N_DYNAMIC] = tolerances.atol
     contact_step = tolerances.contact_step_limit
     flight_step = params.period / FLIGHT_STEPS_PER_PERIOD
-    onsets = [_wall_event(wall, k, -1.0) for wall in (model.LEFT_WALL, model.RIGHT_WALL)]
-    separations = {wall: [_wall_event(wall, k, +1.0)] for wall in (model.LEFT_WALL, model.RIGHT_WALL)}
+    onsets = [_WallEvent(wall, k, -1.0) for wall in (model.LEFT_WALL, model.RIGHT_WALL)]
+    separations = {wall: [_WallEvent(wall, k, +1.0)] for wall in (model.LEFT_WALL, model.RIGHT_WALL)}
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         return model.rhs_numpy(t, y, k)

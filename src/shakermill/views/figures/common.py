@@ -90,10 +90,10 @@ def run_context(run: RunLike) -> str:
 
 def averaging_window_note(run: RunLike) -> str:
     """For the averaged solver, which keeps the impacts of its averaging window only: that window; else empty."""
-    window = run.summary.averaging_window_s
-    if run.params.solver != "averaged" or window is None:
+    averaging = run.summary.averaging
+    if run.params.solver != "averaged" or averaging is None:
         return ""
-    return f"impacts of the {window:.3g} s averaging window only"
+    return f"impacts of the {averaging.window_s:.3g} s averaging window only"
 
 
 def add_context(figure: Figure, *lines: str) -> Figure:

@@ -109,7 +109,7 @@ def _paper_figures(run: RunLike, window: int) -> dict[str, Figure]:
         figures["heat_by_channel"] = heat_by_channel_figure(run)
     zoom_index = heating_zoom_window(params)
     zoom = window_data(run, zoom_index) if zoom_index is not None else None
-    if zoom is not None:
+    if zoom is not None and zoom_index is not None:
         zoom_start = params.record_windows[zoom_index][0]
         figures["ball_heating_zoom"] = heating_zoom_figure(run, zoom, zoom_start)
     return figures
@@ -204,7 +204,8 @@ def steady_label(summary: Summary, balls: bool) -> str:
     steady = summary.ball_steady_C
     if not balls:
         return f"ball steady state {steady:.1f} °C (MODEL.md §11)"
-    each = [value for value in summary.balls_steady_C or () if math.isfinite(value)]
+    each_ball = summary.steady.each_ball_C if summary.steady is not None else None
+    each = [value for value in each_ball or () if math.isfinite(value)]
     spread = f" (each {min(each):.1f}–{max(each):.1f} °C)" if each else ""
     return f"balls' mean steady state {steady:.1f} °C{spread}"
 
@@ -328,7 +329,7 @@ def impact_span(run: RunLike) -> float:
 
     The summary's impact rate is the table's impacts over that span, whichever solver wrote it.
     """
-    rate = run.summary.impact_rate_hz
+    rate = run.summary.impacts.rate_hz
     if not rate > 0.0:
         return float(run.summary.simulated_s)
     return len(run.impacts) / float(rate)

@@ -17,6 +17,7 @@ from shakermill.views.figures.impacts import _radian_ticks
 from shakermill.views.notebook import rpm
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 
@@ -40,10 +41,10 @@ declared_names(column for column, _, _ in SWEEP_QUANTITIES)
 DISPLAY_UNITS = {"m": (1e3, "mm")}
 
 
-CONTOUR_STYLE = {"colors": "white", "linewidths": 2.0, "linestyles": "--"}
+CONTOUR_STYLE: dict[str, Any] = {"colors": "white", "linewidths": 2.0, "linestyles": "--"}
 
 
-NOTE_STYLE = {
+NOTE_STYLE: dict[str, Any] = {
     "fontsize": "small",
     "ha": "left",
     "va": "bottom",
@@ -84,7 +85,7 @@ SUFFIX_UNITS = (
 )
 
 
-MISSING_STYLE = {"marker": "x", "color": "tab:red", "s": 40, "zorder": 3}
+MISSING_STYLE: dict[str, Any] = {"marker": "x", "color": "tab:red", "s": 40, "zorder": 3}
 
 
 def contour_label(column: str, level: float) -> str:
@@ -100,17 +101,17 @@ def column_unit(column: str) -> str:
         return next((unit for suffix, unit in SUFFIX_UNITS if column.endswith(suffix)), "")
 
 
-def rpm_axis(axis: object, key: str, which: str = "x") -> None:
+def rpm_axis(axis: Axes, key: str, which: str = "x") -> None:
     """A second ω axis in rpm (drive cycles per minute, as mills are specified) when ``key`` is omega."""
     if key != "omega":
         return
     per_rad_s = rpm(1.0)
     functions = (lambda omega: omega * per_rad_s, lambda cycles: cycles / per_rad_s)
     if which == "x":
-        secondary = axis.secondary_xaxis("top", functions=functions)  # type: ignore[attr-defined]
+        secondary = axis.secondary_xaxis("top", functions=functions)
         secondary.set_xlabel("drive frequency (rpm)")
     else:
-        secondary = axis.secondary_yaxis("left", functions=functions)  # type: ignore[attr-defined]
+        secondary = axis.secondary_yaxis("left", functions=functions)
         secondary.set_ylabel("drive frequency (rpm)")
         # Outside the rad/s ticks of the same side, so that the two scales do not overlap.
         secondary.spines["left"].set_position(("outward", 45))
@@ -149,10 +150,10 @@ class KeyAxis:
     positions: np.ndarray
     names: tuple[str, ...] = ()
 
-    def mark(self, axis: object, which: str = "x") -> None:
+    def mark(self, axis: Axes, which: str = "x") -> None:
         """One tick per name (nothing for numbers, whose ticks matplotlib chooses)."""
         if self.names:
-            set_ticks = axis.set_xticks if which == "x" else axis.set_yticks  # type: ignore[attr-defined]
+            set_ticks = axis.set_xticks if which == "x" else axis.set_yticks
             set_ticks(range(len(self.names)), self.names)
 
 
@@ -356,9 +357,10 @@ def sweep_map_figure(
             _cell_edges(x), _cell_edges(y), np.ma.masked_invalid(values), cmap="inferno", shading="flat"
         )
         for contour_column, level in contours:
-            _, _, levels = _grid_of(x_all, y_all, _numeric(table, contour_column))  # type: ignore[misc]
-            if _straddled(levels, level):
-                lines = axis.contour(x, y, levels, levels=[level], **CONTOUR_STYLE)
+            # On the quantity's points, so on its grid too.
+            contour_grid = _grid_of(x_all, y_all, _numeric(table, contour_column))
+            if contour_grid is not None and _straddled(contour_grid[2], level):
+                lines = axis.contour(x, y, contour_grid[2], levels=[level], **CONTOUR_STYLE)
                 axis.clabel(lines, fmt=contour_label(contour_column, level), fontsize="small")
     else:
         # A points file: no cells to fill.
@@ -380,12 +382,12 @@ def sweep_map_figure(
     return figure
 
 
-def _mark_missing(axis: object, x: np.ndarray, y: np.ndarray, values: np.ndarray) -> None:
+def _mark_missing(axis: Axes, x: np.ndarray, y: np.ndarray, values: np.ndarray) -> None:
     """A red x on each point without a value (failed, or NaN), so that a blank cell reads as a missing point."""
     missing = ~np.isfinite(values)
     if missing.any():
-        axis.scatter(x[missing], y[missing], label=f"failed or no value ({missing.sum()})", **MISSING_STYLE)  # type: ignore[attr-defined]
-        axis.legend(loc="upper left", bbox_to_anchor=(0.0, -0.12), fontsize="small", frameon=False)  # type: ignore[attr-defined]
+        axis.scatter(x[missing], y[missing], label=f"failed or no value ({missing.sum()})", **MISSING_STYLE)
+        axis.legend(loc="upper left", bbox_to_anchor=(0.0, -0.12), fontsize="small", frameon=False)
 
 
 def regime_figure(table: pd.DataFrame, keys: Sequence[str]) -> Figure:
@@ -486,7 +488,7 @@ def bifurcation_figure(phases: pd.DataFrame, attractors: pd.DataFrame, key: str,
     return figure
 
 
-def _attractor_periods(axis: object, attractors: pd.DataFrame, key: str) -> None:
+def _attractor_periods(axis: Axes, attractors: pd.DataFrame, key: str) -> None:
     """Period of each attractor, irregular ones above the largest period; marker area ∝ basin fraction."""
     from matplotlib.ticker import MaxNLocator
 
@@ -499,17 +501,17 @@ def _attractor_periods(axis: object, attractors: pd.DataFrame, key: str) -> None
     # Open markers: two attractors of the same period at one value show as concentric rings.
     axis.scatter(
         x, shown, s=FULL_BASIN_AREA * attractors["basin_fraction"].to_numpy(), facecolors="none", edgecolors=colours
-    )  # type: ignore[attr-defined]
+    )
     # Periods are whole numbers: half a period of room either way keeps the ticks on them.
-    axis.set_ylim(0.5, np.nanmax(shown, initial=1.0) + 0.5)  # type: ignore[attr-defined]
+    axis.set_ylim(0.5, np.nanmax(shown, initial=1.0) + 0.5)
     ticks = [tick for tick in MaxNLocator(integer=True, min_n_ticks=1).tick_values(1, top - 1) if 1 <= tick < top]
     labels = [f"{tick:g}" for tick in ticks]
     if irregular.any():
         # Irregular motion has no period: its row is named, not numbered, and ruled off from the periods.
-        axis.axhline(top - 0.5, color="0.3", lw=1.0, ls="--")  # type: ignore[attr-defined]
+        axis.axhline(top - 0.5, color="0.3", lw=1.0, ls="--")
         ticks, labels = [*ticks, top], [*labels, "irregular"]
-    axis.set_yticks(ticks, labels)  # type: ignore[attr-defined]
-    axis.set_ylabel("period n (drive periods)\nmarker area ∝ basin fraction")  # type: ignore[attr-defined]
+    axis.set_yticks(ticks, labels)
+    axis.set_ylabel("period n (drive periods)\nmarker area ∝ basin fraction")
 
 
 def _attractor_handles(labels: Sequence[int]) -> list:
