@@ -22,11 +22,11 @@ from typing import Annotated, ClassVar
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from shakermill.engines.thermal.nodes import NODE_NAME
+
 # The thermal network's nodes renamed since version 1 of the summary: the clamp and mill head is the holder. An engine
 # that still names the node so has its keys under the new name.
 RENAMED_NODES = {"clamp": "holder"}
-# A node's name in its keys: one word of lower-case letters (``lid``), so that no other key reads as a node's.
-NODE_NAME = "[a-z]+"
 
 
 @dataclass(frozen=True)
