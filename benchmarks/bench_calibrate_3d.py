@@ -18,7 +18,7 @@ import numpy as np
 import shakermill as sm
 from shakermill.parameters.presets import PRESETS
 from shakermill.solvers.simulate import thermal_variants
-from shakermill.studies.uncertainty import Uncertainty, intervals
+from shakermill.studies.calibration.intervals import Uncertainty, intervals
 
 TARGET_S = 600.0
 

@@ -37,8 +37,8 @@ from pathlib import Path
 import pandas as pd
 
 import shakermill as sm
-from shakermill.studies.sweep import SweepProgress
-from shakermill.studies.sweep_storage import load_sweep
+from shakermill.studies.sweeps.storage import load_sweep
+from shakermill.studies.sweeps.sweep import SweepProgress
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURE = ROOT / "docs" / "figures" / "mill-study.png"

@@ -163,8 +163,8 @@ POWDER_FILES = {
 # Its own code: the node, and the study of it with its rows in `validate` and on the validation page.
 POWDER_OWN = {
     "engines/thermal/powder.py",
-    "studies/powder.py",
-    "studies/validation_report.py",
+    "studies/validation/powder.py",
+    "studies/validation/report.py",
     "cli/validating.py",
     "views/validation_page.py",
 }

@@ -13,9 +13,11 @@ from typer.testing import CliRunner
 
 from shakermill import cli
 from shakermill.parameters.assumed import AssumedInput
-from shakermill.studies import cross_prediction, held_out, joint_calibration, powder, validation_report
-from shakermill.studies.validation import VALIDATION_PRESETS
-from shakermill.studies.validation_matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
+from shakermill.studies.calibration import joint as joint_calibration
+from shakermill.studies.validation import cross_prediction, held_out, powder
+from shakermill.studies.validation import report as validation_report
+from shakermill.studies.validation.matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
+from shakermill.studies.validation.table5 import VALIDATION_PRESETS
 from shakermill.views.validation_page import CROSS_TITLE, QUICK_NOTE
 
 runner = CliRunner()

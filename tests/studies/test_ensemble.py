@@ -12,7 +12,7 @@ import pytest
 from shakermill.analysis.regime import ACTIVE, PACK, charge_regime
 from shakermill.parameters.assumed import AssumedInput
 from shakermill.parameters.errors import ParameterError
-from shakermill.studies.ensemble import (
+from shakermill.studies.ensembles.ensemble import (
     analyse,
     check_members,
     design,

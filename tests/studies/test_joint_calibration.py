@@ -10,8 +10,8 @@ import pytest
 
 from shakermill.parameters.assumed import AssumedInput
 from shakermill.parameters.presets import PRESETS, default_parameters
-from shakermill.studies import joint_calibration
-from shakermill.studies.joint_calibration import (
+from shakermill.studies.calibration import joint as joint_calibration
+from shakermill.studies.calibration.joint import (
     Measured,
     Observable,
     Training,
@@ -116,7 +116,7 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
 
     from shakermill import cli
     from shakermill.parameters.config import config_preset, load_config
-    from shakermill.studies.uncertainty import uncertainty_of
+    from shakermill.studies.calibration.intervals import uncertainty_of
 
     monkeypatch.setattr(joint_calibration, "STEPS", 600)
     out = tmp_path / "fitted.toml"
@@ -184,7 +184,7 @@ def test_a_users_configuration_narrows_an_assumed_range_and_a_wrong_table_is_ref
 
 def test_a_free_key_the_run_does_not_read_or_that_moves_the_mechanics_is_refused_before_any_run():
     from shakermill.parameters.errors import ParameterError
-    from shakermill.studies.joint_calibration import calibrate_jointly
+    from shakermill.studies.calibration.joint import calibrate_jointly
 
     preset = PRESETS["spex8000m-3d-mill-head"]
     params = default_parameters(preset.name)

@@ -1,5 +1,5 @@
-"""90 % intervals of the headline temperatures (studies/uncertainty.py): the delta method against what the network
-says analytically, and its scaling with the covariance."""
+"""90 % intervals of the headline temperatures (studies/calibration/intervals.py): the delta method against what the
+network says analytically, and its scaling with the covariance."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 from scipy.stats import norm
 
 import shakermill as sm
-from shakermill.studies.uncertainty import HEADLINE, Uncertainty, intervals
+from shakermill.studies.calibration.intervals import HEADLINE, Uncertainty, intervals
 
 Z90 = norm.ppf(0.95)
 

@@ -35,7 +35,7 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.support.atomic import check_writable_place
 
 if TYPE_CHECKING:
-    from shakermill.studies.calibrate import Calibration
+    from shakermill.studies.calibration.calibrate import Calibration
 
 
 WithAssumedOption = Annotated[
@@ -104,9 +104,9 @@ def calibrate(
     squares; with --with-assumed, over every uncertain input by Bayesian inference."""
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import load_config, values_beyond_preset
-    from shakermill.studies.calibrate import calibrate as fit_parameters
-    from shakermill.studies.calibrate import default_free, parse_free, parse_targets
-    from shakermill.studies.validation import curve_from_option
+    from shakermill.studies.calibration.calibrate import calibrate as fit_parameters
+    from shakermill.studies.calibration.calibrate import default_free, parse_free, parse_targets
+    from shakermill.studies.measured import curve_from_option
 
     with user_errors():
         # The fit evaluates with its own solver, not the one the parameters name.
@@ -207,9 +207,9 @@ def calibrate_over_assumed(
     curves, printed, and the preset of its medians written."""
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import config_preset, values_beyond_preset
-    from shakermill.studies.ensemble import check_members
-    from shakermill.studies.joint_calibration import calibrate_jointly, write_joint_preset
-    from shakermill.studies.validation import experiment_curve
+    from shakermill.studies.calibration.joint import calibrate_jointly, write_joint_preset
+    from shakermill.studies.ensembles.ensemble import check_members
+    from shakermill.studies.measured import experiment_curve
 
     if targets:
         raise ParameterError(
@@ -302,7 +302,7 @@ def print_joint(joint: Any, out: Path | None) -> None:
 def announce(params: Any, free_keys: Sequence[str], chosen: bool, notes: Sequence[str]) -> None:
     """What a fit says once its inputs are all accepted: the keys it moves and, where they are the default set, which
     keys of that set it left out; then how its curves were read."""
-    from shakermill.studies.calibrate import unstarted_defaults
+    from shakermill.studies.calibration.calibrate import unstarted_defaults
 
     line = f"calibrate: fitting {', '.join(free_keys)}"
     if not chosen:
@@ -336,7 +336,7 @@ def write_fitted_preset(
     settings: Mapping[str, Any],
 ) -> None:
     """Write the fitted preset TOML, saying in it which command fitted which keys to what, under which settings."""
-    from shakermill.studies.fitted_preset import write_preset
+    from shakermill.studies.calibration.fitted_preset import write_preset
 
     command = "shakermill calibrate " + " ".join(sys.argv[2:])
     fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]
@@ -376,7 +376,7 @@ def print_calibration(
     calibration: Calibration, free_keys: Sequence[str], targets: Mapping[str, float], out: Path | None
 ) -> None:
     """The fitted parameters, what the fitted model predicts, the residuals of the targets and of the curve."""
-    from shakermill.studies.identifiability import LOOSE_LOG_ERROR
+    from shakermill.studies.calibration.identifiability import LOOSE_LOG_ERROR
 
     console = stdout_console()
     ranges = calibration.posterior_ranges

@@ -26,10 +26,10 @@ from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import PRESETS, default_parameters, preset_values
 from shakermill.solvers.averaged import integrate_network
 from shakermill.solvers.simulate import thermal_variants
-from shakermill.studies.calibrate import DEFENSIBLE_RANGES, calibrate
-from shakermill.studies.held_out import FIVE_BALLS
-from shakermill.studies.uncertainty import Uncertainty, heat_error_of, propagated, uncertainty_of
-from shakermill.studies.validation import experiment_curve, relative_error
+from shakermill.studies.calibration.calibrate import DEFENSIBLE_RANGES, calibrate
+from shakermill.studies.calibration.intervals import Uncertainty, heat_error_of, propagated, uncertainty_of
+from shakermill.studies.measured import experiment_curve, relative_error
+from shakermill.studies.validation.held_out import FIVE_BALLS
 
 EXPERIMENT_FOLDER = Path(__file__).parent / "experiments"
 # The calibrated 3-D presets compared, one per thermal model, each fitted to the one-ball curve alone.

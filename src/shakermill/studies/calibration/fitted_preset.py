@@ -14,7 +14,7 @@ from shakermill.support.atomic import remove_abandoned_writes, write_text_atomic
 from shakermill.support.version import __version__
 
 if TYPE_CHECKING:
-    from shakermill.studies.calibrate import Calibration
+    from shakermill.studies.calibration.calibrate import Calibration
 
 
 def write_preset(

@@ -2,7 +2,7 @@
 the variance-based sensitivity of each headline, and the motion regimes its members fell into.
 
 The members are a scrambled Sobol' design (``scipy.stats.qmc``) over the assumed inputs' ranges, each mapped
-through its distribution, run as the points of a sweep (``studies/sweep.py``: in parallel, on the local pool or a
+through its distribution, run as the points of a sweep (``studies/sweeps/sweep.py``: in parallel, on the local pool or a
 Dask cluster, stored one file a member, resumable, the same numbers whatever the number of workers). The
 headlines' 5, 50 and 95 % points are those of the members: the design samples the inputs' distribution evenly.
 Sobol' indices need far more runs than an ensemble can afford (N·(d + 2) for d inputs), so they are computed
@@ -39,7 +39,7 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.summary import declared_names, family_members
-from shakermill.studies.sweep import ProgressCallback, sweep
+from shakermill.studies.sweeps.sweep import ProgressCallback, sweep
 
 # The headlines an ensemble reports: summary key -> (what it is, unit). Rises are computed from the end and
 # steady temperatures and the run's starting temperature.

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
-from shakermill.studies.sweep_points import PointInterrupted, PointOutcome, run_point
+from shakermill.studies.sweeps.points import PointInterrupted, PointOutcome, run_point
 from shakermill.support.limits import in_one_line
 
 if TYPE_CHECKING:

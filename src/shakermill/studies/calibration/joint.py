@@ -1,7 +1,7 @@
 """Calibration over every uncertain input (MODEL.md §14.1, issue 36 point 4): the assumed inputs' ranges as priors,
 the measurements as the likelihood, the posterior by emcee, and predictions with posterior-predictive intervals.
 
-A fit of the thermal network alone (``studies/calibrate.py``) measures the mechanics once and moves keys the
+A fit of the thermal network alone (``studies/calibration/calibrate.py``) measures the mechanics once and moves keys the
 mechanics does not read. Freeing friction, restitution, λ or the clamp's motion changes the mechanics, which costs a
 three-dimensional run (seconds to minutes) where emcee needs tens of thousands of evaluations. So the model is
 emulated, as Kennedy & O'Hagan (2001) calibrate a costly computer model:
@@ -38,10 +38,10 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.simulate import thermal_variants
-from shakermill.studies.calibrate import check_free_for_engine, log_bounds
-from shakermill.studies.defensible import DEFENSIBLE_RANGES
-from shakermill.studies.ensemble import LEAST_Q2, QUANTILES, design_seed, from_unit, gaussian_process, q2_of
-from shakermill.studies.fitted_preset import write_preset_file
+from shakermill.studies.calibration.calibrate import check_free_for_engine, log_bounds
+from shakermill.studies.calibration.defensible import DEFENSIBLE_RANGES
+from shakermill.studies.calibration.fitted_preset import write_preset_file
+from shakermill.studies.ensembles.ensemble import LEAST_Q2, QUANTILES, design_seed, from_unit, gaussian_process, q2_of
 
 # A measured rise's standard deviation where its source states none (K): the one-ball curve is an exponential
 # fitted to intermittent calorimetric measurements, which a model following within 2 K follows within their likely
@@ -171,7 +171,7 @@ def train(
 
 
 def _rises(observables: Sequence[Observable]) -> Callable[[Parameters, Any], np.ndarray]:
-    from shakermill.studies.validation_matrix import Point, node_rises
+    from shakermill.studies.validation.matrix import Point, node_rises
 
     points = tuple(Point(item.node, item.time_s, None) for item in observables)
 

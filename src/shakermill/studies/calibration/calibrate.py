@@ -36,8 +36,8 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters, bounds, check_known_keys
 from shakermill.solvers.result import Result
 from shakermill.solvers.simulate import preflight, thermal_variants
-from shakermill.studies.defensible import DEFENSIBLE_RANGES
-from shakermill.studies.fit_statistics import (
+from shakermill.studies.calibration.defensible import DEFENSIBLE_RANGES
+from shakermill.studies.calibration.fit_statistics import (
     CURVE_SCALE_K,
     log_covariance,
     posterior_evaluations,
@@ -46,8 +46,8 @@ from shakermill.studies.fit_statistics import (
     sensitivities,
     standard_errors,
 )
-from shakermill.studies.identifiability import check_determinable, loosely_determined, undetermined_keys
-from shakermill.studies.validation import (
+from shakermill.studies.calibration.identifiability import check_determinable, loosely_determined, undetermined_keys
+from shakermill.studies.measured import (
     CURVE_TOLERANCE_K,
     TARGET_KEYS,
     Curve,
@@ -259,7 +259,7 @@ def calibrate(
     on_start: Callable[[], None] | None = None,
 ) -> Calibration:
     """Fit ``free`` keys of ``base`` to ``targets`` and/or one or several curves (``curve``), each of a node under
-    its own conditions (:class:`~shakermill.studies.validation.Curve`); see the module docstring.
+    its own conditions (:class:`~shakermill.studies.measured.Curve`); see the module docstring.
 
     ``on_start()`` is called once every input has been checked, before the first evaluation;
     ``progress(evaluations, curve_rms_K)`` after every model evaluation (the RMS of that evaluation against the

@@ -2,7 +2,7 @@
 input on the one-ball curve, is the five-ball measurement inside the 90 % posterior-predictive interval; fitted on
 the five-ball point, is the one-ball curve inside. Each fit frees the assumed inputs its run can feel, with their
 stated ranges as priors, and the network's own free keys over their defensible ranges
-(:mod:`studies.joint_calibration`); nothing else is tuned.
+(:mod:`studies.calibration.joint`); nothing else is tuned.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from typing import Any
 
 from shakermill.parameters.defaults import DEFAULT_FREE_BY_NETWORK
 from shakermill.parameters.presets import PRESETS, default_parameters
-from shakermill.studies.joint_calibration import (
+from shakermill.studies.calibration.joint import (
     ASSUMED_MEASUREMENT_SD_K,
     Emulator,
     Measured,
@@ -31,7 +31,7 @@ from shakermill.studies.joint_calibration import (
     sample_posterior,
     train,
 )
-from shakermill.studies.validation_matrix import Experiment, load_experiments
+from shakermill.studies.validation.matrix import Experiment, load_experiments
 
 # The uncalibrated preset both fits start from: the calibrated one was fitted to the one-ball curve already.
 BASE_PRESET = "spex8000m-3d-mill-head"

@@ -32,9 +32,9 @@ from shakermill.engines.budget import interrupts_held
 from shakermill.parameters.defaults import DEFAULT_PRESET, DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
-from shakermill.studies.sweep_backends import backend_for
-from shakermill.studies.sweep_plan import SweepPlan, as_plan, point_ids
-from shakermill.studies.sweep_storage import (
+from shakermill.studies.sweeps.backends import backend_for
+from shakermill.studies.sweeps.plan import SweepPlan, as_plan, point_ids
+from shakermill.studies.sweeps.storage import (
     TABLE_CSV,
     build_table,
     check_folder,

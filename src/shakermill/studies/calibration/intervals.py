@@ -3,8 +3,8 @@ and the averaging error of its mechanics, carried through the thermal network.
 
 A calibration records the covariance of the natural logarithms of its fitted keys (``scipy.optimize.least_squares``'
 Jacobian with the residual variance) and, where an evaluation costs only a network, samples of their posterior
-(emcee, the prior uniform within each key's defensible range; ``studies.calibrate``). Those keys move the thermal
-network alone, so a prediction's spread is taken on the network with the run's own mean load:
+(emcee, the prior uniform within each key's defensible range; ``studies.calibration.calibrate``). Those keys move
+the thermal network alone, so a prediction's spread is taken on the network with the run's own mean load:
 
 * from the posterior samples where there are some: each sample's network (its heat scaled by a draw of the averaging
   error), the 5th and 95th percentiles. One curve often leaves a direction of the keys undetermined; the ranges

@@ -8,7 +8,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from shakermill.studies.validation import ASSUMED_CURVE_SD_K, Curve
+from shakermill.studies.measured import ASSUMED_CURVE_SD_K, Curve
 
 # Scalar targets are matched relatively; curve points in kelvin: one kelvin weighs like 1 % on a target.
 CURVE_SCALE_K = 100.0
