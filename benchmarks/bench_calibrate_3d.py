@@ -47,7 +47,7 @@ def main() -> None:
     print("correlation of the logarithms:\n" + np.array2string(correlation, precision=4))
     fitted = base.replace(**calibration.fitted)
     result = thermal_variants(fitted)(fitted)
-    found = intervals(result, Uncertainty(free, covariance, np.array(calibration.posterior)))
+    found = intervals(result, Uncertainty(free, covariance, calibration.posterior))
     for key in found.centre:
         low, high = found.bounds(key)
         print(f"  {key}: {found.centre[key]:.2f} °C, 90 % interval {low:.2f} to {high:.2f} °C")

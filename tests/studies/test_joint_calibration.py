@@ -11,16 +11,10 @@ import pytest
 from shakermill.parameters.assumed import AssumedInput
 from shakermill.parameters.presets import PRESETS, default_parameters
 from shakermill.studies.calibration import joint as joint_calibration
-from shakermill.studies.calibration.joint import (
-    Measured,
-    Observable,
-    Training,
-    emulate,
-    fit_inputs,
-    predict,
-    prior_sample,
-    sample_posterior,
-)
+from shakermill.studies.calibration.emulators import emulate, predict
+from shakermill.studies.calibration.joint import fit_inputs, prior_sample, sample_posterior
+from shakermill.studies.calibration.observables import Measured, Observable
+from shakermill.studies.calibration.training import Training
 
 A = AssumedInput("friction", 0.0, 1.0, "uniform", "a test's range")
 B = AssumedInput("restitution", 0.0, 1.0, "uniform", "a test's range")
@@ -75,7 +69,7 @@ def test_two_configurations_fit_together_constrain_their_shared_input_more_than_
     two = emulate(linear_training([A, B], [[10.0, 0.0]]))
     alone = sample_posterior([(one, [Measured(Y, 4.0, 0.5)])])
     both = sample_posterior([(one, [Measured(Y, 4.0, 0.5)]), (two, [Measured(Y, 4.0, 0.5)])])
-    assert both.keys == ["friction", "restitution"]
+    assert both.keys == ("friction", "restitution")
     width = {
         name: found.quantiles()["friction"][2] - found.quantiles()["friction"][0]
         for name, found in (("alone", alone), ("both", both))
@@ -132,6 +126,8 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
             "--json",
             "--out",
             str(out),
+            "--runs",
+            str(tmp_path / "runs"),
         ],
     )
     assert outcome.exit_code == 0, outcome.output
@@ -155,7 +151,7 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
     assert config.params.friction == pytest.approx(inputs["friction"]["p50"])
     carried = uncertainty_of(preset)
     assert set(carried.fitted) == {"drive_heat", "clamp_heat_capacity", "clamp_loss", "emissivity", "clamp_conductance"}
-    assert "friction" in carried.left_out and carried.posterior.shape[1] == len(carried.fitted)
+    assert "friction" in carried.left_out and carried.posterior.samples.shape[1] == len(carried.fitted)
 
 
 def test_a_users_configuration_narrows_an_assumed_range_and_a_wrong_table_is_refused_in_one_line(tmp_path):

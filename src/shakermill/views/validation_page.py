@@ -226,7 +226,7 @@ def cross_rows(cross: CrossPrediction) -> list[tuple[str, ...]]:
 
 def cross_statement(cross: CrossPrediction) -> str:
     """The verdicts, what was freed and how, and how well the emulators predict runs they did not see."""
-    from shakermill.studies.calibration.joint import ASSUMED_MEASUREMENT_SD_K
+    from shakermill.studies.calibration.observables import ASSUMED_MEASUREMENT_SD_K
 
     verdicts = "; ".join(
         direction.verdict + (f" (unreliable: {'; '.join(direction.problems)})" if direction.problems else "")

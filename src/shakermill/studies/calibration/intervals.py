@@ -28,6 +28,7 @@ from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.averaged import integrate_network
 from shakermill.solvers.result import Result
+from shakermill.studies.inference.posterior import Posterior
 
 LEVEL = 0.90
 # Step of the finite differences in the logarithm of a key (and of the heat): small beside a fit's relative errors
@@ -69,7 +70,7 @@ class Uncertainty:
 
     fitted: tuple[str, ...]
     covariance: np.ndarray | None = None
-    posterior: np.ndarray | None = None
+    posterior: Posterior | None = None
     # Fitted keys that move the mechanics (a calibration over every uncertain input): a run's mean load cannot carry
     # them, `shakermill uncertainty` does.
     left_out: tuple[str, ...] = ()
@@ -84,9 +85,14 @@ def uncertainty_of(preset: Preset) -> Uncertainty | None:
     thermal_only = describe(preset.values["engine"].value).thermal_only_keys
     kept = [index for index, key in enumerate(preset.fitted) if not thermal_only or key in thermal_only]
     covariance = None if preset.covariance is None else np.asarray(preset.covariance, dtype=float)[np.ix_(kept, kept)]
-    posterior = None if preset.posterior is None else np.asarray(preset.posterior, dtype=float)[:, kept]
+    keys = tuple(preset.fitted[index] for index in kept)
+    posterior = (
+        None
+        if preset.posterior is None
+        else Posterior.of_logarithms(keys, np.asarray(preset.posterior, dtype=float)[:, kept])
+    )
     left_out = tuple(key for index, key in enumerate(preset.fitted) if index not in kept)
-    return Uncertainty(tuple(preset.fitted[index] for index in kept), covariance, posterior, left_out)
+    return Uncertainty(keys, covariance, posterior, left_out)
 
 
 def headline_temperatures(params: Parameters, load: NetworkLoad) -> dict[str, float]:
@@ -135,15 +141,19 @@ def propagated(
     ``uncertainty`` if it has some, else linearly from its covariance; with a relative error ``heat_error`` of the
     heat, independent of the fit. None when nothing is uncertain."""
     if uncertainty.posterior is not None:
-        return _from_samples(params, load, uncertainty, heat_error, quantities)
+        return _from_samples(params, load, uncertainty, uncertainty.posterior, heat_error, quantities)
     return _linear(params, load, uncertainty, heat_error, quantities)
 
 
 def _from_samples(
-    params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, heat_error: float, quantities: Quantities
+    params: Parameters,
+    load: NetworkLoad,
+    uncertainty: Uncertainty,
+    posterior: Posterior,
+    heat_error: float,
+    quantities: Quantities,
 ) -> Intervals:
-    samples = np.asarray(uncertainty.posterior, dtype=float)
-    chosen = samples[np.linspace(0, len(samples) - 1, min(PROPAGATED_SAMPLES, len(samples))).astype(int)]
+    chosen = posterior.logarithms[posterior.thinned(PROPAGATED_SAMPLES)]
     heat_draws = np.random.default_rng(HEAT_DRAW_SEED).standard_normal(len(chosen)) * heat_error
     values = []
     for sample, draw in zip(chosen, heat_draws, strict=True):
