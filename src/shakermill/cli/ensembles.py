@@ -132,7 +132,9 @@ def print_ensemble(ensemble: Ensemble, title: str, target: Path) -> None:
     )
 
     console = stdout_console()
-    tables = [(HEADLINE_HEADERS, headline_rows(ensemble), title)]
+    tables: list[tuple[tuple[str, ...], list[tuple[str, ...]], str]] = [
+        (HEADLINE_HEADERS, headline_rows(ensemble), title)
+    ]
     if ensemble.regimes:
         tables.append((REGIME_HEADERS, regime_rows(ensemble), f"regimes ({REGIME_NOTE})"))
     for headers, rows, caption in tables:

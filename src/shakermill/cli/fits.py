@@ -178,8 +178,8 @@ def calibrate(
     # A fit that leaves its keys undetermined has values that any others would match as well: no preset of them.
     written = out if out is not None and calibration.status != "undetermined" else None
     if written is not None:
-        settings = values_beyond_preset(run_config.params, run_config.preset)
-        write_fitted_preset(calibration, written, run_config.preset, free_keys, targets, settings)
+        beyond = values_beyond_preset(run_config.params, run_config.preset)
+        write_fitted_preset(calibration, written, run_config.preset, free_keys, targets, beyond)
     if json_output:
         typer.echo(
             json.dumps(

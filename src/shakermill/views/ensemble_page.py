@@ -81,7 +81,9 @@ def headline_rows(ensemble: Ensemble) -> list[tuple[str, ...]]:
 
 
 def input_rows(ensemble: Ensemble) -> list[tuple[str, ...]]:
-    rows = [(item.key, item.shown_range(), item.distribution, item.reason) for item in ensemble.inputs]
+    rows: list[tuple[str, ...]] = [
+        (item.key, item.shown_range(), item.distribution, item.reason) for item in ensemble.inputs
+    ]
     if ensemble.posterior is not None:
         rows += [
             (

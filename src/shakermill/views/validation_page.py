@@ -39,7 +39,7 @@ MATRIX_NUMERIC = (3, 5, 6, 7, 8)
 
 def matrix_rows(matrix: ValidationMatrix) -> list[tuple[str, ...]]:
     """One row of text per preset × point: the rise measured and predicted (K), the 90 % interval, the error."""
-    rows = []
+    rows: list[tuple[str, ...]] = []
     for row in matrix.rows:
         measured = row.point.rise_K
         rows.append(
@@ -206,7 +206,7 @@ CROSS_TITLE = "Both directions: fitted over every uncertain input on one SPEX ex
 
 def cross_rows(cross: CrossPrediction) -> list[tuple[str, ...]]:
     """Each direction's predictions of the other experiment's measured points, beside what the prior alone says."""
-    rows = []
+    rows: list[tuple[str, ...]] = []
     for direction in cross.directions:
         for prediction, prior in zip(direction.predictions, direction.prior_predictions, strict=True):
             low, median, high = prediction.quantiles

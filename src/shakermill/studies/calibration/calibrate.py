@@ -47,6 +47,7 @@ from shakermill.studies.calibration.fit_statistics import (
     standard_errors,
 )
 from shakermill.studies.calibration.identifiability import check_determinable, loosely_determined, undetermined_keys
+from shakermill.studies.concluded import summary_of
 from shakermill.studies.inference.posterior import Posterior
 from shakermill.studies.inference.prior import Prior, fitted_key
 from shakermill.studies.measured import (
@@ -302,7 +303,7 @@ def calibrate(
     residuals, results = evaluate(solution.x)
     result = results[()]
     fitted = {key: float(math.exp(v)) for key, v in zip(free, solution.x)}
-    achieved = {key: result.summary.number(key) for key in targets}
+    achieved = {key: summary_of(result).number(key) for key in targets}
     at_bounds = [
         key for key, x, lo, hi in zip(free, solution.x, lower, upper) if x - lo < AT_BOUND or hi - x < AT_BOUND
     ]
@@ -332,7 +333,7 @@ def calibrate(
         covariance=None if covariance is None else covariance.tolist(),
         posterior=posterior,
         sensitivities=sensitivities(solution.jac, free, targets, curves),
-        predictions={key: result.summary.number(key) for key in predicted},
+        predictions={key: summary_of(result).number(key) for key in predicted},
         prediction_stderr=prediction_stderr,
         at_bounds=at_bounds,
         success=status == "fitted",
@@ -547,7 +548,7 @@ def _curve_residuals_K(results: Mapping[tuple[str, ...], Result], measured: Curv
 def _residuals(
     results: Mapping[tuple[str, ...], Result], targets: Mapping[str, float], curves: Sequence[Curve]
 ) -> np.ndarray:
-    parts = [(results[()].summary.number(key) - value) / value for key, value in targets.items()]
+    parts = [(summary_of(results[()]).number(key) - value) / value for key, value in targets.items()]
     for measured in curves:
         parts.extend(_curve_residuals_K(results, measured) / CURVE_SCALE_K)
     values = np.array(parts, dtype=float)
@@ -589,11 +590,12 @@ def _prediction_stderr(
     of the keys (one run each) through their covariance; NaN without a covariance."""
     if covariance is None:
         return {key: math.nan for key in keys}
-    summary = evaluate(best)[1][()].summary
+    summary = summary_of(evaluate(best)[1][()])
     gradients = np.array(
         [
             [
-                (evaluate(best + JACOBIAN_STEP * unit)[1][()].summary.number(key) - summary.number(key)) / JACOBIAN_STEP
+                (summary_of(evaluate(best + JACOBIAN_STEP * unit)[1][()]).number(key) - summary.number(key))
+                / JACOBIAN_STEP
                 for key in keys
             ]
             for unit in np.eye(best.size)

@@ -28,6 +28,7 @@ from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.averaged import integrate_network
 from shakermill.solvers.result import Result
+from shakermill.studies.concluded import summary_of
 from shakermill.studies.inference.posterior import Posterior
 
 LEVEL = 0.90
@@ -124,7 +125,7 @@ def intervals(result: Result, uncertainty: Uncertainty) -> Intervals | None:
     if found is None:
         return None
     # The run's own values, which a full run's averaged network only approaches; the spread is the network's.
-    reported = {name: result.summary.number(name) for name in HEADLINE}
+    reported = {name: summary_of(result).number(name) for name in HEADLINE}
     shift = {name: reported[name] - found.centre[name] for name in HEADLINE}
     return Intervals(
         reported,

@@ -267,7 +267,8 @@ def analyse(
 def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]) -> HeadlineSpread:
     label, symbol = HEADLINES[key] if key in HEADLINES else (_power_label(key), "W")
     good = np.isfinite(values)
-    quantiles = tuple(float(q) for q in np.quantile(values[good], QUANTILES)) if good.any() else (math.nan,) * 3
+    low, middle, high = (float(q) for q in np.quantile(values[good], QUANTILES)) if good.any() else (math.nan,) * 3
+    quantiles = (low, middle, high)
     varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * np.max(np.abs(values[good]))
     if not varies:
         return HeadlineSpread(key, label, symbol, quantiles, math.nan, varies=False)

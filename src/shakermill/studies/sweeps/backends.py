@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import FrameType
 from typing import TYPE_CHECKING, Any, Protocol
 
 from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
@@ -197,16 +198,19 @@ def _called_from_unguarded_main() -> bool:
     path = getattr(main, "__file__", None)
     if main is None or path is None or getattr(main, "__spec__", None) is not None:
         return False  # run with -m, the workers import it under its own name with the guard honoured
-    frame = sys._getframe(1)
+    frame: FrameType | None = sys._getframe(1)
     while frame is not None and not (frame.f_globals is vars(main) and frame.f_code.co_name == "<module>"):
         frame = frame.f_back
     if frame is None:
         return False
+    line = frame.f_lineno
     try:
         tree = ast.parse(Path(path).read_text(encoding="utf-8"))
     except (OSError, SyntaxError, ValueError):
         return True
-    return not any(_is_main_guard(node) and node.lineno <= frame.f_lineno <= node.end_lineno for node in tree.body)
+    return not any(
+        _is_main_guard(node) and node.lineno <= line <= (node.end_lineno or node.lineno) for node in tree.body
+    )
 
 
 def _is_main_guard(node: ast.stmt) -> bool:

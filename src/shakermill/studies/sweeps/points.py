@@ -11,6 +11,7 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.result import INTERRUPTED, Result
 from shakermill.solvers.simulate import simulate
+from shakermill.studies.concluded import summary_of
 
 # A summary key that is also a swept key (only ``solver``: the averaged solver may fall back to
 # full resolution) keeps the summary's value under this suffix; the swept value keeps the key.
@@ -59,8 +60,9 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
         return PointOutcome(failed_row(swept, f"{type(exc).__name__}: {exc}"))
     # The summary's flat keys (solvers/summary.py) are the row's columns. A table cell holds one value: the warnings
     # and notes become one string each, or none (CSV cannot tell "" from missing).
-    told = {"warnings": "; ".join(result.summary.warnings) or None, "notes": " ".join(result.summary.notes) or None}
-    columns = {**result.summary.flat(), **told}
+    summary = summary_of(result)
+    told = {"warnings": "; ".join(summary.warnings) or None, "notes": " ".join(summary.notes) or None}
+    columns = {**summary.flat(), **told}
     row = {
         **swept,
         "regime": regime,

@@ -10,6 +10,7 @@ from typing import Any
 
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.result import INTERRUPTED, Result
+from shakermill.studies.concluded import summary_of
 
 # (summary key, quantity, unit) compared.
 COMPARED_QUANTITIES = (
@@ -43,7 +44,7 @@ class SolverComparison:
 
     def rows(self) -> list[tuple[str, str, Any, Any, Any]]:
         """(quantity, unit, full, averaged, averaged − full) of each compared quantity."""
-        full, averaged = self.full.summary, self.averaged.summary
+        full, averaged = summary_of(self.full), summary_of(self.averaged)
         return [
             (label, unit, full.value(key), averaged.value(key), averaged.number(key) - full.number(key))
             for key, label, unit in COMPARED_QUANTITIES
@@ -51,8 +52,8 @@ class SolverComparison:
 
     def as_dict(self) -> dict[str, Any]:
         return {
-            "full": {key: self.full.summary.value(key) for key, _, _ in COMPARED_QUANTITIES},
-            "averaged": {key: self.averaged.summary.value(key) for key, _, _ in COMPARED_QUANTITIES},
+            "full": {key: summary_of(self.full).value(key) for key, _, _ in COMPARED_QUANTITIES},
+            "averaged": {key: summary_of(self.averaged).value(key) for key, _, _ in COMPARED_QUANTITIES},
             "averaged_solver_used": self.averaged.solver,
             "averaged_message": self.averaged.message,
             "speed_ratio": self.speed_ratio,

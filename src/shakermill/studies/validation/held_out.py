@@ -18,6 +18,7 @@ from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.parameters.presets import PRESETS, default_parameters
 from shakermill.solvers.simulate import thermal_variants
 from shakermill.solvers.summary import Summary
+from shakermill.studies.concluded import summary_of
 from shakermill.studies.measured import relative_error
 from shakermill.studies.validation.kinematics import (
     DEFAULT_FACTORS,
@@ -110,7 +111,9 @@ def five_ball_prediction(overrides: Mapping[str, Any] | None = None) -> HeldOutP
     # Through thermal_variants: the validation matrix has measured these mechanics already (one thermal model apart).
     result = thermal_variants(params)(params)
     fitted_to = str(preset.provenance.get("curve", "the one-ball experiment"))
-    return HeldOutPrediction(HELD_OUT_PRESET, preset.fitted, fitted_to, five_ball_rows(result.summary), result.summary)
+    return HeldOutPrediction(
+        HELD_OUT_PRESET, preset.fitted, fitted_to, five_ball_rows(summary_of(result)), summary_of(result)
+    )
 
 
 # The one-ball case, from the paper's model to the real mill, one change at a time.

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.solvers.simulate import simulate_whole
+from shakermill.studies.concluded import summary_of
 from shakermill.studies.measured import relative_error
 
 if TYPE_CHECKING:
@@ -107,7 +108,7 @@ def kinematic_sensitivity(
 
 def measured(params: Parameters, measures: Sequence[str]) -> dict[str, float]:
     """The summary keys ``measures`` of a whole run of ``params``."""
-    summary = simulate_whole(params).summary
+    summary = summary_of(simulate_whole(params))
     return {name: summary.number(name) for name in measures}
 
 

@@ -25,6 +25,7 @@ from shakermill.solvers.simulate import thermal_variants
 from shakermill.studies.calibration.calibrate import DEFENSIBLE_RANGES, calibrate
 from shakermill.studies.calibration.intervals import Uncertainty, heat_error_of, propagated, uncertainty_of
 from shakermill.studies.calibration.observables import node_rises
+from shakermill.studies.concluded import summary_of
 from shakermill.studies.measured import experiment_curve, relative_error
 from shakermill.studies.validation.held_out import FIVE_BALLS
 
@@ -303,13 +304,13 @@ def structure_study(
         base = default_parameters(structure.preset, **{**settings, **dict(structure.fixed)})
         calibration = calibrate(base, structure.free, sample_posterior=False)
         five_balls = base.replace(n_balls=FIVE_BALLS, duration=3600.0, **calibration.fitted)
-        summary = thermal_variants(five_balls)(five_balls).summary
+        summary = summary_of(thermal_variants(five_balls)(five_balls))
         start = summary.initial_temperature_C
         outcomes.append(
             StructureOutcome(
                 structure,
                 calibration.fitted,
-                float(calibration.curve_rms_K),
+                math.nan if calibration.curve_rms_K is None else calibration.curve_rms_K,
                 tuple(key for key in calibration.at_bounds if key in DEFENSIBLE_RANGES),
                 summary.ball_C - start,
                 summary.vial_C - start,

@@ -21,6 +21,7 @@ from typing import Any
 from shakermill.parameters.presets import default_parameters
 from shakermill.solvers.result import Result
 from shakermill.solvers.simulate import simulate
+from shakermill.studies.concluded import summary_of
 from shakermill.studies.validation.held_out import (
     FIVE_BALL_BALL_RISE_K,
     FIVE_BALL_RATIO,
@@ -90,7 +91,7 @@ class PowderComparison:
 
 def rises(result: Result) -> tuple[float, float, float]:
     """The rises (K) of the balls' mean and the vial at the end of ``result``, and the powder's (NaN without)."""
-    summary = result.summary
+    summary = summary_of(result)
     start = summary.initial_temperature_C
     powder = summary.further_nodes().get("powder", (NAN, None))[0]
     return summary.ball_C - start, summary.vial_C - start, powder - start

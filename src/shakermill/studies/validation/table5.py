@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from shakermill.parameters.keys import field_unit
+from shakermill.studies.concluded import summary_of
 from shakermill.studies.measured import (
     EXPERIMENT_OPERATING_POINT,
     OPERATING_POINT_TOLERANCE,
@@ -93,8 +94,8 @@ def validate(solver: str = "full", progress: Callable[[int], None] | None = None
             ValidationRun(
                 preset=name,
                 fitted=preset.fitted,
-                rows=compare(result.summary, fitted_quantities(preset.provenance)),
-                summary=result.summary,
+                rows=compare(summary_of(result), fitted_quantities(preset.provenance)),
+                summary=summary_of(result),
                 curve_rms_K=curve.rms_K(series["time"].values, series["theta_ball"].values),
                 fitted_to_curve="curve" in preset.provenance,
             )
