@@ -18,7 +18,7 @@ import numpy as np
 import shakermill as sm
 from shakermill.parameters.presets import PRESETS
 from shakermill.solvers.simulate import thermal_variants
-from shakermill.studies.uncertainty import Uncertainty, intervals
+from shakermill.studies.calibration.intervals import Uncertainty, intervals
 
 TARGET_S = 600.0
 
@@ -47,7 +47,7 @@ def main() -> None:
     print("correlation of the logarithms:\n" + np.array2string(correlation, precision=4))
     fitted = base.replace(**calibration.fitted)
     result = thermal_variants(fitted)(fitted)
-    found = intervals(result, Uncertainty(free, covariance, np.array(calibration.posterior)))
+    found = intervals(result, Uncertainty(free, covariance, calibration.posterior))
     for key in found.centre:
         low, high = found.bounds(key)
         print(f"  {key}: {found.centre[key]:.2f} °C, 90 % interval {low:.2f} to {high:.2f} °C")

@@ -14,7 +14,7 @@ import json
 import time
 from pathlib import Path
 
-from shakermill.studies.cross_prediction import MEMBERS, THERMAL_DRAWS, cross_prediction
+from shakermill.studies.validation.cross_prediction import MEMBERS, THERMAL_DRAWS, cross_prediction
 from shakermill.views.validation_page import cross_rows, cross_statement
 
 

@@ -1,6 +1,6 @@
 """Which network structure follows the one-ball curve with physical couplings, and what each predicts for five balls.
 
-Each structure of ``studies.validation_matrix.STRUCTURES`` is fitted to the experiment's one-ball curve
+Each structure of ``studies.validation.matrix.STRUCTURES`` is fitted to the experiment's one-ball curve
 (48 − 28·exp(−t/16.7 min) °C) from its uncalibrated preset, exactly as ``shakermill calibrate --preset P --free
 ...`` does; then five balls with the fitted values, nothing refitted, run the experiment's hour. The bar (issue 23,
 point 7): the curve within 2 K RMS, every free key strictly inside its range, every computed path at its
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time
 
-from shakermill.studies.validation_matrix import structure_study, validation_matrix
+from shakermill.studies.validation.matrix import structure_study, validation_matrix
 from shakermill.views.validation_page import (
     MATRIX_HEADERS,
     matrix_rows,

@@ -37,8 +37,8 @@ from pathlib import Path
 import pandas as pd
 
 import shakermill as sm
-from shakermill.studies.sweep import SweepProgress
-from shakermill.studies.sweep_storage import load_sweep
+from shakermill.studies.sweeps.executor import Progress
+from shakermill.studies.sweeps.storage import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURE = ROOT / "docs" / "figures" / "mill-study.png"
@@ -70,7 +70,7 @@ def grid(counts: list[int]) -> dict[str, list]:
 
 
 def report_progress(started: float):
-    def report(progress: SweepProgress) -> None:
+    def report(progress: Progress) -> None:
         print(
             f"\r  points {progress.done}/{progress.total} done, {progress.failed} failed, {progress.running} running, "
             f"{time.perf_counter() - started:.0f} s",

@@ -21,9 +21,9 @@ import pandas as pd
 from pandas.testing import assert_frame_equal
 
 import shakermill as sm
-from shakermill.studies.sweep import sweep as run_sweep
-from shakermill.studies.sweep_plan import plan_sweep
-from shakermill.studies.sweep_storage import comparable_columns, failed_points
+from shakermill.studies.sweeps.plan import plan_sweep
+from shakermill.studies.sweeps.storage import comparable_columns, failed_points
+from shakermill.studies.sweeps.sweep import sweep as run_sweep
 
 TARGET_S = 30.0
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import shakermill as sm
 from shakermill.parameters.presets import PRESETS
-from shakermill.studies.ensemble import ensemble_inputs, run_ensemble
+from shakermill.studies.ensembles.ensemble import ensemble_inputs, run_ensemble
 
 TARGET_S = 15 * 60.0
 MEASURED_RISES_K = {"ball_rise_K": 46.0, "vial_rise_K": 21.0}

@@ -113,6 +113,23 @@ def _in_package(module: str, package: str) -> bool:
     return module == package or module.startswith(package + ".")
 
 
+# The floors of the studies (docs/ARCHITECTURE.md), bottom to top: a floor imports from its own and those below.
+STUDIES_FLOORS = ("measured", "concluded", "sweeps", "inference", "calibration", "ensembles", "validation")
+
+
+def test_the_studies_floors_import_down_only():
+    floor_of = {name: STUDIES_FLOORS.index(name.split(".")[2]) for name in MODULES if name.count(".") >= 2
+                and name.startswith("shakermill.studies.")}  # fmt: skip
+    assert sorted({name.split(".")[2] for name in floor_of}) == sorted(STUDIES_FLOORS)
+    upward = [
+        f"{name} -> {target}"
+        for name, floor in floor_of.items()
+        for target in GRAPH[name]
+        if target in floor_of and floor_of[target] > floor
+    ]
+    assert upward == []
+
+
 def test_the_engines_do_not_import_each_other():
     crossing = [
         f"{name} -> {target}"

@@ -244,8 +244,8 @@ def test_a_new_rigid_vial_motion_is_its_module_and_its_key_group(tmp_path):
 # The powder's own code: its node, and the study of it with its rows in `validate` and on the validation page.
 POWDER_OWN = {
     "engines/thermal/powder.py",
-    "studies/powder.py",
-    "studies/validation_report.py",
+    "studies/validation/powder.py",
+    "studies/validation/report.py",
     "cli/validating.py",
     "views/validation_page.py",
 }

@@ -27,8 +27,8 @@ _LAZY = {
     "default_parameters": "shakermill.parameters.presets",
     "Result": "shakermill.solvers.result",
     "simulate": "shakermill.solvers.simulate",
-    "sweep": "shakermill.studies.sweep",
-    "calibrate": "shakermill.studies.calibrate",
+    "sweep": "shakermill.studies.sweeps.sweep",
+    "calibrate": "shakermill.studies.calibration.calibrate",
 }
 
 __all__ = [*_LAZY, "__version__"]

@@ -11,7 +11,7 @@ import pytest
 
 import shakermill as sm
 from shakermill.analysis.regime import IRREGULAR, NO_IMPACTS, classify, settled_impacts
-from shakermill.studies.bifurcation import bifurcation, write_bifurcation
+from shakermill.studies.sweeps.bifurcation import bifurcation, write_bifurcation
 
 OMEGA = 100.0
 PERIOD = 2 * math.pi / OMEGA

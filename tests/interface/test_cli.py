@@ -31,9 +31,9 @@ from shakermill.parameters.engine_keys import reads
 from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.parameters.presets import PRESETS
 from shakermill.solvers.result import INTERRUPTED
-from shakermill.studies.calibrate import DEFAULT_FREE
-from shakermill.studies.sweep_plan import plan_sweep
-from shakermill.studies.sweep_storage import load_sweep
+from shakermill.studies.calibration.calibrate import DEFAULT_FREE
+from shakermill.studies.sweeps.plan import plan_sweep
+from shakermill.studies.sweeps.storage import load_sweep
 
 # Short runs with small windows keep every invocation well under a second once Numba's cache is warm.
 SHORT = ["--set", "duration=2", "--set", "record_windows=0:0.2"]
@@ -1043,7 +1043,7 @@ def test_report_onto_an_existing_file_is_refused_unless_overwrite(tmp_path):
 def test_calibrate_onto_an_existing_preset_file_is_refused_unless_overwrite(tmp_path, monkeypatch):
     preset_file = tmp_path / "fitted.toml"
     preset_file.write_text("# an earlier fit\n")
-    calibrate_module = importlib.import_module("shakermill.studies.calibrate")
+    calibrate_module = importlib.import_module("shakermill.studies.calibration.calibrate")
     monkeypatch.setattr(calibrate_module, "calibrate", lambda *_args, **_kwargs: pytest.fail("must not fit"))
     arguments = ["calibrate", "--target", "theta_inf_C=100", "--free", "beta", "--out", str(preset_file)]
     refused = invoke(*arguments)

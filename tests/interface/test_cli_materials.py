@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from shakermill import cli
 from shakermill.parameters import materials
-from shakermill.studies.sweep_storage import load_sweep
+from shakermill.studies.sweeps.storage import load_sweep
 
 runner = CliRunner()
 

@@ -10,7 +10,7 @@ from conftest import assert_one_error_line
 from typer.testing import CliRunner
 
 from shakermill import cli
-from shakermill.studies.sweep_storage import load_sweep
+from shakermill.studies.sweeps.storage import load_sweep
 
 runner = CliRunner()
 # Twenty seconds of the paper's one ball at full resolution, with λ and β uncertain: eight members in seconds.

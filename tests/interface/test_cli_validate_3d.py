@@ -13,9 +13,14 @@ from typer.testing import CliRunner
 
 from shakermill import cli
 from shakermill.parameters.assumed import AssumedInput
-from shakermill.studies import cross_prediction, held_out, joint_calibration, powder, validation_report
-from shakermill.studies.validation import VALIDATION_PRESETS
-from shakermill.studies.validation_matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
+from shakermill.studies.calibration import joint as joint_calibration
+from shakermill.studies.calibration.emulators import emulate
+from shakermill.studies.calibration.observables import Observable
+from shakermill.studies.calibration.training import Training
+from shakermill.studies.validation import cross_prediction, held_out, powder
+from shakermill.studies.validation import report as validation_report
+from shakermill.studies.validation.matrix import THERMAL_MODEL_PRESETS, load_experiments, validation_matrix
+from shakermill.studies.validation.table5 import VALIDATION_PRESETS
 from shakermill.views.validation_page import CROSS_TITLE, QUICK_NOTE
 
 runner = CliRunner()
@@ -46,14 +51,14 @@ def made_up_cross_prediction(progress):
     for name in (cross_prediction.ONE_BALL, cross_prediction.FIVE_BALLS):
         points = experiments[name].points
         rises = np.column_stack([point.rise_K * (1.0 + unit[:, 0]) for point in points])
-        training = joint_calibration.Training(
+        training = Training(
             (AssumedInput("friction", 0.1, 0.6, "uniform", "a test's"),),
-            tuple(joint_calibration.Observable(point.node, point.time_s) for point in points),
+            tuple(Observable(point.node, point.time_s) for point in points),
             unit,
             rises,
             np.arange(16),
         )
-        emulators[name] = joint_calibration.emulate(training)
+        emulators[name] = emulate(training)
     pair = (experiments[cross_prediction.ONE_BALL], experiments[cross_prediction.FIVE_BALLS])
     directions = tuple(
         cross_prediction._direction(fitted_on, predicted, emulators) for fitted_on, predicted in (pair, pair[::-1])

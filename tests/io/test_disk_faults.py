@@ -24,7 +24,7 @@ from typer.testing import CliRunner
 
 from shakermill import cli
 from shakermill.io.runs import load_run
-from shakermill.studies.sweep_storage import MANIFEST_FILE, load_sweep
+from shakermill.studies.sweeps.storage import MANIFEST_FILE, load_sweep
 from shakermill.support.atomic import PARTIAL, create_exclusively, partial_path, remove_abandoned_writes, this_machine
 
 # One simulated second without record windows: the run folder is ~50 kB, written in a second.

@@ -18,8 +18,8 @@ from shakermill.parameters.groups import keys_of_role
 from shakermill.parameters.key_group import VIAL_MOTION
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.solvers import simulate as simulate_module
-from shakermill.studies.calibrate import LONGEST_FULL_RESOLUTION_FIT_S, check_full_resolution_work
-from shakermill.studies.sweep_plan import check_keys_read, plan_sweep
+from shakermill.studies.calibration.calibrate import LONGEST_FULL_RESOLUTION_FIT_S, check_full_resolution_work
+from shakermill.studies.sweeps.plan import check_keys_read, plan_sweep
 
 
 def test_a_reader_names_where_a_key_applies():

@@ -16,7 +16,7 @@ from shakermill.parameters.config import load_config
 from shakermill.parameters.engine_keys import Reader
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.presets import PRESETS, default_parameters
-from shakermill.studies.ensemble import ensemble_inputs
+from shakermill.studies.ensembles.ensemble import ensemble_inputs
 
 CONTACT = {"friction", "pair_friction", "restitution", "pair_restitution", "rolling_friction", "lam"}
 HEAD = {"emissivity", "clamp_heat_capacity", "clamp_conductance", "clamp_loss"}

@@ -13,7 +13,7 @@ from shakermill import cli
 from shakermill.parameters.config import load_config, write_config_toml
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.geometry import balls_for_fill
-from shakermill.studies.sweep_plan import plan_sweep
+from shakermill.studies.sweeps.plan import plan_sweep
 
 # The spex8000m-3d bore, Ø38 x 58 mm: π/4 · 38² · 58 mm³ = 65 779 mm³.
 VIAL_MM3 = math.pi / 4 * 38**2 * 58

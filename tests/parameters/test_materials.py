@@ -10,7 +10,7 @@ from shakermill.parameters import materials
 from shakermill.parameters.config import load_config, write_config_toml
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.presets import PRESETS, load_preset_file
-from shakermill.studies.sweep_plan import plan_sweep
+from shakermill.studies.sweeps.plan import plan_sweep
 
 TWO_BALLS = {"engine": "dem", "n_balls": 2, "vial_diameter": "38 mm"}
 # Room-temperature solids that milling media are made of, in SI.

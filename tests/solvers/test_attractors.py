@@ -20,7 +20,7 @@ from shakermill.analysis.attractors import (
 )
 from shakermill.analysis.regime import IRREGULAR, NO_IMPACTS, PHASE_TOLERANCE
 from shakermill.solvers.attractors import find_attractors, settle
-from shakermill.studies.sweep import sweep
+from shakermill.studies.sweeps.sweep import sweep
 
 # A stroke of 23 mm, just above the free gap of 22.65 mm: period-1 and period-2 coexist at every ω of
 # 90–130 rad/s, at rtol 1e-3 and at 1e-5 alike. At the default 25 mm and ω = 110 rad/s all starts

@@ -12,7 +12,7 @@ from shakermill.parameters.defaults import FAST_IMPACT_SPEED, HIT_SPEED
 from shakermill.parameters.errors import ParameterError
 from shakermill.solvers.averaged import settle_mechanics, simulate_averaged
 from shakermill.solvers.simulate import thermal_variants
-from shakermill.studies.calibrate import calibrate
+from shakermill.studies.calibration.calibrate import calibrate
 
 # Five balls knock each other off the bottom of a wide bore (the cheapest several-ball case) and their means
 # settle to ±3 % in a few seconds of mechanics.

@@ -11,7 +11,7 @@ from shakermill.parameters.defaults import DEM_DEFAULT_FREE
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.presets import PRESETS
-from shakermill.studies.calibrate import (
+from shakermill.studies.calibration.calibrate import (
     DEFAULT_FREE,
     DEFENSIBLE_RANGES,
     calibrate,
@@ -22,14 +22,14 @@ from shakermill.studies.calibrate import (
     parse_targets,
     unstarted_defaults,
 )
-from shakermill.studies.fitted_preset import write_preset
-from shakermill.studies.identifiability import (
+from shakermill.studies.calibration.fitted_preset import write_preset
+from shakermill.studies.calibration.identifiability import (
     check_determinable,
     informative_points,
     loosely_determined,
     undetermined_keys,
 )
-from shakermill.studies.validation import CURVE_TOLERANCE_K, TABLE5, Curve, curve_from_option, experiment_curve
+from shakermill.studies.measured import CURVE_TOLERANCE_K, TABLE5, Curve, curve_from_option, experiment_curve
 
 TABLE5_TARGETS = {entry.key: entry.experiment for entry in TABLE5 if entry.key != "vial_ball_ratio"}
 
@@ -410,7 +410,7 @@ def test_curves_of_two_nodes_under_two_conditions_recover_the_parameters_that_ma
 
 
 def test_a_ctrl_c_while_the_posterior_is_sampled_is_raised_without_emcee_printing_a_traceback(capsys):
-    from shakermill.studies.calibrate import posterior_samples
+    from shakermill.studies.calibration.calibrate import posterior_samples
 
     calls = []
 

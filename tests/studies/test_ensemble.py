@@ -12,14 +12,23 @@ import pytest
 from shakermill.analysis.regime import ACTIVE, PACK, charge_regime
 from shakermill.parameters.assumed import AssumedInput
 from shakermill.parameters.errors import ParameterError
-from shakermill.studies.ensemble import (
-    analyse,
-    check_members,
-    design,
-    fitted_posterior,
-    from_unit,
-    to_unit,
-)
+from shakermill.studies.ensembles.ensemble import analyse, check_members, design
+from shakermill.studies.inference.posterior import Posterior
+from shakermill.studies.inference.prior import Prior
+
+
+def from_unit(inputs, unit):
+    return Prior(tuple(inputs)).values(unit)
+
+
+def to_unit(inputs, values):
+    return Prior(tuple(inputs)).unit(values)
+
+
+def fitted_posterior(keys, samples):
+    """A calibration's recorded posterior (samples of the keys' logarithms) as the ensemble carries it."""
+    return Posterior.of_logarithms(keys, samples).log_normal()
+
 
 LINEAR = AssumedInput("friction", 0.0, 1.0, "uniform", "test")
 SMALL = AssumedInput("restitution", 0.5, 1.0, "uniform", "test")

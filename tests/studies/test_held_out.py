@@ -1,4 +1,4 @@
-"""The held-out five-ball prediction and the one-ball comparison of the engines (studies/held_out.py)."""
+"""The held-out five-ball prediction and the one-ball comparison of the engines (studies/validation/held_out.py)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import pytest
 
 from shakermill.parameters.presets import PRESETS
-from shakermill.studies.held_out import (
+from shakermill.studies.validation.held_out import (
     ENGINE_CASES,
     FIVE_BALLS,
     HELD_OUT_PRESET,

@@ -10,17 +10,11 @@ import pytest
 
 from shakermill.parameters.assumed import AssumedInput
 from shakermill.parameters.presets import PRESETS, default_parameters
-from shakermill.studies import joint_calibration
-from shakermill.studies.joint_calibration import (
-    Measured,
-    Observable,
-    Training,
-    emulate,
-    fit_inputs,
-    predict,
-    prior_sample,
-    sample_posterior,
-)
+from shakermill.studies.calibration import joint as joint_calibration
+from shakermill.studies.calibration.emulators import emulate, predict
+from shakermill.studies.calibration.joint import fit_inputs, prior_sample, sample_posterior
+from shakermill.studies.calibration.observables import Measured, Observable
+from shakermill.studies.calibration.training import Training
 
 A = AssumedInput("friction", 0.0, 1.0, "uniform", "a test's range")
 B = AssumedInput("restitution", 0.0, 1.0, "uniform", "a test's range")
@@ -75,7 +69,7 @@ def test_two_configurations_fit_together_constrain_their_shared_input_more_than_
     two = emulate(linear_training([A, B], [[10.0, 0.0]]))
     alone = sample_posterior([(one, [Measured(Y, 4.0, 0.5)])])
     both = sample_posterior([(one, [Measured(Y, 4.0, 0.5)]), (two, [Measured(Y, 4.0, 0.5)])])
-    assert both.keys == ["friction", "restitution"]
+    assert both.keys == ("friction", "restitution")
     width = {
         name: found.quantiles()["friction"][2] - found.quantiles()["friction"][0]
         for name, found in (("alone", alone), ("both", both))
@@ -116,7 +110,7 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
 
     from shakermill import cli
     from shakermill.parameters.config import config_preset, load_config
-    from shakermill.studies.uncertainty import uncertainty_of
+    from shakermill.studies.calibration.intervals import uncertainty_of
 
     monkeypatch.setattr(joint_calibration, "STEPS", 600)
     out = tmp_path / "fitted.toml"
@@ -132,6 +126,8 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
             "--json",
             "--out",
             str(out),
+            "--runs",
+            str(tmp_path / "runs"),
         ],
     )
     assert outcome.exit_code == 0, outcome.output
@@ -155,7 +151,7 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
     assert config.params.friction == pytest.approx(inputs["friction"]["p50"])
     carried = uncertainty_of(preset)
     assert set(carried.fitted) == {"drive_heat", "clamp_heat_capacity", "clamp_loss", "emissivity", "clamp_conductance"}
-    assert "friction" in carried.left_out and carried.posterior.shape[1] == len(carried.fitted)
+    assert "friction" in carried.left_out and carried.posterior.samples.shape[1] == len(carried.fitted)
 
 
 def test_a_users_configuration_narrows_an_assumed_range_and_a_wrong_table_is_refused_in_one_line(tmp_path):
@@ -184,7 +180,7 @@ def test_a_users_configuration_narrows_an_assumed_range_and_a_wrong_table_is_ref
 
 def test_a_free_key_the_run_does_not_read_or_that_moves_the_mechanics_is_refused_before_any_run():
     from shakermill.parameters.errors import ParameterError
-    from shakermill.studies.joint_calibration import calibrate_jointly
+    from shakermill.studies.calibration.joint import calibrate_jointly
 
     preset = PRESETS["spex8000m-3d-mill-head"]
     params = default_parameters(preset.name)

@@ -1,4 +1,4 @@
-"""The sensitivity of a run to the assumed amplitudes of a named vial motion (studies/kinematics.py)."""
+"""The sensitivity of a run to the assumed amplitudes of a named vial motion (studies/validation/kinematics.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 
 import shakermill as sm
 from shakermill.parameters.errors import ParameterError
-from shakermill.studies.kinematics import MEASURES, kinematic_sensitivity
+from shakermill.studies.validation.kinematics import MEASURES, kinematic_sensitivity
 
 DURATION = 0.2  # s: a few drive periods, enough for the table's shape and its determinism
 

@@ -26,10 +26,9 @@ from pandas.testing import assert_frame_equal
 
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.presets import default_parameters
-from shakermill.studies.sweep import SweepFailed, SweepInterrupted, sweep
-from shakermill.studies.sweep_backends import connect
-from shakermill.studies.sweep_plan import SweepPlan, parse_grid, plan_sweep, point_ids, read_points, sweep_parameters
-from shakermill.studies.sweep_storage import (
+from shakermill.studies.sweeps.backends import connect
+from shakermill.studies.sweeps.plan import SweepPlan, parse_grid, plan_sweep, point_ids, read_points, sweep_parameters
+from shakermill.studies.sweeps.storage import (
     MANIFEST_FILE,
     POINTS_FOLDER,
     TABLE_CSV,
@@ -38,13 +37,14 @@ from shakermill.studies.sweep_storage import (
     failed_points,
     load_sweep,
 )
+from shakermill.studies.sweeps.sweep import SweepFailed, SweepInterrupted, sweep
 
 DURATION = 60.0  # simulated seconds per point
 GRID = ("omega=100:120:3", "amplitude=23mm:29mm:2")  # 6 points
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
 UNREACHABLE = "tcp://127.0.0.1:1"  # port 1 on loopback: nothing listens, connections are refused
-SWEEP_MODULE = importlib.import_module("shakermill.studies.sweep")
-POINTS_MODULE = importlib.import_module("shakermill.studies.sweep_points")
+SWEEP_MODULE = importlib.import_module("shakermill.studies.sweeps.sweep")
+POINTS_MODULE = importlib.import_module("shakermill.studies.sweeps.points")
 
 
 @pytest.fixture(scope="module")
@@ -1270,7 +1270,7 @@ def test_a_tls_scheduler_without_tls_settings_is_one_line(tls_scheduler, tmp_pat
 
 
 def test_a_point_whose_run_spent_its_budget_is_not_probed_on_a_budget_of_its_own():
-    from shakermill.studies.sweep_points import run_point
+    from shakermill.studies.sweeps.points import run_point
 
     base = default_parameters(solver="full", duration=60.0, record_windows=(), max_steps=2000)
     row = run_point(base, {"omega": 110.0}).row

@@ -11,9 +11,9 @@ import json
 import pytest
 
 import shakermill as sm
-from shakermill.studies.sweep import sweep
-from shakermill.studies.sweep_plan import plan_sweep, point_ids
-from shakermill.studies.sweep_storage import POINTS_FOLDER, load_sweep
+from shakermill.studies.sweeps.plan import as_plan, plan_sweep, point_ids
+from shakermill.studies.sweeps.storage import POINTS_FOLDER, load_sweep
+from shakermill.studies.sweeps.sweep import sweep
 
 GRIDS = ("n_balls=1,5", "ball_radius=3mm,6.35mm")
 
@@ -35,7 +35,7 @@ def test_a_plan_over_number_and_size_of_balls():
     assert all(type(point["n_balls"]) is int for point in plan.points)
     # "5" and 5 are one point: counts are stored as numbers, so the ids agree.
     base = sm.default_parameters(engine="dem")
-    assert point_ids(base, plan_sweep(["n_balls=5"])) == point_ids(base, sm.studies.sweep.as_plan([{"n_balls": "5"}]))
+    assert point_ids(base, plan_sweep(["n_balls=5"])) == point_ids(base, as_plan([{"n_balls": "5"}]))
 
 
 @pytest.mark.parametrize(

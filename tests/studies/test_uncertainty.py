@@ -1,5 +1,5 @@
-"""90 % intervals of the headline temperatures (studies/uncertainty.py): the delta method against what the network
-says analytically, and its scaling with the covariance."""
+"""90 % intervals of the headline temperatures (studies/calibration/intervals.py): the delta method against what the
+network says analytically, and its scaling with the covariance."""
 
 from __future__ import annotations
 
@@ -8,7 +8,8 @@ import pytest
 from scipy.stats import norm
 
 import shakermill as sm
-from shakermill.studies.uncertainty import HEADLINE, Uncertainty, intervals
+from shakermill.studies.calibration.intervals import HEADLINE, Uncertainty, intervals
+from shakermill.studies.inference.posterior import Posterior
 
 Z90 = norm.ppf(0.95)
 
@@ -60,7 +61,7 @@ def test_posterior_samples_give_percentile_intervals(full_run):
     # Samples of ln h_outer spread evenly over ±0.2: the steady vial's rise P/(h_o·A_o) spans exp(∓0.2) of its own.
     base = np.log(full_run.params.h_outer)
     samples = base + np.linspace(-0.2, 0.2, 100)[:, None]
-    found = intervals(full_run, Uncertainty(("h_outer",), posterior=samples))
+    found = intervals(full_run, Uncertainty(("h_outer",), posterior=Posterior.of_logarithms(("h_outer",), samples)))
     rise = full_run.summary.vial_steady_C - (full_run.params.ambient_temperature - 273.15)
     low, high = found.bounds("vial_steady_C")
     ambient = full_run.params.ambient_temperature - 273.15

@@ -9,16 +9,15 @@ import pytest
 
 from shakermill.solvers import simulate as simulate_module
 from shakermill.solvers.result import INTERRUPTED
-from shakermill.studies.validation import (
+from shakermill.studies.measured import (
     CURVE_QUANTITIES,
     CURVE_TOLERANCE_K,
     TABLE5,
     Curve,
-    compare,
     fitted_quantities,
     relative_error,
-    validate,
 )
+from shakermill.studies.validation.table5 import compare, validate
 
 
 def test_table5_holds_the_published_numbers(paper: dict) -> None:

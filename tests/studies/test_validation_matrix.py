@@ -1,4 +1,4 @@
-"""The validation matrix (studies/validation_matrix.py): experiments as data with their roles, and the predictions
+"""The validation matrix (studies/validation/matrix.py): experiments as data with their roles, and the predictions
 that need no mechanics."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import pytest
 
 from shakermill.parameters.presets import PRESETS
 from shakermill.solvers.simulate import simulate
-from shakermill.studies.calibrate import DEFENSIBLE_RANGES
-from shakermill.studies.validation_matrix import (
+from shakermill.studies.calibration.calibrate import DEFENSIBLE_RANGES
+from shakermill.studies.validation.matrix import (
     STRUCTURES,
     THERMAL_MODEL_PRESETS,
     Structure,

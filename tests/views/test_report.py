@@ -23,7 +23,7 @@ from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.engine_keys import reads
 from shakermill.parameters.keys import FIELD_NAMES
 from shakermill.parameters.presets import PRESETS
-from shakermill.studies.validation import TABLE5
+from shakermill.studies.measured import TABLE5
 from shakermill.views.report import REPORT_FILE, fitted_targets, number, render_report, write_report
 
 # Every test here reads a run made once for the module: make test-fast leaves them out.

@@ -8,7 +8,7 @@ import re
 
 import pytest
 
-from shakermill.studies.validation_matrix import (
+from shakermill.studies.validation.matrix import (
     Experiment,
     MatrixRow,
     Point,
@@ -16,7 +16,7 @@ from shakermill.studies.validation_matrix import (
     StructureOutcome,
     ValidationMatrix,
 )
-from shakermill.studies.validation_report import ValidationReport
+from shakermill.studies.validation.report import ValidationReport
 from shakermill.views import validation_page
 from shakermill.views.validation_page import matrix_rows, render_validation_page, save_validation_page, structure_rows
 

@@ -27,7 +27,7 @@ from shakermill.cli.common import (
 )
 
 if TYPE_CHECKING:
-    from shakermill.studies.ensemble import Ensemble
+    from shakermill.studies.ensembles.ensemble import Ensemble
 
 SUMMARY = "summary.json"
 REPORT = "report.html"
@@ -70,9 +70,9 @@ def uncertainty(
     """Run a quasi-random ensemble over the assumed inputs; print each headline's 5/50/95 % points, the inputs that
     decide it (Sobol' indices) and the motion regimes found."""
     from shakermill.parameters.config import config_preset
-    from shakermill.studies.ensemble import check_members, ensemble_inputs, run_ensemble
-    from shakermill.studies.sweep import SweepFailed, SweepInterrupted
-    from shakermill.studies.sweep_plan import sweep_parameters
+    from shakermill.studies.ensembles.ensemble import check_members, ensemble_inputs, run_ensemble
+    from shakermill.studies.sweeps.plan import sweep_parameters
+    from shakermill.studies.sweeps.sweep import SweepFailed, SweepInterrupted
     from shakermill.support.atomic import write_text_atomically
     from shakermill.views.ensemble_page import save_ensemble_page
 
@@ -132,7 +132,9 @@ def print_ensemble(ensemble: Ensemble, title: str, target: Path) -> None:
     )
 
     console = stdout_console()
-    tables = [(HEADLINE_HEADERS, headline_rows(ensemble), title)]
+    tables: list[tuple[tuple[str, ...], list[tuple[str, ...]], str]] = [
+        (HEADLINE_HEADERS, headline_rows(ensemble), title)
+    ]
     if ensemble.regimes:
         tables.append((REGIME_HEADERS, regime_rows(ensemble), f"regimes ({REGIME_NOTE})"))
     for headers, rows, caption in tables:

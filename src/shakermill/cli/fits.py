@@ -6,6 +6,7 @@ import json
 import math
 import sys
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -15,18 +16,22 @@ from rich.text import Text
 
 from shakermill.cli.common import (
     EXIT_FAILED_RUN,
+    EXIT_INTERRUPTED,
     PROGRESS_DELAY_S,
     ConfigArgument,
     FullResolutionOption,
     JsonOption,
     PresetOption,
+    SchedulerOption,
     SettingsOption,
     add_plain_row,
+    fail,
     nothing_written_when_a_run_is_stopped,
     nothing_written_when_interrupted,
     number,
     progress_bar,
     stdout_console,
+    timestamped_folder,
     user_errors,
     writing,
 )
@@ -35,7 +40,7 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.support.atomic import check_writable_place
 
 if TYPE_CHECKING:
-    from shakermill.studies.calibrate import Calibration
+    from shakermill.studies.calibration.calibrate import Calibration
 
 
 WithAssumedOption = Annotated[
@@ -50,6 +55,22 @@ WithAssumedOption = Annotated[
 MembersOption = Annotated[
     int,
     typer.Option("--members", "-n", help="With --with-assumed: mechanical runs per set of conditions, a power of two."),
+]
+RunsOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--runs",
+        metavar="DIR",
+        show_default="results/calibrate-<timestamp>",
+        help="With --with-assumed: the folder its mechanical runs are stored in as they finish; re-run into it to "
+        "resume after Ctrl-C.",
+    ),
+]
+WorkersOption = Annotated[
+    int | None,
+    typer.Option(
+        "--workers", "-w", show_default="one per core", help="With --with-assumed: local worker processes of its runs."
+    ),
 ]
 PosteriorOption = Annotated[
     bool,
@@ -99,14 +120,17 @@ def calibrate(
     with_assumed: WithAssumedOption = False,
     members: MembersOption = 32,
     posterior: PosteriorOption = True,
+    runs: RunsOption = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
 ) -> None:
     """Fit free parameters to measured curves (the experiment's by default) and/or Table 5 targets by bounded least
     squares; with --with-assumed, over every uncertain input by Bayesian inference."""
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import load_config, values_beyond_preset
-    from shakermill.studies.calibrate import calibrate as fit_parameters
-    from shakermill.studies.calibrate import default_free, parse_free, parse_targets
-    from shakermill.studies.validation import curve_from_option
+    from shakermill.studies.calibration.calibrate import calibrate as fit_parameters
+    from shakermill.studies.calibration.calibrate import default_free, parse_free, parse_targets
+    from shakermill.studies.measured import curve_from_option
 
     with user_errors():
         # The fit evaluates with its own solver, not the one the parameters name.
@@ -119,8 +143,19 @@ def calibrate(
             # Checked before the fit, which takes a while.
             check_preset_target(out, overwrite)
         if with_assumed:
-            calibrate_over_assumed(run_config, free_keys, targets, measured, members, full_resolution, out, json_output)
+            calibrate_over_assumed(
+                run_config,
+                free_keys,
+                targets,
+                measured,
+                members,
+                full_resolution,
+                out,
+                json_output,
+                Runs(runs, workers, scheduler),
+            )
             return
+        check_no_runs(runs, workers, scheduler)
         with (
             nothing_written_when_interrupted("the fit starts again from the beginning"),
             nothing_written_when_a_run_is_stopped("the fit"),
@@ -143,8 +178,8 @@ def calibrate(
     # A fit that leaves its keys undetermined has values that any others would match as well: no preset of them.
     written = out if out is not None and calibration.status != "undetermined" else None
     if written is not None:
-        settings = values_beyond_preset(run_config.params, run_config.preset)
-        write_fitted_preset(calibration, written, run_config.preset, free_keys, targets, settings)
+        beyond = values_beyond_preset(run_config.params, run_config.preset)
+        write_fitted_preset(calibration, written, run_config.preset, free_keys, targets, beyond)
     if json_output:
         typer.echo(
             json.dumps(
@@ -193,6 +228,26 @@ def fit_progress(update: Callable[..., None]) -> dict[str, Callable[..., None]]:
     }
 
 
+@dataclass(frozen=True)
+class Runs:
+    """Where ``calibrate --with-assumed`` keeps its runs (``--runs``) and where they run (``--workers``,
+    ``--scheduler``)."""
+
+    folder: Path | None
+    workers: int | None
+    scheduler: str | None
+
+
+def check_no_runs(runs: Path | None, workers: int | None, scheduler: str | None) -> None:
+    """A fit of the network alone runs no design of runs: their options are refused in one line."""
+    given = [name for name, value in (("runs", runs), ("workers", workers), ("scheduler", scheduler)) if value]
+    if given:
+        raise ParameterError(
+            f"{given[0]}: a fit of the network alone measures the mechanics once and runs no design of runs; "
+            f"allowed --{given[0]} with --with-assumed"
+        )
+
+
 def calibrate_over_assumed(
     run_config: Any,
     free_keys: Sequence[str],
@@ -202,14 +257,17 @@ def calibrate_over_assumed(
     full_resolution: bool,
     out: Path | None,
     json_output: bool,
+    runs: Runs,
 ) -> None:
     """``calibrate --with-assumed``: the posterior of the network's free keys and the preset's assumed inputs given the
-    curves, printed, and the preset of its medians written."""
+    curves, printed, and the preset of its medians written. Its runs are stored in ``runs.folder`` as they finish:
+    after Ctrl-C the same command into it computes only the others."""
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import config_preset, values_beyond_preset
-    from shakermill.studies.ensemble import check_members
-    from shakermill.studies.joint_calibration import calibrate_jointly, write_joint_preset
-    from shakermill.studies.validation import experiment_curve
+    from shakermill.studies.calibration.joint import calibrate_jointly, write_joint_preset
+    from shakermill.studies.ensembles.ensemble import check_members
+    from shakermill.studies.measured import experiment_curve
+    from shakermill.studies.sweeps.executor import Execution, RunsInterrupted
 
     if targets:
         raise ParameterError(
@@ -222,26 +280,44 @@ def calibrate_over_assumed(
             "runs; allowed without --full-resolution"
         )
     check_members(members)
+    execution = Execution(runs.workers, runs.scheduler)
+    folder = runs.folder if runs.folder is not None else timestamped_folder("calibrate")
     params = run_config.params.replace(solver="averaged", attractor_starts=1)
     curves = list(curves) or [experiment_curve()]
     sets = len({tuple(item.conditions) for item in curves} | {()})
     said = (
         f"calibrate: fitting {', '.join(free_keys)} and the assumed inputs of {run_config.preset} over {members} "
-        f"mechanical runs per set of conditions ({sets}), then emcee on their emulators"
+        f"mechanical runs per set of conditions ({sets}), then emcee on their emulators; the runs are kept in {folder}"
     )
-    with (
-        nothing_written_when_interrupted("the fit starts again from the beginning"),
-        nothing_written_when_a_run_is_stopped("the fit"),
-        progress_bar("fitting", "{task.completed}/{task.total} runs", members * sets, lines_when_piped=True) as update,
-    ):
-        joint = calibrate_jointly(
-            config_preset(run_config),
-            params,
-            free_keys,
-            curves,
-            members,
-            progress=lambda done, total: update(done, total=total),
-            on_start=lambda: typer.echo(said, err=True),
+    resume = f"re-run the same command with --runs {folder}"
+    try:
+        with (
+            nothing_written_when_a_run_is_stopped("the fit"),
+            progress_bar(
+                "fitting", "{task.completed}/{task.total} runs", members * sets, lines_when_piped=True
+            ) as update,
+        ):
+            joint = calibrate_jointly(
+                config_preset(run_config),
+                params,
+                free_keys,
+                curves,
+                members,
+                progress=lambda done, total: update(done, total=total),
+                on_start=lambda: typer.echo(said, err=True),
+                runs=folder,
+                execution=execution,
+            )
+    except RunsInterrupted as stopped:
+        fail(
+            f"interrupted; kept {stopped.kept} of the {stopped.total} runs of a set of conditions in {folder}; "
+            f"{resume} to compute the others",
+            EXIT_INTERRUPTED,
+        )
+    except KeyboardInterrupt:
+        fail(
+            f"interrupted; nothing was written but the runs, kept in {folder}; {resume} to fit from them",
+            EXIT_INTERRUPTED,
         )
     if out is not None:
         command = "shakermill calibrate " + " ".join(sys.argv[2:])
@@ -302,7 +378,7 @@ def print_joint(joint: Any, out: Path | None) -> None:
 def announce(params: Any, free_keys: Sequence[str], chosen: bool, notes: Sequence[str]) -> None:
     """What a fit says once its inputs are all accepted: the keys it moves and, where they are the default set, which
     keys of that set it left out; then how its curves were read."""
-    from shakermill.studies.calibrate import unstarted_defaults
+    from shakermill.studies.calibration.calibrate import unstarted_defaults
 
     line = f"calibrate: fitting {', '.join(free_keys)}"
     if not chosen:
@@ -336,7 +412,7 @@ def write_fitted_preset(
     settings: Mapping[str, Any],
 ) -> None:
     """Write the fitted preset TOML, saying in it which command fitted which keys to what, under which settings."""
-    from shakermill.studies.fitted_preset import write_preset
+    from shakermill.studies.calibration.fitted_preset import write_preset
 
     command = "shakermill calibrate " + " ".join(sys.argv[2:])
     fitted_to = [*targets, *([calibration.curve_source] if calibration.curve_source else [])]
@@ -376,7 +452,7 @@ def print_calibration(
     calibration: Calibration, free_keys: Sequence[str], targets: Mapping[str, float], out: Path | None
 ) -> None:
     """The fitted parameters, what the fitted model predicts, the residuals of the targets and of the curve."""
-    from shakermill.studies.identifiability import LOOSE_LOG_ERROR
+    from shakermill.studies.calibration.identifiability import LOOSE_LOG_ERROR
 
     console = stdout_console()
     ranges = calibration.posterior_ranges

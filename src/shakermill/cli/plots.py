@@ -78,7 +78,7 @@ def plot(
 ) -> None:
     """Draw the figures of a run folder (paper Figs. 4, 5a, 5b, impact statistics; for the dem engine the balls'
     paths and heat by channel, and with --animate a GIF) or of a sweep folder (maps or lines)."""
-    from shakermill.studies.sweep_storage import is_sweep_folder
+    from shakermill.studies.sweeps.storage import is_sweep_folder
     from shakermill.views.figures.common import plot_figures
 
     target = out if out is not None else folder / FIGURES_FOLDER
@@ -103,7 +103,7 @@ def plot(
 
 def _sweep_figures(folder: Path, contour: Sequence[str]) -> dict[str, Any]:
     """The maps or lines of a sweep folder, with the ``--contour`` levels; a note for each level never reached."""
-    from shakermill.studies.sweep_storage import load_sweep
+    from shakermill.studies.sweeps.storage import load_sweep
     from shakermill.views.figures.sweeps import contour_notes, parse_contour, sweep_context, sweep_figures
 
     with user_errors():

@@ -128,7 +128,7 @@ def cluster_for_replicas(params: Parameters, scheduler: str | None, timeout: flo
 
     from shakermill.parameters.errors import ParameterError
     from shakermill.solvers.averaged import full_resolution_instead, replica_count
-    from shakermill.studies.sweep_backends import connect
+    from shakermill.studies.sweeps.backends import connect
 
     if scheduler is None:
         return nullcontext()
@@ -172,10 +172,10 @@ def preset_findings_added(result: Result, preset: str | None, refitted: Sequence
 def with_preset_findings(result: Result, preset: str | None, refitted: Sequence[str] = ()) -> None:
     """Add to the summary of any preset's run what its validation found where it failed or is missing
     (``validation_caveat``, said of the preset as shipped where the configuration ``refitted`` keys), and of a
-    calibrated preset's run the 90 % intervals of its headline temperatures (``studies.uncertainty``), which carry
-    the calibration's uncertainty and the averaging error."""
+    calibrated preset's run the 90 % intervals of its headline temperatures (``studies.calibration.intervals``),
+    which carry the calibration's uncertainty and the averaging error."""
     from shakermill.parameters.presets import PRESETS
-    from shakermill.studies.uncertainty import intervals, uncertainty_of
+    from shakermill.studies.calibration.intervals import intervals, uncertainty_of
 
     known = PRESETS.get(preset) if preset is not None else None
     caveat = known.caveat_for(result.params.model_dump(), refitted) if known is not None else None
@@ -449,7 +449,7 @@ def compare_solvers(
     speed ratio."""
     from shakermill.io.runs import to_jsonable
     from shakermill.parameters.config import load_config
-    from shakermill.studies.compare import compare_solvers as compare
+    from shakermill.studies.validation.compare import compare_solvers as compare
 
     with user_errors(), nothing_written_when_interrupted("compare-solvers writes no files"):
         # Both solvers run: a key of the averaged one is read.

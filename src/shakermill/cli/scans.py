@@ -98,10 +98,10 @@ def sweep(
     json_output: JsonOption = False,
 ) -> None:
     """Run one simulation per point of a grid or a list; write one table (Parquet and CSV) of their summaries."""
-    from shakermill.studies.sweep import SweepFailed, SweepInterrupted
-    from shakermill.studies.sweep import sweep as run_sweep
-    from shakermill.studies.sweep_plan import check_keys_read, plan_sweep, sweep_parameters
-    from shakermill.studies.sweep_storage import is_sweep_folder
+    from shakermill.studies.sweeps.plan import check_keys_read, plan_sweep, sweep_parameters
+    from shakermill.studies.sweeps.storage import is_sweep_folder
+    from shakermill.studies.sweeps.sweep import SweepFailed, SweepInterrupted
+    from shakermill.studies.sweeps.sweep import sweep as run_sweep
 
     with user_errors():
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
@@ -155,7 +155,7 @@ def report_sweep(
 ) -> None:
     """Print the sweep's table (a preview, with the swept values in ``units`` where given, or where it is as JSON);
     exit with EXIT_FAILED_RUN if a point failed."""
-    from shakermill.studies.sweep_storage import TABLE_CSV, TABLE_PARQUET, failed_points
+    from shakermill.studies.sweeps.storage import TABLE_CSV, TABLE_PARQUET, failed_points
 
     failed = failed_points(table)
     if json_output:
@@ -186,7 +186,7 @@ def sweep_preview(table: pd.DataFrame, keys: Sequence[str], target: Path, units:
     import pandas as pd
 
     from shakermill.solvers.summary import declared_names
-    from shakermill.studies.sweep_storage import TABLE_CSV, TABLE_PARQUET, failed_points
+    from shakermill.studies.sweeps.storage import TABLE_CSV, TABLE_PARQUET, failed_points
 
     regime, *summary_columns = (column for column, _, _ in SWEEP_PREVIEW_COLUMNS)
     columns = (regime, *declared_names(summary_columns))
@@ -255,9 +255,9 @@ def bifurcation(
     diagram."""
     from shakermill.io.runs import check_target, write_folder
     from shakermill.parameters.engine_keys import reader_of
-    from shakermill.studies.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
-    from shakermill.studies.bifurcation import bifurcation as regime_scan
-    from shakermill.studies.sweep_plan import grid_unit, parse_grid, sweep_parameters
+    from shakermill.studies.sweeps.bifurcation import BIFURCATION_FIGURE, BIFURCATION_FOLDER, write_bifurcation
+    from shakermill.studies.sweeps.bifurcation import bifurcation as regime_scan
+    from shakermill.studies.sweeps.plan import grid_unit, parse_grid, sweep_parameters
     from shakermill.views.figures.common import plot_figures
     from shakermill.views.figures.sweeps import bifurcation_figure, sweep_context
 

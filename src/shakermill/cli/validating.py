@@ -79,7 +79,7 @@ def validate(
     one-ball experiments, the structures that follow the one-ball curve, the held-out studies, and each SPEX
     experiment fitted over every uncertain input predicting the other."""
     from shakermill.io.runs import to_jsonable
-    from shakermill.studies.validation_report import SOLVERS, validation_report
+    from shakermill.studies.validation.report import SOLVERS, validation_report
 
     solver = solver if solver is not None else "full" if full else "averaged"
     if solver not in SOLVERS:
@@ -120,7 +120,7 @@ def validate(
 
 def print_report(report: Any) -> None:
     """The tables of ``validate`` on the terminal."""
-    from shakermill.studies.validation import TABLE5
+    from shakermill.studies.measured import TABLE5
 
     console = stdout_console()
     console.print(validation_table(report.runs))
@@ -209,7 +209,7 @@ def print_powder(console: Console, comparison: Any) -> None:
 
 
 def print_held_out(console: Console, held_out: Any) -> None:
-    from shakermill.studies.held_out import COMPARED_KEYS, FIVE_BALL_SOURCE
+    from shakermill.studies.validation.held_out import COMPARED_KEYS, FIVE_BALL_SOURCE
     from shakermill.views.validation_page import HELD_OUT_HEADERS, held_out_rows
 
     prediction, comparison, sensitivity = held_out.prediction, held_out.comparison, held_out.sensitivity
@@ -256,7 +256,7 @@ def sensitivity_table(sensitivity: Any) -> Table:
 
 
 def validation_table(runs: Sequence[Any]) -> Table:
-    from shakermill.studies.validation import EXPERIMENT, TABLE5
+    from shakermill.studies.measured import EXPERIMENT, TABLE5
 
     table = Table("quantity", "unit", "experiment", "paper's model", title=f"Table 5 ({EXPERIMENT})")
     for run in runs:

@@ -6,7 +6,7 @@ without importing NumPy, pandas, SciPy or Matplotlib.
 
 # The preset of a run that names none: the paper's SPEX 8000M (parameters/presets.py).
 DEFAULT_PRESET = "spex8000m"
-# What `calibrate --target` fits: the Table 5 quantities of the experiment (studies/validation.py, TABLE5).
+# What `calibrate --target` fits: the Table 5 quantities of the experiment (studies/measured.py, TABLE5).
 TARGET_KEYS = ("theta_inf_C", "tau_min", "rate0_C_per_min", "vial_ball_ratio")
 PNG_DPI = 150
 REPORT_FILE = "report.html"
@@ -19,7 +19,7 @@ DEFAULT_FREE = ("beta", "vial_mass", "h_outer", "lam")
 # three-dimensional mechanics at every evaluation; these three move only the thermal network.
 DEM_DEFAULT_FREE = ("beta", "vial_mass", "h_outer")
 # What a calibration frees by default on each thermal network, before the keys its run does not read are dropped
-# (studies/calibrate.default_free): the paper's network its hand-tuned β, the vial's mass and its loss to the room;
+# (studies/calibration/calibrate.default_free): the paper's network its hand-tuned β, the vial's mass and its loss to the room;
 # a real mill's ('mill-head', MODEL.md §13.2) what no source gives: the drive's heat, the clamp's heat capacity and
 # its loss, as the shipped spex8000m-3d-calibrated was fitted (its outer loss is computed, h_outer is not read).
 DEFAULT_FREE_BY_NETWORK = {"paper": DEFAULT_FREE, "mill-head": ("drive_heat", "clamp_heat_capacity", "clamp_loss")}

@@ -91,7 +91,7 @@ class Summary(Outcome, FitSection, Heat, Numerics, Inputs, StressSection, Mappin
     validation_caveat: str | None = None
     """What the preset's validation found where it failed or is missing (``shakermill run``)."""
     intervals: PredictionIntervals | None = None
-    """The 90 % intervals of a calibrated preset's run (``studies/uncertainty.py``)."""
+    """The 90 % intervals of a calibrated preset's run (``studies/calibration/intervals.py``)."""
     warnings: list[str] = Field(default_factory=list)
     """One line each: what a user should know that did not stop the run."""
     notes: list[str] = Field(default_factory=list)

@@ -1,7 +1,7 @@
 """The sections of a run's summary that the solvers build (``solvers/result.py``: ``summarize``, and the averaging's
 :meth:`~shakermill.solvers.result.MechanicsAverages.as_summary`) and the one a study adds to a run's summary (the 90 %
-intervals of ``studies/uncertainty.py``): typed as :mod:`shakermill.analysis.sections` describes, composed into
-:class:`~shakermill.solvers.summary.Summary`."""
+intervals of ``studies/calibration/intervals.py``): typed as :mod:`shakermill.analysis.sections` describes, composed
+into :class:`~shakermill.solvers.summary.Summary`."""
 
 from __future__ import annotations
 
@@ -194,10 +194,10 @@ class Averaging(Section):
 
 
 class PredictionIntervals(Section):
-    """The 90 % intervals of a calibrated preset's run (``studies/uncertainty.py``; ``summary.intervals``)."""
+    """The 90 % intervals of a calibrated preset's run (``studies/calibration/intervals.py``; ``summary.intervals``)."""
 
     ball_C_low: Celsius
-    """Lower end of the 90 % interval of ``ball_C`` (a calibrated preset's run; ``studies/uncertainty.py``)."""
+    """Lower end of the 90 % interval of ``ball_C`` (a calibrated preset's run; studies/calibration/intervals.py)."""
     ball_C_high: Celsius
     """Upper end of that interval."""
     vial_C_low: Celsius

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from shakermill.studies.ensemble import (
+from shakermill.studies.ensembles.ensemble import (
     ASSUMED_PART,
     LEAST_Q2,
     NOISE_PART,

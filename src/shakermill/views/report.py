@@ -23,15 +23,8 @@ from shakermill.io.runs import CONFIG_FILE, RunData, load_run
 from shakermill.parameters.defaults import DEFAULT_PRESET, REPORT_FILE
 from shakermill.parameters.keys import field_description, field_unit, material_sources
 from shakermill.parameters.presets import PRESETS, Preset
-from shakermill.studies.validation import (
-    EXPERIMENT,
-    OPERATING_POINT_TOLERANCE,
-    PAPER,
-    ComparisonRow,
-    compare,
-    fitted_quantities,
-    operating_point_mismatches,
-)
+from shakermill.studies.measured import EXPERIMENT, OPERATING_POINT_TOLERANCE, PAPER, fitted_quantities
+from shakermill.studies.validation.table5 import ComparisonRow, compare, operating_point_mismatches
 from shakermill.support.version import __version__
 from shakermill.views.figures.common import several_balls
 from shakermill.views.figures.run import comparison_temperature_figure, main_figure_names, model_of, paper_figures
@@ -228,7 +221,7 @@ def fitted_targets(preset: Preset | None) -> tuple[str, ...]:
     """The Table 5 quantities (summary keys) a preset's calibration was fitted to.
 
     ``Preset.fitted`` names the *parameters* the calibration set (beta, vial_mass); the quantities they
-    were fitted to come from its provenance, as in :func:`shakermill.studies.validation.validate`.
+    were fitted to come from its provenance, as in :func:`shakermill.studies.validation.table5.validate`.
     """
     if preset is None:
         return ()

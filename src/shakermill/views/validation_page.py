@@ -16,11 +16,11 @@ from shakermill.views.notebook import esc
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from shakermill.studies.cross_prediction import CrossPrediction
-    from shakermill.studies.held_out import HeldOutPrediction
-    from shakermill.studies.powder import PowderComparison
-    from shakermill.studies.validation_matrix import StructureOutcome, ValidationMatrix
-    from shakermill.studies.validation_report import ValidationReport
+    from shakermill.studies.validation.cross_prediction import CrossPrediction
+    from shakermill.studies.validation.held_out import HeldOutPrediction
+    from shakermill.studies.validation.matrix import StructureOutcome, ValidationMatrix
+    from shakermill.studies.validation.powder import PowderComparison
+    from shakermill.studies.validation.report import ValidationReport
 
 MATRIX_HEADERS = (
     "preset (thermal model)",
@@ -60,7 +60,7 @@ def matrix_rows(matrix: ValidationMatrix) -> list[tuple[str, ...]]:
 
 
 def structure_headers() -> tuple[str, ...]:
-    from shakermill.studies.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
+    from shakermill.studies.validation.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
 
     return (
         "structure (free keys)",
@@ -76,8 +76,8 @@ def structure_headers() -> tuple[str, ...]:
 
 def structure_rows(outcomes: Sequence[StructureOutcome]) -> list[tuple[str, ...]]:
     """Each structure fitted to the one-ball curve: its fit, whether it meets the bar, its five-ball prediction."""
-    from shakermill.studies.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
-    from shakermill.studies.validation import relative_error
+    from shakermill.studies.measured import relative_error
+    from shakermill.studies.validation.held_out import FIVE_BALL_BALL_RISE_K, FIVE_BALL_VIAL_RISE_K
 
     def against(rise: float, measured: float) -> str:
         return f"{rise:.3g} ({100 * relative_error(rise, measured):+.0f} %)"
@@ -138,7 +138,7 @@ def powder_statement(comparison: PowderComparison) -> str:
 
 
 def structure_verdict(outcomes: Sequence[StructureOutcome]) -> str:
-    from shakermill.studies.validation_matrix import FOLLOWS_CURVE_K
+    from shakermill.studies.validation.matrix import FOLLOWS_CURVE_K
 
     meeting = [outcome.structure.label for outcome in outcomes if outcome.meets_point_7]
     return (
@@ -226,7 +226,7 @@ def cross_rows(cross: CrossPrediction) -> list[tuple[str, ...]]:
 
 def cross_statement(cross: CrossPrediction) -> str:
     """The verdicts, what was freed and how, and how well the emulators predict runs they did not see."""
-    from shakermill.studies.joint_calibration import ASSUMED_MEASUREMENT_SD_K
+    from shakermill.studies.calibration.observables import ASSUMED_MEASUREMENT_SD_K
 
     verdicts = "; ".join(
         direction.verdict + (f" (unreliable: {'; '.join(direction.problems)})" if direction.problems else "")

@@ -17,19 +17,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from shakermill.engines.registry import engine_named
-from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.defaults import DEFAULT_FREE_BY_NETWORK
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import PRESETS, default_parameters, preset_values
-from shakermill.solvers.averaged import integrate_network
 from shakermill.solvers.simulate import thermal_variants
-from shakermill.studies.calibrate import DEFENSIBLE_RANGES, calibrate
-from shakermill.studies.held_out import FIVE_BALLS
-from shakermill.studies.uncertainty import Uncertainty, heat_error_of, propagated, uncertainty_of
-from shakermill.studies.validation import experiment_curve, relative_error
+from shakermill.studies.calibration.calibrate import DEFENSIBLE_RANGES, calibrate
+from shakermill.studies.calibration.intervals import Uncertainty, heat_error_of, propagated, uncertainty_of
+from shakermill.studies.calibration.observables import node_rises
+from shakermill.studies.measured import experiment_curve, relative_error
+from shakermill.studies.validation.held_out import FIVE_BALLS
 
 EXPERIMENT_FOLDER = Path(__file__).parent / "experiments"
 # The calibrated 3-D presets compared, one per thermal model, each fitted to the one-ball curve alone.
@@ -148,26 +145,6 @@ class ValidationMatrix:
             },
             "rows": [row.as_dict() for row in self.rows],
         }
-
-
-def node_rises(
-    points: tuple[Point, ...], network_of: Callable[[Parameters], ThermalNetwork]
-) -> Callable[[Parameters, NetworkLoad], dict[str, float]]:
-    """The rises (K) of ``points`` of the network ``network_of`` builds, under a mean load, as named quantities."""
-
-    def rises(params: Parameters, load: NetworkLoad) -> dict[str, float]:
-        network = network_of(params)
-        thermal = integrate_network(network, load, params)
-        index = {"ball": slice(0, network.n_balls), "vial": network.vial}
-        values = {}
-        for point in points:
-            history = np.atleast_2d(thermal.y[index[point.node]]).mean(axis=0)
-            values[f"{point.node}@{point.time_s:g}"] = (
-                float(np.interp(point.time_s, thermal.t, history)) - params.initial_temperature
-            )
-        return values
-
-    return rises
 
 
 def predict(
@@ -332,7 +309,7 @@ def structure_study(
             StructureOutcome(
                 structure,
                 calibration.fitted,
-                float(calibration.curve_rms_K),
+                math.nan if calibration.curve_rms_K is None else calibration.curve_rms_K,
                 tuple(key for key in calibration.at_bounds if key in DEFENSIBLE_RANGES),
                 summary.ball_C - start,
                 summary.vial_C - start,

@@ -8,7 +8,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from shakermill.parameters.errors import ParameterError
-from shakermill.studies.validation import Curve
+from shakermill.studies.measured import Curve
 
 
 def informative_points(curve: Curve) -> int:

@@ -16,51 +16,33 @@ A sweep folder holds
 A point's id is a hash of the base parameters and the point's values, so re-running the same
 sweep into the same folder skips the points whose file exists and can be read. Every point is computed on its
 own from its parameters alone, so the table does not depend on the number of workers, the order
-in which they finish, or whether the points ran on a Dask cluster.
+in which they finish, or whether the points ran on a Dask cluster. The points run through the executor of many runs
+(:mod:`.executor`), which a calibration's training runs share.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+import functools
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-from shakermill.engines.budget import interrupts_held
 from shakermill.parameters.defaults import DEFAULT_PRESET, DEFAULT_SCHEDULER_TIMEOUT_S
-from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
-from shakermill.studies.sweep_backends import backend_for
-from shakermill.studies.sweep_plan import SweepPlan, as_plan, point_ids
-from shakermill.studies.sweep_storage import (
+from shakermill.studies.sweeps.executor import Execution, ProgressCallback, RunsInterrupted, execute
+from shakermill.studies.sweeps.plan import SweepPlan, as_plan, point_ids
+from shakermill.studies.sweeps.points import run_point
+from shakermill.studies.sweeps.storage import (
     TABLE_CSV,
     build_table,
-    check_folder,
-    claim_folder,
     failed_points,
-    finished_counts,
     store_point,
     stored_rows,
     sweep_manifest,
     write_table,
 )
-
-ProgressCallback = Callable[["SweepProgress"], None]
-
-
-@dataclass(frozen=True)
-class SweepProgress:
-    """Where a sweep stands; ``done`` counts failed points and points finished by an earlier run."""
-
-    total: int
-    done: int
-    failed: int
-    running: int
-
-
-# One point --------------------------------------------------------------------------------------
 
 
 class SweepFailed(RuntimeError):
@@ -82,9 +64,6 @@ class SweepInterrupted(KeyboardInterrupt):
     def __init__(self, table: pd.DataFrame, folder: Path, kept: int) -> None:
         super().__init__(f"interrupted; kept {kept} of {len(table)} points in {folder}")
         self.table, self.folder, self.kept = table, folder, kept
-
-
-# The sweep ----------------------------------------------------------------------------------------
 
 
 def sweep(
@@ -114,71 +93,35 @@ def sweep(
     raises :class:`SweepInterrupted` (a ``KeyboardInterrupt``) once the table holds the finished points.
     """
     plan = as_plan(grid_points)
-    _check_execution(workers, scheduler)
+    execution = Execution(workers, scheduler, scheduler_timeout, progress)
     folder = Path(out_dir)
     ids = point_ids(base_params, plan)
-    manifest = sweep_manifest(base_params, plan, ids, preset)
-    check_folder(folder, manifest)
-    stored = stored_rows(folder, ids, warn=True)
-    pending = [(identifier, values) for identifier, values in zip(ids, plan.points) if identifier not in stored]
-    unfinished: dict[str, str] = {}
+    written: list[pd.DataFrame] = []
 
-    def tabulate() -> pd.DataFrame:
+    def tabulate(unfinished: Mapping[str, str]) -> pd.DataFrame:
         # Also on Ctrl-C: the table then holds the finished points, the others marked not finished.
         table = build_table(folder, plan.keys, ids, plan.points, unfinished)
         write_table(table, folder)
+        written.append(table)
         return table
 
-    # The backend first: an unreachable scheduler leaves no folder behind.
-    with backend_for(workers, scheduler, scheduler_timeout, len(pending)) as backend:
-        claim_folder(folder, manifest)
-        try:
-            tracker = _Tracker(len(ids), finished_counts(stored), backend.slots, progress)
-            for identifier, outcome in backend.outcomes(base_params, pending, keep_runs):
-                if isinstance(outcome, BaseException):
-                    unfinished[identifier] = (
-                        f"not finished ({type(outcome).__name__}: {outcome}); re-run the sweep to retry"
-                    )
-                    tracker.finished(failed=True)
-                    continue
-                row = store_point(folder, identifier, outcome, preset)
-                tracker.finished(failed=row.get("error") is not None)
-        except BaseException as stopped:
-            # The workers stop before the table is written, not after their points end; a second Ctrl-C
-            # meanwhile must leave neither workers running nor the table unwritten.
-            with interrupts_held(deliver=False):
-                backend.stop()
-                table = tabulate()
-            if isinstance(stopped, KeyboardInterrupt):
-                # Counted from the folder, not as points are stored: Ctrl-C may fall between a store and a count.
-                raise SweepInterrupted(table, folder, len(stored_rows(folder, ids))) from None
-            raise
-        table = tabulate()
+    try:
+        unfinished = execute(
+            folder,
+            sweep_manifest(base_params, plan, ids, preset),
+            list(zip(ids, plan.points)),
+            functools.partial(run_point, base_params, keep_run=keep_runs),
+            functools.partial(_store, preset=preset),
+            execution,
+            on_stop=tabulate,
+        )
+    except RunsInterrupted:
+        raise SweepInterrupted(written[-1], folder, len(stored_rows(folder, ids))) from None
+    table = tabulate(unfinished)
     if len(failed_points(table)) == len(table):
         raise SweepFailed(table, folder)
     return table
 
 
-def _check_execution(workers: int | None, scheduler: str | None) -> None:
-    if workers is not None and scheduler is not None:
-        raise ParameterError("workers: the local pool's size; with a scheduler the cluster's workers run the points")
-    if workers is not None and workers < 1:
-        raise ParameterError(f"workers: {workers} is out of range; allowed 1 or more")
-
-
-class _Tracker:
-    """Counts finished points and reports them to the progress callback."""
-
-    def __init__(self, total: int, finished: tuple[int, int], slots: int, progress: ProgressCallback | None) -> None:
-        self.total, (self.done, self.failed), self.slots, self.progress = total, finished, slots, progress
-        self._report()
-
-    def finished(self, *, failed: bool) -> None:
-        self.done += 1
-        self.failed += int(failed)
-        self._report()
-
-    def _report(self) -> None:
-        if self.progress is not None:
-            running = min(self.slots, self.total - self.done)
-            self.progress(SweepProgress(self.total, self.done, self.failed, running))
+def _store(folder: Path, identifier: str, outcome: Any, *, preset: str) -> dict[str, Any]:
+    return store_point(folder, identifier, outcome, preset)

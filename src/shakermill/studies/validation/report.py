@@ -12,12 +12,11 @@ from typing import Any
 from shakermill.parameters.config import load_config
 from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.keys import Parameters
-from shakermill.studies.calibrate import FREE_SET_STUDY, FreeSetOutcome, free_set_study
-from shakermill.studies.cross_prediction import CrossPrediction, cross_prediction
-from shakermill.studies.held_out import HeldOutStudies, held_out_steps, held_out_studies
-from shakermill.studies.powder import POWDER_STEPS, PowderComparison, powder_studies
-from shakermill.studies.validation import EXPERIMENT, TABLE5, VALIDATION_PRESETS, ValidationRun, validate
-from shakermill.studies.validation_matrix import (
+from shakermill.studies.calibration.calibrate import FREE_SET_STUDY, FreeSetOutcome, free_set_study
+from shakermill.studies.measured import EXPERIMENT, TABLE5
+from shakermill.studies.validation.cross_prediction import CrossPrediction, cross_prediction
+from shakermill.studies.validation.held_out import HeldOutStudies, held_out_steps, held_out_studies
+from shakermill.studies.validation.matrix import (
     STRUCTURES,
     THERMAL_MODEL_PRESETS,
     Experiment,
@@ -27,6 +26,8 @@ from shakermill.studies.validation_matrix import (
     structure_study,
     validation_matrix,
 )
+from shakermill.studies.validation.powder import POWDER_STEPS, PowderComparison, powder_studies
+from shakermill.studies.validation.table5 import VALIDATION_PRESETS, ValidationRun, validate
 
 SOLVERS = ("full", "averaged")
 

@@ -18,8 +18,8 @@ import pandas as pd
 from shakermill.io.runs import to_jsonable
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
-from shakermill.studies.sweep_plan import POINT_ID_LENGTH, POINT_ID_PATTERN, SweepPlan
-from shakermill.studies.sweep_points import PointOutcome, failed_row
+from shakermill.studies.sweeps.plan import POINT_ID_LENGTH, POINT_ID_PATTERN, SweepPlan
+from shakermill.studies.sweeps.points import PointOutcome, failed_row
 from shakermill.support.atomic import (
     check_writable_place,
     create_exclusively,

@@ -2,28 +2,26 @@
 the variance-based sensitivity of each headline, and the motion regimes its members fell into.
 
 The members are a scrambled Sobol' design (``scipy.stats.qmc``) over the assumed inputs' ranges, each mapped
-through its distribution, run as the points of a sweep (``studies/sweep.py``: in parallel, on the local pool or a
+through its distribution, run as the points of a sweep (``studies/sweeps/sweep.py``: in parallel, on the local pool or a
 Dask cluster, stored one file a member, resumable, the same numbers whatever the number of workers). The
 headlines' 5, 50 and 95 % points are those of the members: the design samples the inputs' distribution evenly.
 Sobol' indices need far more runs than an ensemble can afford (N·(d + 2) for d inputs), so they are computed
 (SALib, Saltelli's design and Jansen's estimators) on a Gaussian-process surrogate fitted to the members
-(scikit-learn), whose own error is measured on members it did not see (k-fold cross-validation): an index
-of a headline the surrogate does not predict is not reported.
+(``studies.inference.surrogate``), whose own error is measured on members it did not see (k-fold cross-validation):
+an index of a headline the surrogate does not predict is not reported.
 
 A calibrated preset's fitted keys are not assumed inputs but they are uncertain: their posterior joins the design
 (MODEL.md §14.1: the interval of a calibrated prediction carries the posterior of the fitted keys, the assumed inputs
 not fitted, and the averaging error of the mechanics, the members' own noise). It enters as a Gaussian in the
-keys' logarithms with the mean and covariance of the calibration's posterior samples, drawn through independent
-normals ξ (log v = mean + L·ξ, L its Cholesky factor), so that each ξ is an input of its own: "KEY (fitted)", the
-part of that key's spread the keys before it do not explain.
+keys' logarithms with the mean and covariance of the calibration's posterior samples
+(``studies.inference.posterior.LogNormal``), drawn through independent normals ξ (log v = mean + L·ξ, L its Cholesky
+factor), so that each ξ is an input of its own: "KEY (fitted)", the part of that key's spread the keys before it do
+not explain.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import math
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,7 +37,12 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.summary import declared_names, family_members
-from shakermill.studies.sweep import ProgressCallback, sweep
+from shakermill.studies.inference.design import design_seed, sobol
+from shakermill.studies.inference.posterior import FITTED_SUFFIX, QUANTILES, LogNormal, Posterior
+from shakermill.studies.inference.prior import Prior
+from shakermill.studies.inference.surrogate import LEAST_Q2, Surrogate, fit_surrogate
+from shakermill.studies.sweeps.executor import ProgressCallback
+from shakermill.studies.sweeps.sweep import sweep
 
 # The headlines an ensemble reports: summary key -> (what it is, unit). Rises are computed from the end and
 # steady temperatures and the run's starting temperature.
@@ -67,64 +70,15 @@ RISES = dict(
 START, REGIME = declared_names(("initial_temperature_C", "charge_regime"))
 # The powers above each stress-energy threshold: a family of summary keys, one per threshold.
 POWER_ABOVE = "stress_power_above_{threshold}_W"
-QUANTILES = (0.05, 0.5, 0.95)
-# The surrogate's cross-validated Q² below which its Sobol' indices are not reported, and its folds.
-LEAST_Q2 = 0.5
+# The surrogate's folds of cross-validation (its indices are not reported below LEAST_Q2).
 FOLDS = 5
 # A headline whose members spread less than this share of its size does not depend on the inputs: a part in a
 # million is the integrators' tolerance, not a sensitivity.
 STEADY_SPREAD = 1e-6
 # Base samples of Saltelli's design on the surrogate: N·(d + 2) predictions.
 SALTELLI_BASE = 1024
-# How the design names a fitted key's normal.
-FITTED_SUFFIX = " (fitted)"
 # The fewest members (a power of two) and the most.
 LEAST_MEMBERS, MOST_MEMBERS = 8, 4096
-
-
-@dataclass(frozen=True)
-class FittedPosterior:
-    """A calibration's fitted keys as a Gaussian in their logarithms (:func:`fitted_posterior`)."""
-
-    keys: tuple[str, ...]
-    mean: np.ndarray
-    factor: np.ndarray  # lower Cholesky factor of the covariance of the logarithms
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        return tuple(f"{key}{FITTED_SUFFIX}" for key in self.keys)
-
-    def values(self, unit: np.ndarray) -> np.ndarray:
-        """The keys' values (last axis) at points of the unit cube, one independent normal per key."""
-        from scipy.stats import norm
-
-        return np.exp(self.mean + norm.ppf(unit) @ self.factor.T)
-
-    def unit(self, values: np.ndarray) -> np.ndarray:
-        """The inverse of :meth:`values`."""
-        from scipy.linalg import solve_triangular
-        from scipy.stats import norm
-
-        normals = solve_triangular(self.factor, (np.log(values) - self.mean).T, lower=True).T
-        return norm.cdf(normals)
-
-    def as_dict(self) -> dict[str, Any]:
-        spread = np.sqrt(np.diag(self.factor @ self.factor.T))
-        return {
-            key: {"median": float(np.exp(centre)), "log_sd": float(sd)}
-            for key, centre, sd in zip(self.keys, self.mean, spread)
-        }
-
-
-def fitted_posterior(keys: Sequence[str], samples: Sequence[Sequence[float]] | None) -> FittedPosterior | None:
-    """The posterior of ``keys`` from a calibration's samples of their logarithms; None without enough samples to
-    estimate a covariance."""
-    if not keys or samples is None or len(samples) <= len(keys):
-        return None
-    logs = np.asarray(samples, dtype=float)
-    return FittedPosterior(
-        tuple(keys), logs.mean(axis=0), np.linalg.cholesky(np.atleast_2d(np.cov(logs, rowvar=False)))
-    )
 
 
 @dataclass(frozen=True)
@@ -170,7 +124,7 @@ class Ensemble:
     """What an ensemble found: its inputs, members, headlines, regimes and the folder that holds its members."""
 
     inputs: tuple[AssumedInput, ...]
-    posterior: FittedPosterior | None
+    posterior: LogNormal | None
     members: int
     failed: int
     headlines: tuple[HeadlineSpread, ...]
@@ -206,7 +160,7 @@ def _finite(value: Any) -> Any:
 
 def ensemble_inputs(
     preset: Preset, params: Parameters, assume: Sequence[str], vary: Sequence[str]
-) -> tuple[list[AssumedInput], FittedPosterior | None]:
+) -> tuple[list[AssumedInput], LogNormal | None]:
     """What an ensemble of ``params`` varies: the assumed inputs ``preset`` states that the run reads, replaced or
     joined by the user's ranges (``assume``: ``KEY=LOW:HIGH[:DIST]``), only those named in ``vary`` where it names
     some; and, varying all, the posterior of the keys the preset's calibration fitted, where the run keeps their
@@ -224,46 +178,22 @@ def ensemble_inputs(
     if vary:
         return [inputs[key] for key in dict.fromkeys(vary)], None
     keeps_fit = all(getattr(params, key) == preset.values[key].value for key in preset.fitted)
-    return list(inputs.values()), fitted_posterior(preset.fitted, preset.posterior) if keeps_fit else None
+    recorded = None if preset.posterior is None else Posterior.of_logarithms(preset.fitted, preset.posterior)
+    return list(inputs.values()), recorded.log_normal() if keeps_fit and recorded is not None else None
 
 
 def design(
-    inputs: Sequence[AssumedInput], members: int, seed: int, posterior: FittedPosterior | None = None
+    inputs: Sequence[AssumedInput], members: int, seed: int, posterior: LogNormal | None = None
 ) -> list[dict[str, float]]:
     """``members`` points (a power of two) of a scrambled Sobol' design over ``inputs`` and the ``posterior``'s
     normals, each value drawn through its input's distribution."""
-    from scipy.stats import qmc
-
     fitted = () if posterior is None else posterior.keys
-    unit = qmc.Sobol(len(inputs) + len(fitted), scramble=True, seed=seed).random_base2(int(math.log2(members)))
-    values = from_unit(inputs, unit[:, : len(inputs)])
+    unit = sobol(len(inputs) + len(fitted), members, seed)
+    values = Prior(tuple(inputs)).values(unit[:, : len(inputs)])
     if posterior is not None:
         values = np.column_stack([values, posterior.values(unit[:, len(inputs) :])])
     keys = [item.key for item in inputs] + list(fitted)
     return [{key: float(value) for key, value in zip(keys, row)} for row in values]
-
-
-def from_unit(inputs: Sequence[AssumedInput], unit: np.ndarray) -> np.ndarray:
-    """Points of the unit cube (last axis: the inputs) mapped onto the inputs' ranges by their distributions."""
-    values = np.empty_like(unit, dtype=float)
-    for column, item in enumerate(inputs):
-        share = unit[..., column]
-        if item.distribution == "log-uniform":
-            values[..., column] = np.exp(np.log(item.low) + share * (np.log(item.high) - np.log(item.low)))
-        else:
-            values[..., column] = item.low + share * (item.high - item.low)
-    return values
-
-
-def to_unit(inputs: Sequence[AssumedInput], values: np.ndarray) -> np.ndarray:
-    """The inverse of :func:`from_unit`."""
-    unit = np.empty_like(values, dtype=float)
-    for column, item in enumerate(inputs):
-        if item.distribution == "log-uniform":
-            unit[..., column] = np.log(values[..., column] / item.low) / np.log(item.high / item.low)
-        else:
-            unit[..., column] = (values[..., column] - item.low) / (item.high - item.low)
-    return unit
 
 
 def check_members(members: int) -> None:
@@ -272,15 +202,6 @@ def check_members(members: int) -> None:
             f"members: {members} is not allowed; a power of two in [{LEAST_MEMBERS}, {MOST_MEMBERS}]"
             " (a Sobol' design is balanced at powers of two)"
         )
-
-
-def design_seed(base: Parameters, inputs: Sequence[AssumedInput]) -> int:
-    """The design's seed: a hash of the configuration and the inputs' ranges, so that the same ensemble asked for
-    twice has the same members (and resumes)."""
-    # An input that moves no derived key hashes as before that field existed: recorded ensembles keep their members.
-    described = [{key: value for key, value in vars(item).items() if key != "moves" or value} for item in inputs]
-    text = json.dumps([base.model_dump(mode="json"), described], sort_keys=True, default=str)
-    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:4], "big")
 
 
 def run_ensemble(
@@ -293,7 +214,7 @@ def run_ensemble(
     progress: ProgressCallback | None = None,
     *,
     preset: str,
-    posterior: FittedPosterior | None = None,
+    posterior: LogNormal | None = None,
     announce: Callable[[str], None] | None = None,
 ) -> Ensemble:
     """Run ``base`` at ``members`` points of a Sobol' design over ``inputs`` and the fitted keys' ``posterior`` (a
@@ -317,7 +238,7 @@ def run_ensemble(
 
 
 def analyse(
-    table: pd.DataFrame, inputs: Sequence[AssumedInput], folder: Path, posterior: FittedPosterior | None = None
+    table: pd.DataFrame, inputs: Sequence[AssumedInput], folder: Path, posterior: LogNormal | None = None
 ) -> Ensemble:
     """The quantiles, Sobol' indices and regimes of an ensemble's members (the sweep ``table``)."""
     finished = table[table["error"].isna()].copy() if "error" in table else table.copy()
@@ -325,7 +246,7 @@ def analyse(
         if end in finished:
             finished[rise] = finished[end] - finished[START]
     keys = [key for key in (*HEADLINES, *sorted(family_members(finished, POWER_ABOVE))) if key in finished]
-    unit = to_unit(inputs, finished[[item.key for item in inputs]].to_numpy(dtype=float))
+    unit = Prior(tuple(inputs)).unit(finished[[item.key for item in inputs]].to_numpy(dtype=float))
     names = [item.key for item in inputs]
     if posterior is not None:
         unit = np.column_stack([unit, posterior.unit(finished[list(posterior.keys)].to_numpy(dtype=float))])
@@ -346,7 +267,8 @@ def analyse(
 def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]) -> HeadlineSpread:
     label, symbol = HEADLINES[key] if key in HEADLINES else (_power_label(key), "W")
     good = np.isfinite(values)
-    quantiles = tuple(float(q) for q in np.quantile(values[good], QUANTILES)) if good.any() else (math.nan,) * 3
+    low, middle, high = (float(q) for q in np.quantile(values[good], QUANTILES)) if good.any() else (math.nan,) * 3
+    quantiles = (low, middle, high)
     varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * np.max(np.abs(values[good]))
     if not varies:
         return HeadlineSpread(key, label, symbol, quantiles, math.nan, varies=False)
@@ -368,10 +290,10 @@ def _sensitivity(
     each input computed on it, and the interval's parts (:attr:`HeadlineSpread.parts`)."""
     if len(values) < FOLDS:
         return math.nan, {}, {}, {}
-    q2 = _cross_validated_q2(unit, values)
-    if not q2 >= LEAST_Q2:
+    surrogate = fit_surrogate(unit, values, FOLDS, least_q2=LEAST_Q2)
+    q2 = surrogate.q2
+    if surrogate.model is None:
         return q2, {}, {}, {}
-    surrogate = gaussian_process(unit, values)
     first, total = _sobol(surrogate, list(names))
     groups = [POSTERIOR_PART if name.endswith(FITTED_SUFFIX) else ASSUMED_PART for name in names]
     by_group = _sobol(surrogate, list(names), groups)[1] if len(set(groups)) > 1 else {groups[0]: 1.0}
@@ -380,7 +302,7 @@ def _sensitivity(
 
 
 def _sobol(
-    surrogate: Any, names: list[str], groups: list[str] | None = None
+    surrogate: Surrogate, names: list[str], groups: list[str] | None = None
 ) -> tuple[dict[str, float], dict[str, float]]:
     """First and total Sobol' indices (SALib: Saltelli's design, Jansen's estimators) of the ``surrogate``'s mean over
     the unit cube of ``names``, of each input or, with ``groups``, of each group of them."""
@@ -391,43 +313,9 @@ def _sobol(
     if groups is not None:
         problem["groups"] = groups
     samples = sobol_sample.sample(problem, SALTELLI_BASE, calc_second_order=False, seed=1)
-    indices = sobol_analyse.analyze(problem, surrogate.predict(samples), calc_second_order=False, seed=1)
+    indices = sobol_analyse.analyze(problem, surrogate.mean(samples), calc_second_order=False, seed=1)
     labels = list(dict.fromkeys(groups)) if groups is not None else names
     return dict(zip(labels, map(float, indices["S1"]))), dict(zip(labels, map(float, indices["ST"])))
-
-
-def gaussian_process(unit: np.ndarray, values: np.ndarray) -> Any:
-    """A Gaussian process fitted to ``values`` at ``unit``, with one length scale per input (Matérn 5/2) and a noise
-    term for the averaging error."""
-    from sklearn.exceptions import ConvergenceWarning
-    from sklearn.gaussian_process import GaussianProcessRegressor
-    from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
-
-    kernel = ConstantKernel(1.0) * Matern(
-        length_scale=np.ones(unit.shape[1]), length_scale_bounds=(1e-2, 1e3), nu=2.5
-    ) + WhiteKernel(1e-3, noise_level_bounds=(1e-8, 1.0))
-    regressor = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=2, random_state=0)
-    # A length scale at its upper bound is an input the headline does not depend on: an answer, not a problem.
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        return regressor.fit(unit, values)
-
-
-def _cross_validated_q2(unit: np.ndarray, values: np.ndarray) -> float:
-    """1 − (sum of squared errors on held-out members)/(their sum of squares about the mean), over FOLDS folds."""
-    from sklearn.model_selection import KFold
-
-    predicted = np.empty_like(values)
-    for train, test in KFold(FOLDS, shuffle=True, random_state=0).split(unit):
-        predicted[test] = gaussian_process(unit[train], values[train]).predict(unit[test])
-    return q2_of(values, predicted)
-
-
-def q2_of(values: np.ndarray, predicted: np.ndarray) -> float:
-    """1 − (sum of squared errors of the predictions of held-out ``values``)/(their sum of squares about the mean);
-    NaN for values that do not vary."""
-    spread = float(np.sum((values - values.mean()) ** 2))
-    return 1.0 - float(np.sum((values - predicted) ** 2)) / spread if spread > 0 else math.nan
 
 
 def _regimes(finished: pd.DataFrame, keys: Sequence[str]) -> dict[str, dict[str, Any]]:

@@ -21,7 +21,7 @@ from typing import Any
 from shakermill.parameters.presets import default_parameters
 from shakermill.solvers.result import Result
 from shakermill.solvers.simulate import simulate
-from shakermill.studies.held_out import (
+from shakermill.studies.validation.held_out import (
     FIVE_BALL_BALL_RISE_K,
     FIVE_BALL_RATIO,
     FIVE_BALL_VIAL_RISE_K,

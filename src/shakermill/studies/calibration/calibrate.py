@@ -36,8 +36,8 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters, bounds, check_known_keys
 from shakermill.solvers.result import Result
 from shakermill.solvers.simulate import preflight, thermal_variants
-from shakermill.studies.defensible import DEFENSIBLE_RANGES
-from shakermill.studies.fit_statistics import (
+from shakermill.studies.calibration.defensible import DEFENSIBLE_RANGES
+from shakermill.studies.calibration.fit_statistics import (
     CURVE_SCALE_K,
     log_covariance,
     posterior_evaluations,
@@ -46,8 +46,10 @@ from shakermill.studies.fit_statistics import (
     sensitivities,
     standard_errors,
 )
-from shakermill.studies.identifiability import check_determinable, loosely_determined, undetermined_keys
-from shakermill.studies.validation import (
+from shakermill.studies.calibration.identifiability import check_determinable, loosely_determined, undetermined_keys
+from shakermill.studies.inference.posterior import Posterior
+from shakermill.studies.inference.prior import Prior, fitted_key
+from shakermill.studies.measured import (
     CURVE_TOLERANCE_K,
     TARGET_KEYS,
     Curve,
@@ -69,6 +71,8 @@ JACOBIAN_STEP = 1e-2
 AT_BOUND = 1e-2
 # A scalar target further off than this (relative) after the fit counts as not met.
 TARGET_TOLERANCE = 5e-3
+# The posterior's range a calibration reports of each key: its 5th and 95th percentiles.
+POSTERIOR_RANGE = (0.05, 0.95)
 # Quantities a calibration predicts without fitting them, reported beside the fit.
 PREDICTED_KEYS = ("vial_ball_ratio", "ball_steady_C", "vial_steady_C", "air_steady_C", "slowest_time_constant_min")
 
@@ -87,8 +91,8 @@ class Calibration:
     parameter_stderr: dict[str, float]
     # Of the natural logarithms of ``free``, in that order (None where the Jacobian does not determine it)
     covariance: list[list[float]] | None
-    # Samples of the posterior of those logarithms (emcee), where an evaluation is cheap enough to sample it
-    posterior: list[list[float]] | None
+    # The posterior of ``free``, sampled in their logarithms (emcee), where an evaluation is cheap enough to sample it
+    posterior: Posterior | None
     # target -> parameter -> d ln(target)/d ln(parameter); for a curve, "ball_C at T min" -> K per e-fold
     sensitivities: dict[str, dict[str, float]]
     predictions: dict[str, float]  # what the fitted model says of quantities that were not fitted
@@ -113,8 +117,9 @@ class Calibration:
         """Each fitted key's 5th and 95th posterior percentiles (its own unit); empty without a posterior."""
         if self.posterior is None:
             return {}
-        low, high = np.exp(np.percentile(np.asarray(self.posterior), [5.0, 95.0], axis=0))
-        return {key: (float(low[i]), float(high[i])) for i, key in enumerate(self.free)}
+        # Interpolated in the logarithms, where the fit sampled them.
+        ranges = self.posterior.quantiles(POSTERIOR_RANGE, in_logarithms=True)
+        return {key: (ranges[key][0], ranges[key][1]) for key in self.free}
 
     @property
     def defensible(self) -> dict[str, str]:
@@ -245,6 +250,18 @@ def log_bounds(key: str, start: float) -> tuple[float, float]:
     return math.log(low), max(math.log(high), math.log(start) + 1e-12)
 
 
+def fitted_prior(params: Parameters, free: Sequence[str]) -> Prior:
+    """The prior of ``free`` keys of a fit from ``params``: each log-uniform within its :func:`log_bounds` (the
+    defensible range, else a factor either way of its start), with the reason for the range. The least-squares fit
+    and its posterior move the keys within it; a calibration over every uncertain input frees them over it."""
+    entries = []
+    for key in free:
+        low, high = (math.exp(bound) for bound in log_bounds(key, float(getattr(params, key))))
+        reason = DEFENSIBLE_RANGES[key].reason if key in DEFENSIBLE_RANGES else "a factor either way of its start"
+        entries.append(fitted_key(key, low, high, reason))
+    return Prior(tuple(entries))
+
+
 def calibrate(
     base: Parameters,
     free: Sequence[str] = DEFAULT_FREE,
@@ -259,7 +276,7 @@ def calibrate(
     on_start: Callable[[], None] | None = None,
 ) -> Calibration:
     """Fit ``free`` keys of ``base`` to ``targets`` and/or one or several curves (``curve``), each of a node under
-    its own conditions (:class:`~shakermill.studies.validation.Curve`); see the module docstring.
+    its own conditions (:class:`~shakermill.studies.measured.Curve`); see the module docstring.
 
     ``on_start()`` is called once every input has been checked, before the first evaluation;
     ``progress(evaluations, curve_rms_K)`` after every model evaluation (the RMS of that evaluation against the
@@ -298,7 +315,9 @@ def calibrate(
     # Sampled only where an evaluation is a network alone: thousands of them take minutes there, hours elsewhere.
     sampled = sample_posterior and covariance is not None and base.engine_keys.thermal_only_keys and not full_resolution
     posterior = (
-        _sampled_posterior(evaluate, solution.x, (lower, upper), residuals, curves, on_posterior) if sampled else None
+        _sampled_posterior(base, free, evaluate, solution.x, (lower, upper), residuals, curves, on_posterior)
+        if sampled
+        else None
     )
     status, message = _verdict(solution, result.success, free, missed, at_bounds, curve_rms, covariance)
     return Calibration(
@@ -545,19 +564,22 @@ def _curve_rms(results: Mapping[tuple[str, ...], Result], curves: Sequence[Curve
 
 
 def _sampled_posterior(
+    base: Parameters,
+    free: Sequence[str],
     evaluate: Callable[[np.ndarray], Evaluation],
     best: np.ndarray,
     limits: tuple[np.ndarray, np.ndarray],
     residuals: np.ndarray,
     curves: Sequence[Curve],
     on_posterior: Callable[[int], None] | None,
-) -> list[list[float]]:
-    """The posterior samples of a fit's keys at the fit's residual variance, ``on_posterior`` told how many
+) -> Posterior:
+    """The posterior of a fit's keys at the fit's residual variance, ``on_posterior`` told how many
     evaluations they take before they begin."""
     if on_posterior is not None:
         on_posterior(posterior_evaluations(best.size))
     variance = residual_variance(residuals, best.size, curves)
-    return posterior_samples(lambda x: evaluate(x)[0], best, *limits, variance).tolist()
+    chain = posterior_samples(lambda x: evaluate(x)[0], best, *limits, variance)
+    return Posterior.of_logarithms(free, chain.samples, fitted_prior(base, free), chain)
 
 
 def _prediction_stderr(
@@ -571,7 +593,8 @@ def _prediction_stderr(
     gradients = np.array(
         [
             [
-                (evaluate(best + JACOBIAN_STEP * unit)[1][()].summary.number(key) - summary.number(key)) / JACOBIAN_STEP
+                ((evaluate(best + JACOBIAN_STEP * unit)[1][()]).summary.number(key) - summary.number(key))
+                / JACOBIAN_STEP
                 for key in keys
             ]
             for unit in np.eye(best.size)

@@ -18,8 +18,13 @@ from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.parameters.presets import PRESETS, default_parameters
 from shakermill.solvers.simulate import thermal_variants
 from shakermill.solvers.summary import Summary
-from shakermill.studies.kinematics import DEFAULT_FACTORS, KinematicSensitivity, kinematic_sensitivity, measured
-from shakermill.studies.validation import relative_error
+from shakermill.studies.measured import relative_error
+from shakermill.studies.validation.kinematics import (
+    DEFAULT_FACTORS,
+    KinematicSensitivity,
+    kinematic_sensitivity,
+    measured,
+)
 
 HELD_OUT_PRESET = "spex8000m-3d-calibrated"
 FIVE_BALLS = 5

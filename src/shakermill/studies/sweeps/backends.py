@@ -1,5 +1,8 @@
-"""Where the points of a sweep run: in this process, on a local pool of worker processes, or on a Dask
-distributed cluster; each gives back the points' outcomes as they finish."""
+"""Where the tasks of many runs run: in this process, on a local pool of worker processes, or on a Dask distributed
+cluster; each gives back the tasks' outcomes as they finish. A task is its id and its values; what is done with them
+is the ``work`` the executor was given (a sweep's :func:`~.points.run_point`, a calibration's training member): a
+function of the values alone, picklable (a module's function, or a ``functools.partial`` of one), so that a worker
+process or a cluster's worker can run it."""
 
 from __future__ import annotations
 
@@ -8,16 +11,16 @@ import logging
 import os
 import sys
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from types import FrameType
+from typing import TYPE_CHECKING, Any, Protocol
 
 from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.errors import ParameterError
-from shakermill.parameters.keys import Parameters
-from shakermill.studies.sweep_points import PointInterrupted, PointOutcome, run_point
+from shakermill.studies.sweeps.points import PointInterrupted
 from shakermill.support.limits import in_one_line
 
 if TYPE_CHECKING:
@@ -25,19 +28,30 @@ if TYPE_CHECKING:
 
 
 Task = tuple[str, Mapping[str, Any]]
+# What a task does with its values; its outcome is what the executor stores.
+Work = Callable[[Mapping[str, Any]], Any]
+Outcomes = Iterator[tuple[str, Any]]
 
 
-Outcomes = Iterator[tuple[str, "PointOutcome | BaseException"]]
+class Backend(Protocol):
+    """Where tasks run: ``slots`` of them at once; their outcomes (or what each raised) as they finish; ``stop``
+    drops the tasks not finished."""
+
+    slots: int
+
+    def outcomes(self, work: Work, tasks: Sequence[Task]) -> Outcomes: ...
+
+    def stop(self) -> None: ...
 
 
 @dataclass
 class _InProcess:
     slots: int = 1
 
-    def outcomes(self, base: Parameters, tasks: Sequence[Task], keep_runs: bool) -> Outcomes:
+    def outcomes(self, work: Work, tasks: Sequence[Task]) -> Outcomes:
         for identifier, values in tasks:
             try:
-                yield identifier, run_point(base, values, keep_runs)
+                yield identifier, work(values)
             except PointInterrupted:
                 raise KeyboardInterrupt from None
 
@@ -68,10 +82,10 @@ class _LocalPool:
             if process.is_alive():
                 process.kill()
 
-    def outcomes(self, base: Parameters, tasks: Sequence[Task], keep_runs: bool) -> Outcomes:
+    def outcomes(self, work: Work, tasks: Sequence[Task]) -> Outcomes:
         from concurrent.futures import as_completed
 
-        futures = {self.executor.submit(run_point, base, values, keep_runs): identifier for identifier, values in tasks}
+        futures = {self.executor.submit(work, values): identifier for identifier, values in tasks}
         for future in as_completed(futures):
             error = future.exception()
             yield futures[future], error if error is not None else future.result()
@@ -83,14 +97,11 @@ class _Cluster:
     slots: int
     submitted: list[Any] = field(default_factory=list)
 
-    def outcomes(self, base: Parameters, tasks: Sequence[Task], keep_runs: bool) -> Outcomes:
+    def outcomes(self, work: Work, tasks: Sequence[Task]) -> Outcomes:
         from distributed import as_completed
 
         # pure=False: a point is a computation to run, not a value Dask may deduplicate or cache.
-        futures = {
-            self.client.submit(run_point, base, values, keep_runs, pure=False): identifier
-            for identifier, values in tasks
-        }
+        futures = {self.client.submit(work, values, pure=False): identifier for identifier, values in tasks}
         self.submitted = list(futures)
         # The client is not Dask's default one (set_as_default=False), so as_completed is told its loop.
         for future in as_completed(futures, loop=self.client.loop):
@@ -112,7 +123,7 @@ def _cluster_error(future: Any) -> BaseException:
 
 
 @contextmanager
-def backend_for(workers: int | None, scheduler: str | None, timeout: float, pending: int) -> Iterator[Any]:
+def backend_for(workers: int | None, scheduler: str | None, timeout: float, pending: int) -> Iterator[Backend]:
     if scheduler is not None:
         client = connect(scheduler, timeout)
         cluster = _Cluster(client, max(1, sum(client.nthreads().values())))
@@ -187,16 +198,19 @@ def _called_from_unguarded_main() -> bool:
     path = getattr(main, "__file__", None)
     if main is None or path is None or getattr(main, "__spec__", None) is not None:
         return False  # run with -m, the workers import it under its own name with the guard honoured
-    frame = sys._getframe(1)
+    frame: FrameType | None = sys._getframe(1)
     while frame is not None and not (frame.f_globals is vars(main) and frame.f_code.co_name == "<module>"):
         frame = frame.f_back
     if frame is None:
         return False
+    line = frame.f_lineno
     try:
         tree = ast.parse(Path(path).read_text(encoding="utf-8"))
     except (OSError, SyntaxError, ValueError):
         return True
-    return not any(_is_main_guard(node) and node.lineno <= frame.f_lineno <= node.end_lineno for node in tree.body)
+    return not any(
+        _is_main_guard(node) and node.lineno <= line <= (node.end_lineno or node.lineno) for node in tree.body
+    )
 
 
 def _is_main_guard(node: ast.stmt) -> bool:

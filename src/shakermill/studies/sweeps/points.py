@@ -59,8 +59,9 @@ def run_point(base: Parameters, values: Mapping[str, Any], keep_run: bool = Fals
         return PointOutcome(failed_row(swept, f"{type(exc).__name__}: {exc}"))
     # The summary's flat keys (solvers/summary.py) are the row's columns. A table cell holds one value: the warnings
     # and notes become one string each, or none (CSV cannot tell "" from missing).
-    told = {"warnings": "; ".join(result.summary.warnings) or None, "notes": " ".join(result.summary.notes) or None}
-    columns = {**result.summary.flat(), **told}
+    summary = result.summary
+    told = {"warnings": "; ".join(summary.warnings) or None, "notes": " ".join(summary.notes) or None}
+    columns = {**summary.flat(), **told}
     row = {
         **swept,
         "regime": regime,

@@ -14,7 +14,7 @@ from shakermill.support.atomic import remove_abandoned_writes, write_text_atomic
 from shakermill.support.version import __version__
 
 if TYPE_CHECKING:
-    from shakermill.studies.calibrate import Calibration
+    from shakermill.studies.calibration.calibrate import Calibration
 
 
 def write_preset(
@@ -58,7 +58,7 @@ def write_preset(
     if calibration.covariance is not None:
         document["provenance"]["covariance_log"] = calibration.covariance
     if calibration.posterior is not None:
-        document["provenance"]["posterior_log"] = calibration.posterior
+        document["provenance"]["posterior_log"] = calibration.posterior.logarithms.tolist()
     if calibration.curve_rms_K is not None:
         document["provenance"]["curve_rms_K"] = calibration.curve_rms_K
         document["provenance"]["curve"] = calibration.curve_source

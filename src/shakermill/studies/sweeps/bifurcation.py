@@ -93,7 +93,7 @@ BIFURCATION_FIGURE = "bifurcation"
 def write_bifurcation(scan: Bifurcation, folder: Path) -> list[Path]:
     """``bifurcation_regimes``, ``bifurcation_attractors`` and ``bifurcation_phases`` tables (Parquet and CSV) in
     ``folder``."""
-    from shakermill.studies.sweep_storage import write_table
+    from shakermill.studies.sweeps.storage import write_table
 
     folder.mkdir(parents=True, exist_ok=True)
     tables = dict(zip(BIFURCATION_TABLES, (scan.regimes, scan.attractors, scan.phases)))

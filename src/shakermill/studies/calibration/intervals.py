@@ -3,8 +3,8 @@ and the averaging error of its mechanics, carried through the thermal network.
 
 A calibration records the covariance of the natural logarithms of its fitted keys (``scipy.optimize.least_squares``'
 Jacobian with the residual variance) and, where an evaluation costs only a network, samples of their posterior
-(emcee, the prior uniform within each key's defensible range; ``studies.calibrate``). Those keys move the thermal
-network alone, so a prediction's spread is taken on the network with the run's own mean load:
+(emcee, the prior uniform within each key's defensible range; ``studies.calibration.calibrate``). Those keys move
+the thermal network alone, so a prediction's spread is taken on the network with the run's own mean load:
 
 * from the posterior samples where there are some: each sample's network (its heat scaled by a draw of the averaging
   error), the 5th and 95th percentiles. One curve often leaves a direction of the keys undetermined; the ranges
@@ -29,6 +29,7 @@ from shakermill.parameters.presets import Preset
 from shakermill.solvers.averaged import integrate_network
 from shakermill.solvers.result import Result
 from shakermill.solvers.summary_sections import PredictionIntervals
+from shakermill.studies.inference.posterior import Posterior
 
 LEVEL = 0.90
 # Step of the finite differences in the logarithm of a key (and of the heat): small beside a fit's relative errors
@@ -77,7 +78,7 @@ class Uncertainty:
 
     fitted: tuple[str, ...]
     covariance: np.ndarray | None = None
-    posterior: np.ndarray | None = None
+    posterior: Posterior | None = None
     # Fitted keys that move the mechanics (a calibration over every uncertain input): a run's mean load cannot carry
     # them, `shakermill uncertainty` does.
     left_out: tuple[str, ...] = ()
@@ -92,9 +93,14 @@ def uncertainty_of(preset: Preset) -> Uncertainty | None:
     thermal_only = describe(preset.values["engine"].value).thermal_only_keys
     kept = [index for index, key in enumerate(preset.fitted) if not thermal_only or key in thermal_only]
     covariance = None if preset.covariance is None else np.asarray(preset.covariance, dtype=float)[np.ix_(kept, kept)]
-    posterior = None if preset.posterior is None else np.asarray(preset.posterior, dtype=float)[:, kept]
+    keys = tuple(preset.fitted[index] for index in kept)
+    posterior = (
+        None
+        if preset.posterior is None
+        else Posterior.of_logarithms(keys, np.asarray(preset.posterior, dtype=float)[:, kept])
+    )
     left_out = tuple(key for index, key in enumerate(preset.fitted) if index not in kept)
-    return Uncertainty(tuple(preset.fitted[index] for index in kept), covariance, posterior, left_out)
+    return Uncertainty(keys, covariance, posterior, left_out)
 
 
 def headline_temperatures(params: Parameters, load: NetworkLoad) -> dict[str, float]:
@@ -143,15 +149,19 @@ def propagated(
     ``uncertainty`` if it has some, else linearly from its covariance; with a relative error ``heat_error`` of the
     heat, independent of the fit. None when nothing is uncertain."""
     if uncertainty.posterior is not None:
-        return _from_samples(params, load, uncertainty, heat_error, quantities)
+        return _from_samples(params, load, uncertainty, uncertainty.posterior, heat_error, quantities)
     return _linear(params, load, uncertainty, heat_error, quantities)
 
 
 def _from_samples(
-    params: Parameters, load: NetworkLoad, uncertainty: Uncertainty, heat_error: float, quantities: Quantities
+    params: Parameters,
+    load: NetworkLoad,
+    uncertainty: Uncertainty,
+    posterior: Posterior,
+    heat_error: float,
+    quantities: Quantities,
 ) -> Intervals:
-    samples = np.asarray(uncertainty.posterior, dtype=float)
-    chosen = samples[np.linspace(0, len(samples) - 1, min(PROPAGATED_SAMPLES, len(samples))).astype(int)]
+    chosen = posterior.logarithms[posterior.thinned(PROPAGATED_SAMPLES)]
     heat_draws = np.random.default_rng(HEAT_DRAW_SEED).standard_normal(len(chosen)) * heat_error
     values = []
     for sample, draw in zip(chosen, heat_draws, strict=True):

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.kinematic_models import KINEMATIC_MODELS
 from shakermill.solvers.simulate import simulate_whole
-from shakermill.studies.validation import relative_error
+from shakermill.studies.measured import relative_error
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -2,7 +2,7 @@
 input on the one-ball curve, is the five-ball measurement inside the 90 % posterior-predictive interval; fitted on
 the five-ball point, is the one-ball curve inside. Each fit frees the assumed inputs its run can feel, with their
 stated ranges as priors, and the network's own free keys over their defensible ranges
-(:mod:`studies.joint_calibration`); nothing else is tuned.
+(:mod:`studies.calibration.joint`); nothing else is tuned.
 """
 
 from __future__ import annotations
@@ -13,25 +13,18 @@ from typing import Any
 
 from shakermill.parameters.defaults import DEFAULT_FREE_BY_NETWORK
 from shakermill.parameters.presets import PRESETS, default_parameters
-from shakermill.studies.joint_calibration import (
+from shakermill.studies.calibration.emulators import Emulator, Prediction, emulate, inside_count, predict
+from shakermill.studies.calibration.joint import fit_inputs, prior_sample, reliability_problems, sample_posterior
+from shakermill.studies.calibration.observables import (
     ASSUMED_MEASUREMENT_SD_K,
-    Emulator,
     Measured,
     Observable,
-    Posterior,
-    Prediction,
-    emulate,
-    emulator_as_dict,
-    fit_inputs,
     measured_of,
-    posterior_as_dict,
-    predict,
-    prior_sample,
-    reliability_problems,
-    sample_posterior,
-    train,
 )
-from shakermill.studies.validation_matrix import Experiment, load_experiments
+from shakermill.studies.calibration.training import train
+from shakermill.studies.inference.posterior import Posterior
+from shakermill.studies.sweeps.executor import LOCAL_POOL, Execution
+from shakermill.studies.validation.matrix import Experiment, load_experiments
 
 # The uncalibrated preset both fits start from: the calibrated one was fitted to the one-ball curve already.
 BASE_PRESET = "spex8000m-3d-mill-head"
@@ -53,16 +46,14 @@ class Direction:
     fitted: tuple[Prediction, ...]  # the fitted experiment's own points at the posterior
     predictions: tuple[Prediction, ...]
     prior_predictions: tuple[Prediction, ...]
-    problems: tuple[str, ...] = ()  # why it cannot be relied on (joint_calibration.reliability_problems)
+    problems: tuple[str, ...] = ()  # why it cannot be relied on (calibration.joint.reliability_problems)
 
     @property
     def verdict(self) -> str:
-        inside = [prediction.inside for prediction in self.predictions]
-        own = [prediction.inside for prediction in self.fitted]
         return (
-            f"fitted on {self.fitted_on.name} ({sum(own)} of its {len(own)} points inside their own 90 % "
-            f"intervals): {sum(inside)} of the {len(inside)} measured points of {self.predicted.name} inside "
-            "their 90 % intervals"
+            f"fitted on {self.fitted_on.name} ({inside_count(self.fitted)} of its {len(self.fitted)} points inside "
+            f"their own 90 % intervals): {inside_count(self.predictions)} of the {len(self.predictions)} measured "
+            f"points of {self.predicted.name} inside their 90 % intervals"
         )
 
     def as_dict(self) -> dict[str, Any]:
@@ -71,7 +62,7 @@ class Direction:
             "predicted": self.predicted.name,
             "verdict": self.verdict,
             "unreliable": self.problems,
-            "posterior": posterior_as_dict(self.posterior),
+            "posterior": self.posterior.as_dict(),
             "fitted_points": [prediction.as_dict() for prediction in self.fitted],
             "predictions": [prediction.as_dict() for prediction in self.predictions],
             "prior_predictions": [prediction.as_dict() for prediction in self.prior_predictions],
@@ -91,7 +82,7 @@ class CrossPrediction:
             "network_free": list(self.free),
             "measurement_sd_K": ASSUMED_MEASUREMENT_SD_K,
             "averaging_error": AVERAGING_ERROR,
-            "emulators": {name: emulator_as_dict(emulator) for name, emulator in self.emulators.items()},
+            "emulators": {name: emulator.as_dict() for name, emulator in self.emulators.items()},
             "directions": [direction.as_dict() for direction in self.directions],
         }
 
@@ -102,9 +93,11 @@ def cross_prediction(
     thermal_draws: int = THERMAL_DRAWS,
     overrides: Mapping[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
+    execution: Execution = LOCAL_POOL,
 ) -> CrossPrediction:
     """Emulate both experiments over their uncertain inputs, fit each and predict the other (module docstring);
-    ``progress(done, total)`` counts the mechanical members of both."""
+    ``progress(done, total)`` counts the mechanical members of both, which run as ``execution`` says (in parallel
+    on one worker a core by default) into a temporary folder: validate writes nothing until its end."""
     experiments = {experiment.name: experiment for experiment in load_experiments()}
     pair = (experiments[ONE_BALL], experiments[FIVE_BALLS])
     settings = {
@@ -124,7 +117,8 @@ def cross_prediction(
             if progress is None
             else (lambda done, total, before=index * members: progress(before + done, 2 * members))
         )
-        training = train(params, fit_inputs(PRESETS[preset], params, free), observables, members, thermal_draws, shown)
+        inputs = fit_inputs(PRESETS[preset], params, free)
+        training = train(params, inputs, observables, members, thermal_draws, shown, execution=execution)
         emulators[experiment.name] = emulate(training)
     directions = tuple(_direction(fitted_on, predicted, emulators) for fitted_on, predicted in (pair, pair[::-1]))
     return CrossPrediction(preset, tuple(free), emulators, directions)

@@ -8,7 +8,8 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from shakermill.studies.validation import ASSUMED_CURVE_SD_K, Curve
+from shakermill.studies.inference.sampler import Chain, sample
+from shakermill.studies.measured import ASSUMED_CURVE_SD_K, Curve
 
 # Scalar targets are matched relatively; curve points in kelvin: one kelvin weighs like 1 % on a target.
 CURVE_SCALE_K = 100.0
@@ -40,9 +41,10 @@ def residual_variance(residuals: np.ndarray, free_count: int, curves: Sequence[C
     return max(variance, (stated / CURVE_SCALE_K) ** 2)
 
 
-# The posterior: emcee's affine-invariant ensemble, WALKERS_PER_KEY walkers a key, POSTERIOR_STEPS steps of which the
-# first half is burn-in; POSTERIOR_KEPT samples are kept, evenly thinned. ~2400 evaluations of a three-key fit,
-# a few minutes of networks (benchmarks/bench_calibrate_3d.py); the seed makes it deterministic.
+# The posterior: emcee's affine-invariant ensemble (``studies.inference.sampler``), WALKERS_PER_KEY walkers a key,
+# POSTERIOR_STEPS steps of which the first half is burn-in; POSTERIOR_KEPT samples are kept, evenly thinned. ~2400
+# evaluations of a three-key fit, a few minutes of networks (benchmarks/bench_calibrate_3d.py); the seed makes it
+# deterministic.
 WALKERS_PER_KEY = 4
 POSTERIOR_STEPS = 200
 POSTERIOR_KEPT = 200
@@ -60,37 +62,22 @@ def posterior_samples(
     lower: np.ndarray,
     upper: np.ndarray,
     variance: float,
-) -> np.ndarray:
-    """Samples (POSTERIOR_KEPT, keys) of the logarithms of the fitted keys: a Gaussian likelihood of the residuals with
+) -> Chain:
+    """POSTERIOR_KEPT samples (keys) of the logarithms of the fitted keys: a Gaussian likelihood of the residuals with
     ``variance`` (the fit's), a prior uniform in the logarithms within [``lower``, ``upper``] (the defensible
     ranges). Where one curve leaves a direction of the keys undetermined, the ranges bound it, which the
     covariance cannot."""
-    import emcee
-
-    # emcee prints a traceback of whatever the likelihood raises (a Ctrl-C, a spent budget) before raising it again:
-    # the first is kept, every later call refused at once, and it is raised after the sampler, with nothing printed.
-    raised: list[BaseException] = []
 
     def log_probability(x: np.ndarray) -> float:
-        if raised or np.any(x < lower) or np.any(x > upper):
+        if np.any(x < lower) or np.any(x > upper):
             return -np.inf
-        try:
-            return -0.5 * float(np.sum(residuals_of(x) ** 2)) / variance
-        except BaseException as exc:  # noqa: BLE001 - raised again below, after the sampler
-            raised.append(exc)
-            return -np.inf
+        return -0.5 * float(np.sum(residuals_of(x) ** 2)) / variance
 
     keys = best.size
     walkers = WALKERS_PER_KEY * keys
     rng = np.random.default_rng(POSTERIOR_SEED)
     start = np.clip(best + 1e-3 * rng.standard_normal((walkers, keys)), lower, upper)
-    sampler = emcee.EnsembleSampler(walkers, keys, log_probability)
-    sampler.random_state = np.random.RandomState(POSTERIOR_SEED).get_state()
-    sampler.run_mcmc(start, POSTERIOR_STEPS)
-    if raised:
-        raise raised[0]
-    chain = sampler.get_chain(discard=POSTERIOR_STEPS // 2, flat=True)
-    return chain[np.linspace(0, len(chain) - 1, POSTERIOR_KEPT).astype(int)]
+    return sample(log_probability, start, POSTERIOR_STEPS, POSTERIOR_KEPT, POSTERIOR_SEED)
 
 
 def standard_errors(

@@ -101,9 +101,10 @@ def grid_values(spec: str) -> tuple[str, Sequence[Any]]:
     ``KEY=A,B,C`` for a key that takes names (``ball_material=steel,zirconia``, ``solver=full,averaged``), a
     count (``n_balls=1,2,5``) or a real value (``ball_radius=4mm,5mm,6.35mm``)."""
     match = GRID_PATTERN.match(spec)
-    key = match["key"] if match is not None else ""
-    if key not in Parameters.model_fields or not _takes_a_list(key, match["range"]):
-        return parse_grid(spec)
+    if match is None or match["key"] not in Parameters.model_fields or not _takes_a_list(match["key"], match["range"]):
+        key, grid = parse_grid(spec)
+        return key, list(grid)
+    key = match["key"]
     items = [item.strip() for item in match["range"].split(",") if item.strip()]
     if not items:
         raise ParameterError(f"grid {quoted(spec)}: expected KEY=A,B,C, for example ball_material=steel,zirconia")
