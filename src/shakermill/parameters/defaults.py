@@ -19,9 +19,10 @@ DEFAULT_FREE = ("beta", "vial_mass", "h_outer", "lam")
 # three-dimensional mechanics at every evaluation; these three move only the thermal network.
 DEM_DEFAULT_FREE = ("beta", "vial_mass", "h_outer")
 # What a calibration frees by default on each thermal network, before the keys its run does not read are dropped
-# (studies/calibration/calibrate.default_free): the paper's network its hand-tuned β, the vial's mass and its loss to the room;
-# a real mill's ('mill-head', MODEL.md §13.2) what no source gives: the drive's heat, the clamp's heat capacity and
-# its loss, as the shipped spex8000m-3d-calibrated was fitted (its outer loss is computed, h_outer is not read).
+# (studies/calibration/calibrate.default_free): the paper's network its hand-tuned β, the vial's mass and its loss to
+# the room; a real mill's ('mill-head', MODEL.md §13.2) what no source gives: the drive's heat, the clamp's heat
+# capacity and its loss, as the shipped spex8000m-3d-calibrated was fitted (its outer loss is computed, h_outer is not
+# read).
 DEFAULT_FREE_BY_NETWORK = {"paper": DEFAULT_FREE, "mill-head": ("drive_heat", "clamp_heat_capacity", "clamp_loss")}
 # The animation of a 'dem' run's balls (views/trajectories.py): a few seconds of GIF, however long the window.
 ANIMATION_FILE = "trajectories.gif"
