@@ -43,7 +43,6 @@ DURATION = 60.0  # simulated seconds per point
 GRID = ("omega=100:120:3", "amplitude=23mm:29mm:2")  # 6 points
 SHAKERMILL = Path(sys.executable).parent / "shakermill"
 UNREACHABLE = "tcp://127.0.0.1:1"  # port 1 on loopback: nothing listens, connections are refused
-SWEEP_MODULE = importlib.import_module("shakermill.studies.sweeps.sweep")
 POINTS_MODULE = importlib.import_module("shakermill.studies.sweeps.points")
 
 
@@ -986,13 +985,15 @@ def test_two_sweeps_racing_into_one_new_folder_one_wins_the_other_is_refused(bas
     plans = {"low": plan_sweep(["omega=100:105:2"]), "high": plan_sweep(["omega=110:115:2"])}
     # Both sweeps find the folder free before either creates it: the moment the race is decided.
     both_checked = threading.Barrier(len(plans), timeout=60)
-    check_folder = SWEEP_MODULE.check_folder
+    # The executor checks a folder for every many-run study, the sweep among them.
+    executor = importlib.import_module("shakermill.studies.sweeps.executor")
+    check_folder = executor.check_folder
 
     def check_then_wait_for_the_other(*args):
         check_folder(*args)
         both_checked.wait()
 
-    monkeypatch.setattr(SWEEP_MODULE, "check_folder", check_then_wait_for_the_other)
+    monkeypatch.setattr(executor, "check_folder", check_then_wait_for_the_other)
     outcomes: dict[str, object] = {}
 
     def start(name: str) -> None:
