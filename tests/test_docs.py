@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+from shakermill.parameters.groups import GROUPS
+
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 # Paths the pages name in backticks, relative to the repository root.
@@ -101,6 +103,12 @@ def test_the_site_builds_strictly_from_its_sources(tmp_path):
     model = (DOCS / "MODEL.md").read_text(encoding="utf-8")
     section_13 = next(line for line in model.splitlines() if line.startswith("## 13."))
     assert section_13.removeprefix("## ") in page_text(site, "MODEL.html")
+    # The keys page holds every key under its component's heading, generated from the key groups.
+    keys_page = page_text(site, "guide/commands/keys.html")
+    for group in GROUPS:
+        assert group.title[1:] in keys_page, group
+        for key in group.keys():
+            assert f" {key} " in keys_page, key
     # The benchmarks page includes benchmarks/README.md, to its last section.
     benchmarks = page_text(site, "benchmarks.html")
     headings = [
