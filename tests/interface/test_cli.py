@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import io
 import json
@@ -781,25 +782,39 @@ def test_bifurcation_bad_grid_exits_2_with_one_line(tmp_path, grid, fragments):
 
 @pytest.fixture(scope="module")
 def start_up_s(tmp_path_factory) -> float:
-    """Seconds a short run takes as a process here, with Numba's cache warm: how long to wait before a Ctrl-C."""
+    """CPU-seconds a short run takes as a process here, with Numba's cache warm: how much work a process does before
+    it can be interrupted in its run. CPU time, not the wall clock: on a machine shared with the rest of the suite a
+    start-up stretches far past what it takes alone, and a Ctrl-C that lands in the start-up is another test's case."""
+    import resource  # POSIX only, like the /proc that cpu_seconds reads
+
     out = tmp_path_factory.mktemp("warm") / "run"
-    started = time.monotonic()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     warm = subprocess.run(
         [str(SHAKERMILL), "run", *SHORT, "--no-plots", "--out", str(out)], capture_output=True, text=True, timeout=300
     )
     assert warm.returncode == 0, warm.stderr
-    return time.monotonic() - started
+    return children_cpu_s(resource.getrusage(resource.RUSAGE_CHILDREN)) - children_cpu_s(before)
 
 
-def interrupt_after(command: list[str], after_s: float, exits_within_s: float = 120.0) -> str:
-    """Run ``command``, send it SIGINT after ``after_s`` seconds, and return its stderr once it exited with 130
-    (within ``exits_within_s`` of the signal)."""
+def children_cpu_s(usage) -> float:
+    return usage.ru_utime + usage.ru_stime
+
+
+def interrupt_after(command: list[str], after_cpu_s: float, stops_within_cpu_s: float = 3.0) -> str:
+    """Run ``command``, send it SIGINT once it has used ``after_cpu_s`` CPU-seconds, and return its stderr once it
+    exited with 130, having used at most ``stops_within_cpu_s`` CPU-seconds after the signal."""
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     process = subprocess.Popen([str(SHAKERMILL), *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(after_s)
-    assert process.poll() is None, f"{command[0]} ended before it could be interrupted"
+    wait_for_cpu(process, after_cpu_s)
+    used = cpu_seconds(process.pid)
     process.send_signal(signal.SIGINT)
-    _, stderr = process.communicate(timeout=exits_within_s)
+    # A hang guard, not a speed bound: the work after the signal is bounded in CPU time below.
+    _, stderr = process.communicate(timeout=600)
     assert process.returncode == 130, stderr
+    after = children_cpu_s(resource.getrusage(resource.RUSAGE_CHILDREN)) - children_cpu_s(before) - used
+    assert after <= stops_within_cpu_s, f"{after:.2f} CPU-s after the signal"
     # A fit says which keys it moves once it starts; the Ctrl-C is the one line after.
     lines = [line for line in stderr.strip().splitlines() if not line.startswith("calibrate: fitting ")]
     assert len(lines) == 1 and "Traceback" not in stderr, stderr
@@ -837,12 +852,19 @@ def test_real_ctrl_c_during_a_scan_or_fit_says_so_in_one_line(tmp_path, start_up
 
 
 def cpu_seconds(pid: int) -> float:
-    """The CPU time a running process has used (Linux: utime + stime of /proc/PID/stat)."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    """The CPU time a running process and its live children have used (a sweep's or a fit's workers do its work)."""
+    import psutil
+
+    process = psutil.Process(pid)
+    total = 0.0
+    for member in (process, *process.children(recursive=True)):
+        with contextlib.suppress(psutil.NoSuchProcess):
+            times = member.cpu_times()
+            total += times.user + times.system
+    return total
 
 
-def wait_for_cpu(process: subprocess.Popen, cpu_s: float, within_s: float = 180.0) -> None:
+def wait_for_cpu(process: subprocess.Popen, cpu_s: float, within_s: float = 600.0) -> None:
     """Wait until ``process`` has used ``cpu_s`` CPU-seconds (or fail after ``within_s`` of wall clock).
 
     CPU time, not the wall clock: on a machine shared with the rest of the suite a process's start-up stretches far
@@ -901,19 +923,16 @@ def test_real_ctrl_c_exits_within_a_second_with_the_data_written(tmp_path, setti
     )
     wait_for_cpu(process, short_run_cpu_s + 1.5)
     used = cpu_seconds(process.pid)
-    signalled = time.monotonic()
     process.send_signal(signal.SIGINT)
     _, status, usage = os.wait4(process.pid, 0)
-    waited = time.monotonic() - signalled
     after = usage.ru_utime + usage.ru_stime - used
     stderr = process.stderr.read()
     assert os.waitstatus_to_exitcode(status) == 130, stderr
     printed = json.loads(process.stdout.read())
     assert printed["status"] == INTERRUPTED and printed["output_dir"] == str(out.absolute())
-    # What Ctrl-C costs: under a second of work. On a machine shared with the rest of the suite the wall clock
-    # stretches it, so its bound is looser; benchmarks/bench_first_hour.py measures it on a quiet one.
+    # What Ctrl-C costs: under a second of work. Its wall time, which a machine shared with the rest of the suite
+    # stretches, benchmarks/bench_first_hour.py measures on a quiet one.
     assert after <= 1.0, f"{after:.2f} CPU-s after the signal"
-    assert waited <= 3.0, f"{waited:.2f} s after the signal"
     assert len(stderr.strip().splitlines()) == 1 and stderr.startswith("interrupted:"), stderr
     assert f"shakermill plot {out}" in stderr
     summary = json.loads((out / "summary.json").read_text())
@@ -927,8 +946,7 @@ def test_real_ctrl_c_in_validate_says_so_in_one_line(start_up_s):
     process = subprocess.Popen(
         [str(SHAKERMILL), "validate", "--no-three-d"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
-    time.sleep(start_up_s + 2.0)
-    assert process.poll() is None, "validate ended before it could be interrupted"
+    wait_for_cpu(process, start_up_s + 2.0)
     process.send_signal(signal.SIGINT)
     # Heard between bytecodes: on a fresh clone a compilation still running (Numba's, tens of seconds) comes first.
     stdout, stderr = process.communicate(timeout=120)
@@ -961,7 +979,7 @@ TINY_STEPS = [*(f"--set={key}={value}" for key, value in TIGHTEST_TOLERANCES.ite
 def test_real_ctrl_c_stops_a_run_stuck_on_tiny_steps_at_once(tmp_path, start_up_s, command, first_words):
     # Before the compiled loop handed control back within a chunk, the signal waited for the chunk's end.
     arguments = [argument.replace("{out}", str(tmp_path / "out")) for argument in command]
-    stderr = interrupt_after([*arguments, *TINY_STEPS], start_up_s + 2.0, exits_within_s=30.0)
+    stderr = interrupt_after([*arguments, *TINY_STEPS], start_up_s + 2.0)
     assert stderr.startswith(first_words)
 
 
