@@ -175,8 +175,9 @@ def calibrate(
                     run_config.params, free_keys, bool(free), [item.note for item in measured if item.note]
                 ),
             )
-    # A fit that leaves its keys undetermined has values that any others would match as well: no preset of them.
-    written = out if out is not None and calibration.status != "undetermined" else None
+    # A fit that missed its targets, or left its keys undetermined (values any others would match as well), has no
+    # values a preset should carry.
+    written = out if out is not None and calibration.success else None
     if written is not None:
         beyond = values_beyond_preset(run_config.params, run_config.preset)
         write_fitted_preset(calibration, written, run_config.preset, free_keys, targets, beyond)
@@ -191,10 +192,9 @@ def calibrate(
     else:
         print_calibration(calibration, free_keys, targets, written)
     if not calibration.success:
-        verdict = "did not meet its targets"
-        if calibration.status == "undetermined":
-            verdict = "could not determine its keys" + (f" (nothing written to {out})" if out is not None else "")
-        typer.echo(f"error: calibration {verdict}: {calibration.message}", err=True)
+        verdict = "could not determine its keys" if calibration.status == "undetermined" else "did not meet its targets"
+        unwritten = f" (nothing written to {out})" if out is not None else ""
+        typer.echo(f"error: calibration {verdict}{unwritten}: {calibration.message}", err=True)
         raise typer.Exit(EXIT_FAILED_RUN)
 
 
