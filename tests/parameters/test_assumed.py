@@ -59,7 +59,7 @@ def test_lambda_spans_the_paper_and_the_effusivity_rule():
     [
         ("friction", {**TABLE, "low": 0.7}, 0.3, "low < high"),
         ("friction", {**TABLE, "high": 6.0}, 0.3, "leaves friction's allowed range [0, 5]"),
-        ("friction", {**TABLE, "distribution": "normal"}, 0.3, "distribution must be one of uniform, log-uniform"),
+        ("friction", {**TABLE, "distribution": "normal"}, 0.3, "distribution: must be one of uniform, log-uniform"),
         ("rolling_friction", {**TABLE, "low": 0.0, "distribution": "log-uniform"}, 0.0, "log-uniform needs low > 0"),
         ("friction", {**TABLE, "reason": " "}, 0.3, "give the reason"),
         (
@@ -69,7 +69,12 @@ def test_lambda_spans_the_paper_and_the_effusivity_rule():
             "give exactly low, high, distribution, reason",
         ),
         ("friction", {**TABLE, "moves": ["vial_mass"]}, 0.3, "moves lists keys derived from the vial's dimensions"),
-        ("vial_diameter", {**TABLE, "low": 0.01, "moves": ["omega"]}, 0.02, "(inner_area, vial_mass), only for"),
+        (
+            "vial_diameter",
+            {**TABLE, "low": 0.01, "moves": ["omega"]},
+            0.02,
+            "moves: lists keys derived from the vial's dimensions (inner_area, vial_mass)",
+        ),
         ("friction", TABLE, 0.8, "the preset's friction = 0.8 lies outside its range [0.1, 0.6]"),
         ("kinematics", TABLE, "planetary", "not a numeric key"),
         ("frction", TABLE, None, "not a numeric key"),

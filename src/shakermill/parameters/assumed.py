@@ -7,24 +7,21 @@ posterior says what it is) nor a key its own run does not read (a planetary jar 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 from shakermill.parameters.engine_keys import Reader
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.file_models import DERIVED_KEYS, AssumedTable, read_table
 from shakermill.parameters.geometry import bore_area, wall_volume
 from shakermill.parameters.keys import Parameters, bounds, field_unit
 
-# Uniform on [low, high], or uniform in the logarithm where the range spans orders of magnitude.
-DISTRIBUTIONS = ("uniform", "log-uniform")
 TABLE_FIELDS = ("low", "high", "distribution", "reason")
 # A table may also say which keys derived from the vial's dimensions follow the input (``moves``): a bowl whose bore
 # is uncertain has an inner area and a mass that go with it, and a member that moved one alone would be no bowl.
 MOVES_FIELD = "moves"
 BOWL_KEYS = ("vial_diameter", "vial_length", "outer_diameter", "outer_length")
-DERIVED_KEYS = ("inner_area", "vial_mass")
 
 
 @dataclass(frozen=True)
@@ -57,27 +54,21 @@ def assumed_input(key: str, table: Any, where: str) -> AssumedInput:
     field = Parameters.model_fields.get(key)
     if field is None or field.annotation is not float:
         raise ParameterError(f"{name}: {key!r} is not a numeric key of a single value; only those can be assumed")
-    if not isinstance(table, Mapping) or set(table) - {MOVES_FIELD} != set(TABLE_FIELDS):
-        raise ParameterError(f"{name}: give exactly {', '.join(TABLE_FIELDS)} (and {MOVES_FIELD}, optionally)")
-    low, high, distribution, reason = (table[field] for field in TABLE_FIELDS)
-    moves = table.get(MOVES_FIELD, [])
-    if key not in BOWL_KEYS and moves or not isinstance(moves, list) or not set(moves) <= set(DERIVED_KEYS):
+    read = read_table(AssumedTable, table, name)
+    low, high, distribution, moves = read.low, read.high, read.distribution, read.moves
+    if key not in BOWL_KEYS and moves:
         raise ParameterError(
             f"{name}: {MOVES_FIELD} lists keys derived from the vial's dimensions "
             f"({', '.join(DERIVED_KEYS)}), only for {', '.join(BOWL_KEYS)}"
         )
-    if not all(isinstance(bound, (int, float)) and math.isfinite(bound) for bound in (low, high)) or not low < high:
+    if not low < high:
         raise ParameterError(f"{name}: low and high must be finite numbers with low < high, not {low!r}, {high!r}")
     allowed = bounds(key)
     if not (allowed.contains(low) and allowed.contains(high)):
         raise ParameterError(f"{name}: [{low:g}, {high:g}] leaves {key}'s allowed range {allowed}")
-    if distribution not in DISTRIBUTIONS or (distribution == "log-uniform" and low <= 0):
-        raise ParameterError(
-            f"{name}: distribution must be one of {', '.join(DISTRIBUTIONS)} (log-uniform needs low > 0)"
-        )
-    if not isinstance(reason, str) or not reason.strip():
-        raise ParameterError(f"{name}: give the reason for the range")
-    return AssumedInput(key, float(low), float(high), str(distribution), reason, tuple(moves))
+    if distribution == "log-uniform" and low <= 0:
+        raise ParameterError(f"{name}: distribution log-uniform needs low > 0")
+    return AssumedInput(key, low, high, distribution, read.reason, moves)
 
 
 def check_holds(assumed: AssumedInput, value: float, where: str) -> None:

@@ -27,6 +27,7 @@ from shakermill.parameters.assumed import inherited_assumed
 from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.engine_keys import reader_for, reader_of
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.file_models import FittedProvenance, read_table
 from shakermill.parameters.keys import (
     Parameters,
     bounds,
@@ -112,8 +113,10 @@ def load_config(
     config = RunConfig(
         params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note), **tables
     )
-    if config.assumed_tables:
-        config_preset(config)  # its [assumed.KEY] tables checked now, with one line for the first that is wrong
+    if config.assumed_tables or "fitted" in config.provenance:
+        # Its [assumed.KEY] tables and a calibration's [provenance] checked now, with one line for the first that is
+        # wrong.
+        config_preset(config)
     return config
 
 
@@ -124,7 +127,7 @@ def config_preset(config: RunConfig) -> Preset:
     if config.source is None:
         return base
     if "fitted" in config.provenance:
-        fitted = tuple(config.provenance["fitted"])
+        fitted = read_table(FittedProvenance, config.provenance, f"{config.source}: [provenance]").fitted
         note = f"fitted by calibration ({config.source.name}, [provenance])"
         values = {**base.values, **{key: Cited(getattr(config.params, key), note) for key in fitted}}
         base = dataclasses.replace(
