@@ -69,6 +69,7 @@ def uncertainty(
 ) -> None:
     """Run a quasi-random ensemble over the assumed inputs; print each headline's 5/50/95 % points, the inputs that
     decide it (Sobol' indices) and the motion regimes found."""
+    from shakermill.io.runs import ENSEMBLE_KIND, KIND_KEY
     from shakermill.parameters.config import config_preset
     from shakermill.studies.ensembles.ensemble import check_members, ensemble_inputs, run_ensemble
     from shakermill.studies.sweeps.plan import sweep_parameters
@@ -112,7 +113,12 @@ def uncertainty(
             EXIT_INTERRUPTED,
         )
     title = f"{run_config.preset}: what the answer hangs on"
-    payload = {"preset": run_config.preset, "output_dir": str(target.absolute()), **ensemble.as_dict()}
+    payload = {
+        KIND_KEY: ENSEMBLE_KIND,
+        "preset": run_config.preset,
+        "output_dir": str(target.absolute()),
+        **ensemble.as_dict(),
+    }
     write_text_atomically(target / SUMMARY, json.dumps(payload, indent=1, allow_nan=False) + "\n")
     save_ensemble_page(ensemble, title, target / REPORT)
     if json_output:

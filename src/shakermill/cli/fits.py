@@ -280,7 +280,9 @@ def calibrate_over_assumed(
             "runs; allowed without --full-resolution"
         )
     check_members(members)
-    execution = Execution(runs.workers, runs.scheduler)
+    execution = Execution(
+        runs.workers, runs.scheduler, announce=lambda line: typer.echo(f"calibrate: {line}", err=True)
+    )
     folder = runs.folder if runs.folder is not None else timestamped_folder("calibrate")
     params = run_config.params.replace(solver="averaged", attractor_starts=1)
     curves = list(curves) or [experiment_curve()]

@@ -129,6 +129,7 @@ def sweep(
                 progress=progress,
                 preset=run_config.preset,
                 scheduler_timeout=scheduler_timeout,
+                announce=lambda line: typer.echo(f"sweep: {line}", err=True),
             )
     except SweepFailed as exc:
         # Said below like any failed point, after the table's preview.

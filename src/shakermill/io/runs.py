@@ -117,7 +117,56 @@ class FolderKind:
     written_by_shakermill: Callable[[Path], bool]
 
 
-RUN_FOLDER = FolderKind("run", lambda folder: (folder / SUMMARY_FILE).is_file())
+# What a folder shakermill wrote holds, recorded as KIND_KEY in the JSON file that describes it (a sweep's manifest, a
+# run's or an ensemble's summary), so that --overwrite replaces only a folder of the command's own kind.
+KIND_KEY = "kind"
+RUN_KIND = "run"
+SWEEP_KIND = "sweep"
+ENSEMBLE_KIND = "uncertainty ensemble"
+DESIGN_KIND = "calibration design"
+KIND_PHRASES = {
+    RUN_KIND: "a run",
+    SWEEP_KIND: "a sweep",
+    ENSEMBLE_KIND: "an uncertainty ensemble",
+    DESIGN_KIND: "the design of runs of a calibration",
+}
+# A sweep's manifest: the executor's folders (sweeps, ensembles, a calibration's design) all have one.
+MANIFEST_FILE = "sweep.json"
+
+
+def folder_kind(folder: Path) -> str | None:
+    """The kind of folder shakermill wrote at ``folder`` (a key of KIND_PHRASES), or None for anything else.
+
+    A folder written before folders recorded their kind is known by its files: a manifest with a summary beside it is
+    an ensemble (its summary written last), a manifest alone a sweep, a summary alone a run."""
+    documents = {name: _json_object(folder / name) for name in (MANIFEST_FILE, SUMMARY_FILE)}
+    for document in documents.values():
+        if document is not None and document.get(KIND_KEY) in KIND_PHRASES:
+            return str(document[KIND_KEY])
+    manifest, summary = (documents[name] is not None for name in (MANIFEST_FILE, SUMMARY_FILE))
+    if manifest:
+        return ENSEMBLE_KIND if summary else SWEEP_KIND
+    return RUN_KIND if summary and (folder / CONFIG_FILE).is_file() else None
+
+
+def _json_object(path: Path) -> dict[str, Any] | None:
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):  # absent, unreadable, not UTF-8, not JSON
+        return None
+    return document if isinstance(document, dict) else None
+
+
+def other_kind_problem(folder: Path, noun: str) -> str | None:
+    """'… holds an uncertainty ensemble, not a run' where ``folder`` holds a shakermill folder of another kind than
+    ``noun``'s."""
+    found = folder_kind(folder)
+    if found is None or found == noun:
+        return None
+    return f"{folder}: holds {KIND_PHRASES[found]}, not {KIND_PHRASES.get(noun, f'a {noun}')}"
+
+
+RUN_FOLDER = FolderKind(RUN_KIND, lambda folder: folder_kind(folder) == RUN_KIND)
 
 
 def check_target(path: Path, *, overwrite: bool = False, kind: FolderKind = RUN_FOLDER) -> None:
@@ -135,7 +184,10 @@ def check_target(path: Path, *, overwrite: bool = False, kind: FolderKind = RUN_
     if not any(path.iterdir()):
         return
     if not kind.written_by_shakermill(path):
-        raise StorageError(f"{path}: a non-empty folder that is not a shakermill {kind.noun}; choose another --out")
+        problem = (
+            other_kind_problem(path, kind.noun) or f"{path}: a non-empty folder that is not a shakermill {kind.noun}"
+        )
+        raise StorageError(f"{problem}; choose another --out")
     if not overwrite:
         raise StorageError(
             f"{path}: holds a {kind.noun} already; choose another --out, or add --overwrite to replace it"
@@ -336,6 +388,7 @@ def summary_document(result: Result, preset: str) -> dict[str, Any]:
     """The content of ``summary.json``, JSON-ready (NaN as ``None``)."""
     return to_jsonable(
         {
+            KIND_KEY: RUN_KIND,
             "status": result.status,
             "success": result.success,
             "message": result.message,
@@ -383,6 +436,9 @@ def load_run(path: Path | str) -> RunData:
         raise StorageError(f"{folder}: a file, not a shakermill run folder")
     if not summary_path.is_file():
         raise StorageError(f"{folder}: not a shakermill run folder (no {SUMMARY_FILE})")
+    problem = other_kind_problem(folder, RUN_KIND)
+    if problem is not None:
+        raise StorageError(f"{problem} folder")
     try:
         document = _read_part(summary_path, _summary_document)
     except SummaryVersionError as exc:

@@ -11,6 +11,7 @@ values alone: the training is the same whatever the number of workers, and wheth
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import json
@@ -25,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from shakermill.engines.registry import engine_named
+from shakermill.io.runs import DESIGN_KIND
 from shakermill.parameters.assumed import AssumedInput, with_derived
 from shakermill.parameters.defaults import DEFAULT_PRESET
 from shakermill.parameters.keys import Parameters
@@ -95,11 +97,13 @@ def train(
         rows = range(member * draws, (member + 1) * draws)
         point = {"draws": [dict(zip(keys, map(float, values[row]))) for row in rows], "observables": names}
         tasks.append((point_id(params, point), point))
-    shown = execution if progress is None else _counting(execution, progress)
+    # A member is one run of the mechanics: its max_wall_time bounds each wait on a cluster.
+    bounded = dataclasses.replace(execution, round_limit_s=params.max_wall_time)
+    shown = bounded if progress is None else _counting(bounded, progress)
     work = functools.partial(run_member, params, tuple(inputs), tuple(observables))
     with _training_folder(folder) as place:
         plan = SweepPlan(tuple(keys), tuple(point for _, point in tasks))
-        manifest = sweep_manifest(params, plan, [identifier for identifier, _ in tasks], DEFAULT_PRESET)
+        manifest = sweep_manifest(params, plan, [identifier for identifier, _ in tasks], DEFAULT_PRESET, DESIGN_KIND)
         execute(place, manifest, tasks, work, _store, shown, raise_failures=True)
         stored = stored_rows(place, [identifier for identifier, _ in tasks])
     rises = np.full((len(unit), len(observables)), np.nan)
@@ -143,7 +147,7 @@ def _counting(execution: Execution, progress: Callable[[int, int], None]) -> Exe
     def report(state: Progress) -> None:
         progress(state.done, state.total)
 
-    return Execution(execution.workers, execution.scheduler, execution.scheduler_timeout, report)
+    return dataclasses.replace(execution, progress=report)
 
 
 @contextmanager

@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from shakermill.analysis.regime import ACTIVE, PACK
+from shakermill.io.runs import ENSEMBLE_KIND
 from shakermill.parameters.assumed import AssumedInput, keeping_moves, parse_assumption, with_derived
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
@@ -232,7 +233,17 @@ def run_ensemble(
     say = announce or (lambda _: None)
     fitted = "" if posterior is None else f" and the posterior of {', '.join(posterior.keys)}"
     say(f"{members} members over {', '.join(item.key for item in inputs) or 'no assumed input'}{fitted}")
-    table = sweep(base, points, out_dir, workers=workers, scheduler=scheduler, progress=progress, preset=preset)
+    table = sweep(
+        base,
+        points,
+        out_dir,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+        preset=preset,
+        kind=ENSEMBLE_KIND,
+        announce=announce,
+    )
     say("analysing the members: a surrogate and Sobol' indices for each headline")
     return analyse(table, inputs, Path(out_dir), posterior)
 

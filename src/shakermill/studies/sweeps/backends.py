@@ -91,21 +91,50 @@ class _LocalPool:
             yield futures[future], error if error is not None else future.result()
 
 
+# How long a wait on the cluster sleeps before it looks again: Ctrl-C is answered within it.
+POLL_S = 0.2
+# How often a wait for the cluster says that it still waits (s).
+WAITING_LINE_S = 5.0
+
+
+class ClusterStalled(ParameterError):
+    """The cluster finished no task within a round's bound: its workers left, or hang (one line, as the scheduler's
+    other failures)."""
+
+
 @dataclass
 class _Cluster:
     client: Client
     slots: int
+    # The longest a task may take (a run's max_wall_time) plus the scheduler's timeout: no task finished within it
+    # means the cluster lost its tasks. None: no bound.
+    round_limit_s: float | None = None
     submitted: list[Any] = field(default_factory=list)
 
     def outcomes(self, work: Work, tasks: Sequence[Task]) -> Outcomes:
-        from distributed import as_completed
+        import time
 
         # pure=False: a point is a computation to run, not a value Dask may deduplicate or cache.
         futures = {self.client.submit(work, values, pure=False): identifier for identifier, values in tasks}
         self.submitted = list(futures)
-        # The client is not Dask's default one (set_as_default=False), so as_completed is told its loop.
-        for future in as_completed(futures, loop=self.client.loop):
-            yield futures[future], future.result() if future.status == "finished" else _cluster_error(future)
+        pending = dict(futures)
+        last = time.monotonic()
+        while pending:
+            # Futures know their state without a call to the scheduler: looking every POLL_S answers Ctrl-C at once.
+            done = [future for future in pending if future.done()]
+            for future in done:
+                del pending[future]
+                yield futures[future], future.result() if future.status == "finished" else _cluster_error(future)
+            now = time.monotonic()
+            if done:
+                last = now
+            elif self.round_limit_s is not None and now - last > self.round_limit_s:
+                raise ClusterStalled(
+                    f"scheduler: no task finished on the cluster for {now - last:.0f} s, longer than a run may take "
+                    f"(max_wall_time and --scheduler-timeout); {len(pending)} unfinished: its workers left or hang"
+                )
+            else:
+                time.sleep(POLL_S)
 
     def stop(self) -> None:
         """Cancel the points not yet finished: the cluster's workers drop them instead of computing them for nobody."""
@@ -123,10 +152,24 @@ def _cluster_error(future: Any) -> BaseException:
 
 
 @contextmanager
-def backend_for(workers: int | None, scheduler: str | None, timeout: float, pending: int) -> Iterator[Backend]:
+def backend_for(
+    workers: int | None,
+    scheduler: str | None,
+    timeout: float,
+    pending: int,
+    *,
+    round_limit_s: float | None = None,
+    announce: Callable[[str], None] | None = None,
+) -> Iterator[Backend]:
     if scheduler is not None:
         client = connect(scheduler, timeout)
-        cluster = _Cluster(client, max(1, sum(client.nthreads().values())))
+        try:
+            threads = wait_for_workers(client, scheduler, timeout, announce or (lambda _: None))
+        except BaseException:
+            client.close()
+            raise
+        limit = None if round_limit_s is None else round_limit_s + timeout
+        cluster = _Cluster(client, threads, limit)
         try:
             yield cluster
         except BaseException:
@@ -290,6 +333,35 @@ def connect(address: str, timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S) -> Clien
             raise ParameterError(f"scheduler: cannot connect to {address}: {in_one_line(exc)}") from None
 
 
+def wait_for_workers(client: Client, address: str, timeout: float, announce: Callable[[str], None]) -> int:
+    """The threads of the cluster's workers, once it has one, waited for up to ``timeout`` (s) and saying so every
+    WAITING_LINE_S; :class:`ParameterError` in one line if none joins. A scheduler without workers would leave
+    every task queued forever."""
+    import time
+
+    started = time.monotonic()
+    said = started
+    while True:
+        # The client's copy of the scheduler's state, refreshed by Dask in the background: no call to wait on.
+        workers = client.scheduler_info().get("workers", {})
+        if workers:
+            return max(1, sum(int(worker.get("nthreads", 1)) for worker in workers.values()))
+        now = time.monotonic()
+        if now - started > timeout:
+            raise ParameterError(
+                f"scheduler: {address} has no workers (waited {timeout:g} s, --scheduler-timeout); start some "
+                f"(dask worker {address}) or allow longer with --scheduler-timeout"
+            )
+        if now - said >= WAITING_LINE_S:
+            said = now
+            announce(f"waiting for a worker to join {address}, {_minutes(now - started)}")
+        time.sleep(POLL_S)
+
+
+def _minutes(seconds: float) -> str:
+    return f"{int(seconds // 60)} min {int(seconds % 60):02d} s"
+
+
 def _check_scheduler_answers(address: str, timeout: float, security: Any) -> None:
     """Open one connection to ``address`` and complete Dask's handshake, within ``timeout`` for each.
 
@@ -299,7 +371,8 @@ def _check_scheduler_answers(address: str, timeout: float, security: Any) -> Non
     The probe runs on its own event loop in its own thread, so it works inside a running loop (Jupyter).
     """
     import asyncio
-    from concurrent.futures import ThreadPoolExecutor
+    import threading
+    from concurrent.futures import Future, wait
 
     from distributed.comm import connect as open_comm
 
@@ -308,21 +381,33 @@ def _check_scheduler_answers(address: str, timeout: float, security: Any) -> Non
         comm = await open_comm(address, timeout=timeout, **security.get_connection_args("client"))
         await comm.close()
 
-    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="scheduler-probe") as probe:
+    probe: Future[None] = Future()
+
+    def run_probe() -> None:
         try:
-            probe.submit(asyncio.run, asyncio.wait_for(handshake(), 2 * timeout)).result()
-        except TimeoutError:
-            raise ParameterError(
-                f"scheduler: {address} accepted the connection but did not answer as a Dask scheduler "
-                f"(waited {2 * timeout:g} s); give the scheduler's address (tcp://HOST:8786), not the dashboard's"
-            ) from None
-        except (OSError, ValueError, TypeError) as exc:
-            # OSError: refused or timed out; ValueError/TypeError: an address Dask cannot parse.
-            raise ParameterError(f"scheduler: cannot connect to {address}: {in_one_line(exc)}") from None
-        except Exception as exc:  # noqa: BLE001 - a peer speaking another protocol can make Dask raise anything
-            raise ParameterError(
-                f"scheduler: {address} does not answer as a Dask scheduler ({type(exc).__name__} in the handshake)"
-            ) from None
+            probe.set_result(asyncio.run(asyncio.wait_for(handshake(), 2 * timeout)))
+        except BaseException as exc:  # noqa: BLE001 - handed to the waiting thread, which says it in one line
+            probe.set_exception(exc)
+
+    # A daemon thread, waited for in slices: Ctrl-C while connecting is answered at once, and neither the command
+    # nor the interpreter's exit waits out the handshake's timeout.
+    threading.Thread(target=run_probe, name="scheduler-probe", daemon=True).start()
+    while not probe.done():
+        wait([probe], timeout=POLL_S)
+    try:
+        probe.result()
+    except TimeoutError:
+        raise ParameterError(
+            f"scheduler: {address} accepted the connection but did not answer as a Dask scheduler "
+            f"(waited {2 * timeout:g} s); give the scheduler's address (tcp://HOST:8786), not the dashboard's"
+        ) from None
+    except (OSError, ValueError, TypeError) as exc:
+        # OSError: refused or timed out; ValueError/TypeError: an address Dask cannot parse.
+        raise ParameterError(f"scheduler: cannot connect to {address}: {in_one_line(exc)}") from None
+    except Exception as exc:  # noqa: BLE001 - a peer speaking another protocol can make Dask raise anything
+        raise ParameterError(
+            f"scheduler: {address} does not answer as a Dask scheduler ({type(exc).__name__} in the handshake)"
+        ) from None
 
 
 @contextmanager

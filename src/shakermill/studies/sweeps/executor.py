@@ -56,6 +56,10 @@ class Execution:
     scheduler: str | None = None
     scheduler_timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S
     progress: ProgressCallback | None = None
+    # The longest one task may take (a run's max_wall_time), which bounds each wait on a cluster; None: no bound.
+    round_limit_s: float | None = None
+    # Where a wait for the cluster says that it still waits (a line for the user).
+    announce: Callable[[str], None] | None = None
 
     def __post_init__(self) -> None:
         if self.workers is not None and self.scheduler is not None:
@@ -95,7 +99,14 @@ def execute(
     pending = [(identifier, values) for identifier, values in tasks if identifier not in stored]
     unfinished: dict[str, str] = {}
     # The backend first: an unreachable scheduler leaves no folder behind.
-    with backend_for(execution.workers, execution.scheduler, execution.scheduler_timeout, len(pending)) as backend:
+    with backend_for(
+        execution.workers,
+        execution.scheduler,
+        execution.scheduler_timeout,
+        len(pending),
+        round_limit_s=execution.round_limit_s,
+        announce=execution.announce,
+    ) as backend:
         claim_folder(folder, manifest)
         try:
             tracker = _Tracker(len(ids), finished_counts(stored), backend.slots, execution.progress)

@@ -15,7 +15,15 @@ from typing import Any
 
 import pandas as pd
 
-from shakermill.io.runs import to_jsonable
+from shakermill.io.runs import (
+    ENSEMBLE_KIND,
+    KIND_KEY,
+    MANIFEST_FILE,
+    SWEEP_KIND,
+    folder_kind,
+    other_kind_problem,
+    to_jsonable,
+)
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.studies.sweeps.plan import POINT_ID_LENGTH, POINT_ID_PATTERN, SweepPlan
@@ -29,9 +37,6 @@ from shakermill.support.atomic import (
 )
 from shakermill.support.limits import in_one_line
 from shakermill.support.version import __version__
-
-MANIFEST_FILE = "sweep.json"
-
 
 POINTS_FOLDER = "points"
 
@@ -71,11 +76,14 @@ class SweepData:
     table: pd.DataFrame
 
 
-def sweep_manifest(base: Parameters, plan: SweepPlan, ids: Sequence[str], preset: str) -> dict[str, Any]:
-    """The content of ``sweep.json``."""
+def sweep_manifest(
+    base: Parameters, plan: SweepPlan, ids: Sequence[str], preset: str, kind: str = SWEEP_KIND
+) -> dict[str, Any]:
+    """The content of ``sweep.json``; ``kind`` says which study's folder it is (``io.runs.KIND_PHRASES``)."""
     return to_jsonable(
         {
             "format": MANIFEST_FORMAT,
+            KIND_KEY: kind,
             "shakermill_version": __version__,
             "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
             "preset": preset,
@@ -94,7 +102,8 @@ def check_folder(folder: Path, manifest: dict[str, Any]) -> None:
     if manifest_path.is_file():
         _check_same_sweep(folder, read_manifest(folder), manifest)
     elif folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
-        raise ParameterError(f"{folder}: exists and is not a shakermill sweep folder; choose another --out")
+        not_ours = f"{folder}: exists and is not a shakermill {manifest[KIND_KEY]} folder"
+        raise ParameterError(f"{other_kind_problem(folder, manifest[KIND_KEY]) or not_ours}; choose another --out")
     elif not folder.exists():
         check_writable_place(folder)
 
@@ -125,7 +134,14 @@ def claim_folder(folder: Path, manifest: dict[str, Any]) -> None:
 
 
 def _check_same_sweep(folder: Path, stored: dict[str, Any], wanted: dict[str, Any]) -> None:
-    """Refuse to resume into a folder whose base parameters or points differ: its rows would not match."""
+    """Refuse to resume into a folder of another kind (an ensemble's, for a sweep), or whose base parameters or points
+    differ: its rows would not match."""
+    # A manifest written before manifests recorded their kind: a finished ensemble's has its summary beside it, and
+    # any other may be resumed by the study that wrote it.
+    legacy = ENSEMBLE_KIND if folder_kind(folder) == ENSEMBLE_KIND else wanted[KIND_KEY]
+    stored_kind = stored.get(KIND_KEY, legacy)
+    if stored_kind != wanted[KIND_KEY]:
+        raise ParameterError(f"{other_kind_problem(folder, wanted[KIND_KEY])}; choose another --out")
     difference = _first_difference(stored.get("base", {}), wanted["base"])
     if difference is not None:
         key, before, now = difference

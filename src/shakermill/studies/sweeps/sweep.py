@@ -23,12 +23,13 @@ in which they finish, or whether the points ran on a Dask cluster. The points ru
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
+from shakermill.io.runs import SWEEP_KIND
 from shakermill.parameters.defaults import DEFAULT_PRESET, DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.keys import Parameters
 from shakermill.studies.sweeps.executor import Execution, ProgressCallback, RunsInterrupted, execute
@@ -77,6 +78,8 @@ def sweep(
     *,
     preset: str = DEFAULT_PRESET,
     scheduler_timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S,
+    kind: str = SWEEP_KIND,
+    announce: Callable[[str], None] | None = None,
 ) -> pd.DataFrame:
     """Run ``base_params`` at every point of ``grid_points`` and return the sweep table.
 
@@ -93,7 +96,7 @@ def sweep(
     raises :class:`SweepInterrupted` (a ``KeyboardInterrupt``) once the table holds the finished points.
     """
     plan = as_plan(grid_points)
-    execution = Execution(workers, scheduler, scheduler_timeout, progress)
+    execution = Execution(workers, scheduler, scheduler_timeout, progress, base_params.max_wall_time, announce)
     folder = Path(out_dir)
     ids = point_ids(base_params, plan)
     written: list[pd.DataFrame] = []
@@ -108,7 +111,7 @@ def sweep(
     try:
         unfinished = execute(
             folder,
-            sweep_manifest(base_params, plan, ids, preset),
+            sweep_manifest(base_params, plan, ids, preset, kind),
             list(zip(ids, plan.points)),
             functools.partial(run_point, base_params, keep_run=keep_runs),
             functools.partial(_store, preset=preset),
