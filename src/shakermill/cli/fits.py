@@ -309,6 +309,7 @@ def calibrate_over_assumed(
                 on_start=lambda: typer.echo(said, err=True),
                 runs=folder,
                 execution=execution,
+                say=lambda line: typer.echo(f"calibrate: {line}", err=True),
             )
     except RunsInterrupted as stopped:
         fail(

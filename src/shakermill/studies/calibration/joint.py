@@ -34,6 +34,7 @@ import numpy as np
 
 from shakermill.parameters.assumed import AssumedInput
 from shakermill.parameters.engine_keys import reader_of
+from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.studies.calibration.calibrate import check_free_for_engine, fitted_prior
@@ -79,8 +80,9 @@ def feels(params: Parameters, key: str) -> bool:
 Data = Sequence[tuple[Emulator, Sequence[Measured]]]
 
 
-def sample_posterior(data: Data) -> Posterior:
-    """The posterior of the inputs of every emulator of ``data`` given its measurements (each an observable of it)."""
+def sample_posterior(data: Data, progress: Callable[[int, int], None] | None = None) -> Posterior:
+    """The posterior of the inputs of every emulator of ``data`` given its measurements (each an observable of it);
+    ``progress(step, steps)`` as the sampler goes."""
     import emcee
 
     prior = Prior.union(emulator.prior for emulator, _ in data)
@@ -117,7 +119,9 @@ def sample_posterior(data: Data) -> Posterior:
     # stretch in a dozen dimensions where most inputs are barely constrained.
     moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
     start = rng.uniform(0.05, 0.95, (walkers, len(prior)))
-    return Posterior.sampled(prior, sample(log_probability, start, STEPS, KEPT, SEED, vectorize=True, moves=moves))
+    return Posterior.sampled(
+        prior, sample(log_probability, start, STEPS, KEPT, SEED, vectorize=True, moves=moves, progress=progress)
+    )
 
 
 def prior_sample(inputs: Sequence[AssumedInput]) -> Posterior:
@@ -209,24 +213,31 @@ def calibrate_jointly(
     on_start: Callable[[], None] | None = None,
     runs: Path | None = None,
     execution: Execution = LOCAL_POOL,
+    say: Callable[[str], None] | None = None,
 ) -> JointCalibration:
     """Fit ``curves`` (``studies.measured.Curve``) over the network's ``free`` keys and every assumed input of
     ``preset`` that a run of ``base`` can feel (module docstring). As for ``calibrate``: the ``free`` keys must be
     the network's and read by the run, ``on_start()`` is called once they are, before the first run; ``progress(done,
     total)`` counts the mechanical members of every set of conditions. The members run as ``execution`` says, into
     ``runs`` (one folder a set of conditions; a temporary one where None): Ctrl-C raises
-    ``executor.RunsInterrupted`` with the finished members kept there, and the same calibration resumes from them."""
+    ``executor.RunsInterrupted`` with the finished members kept there, and the same calibration resumes from them.
+    ``say`` is told each phase after the runs (the emulators, the sampler's steps)."""
     from shakermill.parameters.config import parse_overrides
 
     check_free_for_engine(base, free)
-    if on_start is not None:
-        on_start()
     groups: dict[tuple[str, ...], list[Any]] = {(): []}
     for curve in curves:
         groups.setdefault(tuple(curve.conditions), []).append(curve)
+    # Every set of conditions checked before the first run: a bad one must not be found after the runs of another.
+    conditioned = {conditions: base.replace(**parse_overrides(conditions)) for conditions in groups}
+    for params in conditioned.values():
+        check_has_balls(params)
+    if on_start is not None:
+        on_start()
+    tell = say or (lambda _: None)
     data, emulators, total = [], {}, members * len(groups)
     for index, (conditions, chosen) in enumerate(groups.items()):
-        params = base.replace(**parse_overrides(conditions))
+        params = conditioned[conditions]
         measured = [
             Measured(
                 Observable(curve.node, float(curve.times[point])),
@@ -243,10 +254,11 @@ def calibrate_jointly(
         training = train(
             params, inputs, observables, members, thermal_draws, shown, group_folder(runs, conditions), execution
         )
+        tell(f"fitting the emulators of {len(observables)} measured quantities to the runs (held-out Q² each)")
         emulator = emulate(training)
         emulators[conditions] = emulator
         data.append((emulator, measured))
-    posterior = sample_posterior(data)
+    posterior = sample_posterior(data, lambda step, steps: tell(f"sampling the posterior: step {step} of {steps}"))
     fitted = tuple(
         item
         for emulator, measured in data
@@ -256,6 +268,16 @@ def calibrate_jointly(
     ends = tuple(item for item in predict(emulators[()], posterior) if item.observable.time_s == base.duration)
     source = "; ".join(curve.source for curve in curves)
     return JointCalibration(tuple(free), posterior, emulators, fitted, ends, source)
+
+
+def check_has_balls(params: Parameters) -> None:
+    """An empty mill heats nothing by impacts: its rises are the drive's alone, and the emulators of them would fit no
+    ball (the runs all succeed, the fit fails only after them)."""
+    if params.n_balls == 0:
+        raise ParameterError(
+            "n_balls: 0 is out of range for a calibration --with-assumed, which fits the balls' heat to a measured "
+            "rise; allowed 1 or more"
+        )
 
 
 def _spread_points(count: int) -> list[int]:

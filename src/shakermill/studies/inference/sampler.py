@@ -11,6 +11,8 @@ import numpy as np
 
 # A log-probability of one point (walkers one by one) or of an array of them (vectorized): -inf outside the prior.
 LogProbability = Callable[[np.ndarray], Any]
+# How often the sampler says how far it is: a sampling takes minutes.
+PROGRESS_STEPS = 1000
 
 
 @dataclass(frozen=True)
@@ -33,13 +35,15 @@ def sample(
     *,
     vectorize: bool = False,
     moves: Sequence[tuple[Any, float]] | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Chain:
     """Run the ensemble from ``start`` (walkers, dimensions) for ``steps`` steps and keep ``kept`` samples of the
     second half. ``moves``: emcee's proposals and their weights (its stretch move without).
 
     emcee prints a traceback of whatever the log-probability raises (a Ctrl-C, a spent budget) before raising it
     again: the first is kept, every later call refused at once, and it is raised after the sampler, with nothing
-    printed."""
+    printed; the sampler stops at the step it was raised in. ``progress(step, steps)`` is told every
+    PROGRESS_STEPS steps."""
     import emcee
 
     raised: list[BaseException] = []
@@ -59,7 +63,11 @@ def sample(
         walkers, dimensions, guarded, vectorize=vectorize, moves=None if moves is None else list(moves)
     )
     sampler.random_state = np.random.RandomState(seed).get_state()
-    sampler.run_mcmc(start, steps)
+    for step, _ in enumerate(sampler.sample(start, iterations=steps), start=1):
+        if raised:
+            break
+        if progress is not None and (step % PROGRESS_STEPS == 0 or step == steps):
+            progress(step, steps)
     if raised:
         raise raised[0]
     burn_in = steps // 2
