@@ -26,6 +26,7 @@ from shakermill.engines.thermal.nodes import (
     Deposit,
     NetworkDraft,
     Node,
+    Restitution,
     deposit_arrays,
 )
 from shakermill.engines.thermal.paths import PAPER_PATHS, HeatPath, ball_convection, newton_cooling
@@ -76,8 +77,8 @@ class ThermalNetwork:
     split: BodySplit
     deposits: tuple[Deposit, ...]
     arrays: kernel.NetworkArrays = field(repr=False)
-    # The restitution of a ball on the vessel and of two balls where a node coats them (NetworkDraft); None: uncoated.
-    coated_restitution: tuple[float, float] | None = None
+    # What the contacts rebound with: the bare keys', or a coating node's (NetworkDraft).
+    restitution: Restitution
 
     @property
     def vial(self) -> int:
@@ -249,7 +250,7 @@ def build_network(
     (the paper's 2023 predecessor). Then each of :data:`NODE_EXTENSIONS`. ``split_description`` says how the
     engine splits a contact's heat between the bodies in contact."""
     held = params.model == "ball_only"
-    draft = NetworkDraft(params, tuple(radii))
+    draft = NetworkDraft(params, tuple(radii), Restitution.bare(params))
     for name, capacity in zip(ball_names, capacities, strict=True):
         draft.add(Node(name, BALL, capacity, name))
     vial = draft.add(Node("vial", VESSEL, params.vial_mass * params.vial_heat_capacity, "vial", held))
@@ -285,7 +286,7 @@ def build_network(
         BodySplit(params.lam, split_description),
         tuple(draft.deposits),
         _arrays(params, draft.nodes, draft.paths, np.array(draft.fixed_heat, dtype=float)),
-        draft.coated_restitution,
+        draft.restitution,
     )
 
 
