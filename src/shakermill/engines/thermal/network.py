@@ -189,6 +189,39 @@ class ThermalNetwork:
         )
         return out, lost
 
+    def jacobian(self, theta: np.ndarray, drives: np.ndarray, step: float) -> np.ndarray:
+        """∂(dθ/dt)/∂θ (1/s) over the free nodes, at every node's ``theta`` (K) and the motion's mean ``drives``, from
+        each path's slopes at its two ends (:func:`kernel.path_slopes`, central differences of ``step`` K)."""
+        arrays, nodes = self.arrays, len(self.nodes)
+        by_hot, by_cold = np.empty(len(self.paths)), np.empty(len(self.paths))
+        kernel.path_slopes(
+            np.asarray(theta, dtype=float), np.asarray(drives, dtype=float), arrays, step, by_hot, by_cold
+        )
+        hot, cold = arrays.hot, arrays.cold
+        # d(heat into each node)/dθ (W/K): a flow leaves its hot end and enters its cold end where that is a node.
+        into = np.zeros((nodes, nodes))
+        np.add.at(into, (hot, hot), -by_hot)
+        ends = cold >= 0
+        np.add.at(into, (hot[ends], cold[ends]), -by_cold[ends])
+        np.add.at(into, (cold[ends], hot[ends]), by_hot[ends])
+        np.add.at(into, (cold[ends], cold[ends]), by_cold[ends])
+        self._add_among_balls(into, np.asarray(drives, dtype=float), by_cold)
+        free = self.free
+        return into[np.ix_(free, free)] / arrays.capacity[free][:, None]
+
+    def _add_among_balls(self, into: np.ndarray, drives: np.ndarray, by_cold: np.ndarray) -> None:
+        """The slopes of the AMONG_BALLS paths at their cold end, the balls' conductance-weighted mean
+        (:func:`kernel.among_balls_mean`), spread over the balls it averages."""
+        among = self.arrays.cold == kernel.BALLS
+        conductances = drives[self.arrays.drive[among]]
+        total = conductances.sum()
+        if total <= 0.0:
+            return  # no conduction among the balls: these paths carry nothing
+        weights = np.zeros(len(self.nodes))
+        balls = self.arrays.hot[among]
+        np.add.at(weights, balls, conductances / total)
+        np.add.at(into, balls, -np.outer(by_cold[among], weights))
+
     @property
     def fixed_heat(self) -> float:
         """Heat into the network whatever the balls do (W): the drive's."""
@@ -212,15 +245,9 @@ class ThermalNetwork:
 
     def node_conductances(self, drives: np.ndarray) -> np.ndarray:
         """The conductance (W/K) of all paths at each node: its heat flows when it alone is 1 K above the
-        ambient, every other node at the ambient."""
-        conductances = np.zeros(len(self.nodes))
-        theta = np.full(len(self.nodes), self.ambient)
-        for node in range(len(self.nodes)):
-            theta[node] += 1.0
-            flows = self.flows(theta, drives)
-            theta[node] = self.ambient
-            # Vectorised over the paths: a charge of thousands has thousands of nodes and paths.
-            conductances[node] = np.abs(flows[(self.arrays.hot == node) | (self.arrays.cold == node)]).sum()
+        ambient, every other node at the ambient (:func:`kernel.node_conductances`)."""
+        conductances = np.empty(len(self.nodes))
+        kernel.node_conductances(np.asarray(drives, dtype=float), self.arrays, conductances)
         return conductances
 
 
