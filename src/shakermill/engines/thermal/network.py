@@ -8,6 +8,7 @@ them."""
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from importlib import import_module
@@ -189,6 +190,39 @@ class ThermalNetwork:
         )
         return out, lost
 
+    def check_heat_leaves(self) -> None:
+        """Refuse a network in which the heat of the contacts (into the balls, the vessel and the nodes of the deposits)
+        has no path that can carry it to the room or a held node, naming the keys of the paths that carry nothing:
+        its temperatures would rise without bound, and a fit to them answers millions of degrees. The contacts'
+        conduction, measured by the run, counts as a path."""
+        paths = len(self.paths)
+        by_hot, by_cold = np.empty(paths), np.empty(paths)
+        rest = np.full(len(self.nodes), self.ambient)
+        kernel.path_slopes(rest, np.ones(kernel.drive_count(self.n_balls)), self.arrays, 0.5, by_hot, by_cold)
+        carries = by_hot != 0.0
+        reached = set(np.flatnonzero(self.arrays.held)) | {kernel.ROOM}
+        grown = True
+        while grown:
+            grown = False
+            for path in np.flatnonzero(carries):
+                ends = {int(self.arrays.hot[path]), int(self.arrays.cold[path])} - {kernel.BALLS}
+                if ends & reached and not ends <= reached:
+                    reached |= ends
+                    grown = True
+        heated = {*range(self.n_balls), self.vial, *(deposit.node for deposit in self.deposits if deposit.receives)}
+        trapped = sorted(heated - reached)
+        if not trapped:
+            return
+        dead = [path for path, carried in zip(self.paths, carries, strict=True) if not carried]
+        keys = dict.fromkeys(key for path in dead for key in _leading_keys(path.source))
+        names = ", ".join(self.nodes[node].name for node in trapped)
+        silent = ", ".join(path.name for path in dead)
+        raise ParameterError(
+            f"{', '.join(keys) or 'h_outer'}: the heat of {names} has no path to the room ({silent} "
+            "carry nothing with these values): the temperatures would rise without bound; allowed a nonzero "
+            "coefficient on one of these paths"
+        )
+
     def jacobian(self, theta: np.ndarray, drives: np.ndarray, step: float) -> np.ndarray:
         """∂(dθ/dt)/∂θ (1/s) over the free nodes, at every node's ``theta`` (K) and the motion's mean ``drives``, from
         each path's slopes at its two ends (:func:`kernel.path_slopes`, central differences of ``step`` K)."""
@@ -339,3 +373,9 @@ def _arrays(
         air_conductivity=params.air_conductivity,
         ambient=params.ambient_temperature,
     )
+
+
+def _leading_keys(source: str) -> list[str]:
+    """The keys a path's source names first ("h_inner, inner_area (...)"): those that set its coefficient."""
+    match = re.match(r"[a-z_]+(?:, [a-z_]+)*", source)
+    return match.group(0).split(", ") if match and "_" in match.group(0) else []

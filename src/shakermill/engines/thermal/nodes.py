@@ -69,6 +69,11 @@ class Deposit:
     def share(self, kind: str, channel: str) -> float:
         return float(self.shares.get(kind, {}).get(channel, 0.0))
 
+    @property
+    def receives(self) -> bool:
+        """Whether any contact puts heat into the node."""
+        return any(share > 0.0 for channels in self.shares.values() for share in channels.values())
+
 
 @dataclass(frozen=True)
 class BodySplit:
