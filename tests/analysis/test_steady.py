@@ -139,3 +139,37 @@ def test_run_length_note_only_for_short_runs():
     slowest = steady.slowest_time_constant
     assert run_length_note(2.9 * slowest, steady) is not None
     assert run_length_note(3.1 * slowest, steady) is None
+
+
+def test_a_charge_of_hundreds_of_balls_is_solved_in_few_evaluations_and_at_minpacks_root(monkeypatch):
+    from scipy.optimize import root
+
+    from shakermill.engines.dem.engine import DemEngine
+    from shakermill.engines.thermal import kernel
+    from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
+
+    bowl = {"vial_diameter": 0.1, "vial_length": 0.0637, "outer_diameter": 0.12, "outer_length": 0.08}
+    params = sm.default_parameters("pulverisette7", n_balls=300, ball_radius=2.5e-3, powder_mass=5e-3, **bowl)
+    network = DemEngine.network_for(params)
+    rng = np.random.default_rng(3)
+    drives = rng.uniform(0.05, 3.0, kernel.drive_count(network.n_balls))
+    balls = network.n_balls
+    heat = np.zeros(len(network.nodes))
+    heat[:balls] = rng.uniform(0.0, 0.05, balls)
+    load = NetworkLoad(heat, drives[:balls], float(heat.sum()), float(drives[:balls].mean()), drives[balls:])
+    evaluations = []
+    rates = ThermalNetwork.rates
+    monkeypatch.setattr(ThermalNetwork, "rates", lambda self, *args: evaluations.append(1) or rates(self, *args))
+    steady = steady_state(network, load)
+    # MINPACK's differences took one evaluation per node and iteration: thousands for 300 balls.
+    assert steady.solved and len(evaluations) <= 20
+    free = network.free
+    minpack = root(
+        lambda theta: rates(network, network.with_free(theta), load.heat, drives)[0][free],
+        np.full(free.size, network.ambient + 10.0),
+        method="hybr",
+        tol=1e-12,
+    )
+    assert minpack.success
+    assert np.array(steady.balls) == pytest.approx(minpack.x[: network.n_balls], abs=1e-7)
+    assert steady.vial == pytest.approx(minpack.x[network.vial], abs=1e-7)

@@ -109,3 +109,51 @@ def test_node_conductances_are_the_paths_at_each_node():
     assert conductances[1] == pytest.approx(
         params.h_inner * params.inner_area + params.h_outer * params.outer_area, rel=1e-9
     )
+
+
+def _charge_network(**overrides):
+    """The network of 20 balls in a planetary bowl, with the powder and the mill head's nodes, and drives drawn over
+    what runs see (velocity terms, contact conductances with the vial and among the balls)."""
+    params = sm.default_parameters("pulverisette7", n_balls=20, ball_radius=2.5e-3, **overrides)
+    network = DemEngine.network_for(params)
+    drives = np.random.default_rng(7).uniform(0.05, 3.0, kernel.drive_count(network.n_balls))
+    theta = network.with_free(np.random.default_rng(8).uniform(290.0, 420.0, network.free.size))
+    return network, drives, theta
+
+
+def _whole_network_differences(network, drives, theta, step):
+    """The Jacobian of dθ/dt over the free nodes by central differences of the whole network, node by node."""
+    free = network.free
+    heat = np.zeros(len(network.nodes))
+    columns = []
+    for node in free:
+        up, down = theta.copy(), theta.copy()
+        up[node] += step
+        down[node] -= step
+        columns.append((network.rates(up, heat, drives)[0] - network.rates(down, heat, drives)[0])[free] / (2 * step))
+    return np.column_stack(columns)
+
+
+@pytest.mark.parametrize("overrides", [{}, {"powder_mass": 2e-3}], ids=["bare", "powder"])
+def test_the_assembled_jacobian_is_the_whole_networks_differences(overrides):
+    network, drives, theta = _charge_network(**overrides)
+    assembled = network.jacobian(theta, drives, 0.5)
+    whole = _whole_network_differences(network, drives, theta, 0.5)
+    assert assembled.shape == (network.free.size, network.free.size)
+    # Every path and the balls' mean among them: the largest entry sets the scale of round-off.
+    assert np.max(np.abs(assembled - whole)) <= 1e-9 * np.max(np.abs(whole))
+    assert np.count_nonzero(np.abs(whole) > 0) == np.count_nonzero(np.abs(assembled) > 0)
+
+
+@pytest.mark.parametrize("overrides", [{}, {"powder_mass": 2e-3}], ids=["bare", "powder"])
+def test_node_conductances_in_one_pass_are_those_node_by_node(overrides):
+    network, drives, _ = _charge_network(**overrides)
+    expected = []
+    theta = np.full(len(network.nodes), network.ambient)
+    for node in range(len(network.nodes)):
+        theta[node] += 1.0
+        flows = network.flows(theta, drives)
+        theta[node] = network.ambient
+        ends = (network.arrays.hot == node) | (network.arrays.cold == node)
+        expected.append(np.abs(flows[ends]).sum())
+    assert network.node_conductances(drives) == pytest.approx(expected, rel=1e-12)

@@ -389,6 +389,24 @@ def test_a_coarse_contact_step_is_warned_of_and_the_default_one_is_not():
     assert restitution_warning(sm.default_parameters(contact_step_fraction=0.9), describe("1d")) is None
 
 
+def test_a_powder_coated_contact_is_measured_against_the_powders_restitution():
+    # The powder coats the contacts: a resolved impact rebounds with powder_restitution, not with restitution.
+    powder = sm.default_parameters(engine="dem", powder_mass=5e-3, restitution=0.9, powder_restitution=0.5)
+    assert single_impact(powder, 1.0).configured_restitution == ("powder_restitution", 0.5)
+    assert restitution_warning(powder, describe("dem")) is None
+    coarse = restitution_warning(powder.replace(contact_step_fraction=0.9), describe("dem"))
+    assert coarse is not None and "% off the configured powder_restitution = 0.5;" in coarse
+    achieved = float(coarse.split("restitution of ")[1].split(",")[0])
+    percent = float(coarse.split(", ")[1].split(" %")[0])
+    assert percent == pytest.approx(100 * abs(achieved - 0.5) / 0.5, abs=0.06)
+    bare = sm.default_parameters(engine="dem", contact_step_fraction=0.9)
+    assert "off the configured restitution = 0.7;" in str(restitution_warning(bare, describe("dem")))
+    assert single_impact(bare.replace(n_balls=2), 1.0, target="ball").configured_restitution == (
+        "pair_restitution",
+        bare.pair_restitution,
+    )
+
+
 @pytest.mark.slow
 def test_a_dem_run_with_a_coarse_contact_step_carries_the_warning_once():
     coarse = sm.simulate(sm.default_parameters(engine="dem", contact_step_fraction=0.9, duration=0.2, solver="full"))

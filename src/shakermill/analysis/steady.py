@@ -19,7 +19,6 @@ from dataclasses import dataclass
 from typing import Annotated
 
 import numpy as np
-from scipy.differentiate import jacobian
 from scipy.optimize import root
 
 from shakermill.analysis.sections import Celsius, Key, Minutes, NodeTemperatures, Watts, further_nodes
@@ -100,8 +99,11 @@ def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:
     def rates(theta: np.ndarray) -> np.ndarray:
         return network.rates(network.with_free(theta), load.heat, drives)[0][free]
 
+    def slopes(theta: np.ndarray, step: float) -> np.ndarray:
+        return network.jacobian(network.with_free(theta), drives, step)
+
     rise = heat / outer if outer > 0 else 0.0
-    solved = _solve(rates, np.full(free.size, network.ambient + rise))
+    solved = _solve(rates, slopes, np.full(free.size, network.ambient + rise))
     if isinstance(solved, str):
         return _unsolved(load, solved)
     theta, time_constants = solved
@@ -126,30 +128,56 @@ def steady_state(network: ThermalNetwork, load: NetworkLoad) -> SteadyState:
 NO_HEAT_LEAVES = "no heat leaves the vial (h_outer = 0): the temperatures rise without bound"
 
 
-def _vectorised(rates: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarray], np.ndarray]:
-    """``rates`` for scipy.differentiate.jacobian, which evaluates many points at once (trailing axes)."""
-
-    def evaluate(theta: np.ndarray) -> np.ndarray:
-        flat = theta.reshape(theta.shape[0], -1)
-        values = np.stack([rates(flat[:, j]) for j in range(flat.shape[1])], axis=-1)
-        return values.reshape(theta.shape)
-
-    return evaluate
-
-
-def _solve(rates: Callable[[np.ndarray], np.ndarray], guess: np.ndarray) -> tuple[np.ndarray, tuple[float, ...]] | str:
-    """The root of ``rates`` and the time constants there (s, slowest first), or why it was not found."""
-    solution = root(rates, guess, method="hybr", tol=1e-12)
-    residual = float(np.max(np.abs(rates(solution.x))))
-    if not np.all(np.isfinite(solution.x)) or residual > ROOT_TOLERANCE:
-        return f"the root of the thermal network was not found ({solution.message})"
-    # One pass of central differences of step 0.5 K (order 2): f is smooth on that scale (Sutherland's factor and
-    # Whitaker's Nu vary over tens of kelvin), so the time constants agree with scipy's adaptive default to ~4e-7,
-    # in 2N evaluations of f instead of ~20N; a charge of thousands of balls has as many nodes.
-    derivative = jacobian(_vectorised(rates), solution.x, initial_step=0.5, order=2, maxiter=1).df
-    eigenvalues = np.linalg.eigvals(np.atleast_2d(derivative))
+def _solve(
+    rates: Callable[[np.ndarray], np.ndarray], slopes: Callable[[np.ndarray, float], np.ndarray], guess: np.ndarray
+) -> tuple[np.ndarray, tuple[float, ...]] | str:
+    """The root of ``rates`` (Jacobian ``slopes(θ, step)``) and the time constants there (s, slowest first), or why
+    it was not found."""
+    theta = _newton(rates, slopes, guess)
+    if theta is None:
+        # Newton's steps left the range where the network is defined, or met a node with no path at all: MINPACK's
+        # trust region, slower (a dense factorisation per Jacobian), says why it fails where it does.
+        solution = root(rates, guess, jac=lambda x: slopes(x, NEWTON_STEP), method="hybr", tol=1e-12)
+        theta = solution.x
+        residual = float(np.max(np.abs(rates(theta)), initial=0.0))
+        if not np.all(np.isfinite(theta)) or residual > ROOT_TOLERANCE:
+            return f"the root of the thermal network was not found ({solution.message})"
+    # Central differences of step 0.5 K: f is smooth on that scale (Sutherland's factor and Whitaker's Nu vary over
+    # tens of kelvin), so the time constants agree with scipy's adaptive differences to ~4e-7.
+    eigenvalues = np.linalg.eigvals(np.atleast_2d(slopes(theta, TIME_CONSTANT_STEP)))
     time_constants = tuple(sorted((float(-1.0 / value.real) for value in eigenvalues), reverse=True))
-    return solution.x, time_constants
+    return theta, time_constants
+
+
+# Newton's iterations: Sutherland's factor and the radiation's fourth power are mild, so a root takes 3 to 6.
+NEWTON_ITERATIONS = 30
+NEWTON_STEP = 1e-3  # K, of the differences of Newton's Jacobian: near exact, as its convergence needs
+TIME_CONSTANT_STEP = 0.5  # K
+NEWTON_TOLERANCE = 1e-12  # relative, of the last step
+
+
+def _newton(
+    rates: Callable[[np.ndarray], np.ndarray], slopes: Callable[[np.ndarray, float], np.ndarray], guess: np.ndarray
+) -> np.ndarray | None:
+    """The root of ``rates`` by Newton's method from ``guess``, or None where it does not reach
+    :data:`ROOT_TOLERANCE`. Each iteration solves one linear system of the network's assembled Jacobian (one
+    evaluation per path), where differencing the whole network costs one evaluation per node: thousands of balls,
+    thousands of nodes."""
+    theta = np.array(guess, dtype=float)
+    for _ in range(NEWTON_ITERATIONS):
+        residual = rates(theta)
+        if not np.all(np.isfinite(residual)):
+            return None
+        try:
+            step = np.linalg.solve(np.atleast_2d(slopes(theta, NEWTON_STEP)), residual)
+        except np.linalg.LinAlgError:
+            return None
+        theta = theta - step
+        # Converged to round-off, as MINPACK's tolerance on the root asked before.
+        if np.max(np.abs(step), initial=0.0) <= NEWTON_TOLERANCE * np.max(np.abs(theta), initial=0.0):
+            solved = np.all(np.isfinite(theta)) and np.max(np.abs(rates(theta)), initial=0.0) <= ROOT_TOLERANCE
+            return theta if solved else None
+    return None
 
 
 def _unsolved(load: NetworkLoad, message: str) -> SteadyState:

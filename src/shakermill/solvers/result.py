@@ -52,6 +52,11 @@ INTERRUPTED_MESSAGE = "Interrupted by the user; the results cover the time simul
 OUT_OF_PHYSICAL_BOUNDS = -5
 # The run finished, but its energy audit does not close within ENERGY_AUDIT_TOLERANCE.
 ENERGY_AUDIT_FAILED = -6
+# The run stayed in range, but what it answers beyond its end (a node's steady state, the fitted θ∞) is above
+# PHYSICAL_CEILING: no charge gets there; its heat has (nearly) no way out. -7 is the 1-D engine's WINDOWS_FULL.
+UNPHYSICAL_ANSWER = -8
+# K, 2,000 °C: above it every node of a mill (steel, air, a metal powder) has melted or the model has no meaning.
+PHYSICAL_CEILING = 2273.15
 # Relative residual of the energy audit above which a run's heat and temperatures are not to be trusted.
 # With the energy projection the balance closes to round-off (~1e-11 over the operating range, presets
 # included); without it, it shows the contacts' truncation error: 0.2–0.8 % at the default rtol for
@@ -242,9 +247,13 @@ def conclude(output: RunOutput, network: ThermalNetwork, load: NetworkLoad) -> R
     params = output.params
     steady = steady_state(network, load)
     status, message = output.status, output.message
-    checks = ((OUT_OF_PHYSICAL_BOUNDS, physical_bounds_problem), (ENERGY_AUDIT_FAILED, energy_audit_problem))
+    checks = (
+        (OUT_OF_PHYSICAL_BOUNDS, lambda: physical_bounds_problem(output, network)),
+        (ENERGY_AUDIT_FAILED, lambda: energy_audit_problem(output)),
+        (UNPHYSICAL_ANSWER, lambda: unphysical_answer(output, steady)),
+    )
     for code, problem_of in checks:
-        problem = problem_of(output) if status == REACHED_STOP else None
+        problem = problem_of() if status == REACHED_STOP else None
         if problem is not None:
             status, message = code, problem
     gathered = {item.name: getattr(output, item.name) for item in fields(RunOutput)}
@@ -279,8 +288,9 @@ def mean_path_flows(network: ThermalNetwork, history: StateHistory, drives: np.n
     return {path.name: float(value) for path, value in zip(network.paths, means, strict=True)}
 
 
-def physical_bounds_problem(result: RunOutput) -> str | None:
-    """Why the temperatures of a run cannot be physical, or None."""
+def physical_bounds_problem(result: RunOutput, network: ThermalNetwork) -> str | None:
+    """Why the temperatures of a run cannot be physical, or None: a ball above ball_temperature_limit, any other node
+    above :data:`PHYSICAL_CEILING`, any below absolute zero."""
     series = result.history
     balls = series[BALL_TEMPERATURES if BALL_TEMPERATURES in series.variables else "theta_ball"]
     # With no balls (an empty mill) there is nothing to reduce: the initial value keeps nanmax from raising.
@@ -292,9 +302,35 @@ def physical_bounds_problem(result: RunOutput) -> str | None:
             f"({kelvin_to_celsius(limit):.4g} °C): the model does not hold there. Check omega, amplitude and the "
             "units of the inputs (bare numbers are SI)."
         )
+    others = [node.name for node in network.others if f"theta_{node.name}" in series.variables]
+    hottest = max(others, key=lambda name: float(np.nanmax(series[f"theta_{name}"], initial=-np.inf)), default=None)
+    peak = float(np.nanmax(series[f"theta_{hottest}"])) if hottest is not None else -math.inf
+    if peak > PHYSICAL_CEILING:
+        return (
+            f"The {hottest} temperature reached {kelvin_to_celsius(peak):.4g} °C, "
+            f"above {kelvin_to_celsius(PHYSICAL_CEILING):.4g} °C: the model does not hold there. Check the heat paths' "
+            "coefficients and the units of the inputs."
+        )
     coldest = min(float(np.nanmin(series[name], initial=np.inf)) for name in ("theta_ball", "theta_vial", "theta_air"))
     if coldest < 0.0:
         return f"A temperature fell to {coldest:.4g} K, below absolute zero: the thermal network is not physical here."
+    return None
+
+
+def unphysical_answer(result: RunOutput, steady: SteadyState) -> str | None:
+    """Why what a run answers beyond its end, the fitted θ∞ of the balls or a node's steady state, is no temperature
+    a mill reaches (above :data:`PHYSICAL_CEILING`), or None."""
+    answers = {"the balls' fitted theta_inf": result.ball_fit.theta_inf if result.ball_fit.success else math.nan}
+    if steady.solved:
+        answers |= {"the ball's steady state": steady.ball, "the vial's steady state": steady.vial}
+        answers |= {f"the {name}'s steady state": value for name, value in steady.others}
+    for what, value in answers.items():
+        if value > PHYSICAL_CEILING:
+            return (
+                f"The run is not physical: {what} is {kelvin_to_celsius(value):.4g} °C, above "
+                f"{kelvin_to_celsius(PHYSICAL_CEILING):.4g} °C, where no mill goes: its heat has almost no way out. "
+                "Check the heat paths' coefficients (h_outer, h_inner, the powder's) and the units of the inputs."
+            )
     return None
 
 

@@ -61,6 +61,7 @@ def preflight(params: Parameters) -> None:
         averaging_engine(engine)
         if replica_count(params) > 1:
             replicated_engine(engine)
+    engine.network_for(params).check_heat_leaves()
     if issubclass(engine, StepBound):
         _check_step_budget(params, engine.least_steps)
     if issubclass(engine, MemoryBound):

@@ -313,8 +313,6 @@ def constants_from(params: Parameters, network: ThermalNetwork | None = None) ->
         default=params.max_flight_step / params.contact_step_fraction,
     )
     impact_fraction = params.contact_step_fraction * IMPACT_STEP_SCALE
-    # A node that coats the bodies in contact (the powder) sets their restitution.
-    wall_restitution, pair_restitution = network.coated_restitution or (params.restitution, params.pair_restitution)
     return Constants(
         relative_convection=params.relative_convection,
         air_density=params.air_density,
@@ -334,8 +332,8 @@ def constants_from(params: Parameters, network: ThermalNetwork | None = None) ->
         conductivity=conductivity,
         vial_effusivity=vial_effusivity,
         vial_conductivity=params.vial_conductivity,
-        beta_e=contact.damping_ratio(wall_restitution),
-        pair_beta_e=contact.damping_ratio(pair_restitution),
+        beta_e=contact.damping_ratio(network.restitution.wall),
+        pair_beta_e=contact.damping_ratio(network.restitution.pair),
         no_tension=params.no_tension,
         friction=params.friction,
         pair_friction=params.pair_friction,

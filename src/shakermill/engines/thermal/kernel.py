@@ -109,19 +109,74 @@ def path_flows(theta: np.ndarray, drives: np.ndarray, net: NetworkArrays, out: n
     motion's ``drives``."""
     balls_mean, among_factor = among_balls_mean(theta, drives, net)
     for p in range(net.kind.shape[0]):
-        hot = theta[net.hot[p]]
-        cold = net.ambient if net.cold[p] == ROOM else (balls_mean if net.cold[p] == BALLS else theta[net.cold[p]])
-        kind = net.kind[p]
-        if kind == AMONG_BALLS:
-            out[p] = among_factor * drives[net.drive[p]] * (hot - cold)
-        elif kind == WHITAKER:
-            out[p] = whitaker_flow(hot, cold, drives[net.drive[p]], net.radius[p], net)
-        elif kind == CONTACT:
-            out[p] = drives[net.drive[p]] * (hot - cold)
-        elif kind == RADIATION:
-            out[p] = net.conductance[p] * (hot**4 - cold**4)
-        else:
-            out[p] = net.conductance[p] * (hot - cold)
+        out[p] = path_flow(p, theta[net.hot[p]], cold_end(p, theta, balls_mean, net), among_factor, drives, net)
+
+
+@njit(cache=True)
+def cold_end(p: int, theta: np.ndarray, balls_mean: float, net: NetworkArrays) -> float:
+    """The temperature (K) at path ``p``'s cold end: a node's, the room's or the other balls' mean."""
+    if net.cold[p] == ROOM:
+        return net.ambient
+    return balls_mean if net.cold[p] == BALLS else theta[net.cold[p]]
+
+
+@njit(cache=True)
+def path_flow(p: int, hot: float, cold: float, among_factor: float, drives: np.ndarray, net: NetworkArrays) -> float:
+    """Path ``p``'s heat flow (W) with its ends at ``hot`` and ``cold`` (K)."""
+    kind = net.kind[p]
+    if kind == AMONG_BALLS:
+        return among_factor * drives[net.drive[p]] * (hot - cold)
+    if kind == WHITAKER:
+        return whitaker_flow(hot, cold, drives[net.drive[p]], net.radius[p], net)
+    if kind == CONTACT:
+        return drives[net.drive[p]] * (hot - cold)
+    if kind == RADIATION:
+        return net.conductance[p] * (hot**4 - cold**4)
+    return net.conductance[p] * (hot - cold)
+
+
+@njit(cache=True)
+def path_slopes(
+    theta: np.ndarray, drives: np.ndarray, net: NetworkArrays, step: float, by_hot: np.ndarray, by_cold: np.ndarray
+) -> None:
+    """Each path's ∂flow/∂θ (W/K) at its hot end into ``by_hot`` and at its cold end into ``by_cold``, by central
+    differences of ``step`` (K): a flow depends on its two ends alone, so the network's Jacobian is assembled from
+    these in O(paths) evaluations where differencing the whole network takes O(nodes × paths)."""
+    balls_mean, among_factor = among_balls_mean(theta, drives, net)
+    for p in range(net.kind.shape[0]):
+        hot, cold = theta[net.hot[p]], cold_end(p, theta, balls_mean, net)
+        by_hot[p] = (
+            path_flow(p, hot + step, cold, among_factor, drives, net)
+            - path_flow(p, hot - step, cold, among_factor, drives, net)
+        ) / (2.0 * step)
+        by_cold[p] = (
+            path_flow(p, hot, cold + step, among_factor, drives, net)
+            - path_flow(p, hot, cold - step, among_factor, drives, net)
+        ) / (2.0 * step)
+
+
+@njit(cache=True)
+def node_conductances(drives: np.ndarray, net: NetworkArrays, out: np.ndarray) -> None:
+    """The conductance (W/K) of all paths at each node into ``out``: the sum of the flows' magnitudes on the paths
+    that end at it when it alone is 1 K above the ambient (the other balls' mean, an AMONG_BALLS path's cold end,
+    moving by its own weight in it). One pass over the paths, not one per node: thousands of balls."""
+    weights = np.zeros(out.shape[0])
+    total = 0.0
+    for p in range(net.kind.shape[0]):
+        if net.kind[p] == AMONG_BALLS:
+            weights[net.hot[p]] += drives[net.drive[p]]
+            total += drives[net.drive[p]]
+    if total > 0.0:
+        weights /= total
+    _, among_factor = among_balls_mean(np.full(out.shape[0], net.ambient), drives, net)
+    out[:] = 0.0
+    ambient = net.ambient
+    for p in range(net.kind.shape[0]):
+        hot, cold = net.hot[p], net.cold[p]
+        raised_cold = ambient + weights[hot] if cold == BALLS else ambient
+        out[hot] += abs(path_flow(p, ambient + 1.0, raised_cold, among_factor, drives, net))
+        if cold >= 0:
+            out[cold] += abs(path_flow(p, ambient, ambient + 1.0, among_factor, drives, net))
 
 
 @njit(cache=True)

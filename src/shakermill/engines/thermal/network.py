@@ -8,6 +8,7 @@ them."""
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from importlib import import_module
@@ -26,6 +27,7 @@ from shakermill.engines.thermal.nodes import (
     Deposit,
     NetworkDraft,
     Node,
+    Restitution,
     deposit_arrays,
 )
 from shakermill.engines.thermal.paths import PAPER_PATHS, HeatPath, ball_convection, newton_cooling
@@ -76,8 +78,8 @@ class ThermalNetwork:
     split: BodySplit
     deposits: tuple[Deposit, ...]
     arrays: kernel.NetworkArrays = field(repr=False)
-    # The restitution of a ball on the vessel and of two balls where a node coats them (NetworkDraft); None: uncoated.
-    coated_restitution: tuple[float, float] | None = None
+    # What the contacts rebound with: the bare keys', or a coating node's (NetworkDraft).
+    restitution: Restitution
 
     @property
     def vial(self) -> int:
@@ -188,6 +190,72 @@ class ThermalNetwork:
         )
         return out, lost
 
+    def check_heat_leaves(self) -> None:
+        """Refuse a network in which the heat of the contacts (into the balls, the vessel and the nodes of the deposits)
+        has no path that can carry it to the room or a held node, naming the keys of the paths that carry nothing:
+        its temperatures would rise without bound, and a fit to them answers millions of degrees. The contacts'
+        conduction, measured by the run, counts as a path."""
+        paths = len(self.paths)
+        by_hot, by_cold = np.empty(paths), np.empty(paths)
+        rest = np.full(len(self.nodes), self.ambient)
+        kernel.path_slopes(rest, np.ones(kernel.drive_count(self.n_balls)), self.arrays, 0.5, by_hot, by_cold)
+        carries = by_hot != 0.0
+        reached = set(np.flatnonzero(self.arrays.held)) | {kernel.ROOM}
+        grown = True
+        while grown:
+            grown = False
+            for path in np.flatnonzero(carries):
+                ends = {int(self.arrays.hot[path]), int(self.arrays.cold[path])} - {kernel.BALLS}
+                if ends & reached and not ends <= reached:
+                    reached |= ends
+                    grown = True
+        heated = {*range(self.n_balls), self.vial, *(deposit.node for deposit in self.deposits if deposit.receives)}
+        trapped = sorted(heated - reached)
+        if not trapped:
+            return
+        dead = [path for path, carried in zip(self.paths, carries, strict=True) if not carried]
+        keys = dict.fromkeys(key for path in dead for key in _leading_keys(path.source))
+        names = ", ".join(self.nodes[node].name for node in trapped)
+        silent = ", ".join(path.name for path in dead)
+        raise ParameterError(
+            f"{', '.join(keys) or 'h_outer'}: the heat of {names} has no path to the room ({silent} "
+            "carry nothing with these values): the temperatures would rise without bound; allowed a nonzero "
+            "coefficient on one of these paths"
+        )
+
+    def jacobian(self, theta: np.ndarray, drives: np.ndarray, step: float) -> np.ndarray:
+        """∂(dθ/dt)/∂θ (1/s) over the free nodes, at every node's ``theta`` (K) and the motion's mean ``drives``, from
+        each path's slopes at its two ends (:func:`kernel.path_slopes`, central differences of ``step`` K)."""
+        arrays, nodes = self.arrays, len(self.nodes)
+        by_hot, by_cold = np.empty(len(self.paths)), np.empty(len(self.paths))
+        kernel.path_slopes(
+            np.asarray(theta, dtype=float), np.asarray(drives, dtype=float), arrays, step, by_hot, by_cold
+        )
+        hot, cold = arrays.hot, arrays.cold
+        # d(heat into each node)/dθ (W/K): a flow leaves its hot end and enters its cold end where that is a node.
+        into = np.zeros((nodes, nodes))
+        np.add.at(into, (hot, hot), -by_hot)
+        ends = cold >= 0
+        np.add.at(into, (hot[ends], cold[ends]), -by_cold[ends])
+        np.add.at(into, (cold[ends], hot[ends]), by_hot[ends])
+        np.add.at(into, (cold[ends], cold[ends]), by_cold[ends])
+        self._add_among_balls(into, np.asarray(drives, dtype=float), by_cold)
+        free = self.free
+        return into[np.ix_(free, free)] / arrays.capacity[free][:, None]
+
+    def _add_among_balls(self, into: np.ndarray, drives: np.ndarray, by_cold: np.ndarray) -> None:
+        """The slopes of the AMONG_BALLS paths at their cold end, the balls' conductance-weighted mean
+        (:func:`kernel.among_balls_mean`), spread over the balls it averages."""
+        among = self.arrays.cold == kernel.BALLS
+        conductances = drives[self.arrays.drive[among]]
+        total = conductances.sum()
+        if total <= 0.0:
+            return  # no conduction among the balls: these paths carry nothing
+        weights = np.zeros(len(self.nodes))
+        balls = self.arrays.hot[among]
+        np.add.at(weights, balls, conductances / total)
+        np.add.at(into, balls, -np.outer(by_cold[among], weights))
+
     @property
     def fixed_heat(self) -> float:
         """Heat into the network whatever the balls do (W): the drive's."""
@@ -211,15 +279,9 @@ class ThermalNetwork:
 
     def node_conductances(self, drives: np.ndarray) -> np.ndarray:
         """The conductance (W/K) of all paths at each node: its heat flows when it alone is 1 K above the
-        ambient, every other node at the ambient."""
-        conductances = np.zeros(len(self.nodes))
-        theta = np.full(len(self.nodes), self.ambient)
-        for node in range(len(self.nodes)):
-            theta[node] += 1.0
-            flows = self.flows(theta, drives)
-            theta[node] = self.ambient
-            # Vectorised over the paths: a charge of thousands has thousands of nodes and paths.
-            conductances[node] = np.abs(flows[(self.arrays.hot == node) | (self.arrays.cold == node)]).sum()
+        ambient, every other node at the ambient (:func:`kernel.node_conductances`)."""
+        conductances = np.empty(len(self.nodes))
+        kernel.node_conductances(np.asarray(drives, dtype=float), self.arrays, conductances)
         return conductances
 
 
@@ -249,7 +311,7 @@ def build_network(
     (the paper's 2023 predecessor). Then each of :data:`NODE_EXTENSIONS`. ``split_description`` says how the
     engine splits a contact's heat between the bodies in contact."""
     held = params.model == "ball_only"
-    draft = NetworkDraft(params, tuple(radii))
+    draft = NetworkDraft(params, tuple(radii), Restitution.bare(params))
     for name, capacity in zip(ball_names, capacities, strict=True):
         draft.add(Node(name, BALL, capacity, name))
     vial = draft.add(Node("vial", VESSEL, params.vial_mass * params.vial_heat_capacity, "vial", held))
@@ -285,7 +347,7 @@ def build_network(
         BodySplit(params.lam, split_description),
         tuple(draft.deposits),
         _arrays(params, draft.nodes, draft.paths, np.array(draft.fixed_heat, dtype=float)),
-        draft.coated_restitution,
+        draft.restitution,
     )
 
 
@@ -311,3 +373,9 @@ def _arrays(
         air_conductivity=params.air_conductivity,
         ambient=params.ambient_temperature,
     )
+
+
+def _leading_keys(source: str) -> list[str]:
+    """The keys a path's source names first ("h_inner, inner_area (...)"): those that set its coefficient."""
+    match = re.match(r"[a-z_]+(?:, [a-z_]+)*", source)
+    return match.group(0).split(", ") if match and "_" in match.group(0) else []

@@ -69,6 +69,11 @@ class Deposit:
     def share(self, kind: str, channel: str) -> float:
         return float(self.shares.get(kind, {}).get(channel, 0.0))
 
+    @property
+    def receives(self) -> bool:
+        """Whether any contact puts heat into the node."""
+        return any(share > 0.0 for channels in self.shares.values() for share in channels.values())
+
 
 @dataclass(frozen=True)
 class BodySplit:
@@ -80,19 +85,35 @@ class BodySplit:
     description: str
 
 
+@dataclass(frozen=True)
+class Restitution:
+    """The restitution a run's contacts are configured with, of a ball on the vessel and of two balls, and the key
+    that sets each: the one place the engine, its contact-step guard and their messages read it from."""
+
+    wall: float
+    pair: float
+    wall_key: str
+    pair_key: str
+
+    @classmethod
+    def bare(cls, params: Parameters) -> Restitution:
+        """Of uncoated contacts: ``restitution`` and ``pair_restitution``."""
+        return cls(params.restitution, params.pair_restitution, "restitution", "pair_restitution")
+
+
 @dataclass
 class NetworkDraft:
     """A network being built: the nodes, paths, deposits and the heat each node receives whatever the balls do (W),
     and the balls' radii, for the extensions that add to it (:data:`network.NODE_EXTENSIONS`). A node that coats the
-    bodies in contact (the powder) sets their ``coated_restitution``: of a ball on the vessel and of two balls."""
+    bodies in contact (the powder) replaces their ``restitution``."""
 
     params: Parameters
     radii: Sequence[float]
+    restitution: Restitution
     nodes: list[Node] = field(default_factory=list)
     paths: list[HeatPath] = field(default_factory=list)
     deposits: list[Deposit] = field(default_factory=list)
     fixed_heat: list[float] = field(default_factory=list)
-    coated_restitution: tuple[float, float] | None = None
 
     def add(self, node: Node, fixed_heat: float = 0.0) -> int:
         """Add ``node`` (receiving ``fixed_heat`` W whatever the balls do); its index."""

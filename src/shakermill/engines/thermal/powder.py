@@ -19,6 +19,7 @@ from shakermill.engines.thermal.nodes import (
     Deposit,
     NetworkDraft,
     Node,
+    Restitution,
 )
 from shakermill.engines.thermal.paths import newton_cooling
 from shakermill.parameters.groups.powder import PowderCoating, PowderHeat
@@ -67,7 +68,8 @@ def add_node(draft: NetworkDraft) -> None:
             "h_inner, inner_area: the layer's free surface meets the gas where the bare wall does (vial → air)",
         ),
     ]
-    draft.coated_restitution = (coating.powder_restitution, coating.powder_restitution)
+    restitution = coating.powder_restitution
+    draft.restitution = Restitution(restitution, restitution, "powder_restitution", "powder_restitution")
     share = heat.powder_heat_share
     draft.deposits.append(
         Deposit(
