@@ -61,6 +61,9 @@ class RunConfig:
     # The file's [assumed.KEY] tables and [provenance] (a calibration's), unchecked: parameters/assumed.py reads them.
     assumed_tables: Mapping[str, Any] = field(default_factory=dict)
     provenance: Mapping[str, Any] = field(default_factory=dict)
+    # The keys the user set: on the command line (--set) or in a configuration written by hand (a file shakermill
+    # wrote sets every key, the user's or not). A command reads each as given or refuses it; no posterior replaces it.
+    explicit: tuple[str, ...] = ()
 
 
 def load_config(
@@ -96,10 +99,10 @@ def load_config(
     base = layered(with_materials(preset_layer), with_materials(file_values))
     asked = parse_overrides(overrides)
     params = build_parameters(base, asked)
+    explicit = tuple(dict.fromkeys([*(key for key in file_values if written_by_hand), *asked]))
     if reader is None:
-        return RunConfig(params=params, preset=chosen_preset, source=source, **tables)
+        return RunConfig(params=params, preset=chosen_preset, source=source, explicit=explicit, **tables)
     run = reader_of(params, None if reader == "run" else reader)
-    explicit = [*(key for key in file_values if written_by_hand and key != PRESET_KEY), *asked]
     problem = run.unread_problem(explicit)
     if problem is not None:
         raise ParameterError(problem)
@@ -110,7 +113,12 @@ def load_config(
     if file_preset is not None and chosen_preset != file_preset:
         notes.append(f"The preset is {chosen_preset!r} (--preset), not the {file_preset!r} that {source} names.")
     config = RunConfig(
-        params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note), **tables
+        params=params,
+        preset=chosen_preset,
+        source=source,
+        notes=tuple(note for note in notes if note),
+        explicit=explicit,
+        **tables,
     )
     if config.assumed_tables:
         config_preset(config)  # its [assumed.KEY] tables checked now, with one line for the first that is wrong
