@@ -25,6 +25,8 @@ TABLE_FIELDS = ("low", "high", "distribution", "reason")
 MOVES_FIELD = "moves"
 BOWL_KEYS = ("vial_diameter", "vial_length", "outer_diameter", "outer_length")
 DERIVED_KEYS = ("inner_area", "vial_mass")
+# What each derived key follows, for a user who gives it a range of its own where it moves with the bowl.
+DERIVED_FROM = {"inner_area": "the bore diameter and length", "vial_mass": "the vial's dimensions"}
 
 
 @dataclass(frozen=True)

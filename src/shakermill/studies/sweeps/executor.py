@@ -56,6 +56,9 @@ class Execution:
     scheduler: str | None = None
     scheduler_timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S
     progress: ProgressCallback | None = None
+    # Told once every check has passed and the workers are up, before the first task: a command's announcement of
+    # its work must not come before a refusal of its folder, its workers or its scheduler.
+    on_start: Callable[[], None] | None = None
 
     def __post_init__(self) -> None:
         if self.workers is not None and self.scheduler is not None:
@@ -97,6 +100,8 @@ def execute(
     # The backend first: an unreachable scheduler leaves no folder behind.
     with backend_for(execution.workers, execution.scheduler, execution.scheduler_timeout, len(pending)) as backend:
         claim_folder(folder, manifest)
+        if execution.on_start is not None:
+            execution.on_start()
         try:
             tracker = _Tracker(len(ids), finished_counts(stored), backend.slots, execution.progress)
             for identifier, outcome in backend.outcomes(work, pending):

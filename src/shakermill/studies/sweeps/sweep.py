@@ -23,7 +23,7 @@ in which they finish, or whether the points ran on a Dask cluster. The points ru
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -77,6 +77,7 @@ def sweep(
     *,
     preset: str = DEFAULT_PRESET,
     scheduler_timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S,
+    on_start: Callable[[], None] | None = None,
 ) -> pd.DataFrame:
     """Run ``base_params`` at every point of ``grid_points`` and return the sweep table.
 
@@ -86,14 +87,15 @@ def sweep(
     to the averaged one, see :func:`sweep_parameters`). Points run on ``workers`` local processes
     (default: one per core; 1 runs them in this process) or on the Dask cluster at ``scheduler``
     ("tcp://host:8786"). Each finished point is stored at once in ``out_dir``; points stored by an
-    earlier run of the same sweep are skipped. Raises :class:`ParameterError` (one line) for bad
+    earlier run of the same sweep are skipped; ``on_start`` is told when the checks have passed and the points
+    start. Raises :class:`ParameterError` (one line) for bad
     input, a folder that holds another sweep, or an unreachable scheduler,
     :class:`~shakermill.atomic.StorageError` for a place where the folder cannot be created, and
     :class:`SweepFailed` (naming the first failure) when no point succeeded. Ctrl-C stops the workers at once and
     raises :class:`SweepInterrupted` (a ``KeyboardInterrupt``) once the table holds the finished points.
     """
     plan = as_plan(grid_points)
-    execution = Execution(workers, scheduler, scheduler_timeout, progress)
+    execution = Execution(workers, scheduler, scheduler_timeout, progress, on_start)
     folder = Path(out_dir)
     ids = point_ids(base_params, plan)
     written: list[pd.DataFrame] = []
