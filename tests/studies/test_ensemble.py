@@ -102,6 +102,14 @@ def test_a_headline_the_surrogate_cannot_predict_gets_no_indices(tmp_path: Path)
     assert spread.surrogate_q2 < 0.5 and spread.total == {} and spread.deciding == []
 
 
+def test_a_share_zero_to_round_off_does_not_vary_where_a_power_of_that_size_does(tmp_path: Path):
+    points = design([LINEAR], 16, seed=9)
+    round_off = np.linspace(0.0, 3e-17, 16)
+    ensemble = analyse(members_table(points, 1e-16 + round_off, stress_lasting_share=round_off), [LINEAR], tmp_path)
+    assert not ensemble.headline("stress_lasting_share").varies
+    assert ensemble.headline("heat_power_W").varies
+
+
 def test_failed_members_are_counted_and_left_out(tmp_path: Path):
     points = design([LINEAR], 8, seed=8)
     table = members_table(points, np.arange(8.0))

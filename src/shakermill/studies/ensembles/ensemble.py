@@ -75,6 +75,8 @@ FOLDS = 5
 # A headline whose members spread less than this share of its size does not depend on the inputs: a part in a
 # million is the integrators' tolerance, not a sensitivity.
 STEADY_SPREAD = 1e-6
+# The headlines that are shares of a whole (a fraction of the dissipation): their size is 1, not their members'.
+SHARE_SUFFIX = "_share"
 # Base samples of Saltelli's design on the surrogate: N·(d + 2) predictions.
 SALTELLI_BASE = 1024
 # The fewest members (a power of two) and the most.
@@ -344,11 +346,17 @@ def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]
     good = np.isfinite(values)
     low, middle, high = (float(q) for q in np.quantile(values[good], QUANTILES)) if good.any() else (math.nan,) * 3
     quantiles = (low, middle, high)
-    varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * np.max(np.abs(values[good]))
+    varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * _size(key, values[good])
     if not varies:
         return HeadlineSpread(key, label, symbol, quantiles, math.nan, varies=False)
     q2, first, total, parts = _sensitivity(unit[good], values[good], names)
     return HeadlineSpread(key, label, symbol, quantiles, q2, first, total, parts=parts)
+
+
+def _size(key: str, values: np.ndarray) -> float:
+    """What a headline's spread is measured against: a share's whole, else its members' largest value. A share zero
+    to round-off is no share at all, however its round-off spreads."""
+    return 1.0 if key.endswith(SHARE_SUFFIX) else float(np.max(np.abs(values)))
 
 
 def _power_label(key: str) -> str:
