@@ -217,11 +217,20 @@ def resolve_aliases(layer: Mapping[str, Any]) -> dict[str, Any]:
         if key in found:
             raise ParameterError(f"{alias}: give {key} or {alias} (twice {key}), not both")
         try:
-            found[key] = guards.quantity(alias, found.pop(alias), field_unit(key)) / 2.0
+            length = guards.quantity(alias, found.pop(alias), field_unit(key))
         except UnitError as exc:
-            low, high = (2.0 * bound for bound in (bounds(key).low, bounds(key).high))
-            raise ParameterError(f"{exc}; allowed a length from {low:g} to {high:g} m (twice {key})") from None
+            raise ParameterError(f"{exc}; allowed {twice_range(key)}") from None
+        # Refused in the user's terms: the radius's range would name a key the user never typed.
+        if not bounds(key).contains(bounds(key).snapped(length / 2.0)):
+            raise ParameterError(f"{alias}: {length:g} {field_unit(key)} is out of range; allowed {twice_range(key)}")
+        found[key] = length / 2.0
     return found
+
+
+def twice_range(key: str) -> str:
+    """The lengths an alias of ``key`` (twice it) allows, in words."""
+    low, high = (2.0 * bound for bound in (bounds(key).low, bounds(key).high))
+    return f"a length from {low:g} to {high:g} {field_unit(key)} (twice {key})"
 
 
 def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
