@@ -51,9 +51,13 @@ def test_a_reader_names_where_a_key_applies():
     assert dem.not_read("powder_heat_share") == (
         "a run without powder (powder_mass = 0) does not read it; it applies to powder_mass > 0"
     )
-    coated = Reader(engine="dem", solver="averaged", thermal_model="paper", kinematics="axial", powder_mass=0.004)
+    coated = Reader(
+        engine="dem", solver="averaged", thermal_model="paper", kinematics="axial", powder_mass=0.004, n_balls=2
+    )
     assert coated.not_read("powder_heat_share") is None and dem.not_read("restitution") is None
     assert "powder_restitution applies instead" in coated.not_read("pair_restitution")
+    # One ball touches no other: the pair's own keys are no input of its run.
+    assert dem.not_read("pair_friction") == "with n_balls = 1 no two balls touch; it applies to n_balls >= 2"
     assert "engine = 'dem'" in Reader(
         engine="1d", solver="full", thermal_model="paper", kinematics="axial", powder_mass=0.004
     ).not_read("powder_heat_share")
@@ -61,7 +65,7 @@ def test_a_reader_names_where_a_key_applies():
     readers = [
         Reader(engine="1d", solver="averaged", thermal_model="paper", kinematics="axial"),
         *(
-            Reader(engine="dem", solver="averaged", thermal_model="mill-head", kinematics=motion)
+            Reader(engine="dem", solver="averaged", thermal_model="mill-head", kinematics=motion, n_balls=2)
             for motion in KINEMATIC_MODELS
         ),
         Reader(engine="dem", solver="averaged", thermal_model="paper", kinematics="axial", powder_mass=0.004),

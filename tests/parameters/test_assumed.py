@@ -136,7 +136,7 @@ def test_a_planetary_bowls_dimensions_move_its_inner_area_and_wall_mass_with_the
     # An input that moves nothing derived leaves the member as it is.
     assert with_derived(params, list(preset.assumed.values()), {"friction": 0.2}) == {"friction": 0.2}
     # A user's own range of a bowl key keeps what the preset's range of it moves.
-    inputs, _ = ensemble_inputs(preset, params, ["vial_diameter=0.042:0.048"], ["vial_diameter"])
+    inputs, _, _ = ensemble_inputs(preset, params, ["vial_diameter=0.042:0.048"], ["vial_diameter"])
     assert inputs[0].moves == ("inner_area", "vial_mass") and inputs[0].low == 0.042
 
 

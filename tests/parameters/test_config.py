@@ -238,6 +238,12 @@ def test_a_balls_diameter_is_taken_as_twice_its_radius_from_the_command_line_and
         ParameterError, match=r"^ball_diameter: .*allowed a length from 5e-05 to 0.2 m \(twice ball_radius\)$"
     ):
         load_config(overrides=["ball_diameter=10 kg"])
+    # Out of range, the diameter is refused as the diameter the user gave, not as a radius they never typed.
+    with pytest.raises(
+        ParameterError,
+        match=r"^ball_diameter: 1 m is out of range; allowed a length from 5e-05 to 0.2 m \(twice ball_radius\)$",
+    ):
+        load_config(overrides=["ball_diameter=1 m"])
 
 
 def test_a_fitted_files_run_says_the_presets_caveat_is_of_the_preset_as_shipped():

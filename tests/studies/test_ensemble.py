@@ -3,6 +3,8 @@ its regimes (MODEL.md §§14.1-14.2, issue 36)."""
 
 from __future__ import annotations
 
+import dataclasses
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -11,8 +13,10 @@ import pytest
 
 from shakermill.analysis.regime import ACTIVE, PACK, charge_regime
 from shakermill.parameters.assumed import AssumedInput
+from shakermill.parameters.config import config_preset, load_config
 from shakermill.parameters.errors import ParameterError
-from shakermill.studies.ensembles.ensemble import analyse, check_members, design
+from shakermill.parameters.presets import PRESET_FOLDER, PRESETS, default_parameters
+from shakermill.studies.ensembles.ensemble import analyse, check_members, design, ensemble_inputs, fitted_keys_posterior
 from shakermill.studies.inference.posterior import Posterior
 from shakermill.studies.inference.prior import Prior
 
@@ -98,6 +102,14 @@ def test_a_headline_the_surrogate_cannot_predict_gets_no_indices(tmp_path: Path)
     assert spread.surrogate_q2 < 0.5 and spread.total == {} and spread.deciding == []
 
 
+def test_a_share_zero_to_round_off_does_not_vary_where_a_power_of_that_size_does(tmp_path: Path):
+    points = design([LINEAR], 16, seed=9)
+    round_off = np.linspace(0.0, 3e-17, 16)
+    ensemble = analyse(members_table(points, 1e-16 + round_off, stress_lasting_share=round_off), [LINEAR], tmp_path)
+    assert not ensemble.headline("stress_lasting_share").varies
+    assert ensemble.headline("heat_power_W").varies
+
+
 def test_failed_members_are_counted_and_left_out(tmp_path: Path):
     points = design([LINEAR], 8, seed=8)
     table = members_table(points, np.arange(8.0))
@@ -164,3 +176,47 @@ def test_the_interval_is_split_into_its_named_parts(tmp_path: Path):
     assert parts["assumed inputs"] == pytest.approx(0.77, abs=0.08)
     assert parts["fitted keys' posterior"] == pytest.approx(0.21, abs=0.06)
     assert 0.0 < parts["unexplained"] < 0.08
+
+
+FITTED_FILE = PRESET_FOLDER / "spex8000m-3d-calibrated-paper.toml"
+
+
+def test_a_key_the_user_sets_wins_over_a_fitted_files_posterior_and_the_others_keep_their_marginal(tmp_path: Path):
+    mine = tmp_path / "fitted.toml"
+    shutil.copy(FITTED_FILE, mine)
+    config = load_config(mine, overrides=["beta=5"])
+    whole = fitted_keys_posterior(config_preset(load_config(mine)), load_config(mine).params)[0]
+    inputs, posterior, notes = ensemble_inputs(config_preset(config), config.params, [], [], config.explicit)
+    assert posterior is not None and whole is not None
+    assert posterior.keys == ("vial_mass", "h_outer")
+    # The marginal of a Gaussian: the same means and covariance of the keys drawn, without beta's.
+    whole_covariance = whole.factor @ whole.factor.T
+    np.testing.assert_allclose(posterior.mean, whole.mean[1:])
+    np.testing.assert_allclose(posterior.factor @ posterior.factor.T, whole_covariance[1:, 1:])
+    assert notes == [
+        "beta: the run's own value, not drawn from the posterior of fitted's calibration; vial_mass, h_outer drawn "
+        "from their marginal posterior"
+    ]
+    assert all("beta" not in point for point in design(inputs, 8, seed=1, posterior=posterior))
+
+
+def test_a_calibration_that_recorded_only_its_covariance_is_drawn_about_its_fitted_values():
+    preset = PRESETS["spex8000m-calibrated"]
+    posterior, notes = fitted_keys_posterior(preset, default_parameters("spex8000m-calibrated"))
+    assert posterior is not None and posterior.keys == preset.fitted
+    np.testing.assert_allclose(np.exp(posterior.mean), [preset.values[key].value for key in preset.fitted])
+    np.testing.assert_allclose(posterior.factor @ posterior.factor.T, preset.covariance)
+    assert "covariance_log" in notes[0]
+    broken = dataclasses.replace(preset, provenance={**preset.provenance, "covariance_log": [[1.0, 2.0], [2.0, 1.0]]})
+    with pytest.raises(ParameterError, match=r"covariance_log: a symmetric 4 x 4 matrix is needed"):
+        fitted_keys_posterior(broken, default_parameters("spex8000m-calibrated"))
+
+
+def test_an_input_the_bore_moves_takes_no_range_of_its_own():
+    with pytest.raises(ParameterError, match=r"^inner_area: its value is derived from the bore diameter and length"):
+        ensemble_inputs(PRESETS["pm100"], default_parameters("pm100"), ["inner_area=0.005:0.009"], [])
+    # Alone, nothing moves it: it is the user's to vary.
+    inputs, _, _ = ensemble_inputs(
+        PRESETS["pm100"], default_parameters("pm100"), ["inner_area=0.005:0.009"], ["inner_area"]
+    )
+    assert [item.key for item in inputs] == ["inner_area"]

@@ -18,6 +18,7 @@ from shakermill.cli.common import (
     SchedulerOption,
     SettingsOption,
     add_plain_row,
+    echo_notes,
     fail,
     progress_bar,
     stdout_console,
@@ -80,7 +81,9 @@ def uncertainty(
     with user_errors():
         check_members(members)
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
-        inputs, posterior = ensemble_inputs(config_preset(run_config), run_config.params, assume or [], vary or [])
+        inputs, posterior, notes = ensemble_inputs(
+            config_preset(run_config), run_config.params, assume or [], vary or [], run_config.explicit
+        )
     target = out if out is not None else timestamped_folder("uncertainty")
     try:
         counter = (
@@ -102,6 +105,8 @@ def uncertainty(
                 preset=run_config.preset,
                 posterior=posterior,
                 announce=lambda line: typer.echo(f"uncertainty: {line}", err=True),
+                # Said once every check has passed: a refused command says one line.
+                on_start=lambda: echo_notes(notes),
                 progress=lambda state: update(state.done, running=state.running, failed=state.failed),
             )
     except SweepFailed as exc:

@@ -52,9 +52,16 @@ WithAssumedOption = Annotated[
         "of the runs, with posterior-predictive intervals (MODEL.md §14.1; minutes).",
     ),
 ]
+# The mechanical runs of --with-assumed per set of conditions, where --members does not say.
+JOINT_MEMBERS = 32
 MembersOption = Annotated[
-    int,
-    typer.Option("--members", "-n", help="With --with-assumed: mechanical runs per set of conditions, a power of two."),
+    int | None,
+    typer.Option(
+        "--members",
+        "-n",
+        show_default=str(JOINT_MEMBERS),
+        help="With --with-assumed: mechanical runs per set of conditions, a power of two.",
+    ),
 ]
 RunsOption = Annotated[
     Path | None,
@@ -73,9 +80,10 @@ WorkersOption = Annotated[
     ),
 ]
 PosteriorOption = Annotated[
-    bool,
+    bool | None,
     typer.Option(
         "--posterior/--no-posterior",
+        show_default="--posterior",
         help="Sample the posterior of the fitted keys where an evaluation is "
         "the thermal network alone (engine 'dem': ~2400 evaluations, a few minutes); without it, the "
         "standard errors are linear.",
@@ -118,8 +126,8 @@ def calibrate(
     json_output: JsonOption = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace the preset file if it exists.")] = False,
     with_assumed: WithAssumedOption = False,
-    members: MembersOption = 32,
-    posterior: PosteriorOption = True,
+    members: MembersOption = None,
+    posterior: PosteriorOption = None,
     runs: RunsOption = None,
     workers: WorkersOption = None,
     scheduler: SchedulerOption = None,
@@ -143,19 +151,24 @@ def calibrate(
             # Checked before the fit, which takes a while.
             check_preset_target(out, overwrite)
         if with_assumed:
+            if posterior is False:
+                raise ParameterError(
+                    "no-posterior: a calibration --with-assumed is its posterior (emcee on emulators of its runs); "
+                    "allowed --no-posterior without --with-assumed"
+                )
             calibrate_over_assumed(
                 run_config,
                 free_keys,
                 targets,
                 measured,
-                members,
+                JOINT_MEMBERS if members is None else members,
                 full_resolution,
                 out,
                 json_output,
                 Runs(runs, workers, scheduler),
             )
             return
-        check_no_runs(runs, workers, scheduler)
+        check_no_runs(runs, workers, scheduler, members)
         with (
             nothing_written_when_interrupted("the fit starts again from the beginning"),
             nothing_written_when_a_run_is_stopped("the fit"),
@@ -169,7 +182,7 @@ def calibrate(
                 targets,
                 measured,
                 full_resolution=full_resolution,
-                sample_posterior=posterior,
+                sample_posterior=posterior is not False,
                 **fit_progress(update),
                 on_start=lambda: announce(
                     run_config.params, free_keys, bool(free), [item.note for item in measured if item.note]
@@ -238,9 +251,10 @@ class Runs:
     scheduler: str | None
 
 
-def check_no_runs(runs: Path | None, workers: int | None, scheduler: str | None) -> None:
+def check_no_runs(runs: Path | None, workers: int | None, scheduler: str | None, members: int | None) -> None:
     """A fit of the network alone runs no design of runs: their options are refused in one line."""
-    given = [name for name, value in (("runs", runs), ("workers", workers), ("scheduler", scheduler)) if value]
+    options = (("runs", runs), ("workers", workers), ("scheduler", scheduler), ("members", members))
+    given = [name for name, value in options if value is not None]
     if given:
         raise ParameterError(
             f"{given[0]}: a fit of the network alone measures the mechanics once and runs no design of runs; "

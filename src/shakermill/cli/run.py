@@ -478,6 +478,7 @@ def compare_solvers(
 # network, which has no outside to hold that bore, stands in for a preset's 'mill-head' one. The user's own settings
 # come after.
 IMPACT_VIAL = ["vial_length=0.5 m", "vial_diameter=0.5 m", "thermal_model=paper"]
+IMPACT_VIAL_KEYS = frozenset(setting.partition("=")[0] for setting in IMPACT_VIAL)
 IMPACT_ROWS = (
     ("normal_restitution", "normal restitution", 1.0, ".6f", ""),
     ("tangential_velocity_out_m_s", "tangential velocity of the centre after", 1.0, ".6g", "m/s"),
@@ -517,14 +518,24 @@ def impact(
     """One impact on its own, through the 'dem' engine: restitution, rebound, spin, contact time, peak force and
     the dissipated energy by channel. Materials, restitution, friction and the contact step come from --set."""
     from shakermill.parameters.config import load_config, parse_overrides
+    from shakermill.parameters.errors import ParameterError
     from shakermill.parameters.keys import unit_slip_warnings
-    from shakermill.solvers.impact import check_keys_read, single_impact
+    from shakermill.solvers.impact import check_keys_read, check_reads, single_impact
 
     with user_errors(), nothing_written_when_interrupted("impact writes no files"):
+        asked = parse_overrides(settings or [])
         # Before the parameters are built: a fill would make balls for the impact's own large vial.
-        check_keys_read(parse_overrides(settings or []), target)
+        check_keys_read(asked, target)
         # A lone impact reads the keys its own way (solvers/impact.py), whatever engine the preset names.
-        params = load_config(config, preset=preset, overrides=[*IMPACT_VIAL, *(settings or [])], reader=None).params
+        run_config = load_config(config, preset=preset, overrides=[*IMPACT_VIAL, *(settings or [])], reader=None)
+        if run_config.assumed_tables:
+            raise ParameterError(
+                f"{run_config.source}: [assumed]: a lone impact varies no input; ranges of inputs apply to "
+                "uncertainty and calibrate --with-assumed"
+            )
+        params = run_config.params
+        # The impact's own vial is the command's, not the user's: only what the user set is checked.
+        check_reads([key for key in run_config.explicit if key not in IMPACT_VIAL_KEYS or key in asked], params, target)
         echo_warnings(unit_slip_warnings(params))
         outcome = single_impact(params, speed, angle, target, spin).as_dict()
     if json_output:

@@ -62,6 +62,9 @@ class RunConfig:
     # The file's [assumed.KEY] tables and [provenance] (a calibration's), unchecked: parameters/assumed.py reads them.
     assumed_tables: Mapping[str, Any] = field(default_factory=dict)
     provenance: Mapping[str, Any] = field(default_factory=dict)
+    # The keys the user set: on the command line (--set) or in a configuration written by hand (a file shakermill
+    # wrote sets every key, the user's or not). A command reads each as given or refuses it; no posterior replaces it.
+    explicit: tuple[str, ...] = ()
 
 
 def load_config(
@@ -97,10 +100,10 @@ def load_config(
     base = layered(with_materials(preset_layer), with_materials(file_values))
     asked = parse_overrides(overrides)
     params = build_parameters(base, asked)
+    explicit = tuple(dict.fromkeys([*(key for key in file_values if written_by_hand), *asked]))
     if reader is None:
-        return RunConfig(params=params, preset=chosen_preset, source=source, **tables)
+        return RunConfig(params=params, preset=chosen_preset, source=source, explicit=explicit, **tables)
     run = reader_of(params, None if reader == "run" else reader)
-    explicit = [*(key for key in file_values if written_by_hand and key != PRESET_KEY), *asked]
     problem = run.unread_problem(explicit)
     if problem is not None:
         raise ParameterError(problem)
@@ -111,7 +114,12 @@ def load_config(
     if file_preset is not None and chosen_preset != file_preset:
         notes.append(f"The preset is {chosen_preset!r} (--preset), not the {file_preset!r} that {source} names.")
     config = RunConfig(
-        params=params, preset=chosen_preset, source=source, notes=tuple(note for note in notes if note), **tables
+        params=params,
+        preset=chosen_preset,
+        source=source,
+        notes=tuple(note for note in notes if note),
+        explicit=explicit,
+        **tables,
     )
     if config.assumed_tables or "fitted" in config.provenance:
         # Its [assumed.KEY] tables and a calibration's [provenance] checked now, with one line for the first that is
@@ -212,11 +220,20 @@ def resolve_aliases(layer: Mapping[str, Any]) -> dict[str, Any]:
         if key in found:
             raise ParameterError(f"{alias}: give {key} or {alias} (twice {key}), not both")
         try:
-            found[key] = guards.quantity(alias, found.pop(alias), field_unit(key)) / 2.0
+            length = guards.quantity(alias, found.pop(alias), field_unit(key))
         except UnitError as exc:
-            low, high = (2.0 * bound for bound in (bounds(key).low, bounds(key).high))
-            raise ParameterError(f"{exc}; allowed a length from {low:g} to {high:g} m (twice {key})") from None
+            raise ParameterError(f"{exc}; allowed {twice_range(key)}") from None
+        # Refused in the user's terms: the radius's range would name a key the user never typed.
+        if not bounds(key).contains(bounds(key).snapped(length / 2.0)):
+            raise ParameterError(f"{alias}: {length:g} {field_unit(key)} is out of range; allowed {twice_range(key)}")
+        found[key] = length / 2.0
     return found
+
+
+def twice_range(key: str) -> str:
+    """The lengths an alias of ``key`` (twice it) allows, in words."""
+    low, high = (2.0 * bound for bound in (bounds(key).low, bounds(key).high))
+    return f"a length from {low:g} to {high:g} {field_unit(key)} (twice {key})"
 
 
 def parse_overrides(items: Sequence[str]) -> dict[str, Any]:

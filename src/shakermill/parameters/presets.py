@@ -107,7 +107,9 @@ def load_preset_file(path: Path, known: Mapping[str, Preset]) -> Preset:
         source = note if key in fitted else sources.get(key, f"set in {path.name}")
         values[key] = Cited(tuple(map(tuple, value)) if key == "record_windows" else value, source)
     plain = {key: cited.value for key, cited in values.items()}
-    reader = reader_for(plain)
+    # A preset's ranges are of its mill whatever its own charge: a range of two balls' keys serves a run of more balls
+    # (--set n_balls), though the preset's own has one; a run that cannot feel it does not vary it (ensemble_inputs).
+    reader = reader_for({**plain, "n_balls": max(2, plain["n_balls"])})
     return Preset(
         name=path.stem,
         description=str(provenance.get("description", f"{base.name} with values from {path.name}")),

@@ -18,9 +18,18 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from shakermill.parameters.engine_keys import reads_of
+from shakermill.parameters.engine_keys import reader_of, reads_of
 from shakermill.parameters.errors import ParameterError
-from shakermill.parameters.groups import GROUP_OF, GROUPS, Balls, ContactDamping, DemContacts, DemStepping, VialWall
+from shakermill.parameters.groups import (
+    GROUP_OF,
+    GROUPS,
+    BallPairs,
+    Balls,
+    ContactDamping,
+    DemContacts,
+    DemStepping,
+    VialWall,
+)
 from shakermill.parameters.key_group import CONTACT_COATING
 from shakermill.parameters.keys import PER_BALL_KEYS, Parameters
 
@@ -50,9 +59,10 @@ GUARD_SPEEDS = (0.1, 20.0)  # m/s
 RESTITUTION_TOLERANCE = 0.01  # relative
 
 # What a lone impact reads: the 'dem' engine's contact law at its contact step (the balls and the vial's wall, the
-# contacts' damping, friction and rolling, the coatings of contacts) and nothing of a run: it sets the rest itself
-# (impact_parameters). A key of any other group, a new one included, is refused without anyone's edit.
-READ_GROUPS = (Balls, VialWall, ContactDamping, DemContacts, DemStepping)
+# contacts' damping, friction and rolling, two balls' own pair, the coatings of contacts) and nothing of a run: it
+# sets the rest itself (impact_parameters). A key of any other group, a new one included, is refused without anyone's
+# edit.
+READ_GROUPS = (Balls, VialWall, ContactDamping, DemContacts, BallPairs, DemStepping)
 IMPACT_READS = reads_of(*READ_GROUPS, roles=(CONTACT_COATING,))
 READ_TITLES = ", ".join(group.title for group in GROUPS if set(group.keys()) & IMPACT_READS)
 
@@ -76,6 +86,16 @@ def check_keys_read(keys: Iterable[str], target: str) -> None:
             )
         if key in other:
             raise ParameterError(f"{key}: an impact on a {target} does not read it; it applies to {applies}")
+
+
+def check_reads(keys: Iterable[str], params: Parameters, target: str) -> None:
+    """:func:`check_keys_read`, then the rules by which a run reads a key, on the impact's own run of ``params``: a
+    powder coats its contacts, and its restitution replaces the bare contacts' (parameters/groups/powder.py)."""
+    chosen = list(keys)
+    check_keys_read(chosen, target)
+    problem = reader_of(impact_parameters(params, target)).unread_problem(chosen)
+    if problem is not None:
+        raise ParameterError(problem)
 
 
 @dataclass(frozen=True)

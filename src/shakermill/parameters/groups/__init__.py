@@ -14,7 +14,7 @@ import pkgutil
 from typing import Any
 
 from shakermill.parameters.groups.balls import Balls, OneBallStart, SeveralBalls
-from shakermill.parameters.groups.contacts import ContactDamping, DemContacts, VialWall
+from shakermill.parameters.groups.contacts import BallPairs, ContactDamping, DemContacts, VialWall
 from shakermill.parameters.groups.dem import DemAveraging, DemStepping, EnduringContacts, LabFrame
 from shakermill.parameters.groups.geometry import Drive, Stroke, Vial
 from shakermill.parameters.groups.one_d import OneDAveraging, OneDIntegrator
@@ -31,6 +31,7 @@ class CoreKeys(
     DemStepping,
     LabFrame,
     HeatSplit,
+    BallPairs,
     DemContacts,
     SeveralBalls,
     OneDAveraging,

@@ -1,11 +1,11 @@
 """A ball's contacts as Hertz contacts with damping (MODEL.md §2): the vial wall's elastic constants, the
-restitution the contacts are damped to and whether they may pull, and the 'dem' engine's friction, rolling
-resistance and its own restitution of two balls (MODEL.md §§12.3, 14.1)."""
+restitution the contacts are damped to and whether they may pull, the 'dem' engine's friction and rolling
+resistance, and its own restitution and friction of two balls (MODEL.md §§12.3, 14.1)."""
 
 from __future__ import annotations
 
 from shakermill.parameters.fields import material_name, quantity, switch
-from shakermill.parameters.key_group import KeyGroup
+from shakermill.parameters.key_group import KeyGroup, ReadRule, When
 from shakermill.parameters.sources import PAPER
 
 
@@ -51,10 +51,9 @@ class ContactDamping(KeyGroup):
 
 
 class DemContacts(KeyGroup):
-    """The 'dem' engine's contacts beyond the 1-D law: Coulomb friction and rolling resistance, and two balls' own
-    restitution and friction (ball-ball and ball-wall contacts are different pairs of bodies, MODEL.md §14.1)."""
+    """The 'dem' engine's contacts beyond the 1-D law: Coulomb friction and rolling resistance (MODEL.md §12.3)."""
 
-    title = "friction and ball pairs"
+    title = "friction and rolling"
 
     # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
     friction: float = quantity(
@@ -66,6 +65,31 @@ class DemContacts(KeyGroup):
         ge=0,
         le=5.0,
     )
+    rolling_friction: float = quantity(
+        "",
+        "rolling resistance coefficient μ_r (engine = 'dem')",
+        default=0.0,
+        source="MODEL.md section 12.3: no rolling resistance by default",
+        ge=0,
+        le=1.0,
+    )
+
+
+# One ball, or none, touches no other: a pair's own keys are no input of its run.
+WITH_TWO_BALLS: ReadRule = When(
+    "n_balls",
+    lambda balls: balls >= 2,
+    "with n_balls = {value} no two balls touch; it applies to n_balls >= 2",
+)
+
+
+class BallPairs(KeyGroup):
+    """Two balls' own restitution and friction (ball-ball and ball-wall contacts are different pairs of bodies,
+    MODEL.md §14.1): read where there are two balls to touch."""
+
+    title = "ball pairs"
+    rule = WITH_TWO_BALLS
+
     pair_friction: float = quantity(
         "",
         "Coulomb friction coefficient μ of two balls (engine = 'dem')",
@@ -81,12 +105,4 @@ class DemContacts(KeyGroup):
         source=f"{PAPER}, Table 4 (e): the paper's one e, for two balls too (no source of its own)",
         gt=0,
         le=1,
-    )
-    rolling_friction: float = quantity(
-        "",
-        "rolling resistance coefficient μ_r (engine = 'dem')",
-        default=0.0,
-        source="MODEL.md section 12.3: no rolling resistance by default",
-        ge=0,
-        le=1.0,
     )

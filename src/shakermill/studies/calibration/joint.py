@@ -55,26 +55,15 @@ WALKERS_PER_INPUT, LEAST_WALKERS = 4, 16
 STEPS = 10000
 KEPT = 2000
 SEED = 20261128
-# Pair keys act between two balls: a run of one ball cannot feel them.
-PAIR_PREFIX = "pair_"
 
 
 def fit_inputs(preset: Preset, params: Parameters, free: Sequence[str]) -> list[AssumedInput]:
     """The inputs a calibration of ``params`` over everything uncertain frees: the assumed inputs ``preset`` states
-    that the run reads and can feel (no pair key for one ball), and the thermal ``free`` keys, each log-uniform over
-    its defensible range (the prior of the network's own fit, ``calibrate.fitted_prior``)."""
+    that the run reads (a run of one ball no pair key: the group's rule), and the thermal ``free`` keys, each
+    log-uniform over its defensible range (the prior of the network's own fit, ``calibrate.fitted_prior``)."""
     reader = reader_of(params)
-    assumed = [
-        item
-        for key, item in preset.assumed.items()
-        if reader.not_read(key) is None and key not in free and feels(params, key)
-    ]
+    assumed = [item for key, item in preset.assumed.items() if reader.not_read(key) is None and key not in free]
     return assumed + list(fitted_prior(params, free).inputs)
-
-
-def feels(params: Parameters, key: str) -> bool:
-    """Whether a run of ``params`` can be moved by ``key``: a pair key needs two balls."""
-    return not key.startswith(PAIR_PREFIX) or params.n_balls >= 2
 
 
 Data = Sequence[tuple[Emulator, Sequence[Measured]]]
@@ -222,14 +211,12 @@ def calibrate_jointly(
     ``runs`` (one folder a set of conditions; a temporary one where None): Ctrl-C raises
     ``executor.RunsInterrupted`` with the finished members kept there, and the same calibration resumes from them.
     ``say`` is told each phase after the runs (the emulators, the sampler's steps)."""
-    from shakermill.parameters.config import parse_overrides
-
     check_free_for_engine(base, free)
     groups: dict[tuple[str, ...], list[Any]] = {(): []}
     for curve in curves:
         groups.setdefault(tuple(curve.conditions), []).append(curve)
-    # Every set of conditions checked before the first run: a bad one must not be found after the runs of another.
-    conditioned = {conditions: base.replace(**parse_overrides(conditions)) for conditions in groups}
+    # Every curve's conditions checked before the first run: a bad one found after a set's runs wastes them.
+    conditioned = {conditions: _conditioned(base, conditions) for conditions in groups}
     for params in conditioned.values():
         check_has_balls(params)
     if on_start is not None:
@@ -278,6 +265,18 @@ def check_has_balls(params: Parameters) -> None:
             "n_balls: 0 is out of range for a calibration --with-assumed, which fits the balls' heat to a measured "
             "rise; allowed 1 or more"
         )
+
+
+def _conditioned(base: Parameters, conditions: Sequence[str]) -> Parameters:
+    """``base`` under a curve's ``conditions`` ("KEY=VALUE"): each value checked, and each key one its run reads."""
+    from shakermill.parameters.config import parse_overrides
+
+    settings = parse_overrides(conditions)
+    params = base.replace(**settings)
+    problem = reader_of(params).unread_problem(settings, how="a curve's condition")
+    if problem is not None:
+        raise ParameterError(problem)
+    return params
 
 
 def _spread_points(count: int) -> list[int]:

@@ -22,7 +22,7 @@ not explain.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -32,7 +32,7 @@ import pandas as pd
 
 from shakermill.analysis.regime import ACTIVE, PACK
 from shakermill.io.runs import ENSEMBLE_KIND
-from shakermill.parameters.assumed import AssumedInput, keeping_moves, parse_assumption, with_derived
+from shakermill.parameters.assumed import DERIVED_FROM, AssumedInput, keeping_moves, parse_assumption, with_derived
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
@@ -76,6 +76,8 @@ FOLDS = 5
 # A headline whose members spread less than this share of its size does not depend on the inputs: a part in a
 # million is the integrators' tolerance, not a sensitivity.
 STEADY_SPREAD = 1e-6
+# The headlines that are shares of a whole (a fraction of the dissipation): their size is 1, not their members'.
+SHARE_SUFFIX = "_share"
 # Base samples of Saltelli's design on the surrogate: N·(d + 2) predictions.
 SALTELLI_BASE = 1024
 # The fewest members (a power of two) and the most.
@@ -160,27 +162,85 @@ def _finite(value: Any) -> Any:
 
 
 def ensemble_inputs(
-    preset: Preset, params: Parameters, assume: Sequence[str], vary: Sequence[str]
-) -> tuple[list[AssumedInput], LogNormal | None]:
-    """What an ensemble of ``params`` varies: the assumed inputs ``preset`` states that the run reads, replaced or
-    joined by the user's ranges (``assume``: ``KEY=LOW:HIGH[:DIST]``), only those named in ``vary`` where it names
-    some; and, varying all, the posterior of the keys the preset's calibration fitted, where the run keeps their
-    fitted values (a run that sets one asks about its own value, not the calibration's)."""
+    preset: Preset, params: Parameters, assume: Sequence[str], vary: Sequence[str], explicit: Collection[str] = ()
+) -> tuple[list[AssumedInput], LogNormal | None, list[str]]:
+    """What an ensemble of ``params`` varies, and notes for the user: the assumed inputs ``preset`` states that the
+    run reads, replaced or joined by the user's ranges (``assume``: ``KEY=LOW:HIGH[:DIST]``), only those named in
+    ``vary`` where it names some; and, varying all, the posterior of the keys the preset's calibration fitted
+    (:func:`fitted_keys_posterior`; ``explicit``: the keys the user set)."""
     reader = reader_of(params)
     stated = {key: item for key, item in preset.assumed.items() if reader.not_read(key) is None}
-    users = (keeping_moves(parse_assumption(text, reader), stated) for text in assume)
+    users = [keeping_moves(parse_assumption(text, reader), stated) for text in assume]
     inputs = {**stated, **{item.key: item for item in users}}
+    unfelt = [key for key in preset.assumed if key not in stated]
+    notes = (
+        [f"not varied, as this run does not read them: the preset's ranges of {', '.join(unfelt)}"] if unfelt else []
+    )
     missing = [key for key in vary if key not in inputs]
     if missing:
         raise ParameterError(
             f"--vary {missing[0]}: no range is stated for it; give one with --assume "
             f"{missing[0]}=LOW:HIGH (stated: {', '.join(inputs) or 'none'})"
         )
+    chosen = [inputs[key] for key in dict.fromkeys(vary)] if vary else list(inputs.values())
+    _check_none_derived(chosen)
     if vary:
-        return [inputs[key] for key in dict.fromkeys(vary)], None
-    keeps_fit = all(getattr(params, key) == preset.values[key].value for key in preset.fitted)
-    recorded = None if preset.posterior is None else Posterior.of_logarithms(preset.fitted, preset.posterior)
-    return list(inputs.values()), recorded.log_normal() if keeps_fit and recorded is not None else None
+        return chosen, None, []
+    posterior, fitted_notes = fitted_keys_posterior(preset, params, explicit)
+    return chosen, posterior, notes + fitted_notes
+
+
+def _check_none_derived(inputs: Sequence[AssumedInput]) -> None:
+    """No input varies on its own where another's range moves it (a member's bowl derives it again)."""
+    for item in inputs:
+        mover = next((other for other in inputs if item.key in other.moves), None)
+        if mover is not None:
+            raise ParameterError(
+                f"{item.key}: its value is derived from {DERIVED_FROM[item.key]}, which the range of {mover.key} "
+                f"moves; it takes no range of its own here: vary {mover.key}, or {item.key} alone with --vary"
+            )
+
+
+def fitted_keys_posterior(
+    preset: Preset, params: Parameters, explicit: Collection[str] = ()
+) -> tuple[LogNormal | None, list[str]]:
+    """The posterior of the keys ``preset``'s calibration fitted, as an ensemble draws it, and notes for the user: a
+    key the user sets (``explicit``), or the run changes, keeps the run's value (it asks about that value, not the
+    calibration's), and the other fitted keys are drawn from their marginal posterior. A calibration that recorded
+    no samples gives its covariance about the fitted values."""
+    recorded = _recorded_posterior(preset)
+    if recorded is None:
+        return None, []
+    pinned = [key for key in preset.fitted if key in explicit or getattr(params, key) != preset.values[key].value]
+    drawn = [key for key in preset.fitted if key not in pinned]
+    notes = []
+    if preset.posterior is None:
+        notes.append(
+            f"the calibration of {preset.name} recorded no posterior samples: its fitted keys are drawn from its "
+            "covariance (covariance_log), a Gaussian in their logarithms about the fitted values"
+        )
+    if pinned:
+        rest = f"{', '.join(drawn)} drawn from their marginal posterior" if drawn else "no fitted key is drawn"
+        notes.append(
+            f"{', '.join(pinned)}: the run's own value, not drawn from the posterior of {preset.name}'s "
+            f"calibration; {rest}"
+        )
+    return (recorded.marginal(drawn) if drawn else None), notes
+
+
+def _recorded_posterior(preset: Preset) -> LogNormal | None:
+    """The posterior a calibrated ``preset`` records: its samples' mean and covariance, or else its covariance."""
+    if not preset.fitted:
+        return None
+    if preset.posterior is not None:
+        return Posterior.of_logarithms(preset.fitted, preset.posterior).log_normal()
+    if preset.covariance is None:
+        return None
+    values = [float(preset.values[key].value) for key in preset.fitted]
+    try:
+        return LogNormal.of_covariance(preset.fitted, values, preset.covariance)
+    except ValueError as exc:
+        raise ParameterError(f"{preset.name}: [provenance] covariance_log: {exc}") from None
 
 
 def design(
@@ -217,11 +277,13 @@ def run_ensemble(
     preset: str,
     posterior: LogNormal | None = None,
     announce: Callable[[str], None] | None = None,
+    on_start: Callable[[], None] | None = None,
 ) -> Ensemble:
     """Run ``base`` at ``members`` points of a Sobol' design over ``inputs`` and the fitted keys' ``posterior`` (a
     sweep stored in ``out_dir``, resumed where an earlier run of the same ensemble stopped) and analyse the members
     (:func:`analyse`). ``announce`` is told what runs and when the members are being analysed, which takes a while
-    (a surrogate cross-validated for each headline)."""
+    (a surrogate cross-validated for each headline); ``on_start`` is told with the first, once every check of the
+    folder and the workers has passed."""
     check_members(members)
     if not inputs and posterior is None:
         raise ParameterError(
@@ -232,7 +294,7 @@ def run_ensemble(
     points = [with_derived(base, inputs, point) for point in design(inputs, members, seed, posterior)]
     say = announce or (lambda _: None)
     fitted = "" if posterior is None else f" and the posterior of {', '.join(posterior.keys)}"
-    say(f"{members} members over {', '.join(item.key for item in inputs) or 'no assumed input'}{fitted}")
+    over = f"{members} members over {', '.join(item.key for item in inputs) or 'no assumed input'}{fitted}"
     table = sweep(
         base,
         points,
@@ -243,9 +305,16 @@ def run_ensemble(
         preset=preset,
         kind=ENSEMBLE_KIND,
         announce=announce,
+        on_start=lambda: _started(say, over, on_start),
     )
     say("analysing the members: a surrogate and Sobol' indices for each headline")
     return analyse(table, inputs, Path(out_dir), posterior)
+
+
+def _started(say: Callable[[str], None], over: str, on_start: Callable[[], None] | None) -> None:
+    if on_start is not None:
+        on_start()
+    say(over)
 
 
 def analyse(
@@ -280,11 +349,17 @@ def _spread(key: str, values: np.ndarray, unit: np.ndarray, names: Sequence[str]
     good = np.isfinite(values)
     low, middle, high = (float(q) for q in np.quantile(values[good], QUANTILES)) if good.any() else (math.nan,) * 3
     quantiles = (low, middle, high)
-    varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * np.max(np.abs(values[good]))
+    varies = bool(good.any()) and np.ptp(values[good]) > STEADY_SPREAD * _size(key, values[good])
     if not varies:
         return HeadlineSpread(key, label, symbol, quantiles, math.nan, varies=False)
     q2, first, total, parts = _sensitivity(unit[good], values[good], names)
     return HeadlineSpread(key, label, symbol, quantiles, q2, first, total, parts=parts)
+
+
+def _size(key: str, values: np.ndarray) -> float:
+    """What a headline's spread is measured against: a share's whole, else its members' largest value. A share zero
+    to round-off is no share at all, however its round-off spreads."""
+    return 1.0 if key.endswith(SHARE_SUFFIX) else float(np.max(np.abs(values)))
 
 
 def _power_label(key: str) -> str:

@@ -146,6 +146,26 @@ class LogNormal:
     mean: np.ndarray
     factor: np.ndarray
 
+    @classmethod
+    def of_covariance(cls, keys: Sequence[str], values: Sequence[float], covariance: Any) -> LogNormal:
+        """The Gaussian about a fit's ``values`` with the ``covariance`` of their logarithms (a calibration that
+        recorded no samples); ValueError where the covariance is no covariance (not symmetric positive definite)."""
+        matrix = np.atleast_2d(np.asarray(covariance, dtype=float))
+        if matrix.shape != (len(keys), len(keys)) or not np.allclose(matrix, matrix.T):
+            raise ValueError(f"a symmetric {len(keys)} x {len(keys)} matrix is needed, one row per fitted key")
+        try:
+            factor = np.linalg.cholesky(matrix)
+        except np.linalg.LinAlgError:
+            raise ValueError("it is not positive definite") from None
+        return cls(tuple(keys), np.log(np.asarray(values, dtype=float)), factor)
+
+    def marginal(self, keys: Sequence[str]) -> LogNormal:
+        """The Gaussian of ``keys`` alone (some of :attr:`keys`): the others left at whatever values a run gives
+        them, these drawn from their own mean and covariance."""
+        chosen = [self.keys.index(key) for key in keys]
+        covariance = (self.factor @ self.factor.T)[np.ix_(chosen, chosen)]
+        return LogNormal(tuple(keys), self.mean[chosen], np.linalg.cholesky(covariance))
+
     @property
     def names(self) -> tuple[str, ...]:
         return tuple(f"{key}{FITTED_SUFFIX}" for key in self.keys)

@@ -60,6 +60,9 @@ class Execution:
     round_limit_s: float | None = None
     # Where a wait for the cluster says that it still waits (a line for the user).
     announce: Callable[[str], None] | None = None
+    # Told once every check has passed and the workers are up, before the first task: a command's announcement of
+    # its work must not come before a refusal of its folder, its workers or its scheduler.
+    on_start: Callable[[], None] | None = None
 
     def __post_init__(self) -> None:
         if self.workers is not None and self.scheduler is not None:
@@ -108,6 +111,8 @@ def execute(
         announce=execution.announce,
     ) as backend:
         claim_folder(folder, manifest)
+        if execution.on_start is not None:
+            execution.on_start()
         try:
             tracker = _Tracker(len(ids), finished_counts(stored), backend.slots, execution.progress)
             for identifier, outcome in backend.outcomes(work, pending):

@@ -80,6 +80,7 @@ def sweep(
     scheduler_timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S,
     kind: str = SWEEP_KIND,
     announce: Callable[[str], None] | None = None,
+    on_start: Callable[[], None] | None = None,
 ) -> pd.DataFrame:
     """Run ``base_params`` at every point of ``grid_points`` and return the sweep table.
 
@@ -89,14 +90,17 @@ def sweep(
     to the averaged one, see :func:`sweep_parameters`). Points run on ``workers`` local processes
     (default: one per core; 1 runs them in this process) or on the Dask cluster at ``scheduler``
     ("tcp://host:8786"). Each finished point is stored at once in ``out_dir``; points stored by an
-    earlier run of the same sweep are skipped. Raises :class:`ParameterError` (one line) for bad
+    earlier run of the same sweep are skipped; ``on_start`` is told when the checks have passed and the points
+    start. Raises :class:`ParameterError` (one line) for bad
     input, a folder that holds another sweep, or an unreachable scheduler,
     :class:`~shakermill.atomic.StorageError` for a place where the folder cannot be created, and
     :class:`SweepFailed` (naming the first failure) when no point succeeded. Ctrl-C stops the workers at once and
     raises :class:`SweepInterrupted` (a ``KeyboardInterrupt``) once the table holds the finished points.
     """
     plan = as_plan(grid_points)
-    execution = Execution(workers, scheduler, scheduler_timeout, progress, base_params.max_wall_time, announce)
+    execution = Execution(
+        workers, scheduler, scheduler_timeout, progress, base_params.max_wall_time, announce, on_start
+    )
     folder = Path(out_dir)
     ids = point_ids(base_params, plan)
     written: list[pd.DataFrame] = []
