@@ -331,7 +331,8 @@ def unphysical_answer(result: RunOutput, steady: SteadyState) -> str | None:
         if value > PHYSICAL_CEILING:
             return (
                 f"The run is not physical: {what} is {kelvin_to_celsius(value):.4g} °C, above "
-                f"{kelvin_to_celsius(PHYSICAL_CEILING):.4g} °C, where no mill goes: its heat has almost no way out, or far more heat is made than a mill makes. "
+                f"{kelvin_to_celsius(PHYSICAL_CEILING):.4g} °C, where no mill goes: its heat has almost no way out, "
+                "or far more heat is made than a mill makes. "
                 "Check the heat paths' coefficients (h_outer, h_inner, the powder's) and the units of the inputs."
             )
     return None
