@@ -155,24 +155,12 @@ def _refuse_fill_that_does_not_fit(params: Any) -> None:
     )
 
 
-def powder_fits_the_vial(params: Any) -> None:
-    """The powder's solid volume (its mass over its material's density: the least it can take, packed to no voids)
-    and the balls' fit the vial together."""
-    if params.powder_mass <= 0.0 or not params.powder_material:
-        return
-    from shakermill.parameters.materials import material
+def components_are_consistent(params: Any) -> None:
+    """Each component's own checks of its keys against the rest of the run (its group's ``check_across``)."""
+    from shakermill.parameters.groups import GROUPS
 
-    density = float(material(params.powder_material).density.value)  # type: ignore[arg-type]
-    balls = sum(ball_volume(radius) for radius in params.ball_values("ball_radius"))
-    room = params.vial_volume - balls
-    powder = params.powder_mass / density
-    if powder > room:
-        raise ValueError(
-            f"powder_mass: {params.powder_mass * 1e3:g} g of {params.powder_material} ({density:g} kg/m^3) is "
-            f"{powder * 1e6:.4g} ml of solid, more than the {room * 1e6:.4g} ml the balls leave of the "
-            f"{params.vial_volume * 1e6:.4g}-ml vial; allowed powder_mass <= {max(room, 0.0) * density * 1e3:.4g} g "
-            "here"
-        )
+    for group in GROUPS:
+        group.check_across(params)
 
 
 def stored_data_fit_in_memory(params: Any) -> None:

@@ -135,6 +135,11 @@ class KeyGroup(BaseModel):
     superseded_because: ClassVar[str] = ""
 
     @classmethod
+    def check_across(cls, params: Any) -> None:
+        """Refuse, with a ValueError naming the key, values of the group's keys that the rest of the run (``params``,
+        every group's keys) makes impossible; a group with no such check has none."""
+
+    @classmethod
     def keys(cls) -> tuple[str, ...]:
         """The group's keys, in the order it declares them."""
         return tuple(cls.model_fields)

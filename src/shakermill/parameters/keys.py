@@ -57,7 +57,7 @@ class CoreParameters(DerivedQuantities):
             _check_per_ball(key, getattr(self, key), self.n_balls)
         consistency.motion_is_well_formed(self)
         consistency.balls_fit_side_by_side(self)
-        consistency.powder_fits_the_vial(self)
+        consistency.components_are_consistent(self)
         consistency.stored_data_fit_in_memory(self)
         consistency.thermal_network_is_not_stiff(self)
         consistency.thresholds_are_distinct(self)

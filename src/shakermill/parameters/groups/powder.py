@@ -5,6 +5,8 @@ stated range (``[assumed]`` tables of the presets)."""
 
 from __future__ import annotations
 
+from typing import Any
+
 from shakermill.parameters.fields import material_name, quantity
 from shakermill.parameters.key_group import CONTACT_COATING, NETWORK_NODE, KeyGroup, ReadRule, When
 
@@ -91,3 +93,24 @@ class PowderHeat(KeyGroup):
         le=1e5,
         thermal_only=True,
     )
+
+    @classmethod
+    def check_across(cls, params: Any) -> None:
+        """The powder's solid volume (its mass over its material's density: the least it can take, packed to no voids)
+        and the balls' fit the vial together."""
+        if params.powder_mass <= 0.0 or not params.powder_material:
+            return
+        from shakermill.parameters.geometry import ball_volume
+        from shakermill.parameters.materials import material
+
+        density = float(material(params.powder_material).density.value)  # type: ignore[arg-type]
+        balls = sum(ball_volume(radius) for radius in params.ball_values("ball_radius"))
+        room = params.vial_volume - balls
+        powder = params.powder_mass / density
+        if powder > room:
+            raise ValueError(
+                f"powder_mass: {params.powder_mass * 1e3:g} g of {params.powder_material} ({density:g} kg/m^3) is "
+                f"{powder * 1e6:.4g} ml of solid, more than the {room * 1e6:.4g} ml the balls leave of the "
+                f"{params.vial_volume * 1e6:.4g}-ml vial; allowed powder_mass "
+                f"<= {max(room, 0.0) * density * 1e3:.4g} g here"
+            )
