@@ -22,8 +22,6 @@ TABLE_FIELDS = ("low", "high", "distribution", "reason")
 # is uncertain has an inner area and a mass that go with it, and a member that moved one alone would be no bowl.
 MOVES_FIELD = "moves"
 BOWL_KEYS = ("vial_diameter", "vial_length", "outer_diameter", "outer_length")
-# What each derived key follows, for a user who gives it a range of its own where it moves with the bowl.
-DERIVED_FROM = {"inner_area": "the bore diameter and length", "vial_mass": "the vial's dimensions"}
 
 
 @dataclass(frozen=True)

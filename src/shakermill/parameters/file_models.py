@@ -21,8 +21,10 @@ from shakermill.support.limits import quoted
 
 # Uniform on [low, high], or uniform in the logarithm where the range spans orders of magnitude.
 DISTRIBUTIONS = ("uniform", "log-uniform")
-# The keys an input of a vial's dimensions may move with it (parameters/assumed.py).
-DERIVED_KEYS = ("inner_area", "vial_mass")
+# The keys an input of a vial's dimensions may move with it (parameters/assumed.py), and what each follows, for a
+# user who gives it a range of its own where it moves with the bowl.
+DERIVED_FROM = {"inner_area": "the bore diameter and length", "vial_mass": "the vial's dimensions"}
+DERIVED_KEYS = tuple(DERIVED_FROM)
 ASSUMED_FIELDS = "low, high, distribution, reason (and moves, optionally)"
 
 

@@ -217,8 +217,6 @@ def calibrate_jointly(
         groups.setdefault(tuple(curve.conditions), []).append(curve)
     # Every curve's conditions checked before the first run: a bad one found after a set's runs wastes them.
     conditioned = {conditions: _conditioned(base, conditions) for conditions in groups}
-    for params in conditioned.values():
-        check_has_balls(params)
     if on_start is not None:
         on_start()
     tell = say or (lambda _: None)
@@ -268,7 +266,8 @@ def check_has_balls(params: Parameters) -> None:
 
 
 def _conditioned(base: Parameters, conditions: Sequence[str]) -> Parameters:
-    """``base`` under a curve's ``conditions`` ("KEY=VALUE"): each value checked, and each key one its run reads."""
+    """``base`` under a curve's ``conditions`` ("KEY=VALUE"): each value checked, each key one its run reads, and
+    balls in the mill."""
     from shakermill.parameters.config import parse_overrides
 
     settings = parse_overrides(conditions)
@@ -276,6 +275,7 @@ def _conditioned(base: Parameters, conditions: Sequence[str]) -> Parameters:
     problem = reader_of(params).unread_problem(settings, how="a curve's condition")
     if problem is not None:
         raise ParameterError(problem)
+    check_has_balls(params)
     return params
 
 

@@ -32,9 +32,10 @@ import pandas as pd
 
 from shakermill.analysis.regime import ACTIVE, PACK
 from shakermill.io.runs import ENSEMBLE_KIND
-from shakermill.parameters.assumed import DERIVED_FROM, AssumedInput, keeping_moves, parse_assumption, with_derived
+from shakermill.parameters.assumed import AssumedInput, keeping_moves, parse_assumption, with_derived
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
+from shakermill.parameters.file_models import DERIVED_FROM
 from shakermill.parameters.keys import Parameters
 from shakermill.parameters.presets import Preset
 from shakermill.solvers.summary import declared_names, family_members
