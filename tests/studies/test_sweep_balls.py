@@ -38,6 +38,25 @@ def test_a_plan_over_number_and_size_of_balls():
     assert point_ids(base, plan_sweep(["n_balls=5"])) == point_ids(base, as_plan([{"n_balls": "5"}]))
 
 
+def test_a_diameter_people_type_sets_the_radius_in_grids_and_points(tmp_path):
+    """issue 49: ``ball_diameter`` (twice ball_radius) is read where ``--set`` reads it, in grids and points files."""
+    assert plan_sweep(["ball_diameter=8mm:12mm:3"]).points == tuple(
+        {"ball_radius": pytest.approx(radius)} for radius in (4e-3, 5e-3, 6e-3)
+    )
+    assert plan_sweep(["ball_diameter=10mm,12.7mm"]).points == (
+        {"ball_radius": pytest.approx(5e-3)},
+        {"ball_radius": pytest.approx(6.35e-3)},
+    )
+    points = tmp_path / "points.csv"
+    points.write_text("ball_diameter,n_balls\n10 mm,2\n0.5 in,3\n")
+    plan = plan_sweep(points_file=points)
+    assert plan.keys == ("ball_radius", "n_balls")
+    assert plan.points == ({"ball_radius": pytest.approx(5e-3), "n_balls": 2}, {"ball_radius": 6.35e-3, "n_balls": 3})
+    assert dict(plan.units) == {"ball_radius": "mm"}
+    with pytest.raises(sm.ParameterError, match="ball_radius: more than one grid or points column for this key"):
+        plan_sweep(["ball_radius=4mm,5mm"], points_file=points)
+
+
 @pytest.mark.parametrize(
     ("spec", "fragments"),
     [

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from shakermill.io.runs import to_jsonable
-from shakermill.parameters.config import RunConfig, load_config, parse_overrides, read_config_file
+from shakermill.parameters.config import HALVED_ALIASES, RunConfig, load_config, parse_overrides, read_config_file
 from shakermill.parameters.csvinput import read_csv_rows
 from shakermill.parameters.engine_keys import DECIDING, reader_for
 from shakermill.parameters.errors import ParameterError
@@ -67,13 +67,27 @@ def normalize_value(key: str, value: Any) -> Any:
     return to_jsonable(value)
 
 
+def aliased(key: str) -> str:
+    """The key a column or a grid of ``key`` sets: an alias people type (:data:`HALVED_ALIASES`: ``ball_diameter``)
+    sets its key (``ball_radius``) at half the value (:func:`aliased_value`); a key sets itself."""
+    return HALVED_ALIASES.get(key, key)
+
+
+def aliased_value(column: str, value: Any) -> Any:
+    """``value`` of a column or a grid of ``column``, as its key (:func:`aliased`) stores it."""
+    stored = normalize_value(aliased(column), value)
+    return stored / 2.0 if column in HALVED_ALIASES else stored
+
+
 def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray]:
-    """``"omega=90:130:9"`` -> ``("omega", linspace(90, 130, 9))``; START and STOP may carry units; N <= ``most``."""
+    """``"omega=90:130:9"`` -> ``("omega", linspace(90, 130, 9))``; START and STOP may carry units; N <= ``most``.
+    A grid of an alias is its key's (``ball_diameter=8mm:12mm:3`` -> ``ball_radius`` 4, 5, 6 mm)."""
     shown = quoted(spec)
     match = GRID_PATTERN.match(spec)
     if match is None:
         raise ParameterError(f"grid {shown}: expected KEY=START:STOP:N, for example omega=90:130:9")
-    key, bounds = match["key"], match["range"].split(":")
+    column, bounds = match["key"], match["range"].split(":")
+    key = aliased(column)
     try:
         check_known_keys([key])
     except ParameterError as exc:
@@ -90,7 +104,7 @@ def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray
     if not (count.isascii() and count.isdigit()) or len(count) > len(str(most)) or not 1 <= int(count) <= most:
         raise ParameterError(f"grid {shown}: N must be a whole number of points in [1, {most:,}], got {quoted(count)}")
     try:
-        low, high = normalize_value(key, start), normalize_value(key, stop)
+        low, high = (aliased_value(column, bound) for bound in (start, stop))
     except ParameterError as exc:
         raise ParameterError(f"grid {shown}: {exc}") from None
     return key, np.linspace(low, high, int(count))
@@ -99,19 +113,20 @@ def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray
 def grid_values(spec: str) -> tuple[str, Sequence[Any]]:
     """The values of one ``--grid``: ``KEY=START:STOP:N`` for a real-valued key (:func:`parse_grid`), or
     ``KEY=A,B,C`` for a key that takes names (``ball_material=steel,zirconia``, ``solver=full,averaged``), a
-    count (``n_balls=1,2,5``) or a real value (``ball_radius=4mm,5mm,6.35mm``)."""
+    count (``n_balls=1,2,5``) or a real value (``ball_radius=4mm,5mm,6.35mm``, or ``ball_diameter=8mm,10mm``)."""
     match = GRID_PATTERN.match(spec)
-    if match is None or match["key"] not in Parameters.model_fields or not _takes_a_list(match["key"], match["range"]):
+    column = match["key"] if match is not None else ""
+    key = aliased(column)
+    if match is None or key not in Parameters.model_fields or not _takes_a_list(key, match["range"]):
         key, grid = parse_grid(spec)
         return key, list(grid)
-    key = match["key"]
     items = [item.strip() for item in match["range"].split(",") if item.strip()]
     if not items:
         raise ParameterError(f"grid {quoted(spec)}: expected KEY=A,B,C, for example ball_material=steel,zirconia")
     check_point_count(len(items))
     try:
         # A misspelt name or unit fails the sweep before it starts, not one point in the middle of it.
-        return key, [checked_name(key, item) if takes_names(key) else normalize_value(key, item) for item in items]
+        return key, [checked_name(key, item) if takes_names(key) else aliased_value(column, item) for item in items]
     except ParameterError as exc:
         raise ParameterError(f"grid {quoted(spec)}: {exc}") from None
 
@@ -163,8 +178,8 @@ def _point_rows(path: Path | str) -> tuple[Path, list[str], list[list[str]]]:
         raise ParameterError(f"points {source}: expected a header of parameter keys and at least one row of values")
     header = [cell.strip() for cell in rows[0]]
     try:
-        check_known_keys(header)
-        _check_distinct(header, "column")
+        check_known_keys(header, extra_allowed=tuple(HALVED_ALIASES))
+        _check_distinct([aliased(column) for column in header], "column")
     except ParameterError as exc:
         raise ParameterError(f"points {source}: {exc}") from None
     return source, header, rows[1:]
@@ -178,11 +193,11 @@ def _point_from_row(source: Path, line: int, header: list[str], row: list[str]) 
     if len(row) != len(header):
         raise ParameterError(f"points {source} line {line}: {len(row)} values for {len(header)} columns")
     point = {}
-    for key, cell in zip(header, row):
+    for column, cell in zip(header, row):
         if not cell.strip():
-            raise ParameterError(f"points {source} line {line}: no value for {key}")
+            raise ParameterError(f"points {source} line {line}: no value for {column}")
         try:
-            point[key] = normalize_value(key, cell.strip())
+            point[aliased(column)] = aliased_value(column, cell.strip())
         except ParameterError as exc:
             raise ParameterError(f"points {source} line {line}: {exc}") from None
     return point
@@ -213,7 +228,8 @@ def _units_written(
     table: tuple[Path, list[str], list[list[str]]] | None, grids: Mapping[str, str]
 ) -> tuple[tuple[str, str], ...]:
     """(key, unit) for each real key whose values a points file's column or a ``--grid`` writes with a unit."""
-    written = {key: first_unit(row[index] for row in table[2]) for index, key in enumerate(table[1])} if table else {}
+    columns = [aliased(column) for column in table[1]] if table else []
+    written = {key: first_unit(row[index] for row in table[2]) for index, key in enumerate(columns)} if table else {}
     written |= {key: grid_unit(spec) for key, spec in grids.items()}
     return tuple(
         (key, unit) for key, unit in written.items() if unit and Parameters.model_fields[key].annotation is float
