@@ -84,10 +84,23 @@ def test_statistics_that_do_not_converge_are_refused() -> None:
     params = sm.default_parameters(
         duration=60.0, solver="averaged", averaging_rel_error=1e-15, averaging_max_time=50.0, record_windows=()
     )
-    result = sm.simulate(params)
+    told: list[tuple[str, float]] = []
+    result = sm.simulate(
+        params,
+        progress=lambda done, total: told.append(("progress", total)),
+        notice=lambda line: told.append((line, 0.0)),
+    )
     assert result.solver == "full"
     assert "did not converge" in result.message
     assert result.summary.averaging.converged is False
+    # Issue 49, point 10: the fall-back is said before it runs, with what it will take.
+    notes = [index for index, (what, _) in enumerate(told) if what != "progress"]
+    assert len(notes) == 1
+    line = told[notes[0]][0]
+    assert line.startswith("averaging is not valid (the averages did not converge") and " steps and ~" in line
+    full_run = [index for index, (what, total) in enumerate(told) if what == "progress" and total == 60.0]
+    assert full_run and notes[0] < full_run[0]
+    assert all(total == 50.0 for what, total in told[: notes[0]])
 
 
 def test_a_fall_back_that_could_not_end_within_the_budget_is_not_started() -> None:

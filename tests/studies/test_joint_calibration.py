@@ -113,23 +113,21 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
     from shakermill.studies.calibration.intervals import uncertainty_of
 
     monkeypatch.setattr(joint_calibration, "STEPS", 600)
+
+    def fit(out, problems):
+        # Eight runs cannot make a reliable emulator of nine inputs; whether a fit is reliable is decided here, so
+        # that both outcomes are seen (the second fit reuses the first one's runs).
+        monkeypatch.setattr(joint_calibration, "reliability_problems", lambda emulators, posterior: problems)
+        arguments = ["calibrate", "--preset", "spex8000m-3d-mill-head", "--with-assumed", "--members", "8", "--json"]
+        return CliRunner().invoke(cli.app, [*arguments, "--out", str(out), "--runs", str(tmp_path / "runs")])
+
+    # Issue 49, point 9: an unreliable fit says why and writes nothing.
+    unreliable = fit(tmp_path / "unreliable.toml", ["a test's reason"])
+    assert unreliable.exit_code == 1 and not (tmp_path / "unreliable.toml").exists()
+    assert json.loads(unreliable.stdout)["output"] is None
+    assert "unreliable (nothing written to" in unreliable.stderr and "a test's reason" in unreliable.stderr
     out = tmp_path / "fitted.toml"
-    outcome = CliRunner().invoke(
-        cli.app,
-        [
-            "calibrate",
-            "--preset",
-            "spex8000m-3d-mill-head",
-            "--with-assumed",
-            "--members",
-            "8",
-            "--json",
-            "--out",
-            str(out),
-            "--runs",
-            str(tmp_path / "runs"),
-        ],
-    )
+    outcome = fit(out, [])
     assert outcome.exit_code == 0, outcome.output
     payload = json.loads(outcome.stdout)
     inputs = payload["posterior"]["inputs"]
@@ -142,9 +140,8 @@ def test_calibrate_with_assumed_writes_a_preset_of_posterior_medians_whose_mecha
     for point in payload["fitted_points"]:
         assert point["inside_90"] == (point["p5"] <= point["measured_K"] <= point["p95"])
     assert {item["observable"] for item in payload["predictions"]} == {"ball@3600s", "vial@3600s"}
-    # Eight runs cannot make a reliable emulator of nine inputs: the fit says so instead of pretending.
-    assert payload["status"] in ("sampled", "unreliable")
-    assert (payload["status"] == "unreliable") == ("unreliable" in payload["message"])
+    assert payload["status"] == "sampled" and "unreliable" not in payload["message"]
+    assert payload["output"] == str(out)
     config = load_config(out)
     preset = config_preset(config)
     assert set(preset.fitted) == set(inputs) and not set(preset.assumed) & set(inputs)

@@ -283,13 +283,17 @@ def simulate_with_progress(params: Parameters) -> Result:
 
     The bar counts the simulated seconds of each phase in turn: the averaged solver's mechanics (out of
     averaging_max_time, or the duration when shorter), the whole duration, then its attractor probe (all starts
-    together).
+    together). A fall-back to full resolution is announced on stderr in a ``note:`` line before it starts.
     """
     from shakermill.solvers.simulate import simulate
 
     counter = "{task.completed:.5g}/{task.total:.5g} s simulated"
     with progress_bar("simulating", counter, params.duration, delay_s=PROGRESS_DELAY_S) as update:
-        return simulate(params, progress=lambda done, total: update(done, total=total))
+        return simulate(
+            params,
+            progress=lambda done, total: update(done, total=total),
+            notice=lambda line: print(f"note: {line}", file=sys.stderr, flush=True),
+        )
 
 
 # Long work piped into a log says how far it is in a plain line at most this often (s), the first after as long: a

@@ -336,12 +336,15 @@ def calibrate_over_assumed(
             f"interrupted; nothing was written but the runs, kept in {folder}; {resume} to fit from them",
             EXIT_INTERRUPTED,
         )
-    if out is not None:
+    # An unreliable posterior (an emulator that misses runs it did not see, or a chain too short) has no medians a
+    # preset should carry, as a network fit that missed its targets has none.
+    written = out if out is not None and not joint.problems else None
+    if written is not None:
         command = "shakermill calibrate " + " ".join(sys.argv[2:])
-        with writing(out, "the preset"):
+        with writing(written, "the preset"):
             write_joint_preset(
                 joint,
-                out,
+                written,
                 base_preset=run_config.preset,
                 command=command,
                 settings=values_beyond_preset(run_config.params, run_config.preset),
@@ -349,11 +352,21 @@ def calibrate_over_assumed(
     if json_output:
         typer.echo(
             json.dumps(
-                to_jsonable({**joint.as_dict(), "output": str(out) if out else None}), sort_keys=True, allow_nan=False
+                to_jsonable({**joint.as_dict(), "output": str(written) if written else None}),
+                sort_keys=True,
+                allow_nan=False,
             )
         )
     else:
-        print_joint(joint, out)
+        print_joint(joint, written)
+    if joint.problems:
+        unwritten = f" (nothing written to {out})" if out is not None else ""
+        typer.echo(
+            f"error: calibration over every uncertain input is unreliable{unwritten}: {'; '.join(joint.problems)}; "
+            f"more --members (the runs in {folder} are kept and reused) make a better emulator",
+            err=True,
+        )
+        raise typer.Exit(EXIT_FAILED_RUN)
 
 
 def print_joint(joint: Any, out: Path | None) -> None:

@@ -98,7 +98,7 @@ class RunBudget:
         self.reason = (
             f"The run was stopped early: at its pace so far ({simulated:.3g} s simulated in {wall:.3g} s) it would "
             "need "
-            f"~{_hours_or_minutes(needed)} of computing to reach t = {end:g} s, beyond its wall-clock budget "
+            f"~{hours_or_minutes(needed)} of computing to reach t = {end:g} s, beyond its wall-clock budget "
             f"(max_wall_time = {self.max_wall_time:g} s). Ask for less work (a shorter duration, fewer balls, "
             f"solver = 'averaged') or allow it, e.g. --set max_wall_time={math.ceil(needed * PACE_MARGIN):d}."
         )
@@ -130,7 +130,10 @@ PACE_JUDGED_AFTER_S = 10.0
 PACE_MARGIN = 1.5
 
 
-def _hours_or_minutes(seconds: float) -> str:
+def hours_or_minutes(seconds: float) -> str:
+    """A span of wall time in the unit a reader expects of it: seconds under 1.5 min, hours from 1.5 h."""
+    if seconds < 90:
+        return f"{seconds:.2g} s"
     return f"{seconds / 3600:.2g} h" if seconds >= 5400 else f"{seconds / 60:.2g} min"
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -28,7 +29,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from shakermill.analysis.fit import fit_exponential
-from shakermill.engines.budget import RunBudget
+from shakermill.engines.budget import RunBudget, hours_or_minutes
 from shakermill.engines.interface import (
     AveragedEngine,
     Averaging,
@@ -64,6 +65,16 @@ THERMAL_RTOL = 1e-9
 THERMAL_ATOL = 1e-9
 
 AVERAGING_FAILED = -10
+
+Notice = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class Told:
+    """Whom a run tells how far it is (``progress(done, total)``) and what it decided on the way (``notice(line)``)."""
+
+    progress: ProgressCallback | None
+    notice: Notice | None
 
 
 @dataclass(frozen=True)
@@ -114,6 +125,7 @@ def simulate_averaged(
     progress: ProgressCallback | None = None,
     budget: RunBudget | None = None,
     mechanics: Mechanics | None = None,
+    notice: Notice | None = None,
 ) -> Result:
     """Run ``params`` with the multiscale solver (module docstring); the same :class:`Result` as a full run.
 
@@ -121,7 +133,9 @@ def simulate_averaged(
     One ``budget`` (``params``' own if None) covers the mechanics, a fall-back and the attractor probe, which an
     engine whose runs start as one ball on the axis gets when ``attractor_starts`` > 1: the summary then counts
     the attractors, and a warning names every one whose heat power differs from the configured start's by more
-    than 1 %. ``progress(done, total)`` is told the simulated seconds of each phase in turn.
+    than 1 %. ``progress(done, total)`` is told the simulated seconds of each phase in turn; ``notice(line)``, before
+    a fall-back to full resolution starts, why and what it will take (it may take minutes where averaging took
+    seconds).
     """
     averaging_engine(engine_class)
     budget = budget if budget is not None else RunBudget.of(params)
@@ -137,7 +151,7 @@ def simulate_averaged(
         mechanics = settle_mechanics(params, engine_class, progress, budget)
     elif not mechanics.serves(params):
         raise ValueError("mechanics: measured for parameters that differ in more than the engine's thermal-only keys")
-    result = _from_mechanics(params, engine_class, mechanics, progress, budget, started)
+    result = _from_mechanics(params, engine_class, mechanics, Told(progress, notice), budget, started)
     stopped_by_the_user_or_the_budget = result.status in (INTERRUPTED, BUDGET_EXCEEDED)
     if (
         engine_class.description.attractor_starts
@@ -207,7 +221,7 @@ def _from_mechanics(
     params: Parameters,
     engine_class: type[Engine],
     mechanics: Mechanics,
-    progress: ProgressCallback | None,
+    told: Told,
     budget: RunBudget,
     started: float,
 ) -> Result:
@@ -222,13 +236,13 @@ def _from_mechanics(
         means.averages.message if not means.averages.converged else time_scale_problem(mechanics.engine, network, means)
     )
     if problem is not None:
-        return _refuse(params, engine_class, mechanics, _not_valid(means.averages, problem), progress, budget, started)
+        return _refuse(params, engine_class, mechanics, _not_valid(means.averages, problem), told, budget, started)
     thermal = integrate_network(network, means.load, params)
-    if progress is not None:
-        progress(params.duration, params.duration)
+    if told.progress is not None:
+        told.progress(params.duration, params.duration)
     if not thermal.success:
         averages = _not_valid(means.averages, f"the thermal network solver failed: {thermal.message}")
-        return _refuse(params, engine_class, mechanics, averages, progress, budget, started)
+        return _refuse(params, engine_class, mechanics, averages, told, budget, started)
     return _averaged_result(params, network, mechanics.engine, means, thermal, started)
 
 
@@ -353,23 +367,29 @@ def _stopped(mechanics: Mechanics, status: int, message: str, started: float) ->
     return concluded(engine, status, message, time.perf_counter() - started, solver="averaged", averages=averages)
 
 
-def _full_resolution_out_of_reach(params: Parameters, mechanics: Mechanics, started: float) -> str | None:
-    """Why the fall-back to full resolution could not end within the run's budget, judged by the pace of the mechanics
-    just run (steps and wall time per simulated second), or None: a three-dimensional hour at full resolution takes
-    a billion steps, and running it to learn that would take hours."""
+def _full_resolution_cost(params: Parameters, mechanics: Mechanics, started: float) -> tuple[float, float]:
+    """The steps and the wall time (s) a full-resolution run of ``params`` would take at the pace of the mechanics
+    just run (steps and wall time per simulated second); zero where no mechanics ran to judge it by."""
     engine = mechanics.engine
     simulated = engine.t
     if simulated <= 0:
-        return None
+        return 0.0, 0.0
     replicas = replica_count(params)
     steps = engine.counters()["steps"] / simulated * params.duration
     wall = (time.perf_counter() - started) / (replicas * simulated) * params.duration
+    return steps, wall
+
+
+def _out_of_reach(params: Parameters, steps: float, wall: float) -> str | None:
+    """Why a fall-back to full resolution taking ``steps`` and ``wall`` s could not end within the run's budget, or
+    None: a three-dimensional hour at full resolution takes a billion steps, and running it to learn that would take
+    hours."""
     if steps <= params.max_steps and wall <= params.max_wall_time:
         return None
     return (
         f"A full-resolution run instead (averaging_fallback = 'full') would take ~{steps:.2g} steps and "
-        f"~{wall / 3600:.2g} h "
-        f"at the mechanics' pace, beyond max_steps = {params.max_steps} or max_wall_time = {params.max_wall_time:g} s: "
+        f"~{hours_or_minutes(wall)} at the mechanics' pace, beyond max_steps = {params.max_steps} or "
+        f"max_wall_time = {params.max_wall_time:g} s: "
         "not started. Allow the averaging more time (averaging_max_time) or ask for a shorter duration."
     )
 
@@ -379,22 +399,24 @@ def _refuse(
     engine_class: type[Engine],
     mechanics: Mechanics,
     averages: MechanicsAverages,
-    progress: ProgressCallback | None,
+    told: Told,
     budget: RunBudget,
     started: float,
 ) -> Result:
     """Averaging is not valid: fall back to full resolution, or fail, as ``averaging_fallback`` says."""
-    out_of_reach = (
-        None if params.averaging_fallback == "fail" else _full_resolution_out_of_reach(params, mechanics, started)
-    )
+    steps, wall = _full_resolution_cost(params, mechanics, started)
+    out_of_reach = None if params.averaging_fallback == "fail" else _out_of_reach(params, steps, wall)
     if params.averaging_fallback == "fail" or out_of_reach is not None:
         advice = out_of_reach or "Set averaging_fallback = 'full' to run at full resolution."
         reason = f"Averaging is not valid: {averages.message}. {advice}"
         result = _stopped(mechanics, AVERAGING_FAILED, reason, started)
         result.message, result.averages = reason, averages
     else:
-        result = simulate_full(params, engine_class, progress, budget)
         fell_back = f"Averaging is not valid ({averages.message}); ran at full resolution instead."
+        if told.notice is not None:
+            pace = f", ~{steps:.2g} steps and ~{hours_or_minutes(wall)} at the mechanics' pace" if steps > 0 else ""
+            told.notice(f"averaging is not valid ({averages.message}); running at full resolution instead{pace}")
+        result = simulate_full(params, engine_class, told.progress, budget)
         result.message = f"{fell_back} {result.message}"
         result.warn(fell_back, first=True)
         result.averages = averages

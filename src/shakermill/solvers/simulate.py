@@ -14,6 +14,7 @@ from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.keys import Parameters
 from shakermill.solvers.averaged import (
     Mechanics,
+    Notice,
     averaging_engine,
     full_resolution_instead,
     least_mechanics,
@@ -28,16 +29,22 @@ from shakermill.solvers.impact import restitution_warning
 from shakermill.solvers.result import INTERRUPTED, Result, summarize
 
 
-def simulate(params: Parameters, progress: ProgressCallback | None = None, budget: RunBudget | None = None) -> Result:
+def simulate(
+    params: Parameters,
+    progress: ProgressCallback | None = None,
+    budget: RunBudget | None = None,
+    notice: Notice | None = None,
+) -> Result:
     """Run ``params`` with the engine and solver it names, within ``budget`` (``params``' own if None): see
-    :func:`~shakermill.solvers.full.simulate_full` and :func:`~shakermill.solvers.averaged.simulate_averaged`.
+    :func:`~shakermill.solvers.full.simulate_full` and :func:`~shakermill.solvers.averaged.simulate_averaged`
+    (which tells ``notice`` of a fall-back to full resolution before it starts).
     Raises :class:`ParameterError` before anything is allocated for a run that would not fit (:func:`preflight`)."""
     preflight(params)
     engine = engine_named(params.engine)
     # Measured before the run, so that a Ctrl-C is not kept waiting for it (its first call loads compiled code).
     caution = restitution_warning(params, engine.description)
     if params.solver == "averaged":
-        result = simulate_averaged(params, engine, progress, budget)
+        result = simulate_averaged(params, engine, progress, budget, notice=notice)
     else:
         result = simulate_full(params, engine, progress, budget)
     if caution is not None:
