@@ -49,6 +49,26 @@ def test_every_value_has_a_source_a_unit_pint_reads_and_a_plausible_size(found):
     for key in materials.RANGES:
         low, high = getattr(found, key).value
         assert 0.0 < low <= high <= 1.0, (found.name, key)
+    if found.melting_point is not None:
+        assert 1000.0 < found.melting_point.value < 4000.0, found.name
+
+
+def test_a_powder_node_is_bounded_by_its_materials_melting_point_where_it_is_below_the_ceiling():
+    from shakermill.engines.dem.model import network_of
+    from shakermill.solvers.result import PHYSICAL_CEILING, node_ceiling
+
+    charge = {"powder_mass": "5 g", "record_windows": ()}
+
+    def powder_of(material):
+        params = sm.default_parameters("spex8000m-3d", **charge, powder_material=material)
+        return next(node for node in network_of(params).others if node.name == "powder")
+
+    iron = powder_of("iron")
+    assert node_ceiling(iron) == (1811.0, "1538 °C, the melting point of its material (iron)")
+    # Zirconia melts above the ceiling every node has, and silicon nitride decomposes before it melts.
+    assert node_ceiling(powder_of("zirconia"))[0] == PHYSICAL_CEILING
+    assert powder_of("silicon-nitride").melting_point is None
+    assert node_ceiling(powder_of("silicon-nitride"))[0] == PHYSICAL_CEILING
 
 
 def test_hardened_steel_is_the_papers_steel_so_selecting_it_changes_nothing():

@@ -30,10 +30,13 @@ PROPERTIES: dict[str, tuple[str, str]] = {
     "conductivity": ("W/(m*K)", "thermal conductivity k"),
     "restitution": ("", "restitution e on the same material (shown, not applied)"),
     "friction": ("", "friction μ on the same material (shown, not applied)"),
+    "melting_point": ("K", "melting point T_m (onset, 1 atm), where known"),
 }
 # The properties a material fills in: ``ball_<property>`` and ``vial_<property>`` where such a key exists.
 FILLED = ("density", "youngs_modulus", "poisson_ratio", "heat_capacity", "conductivity")
 RANGES = ("restitution", "friction")
+# Properties a material may lack: a ceramic that decomposes before it melts, or a value no source was found for.
+OPTIONAL = ("melting_point",)
 
 
 class UnknownMaterial(ValueError):
@@ -63,9 +66,11 @@ class Material:
     conductivity: Sourced
     restitution: Sourced
     friction: Sourced
+    melting_point: Sourced | None = None
 
     def properties(self) -> dict[str, Sourced]:
-        return {name: getattr(self, name) for name in PROPERTIES}
+        """Every property the material has (an optional one it lacks is left out)."""
+        return {name: getattr(self, name) for name in PROPERTIES if getattr(self, name) is not None}
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready: name, description, aliases and every property as {value, unit, source} (SI)."""
@@ -89,7 +94,7 @@ def library() -> dict[str, Material]:
 
 
 def _material(name: str, entry: dict) -> Material:
-    properties = {key: _sourced(name, key, entry.get(key)) for key in PROPERTIES}
+    properties = {key: _sourced(name, key, entry.get(key)) for key in PROPERTIES if key not in OPTIONAL or key in entry}
     extra = set(entry) - set(PROPERTIES) - {"description", "aliases"}
     if extra:
         raise ValueError(f"{LIBRARY_FILE.name}: [{name}] has unknown entries {sorted(extra)}")

@@ -27,6 +27,7 @@ from shakermill.engines.records import (
 )
 from shakermill.engines.status import REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
+from shakermill.engines.thermal.nodes import Node
 from shakermill.parameters.defaults import FAST_IMPACT_SPEED, HIT_SPEED
 from shakermill.parameters.keys import Parameters, unit_slip_warnings
 from shakermill.solvers.summary import Summary
@@ -250,7 +251,7 @@ def conclude(output: RunOutput, network: ThermalNetwork, load: NetworkLoad) -> R
     checks = (
         (OUT_OF_PHYSICAL_BOUNDS, lambda: physical_bounds_problem(output, network)),
         (ENERGY_AUDIT_FAILED, lambda: energy_audit_problem(output)),
-        (UNPHYSICAL_ANSWER, lambda: unphysical_answer(output, steady)),
+        (UNPHYSICAL_ANSWER, lambda: unphysical_answer(output, network, steady)),
     )
     for code, problem_of in checks:
         problem = problem_of() if status == REACHED_STOP else None
@@ -302,37 +303,55 @@ def physical_bounds_problem(result: RunOutput, network: ThermalNetwork) -> str |
             f"({kelvin_to_celsius(limit):.4g} °C): the model does not hold there. Check omega, amplitude and the "
             "units of the inputs (bare numbers are SI)."
         )
-    others = [node.name for node in network.others if f"theta_{node.name}" in series.variables]
-    hottest = max(others, key=lambda name: float(np.nanmax(series[f"theta_{name}"], initial=-np.inf)), default=None)
-    peak = float(np.nanmax(series[f"theta_{hottest}"])) if hottest is not None else -math.inf
-    if peak > PHYSICAL_CEILING:
-        return (
-            f"The {hottest} temperature reached {kelvin_to_celsius(peak):.4g} °C, "
-            f"above {kelvin_to_celsius(PHYSICAL_CEILING):.4g} °C: the model does not hold there. Check the heat paths' "
-            "coefficients and the units of the inputs."
-        )
+    for node in network.others:
+        if f"theta_{node.name}" not in series.variables:
+            continue
+        peak = float(np.nanmax(series[f"theta_{node.name}"], initial=-np.inf))
+        ceiling, what = node_ceiling(node)
+        if peak > ceiling:
+            return (
+                f"The {node.name} temperature reached {kelvin_to_celsius(peak):.4g} °C, above {what}: the model does "
+                "not hold there. Check the heat paths' coefficients and the units of the inputs."
+            )
     coldest = min(float(np.nanmin(series[name], initial=np.inf)) for name in ("theta_ball", "theta_vial", "theta_air"))
     if coldest < 0.0:
         return f"A temperature fell to {coldest:.4g} K, below absolute zero: the thermal network is not physical here."
     return None
 
 
-def unphysical_answer(result: RunOutput, steady: SteadyState) -> str | None:
+def node_ceiling(node: Node) -> tuple[float, str]:
+    """The highest temperature (K) ``node`` may reach, and what it is in words: its material's melting point where
+    known and lower, :data:`PHYSICAL_CEILING` otherwise."""
+    ceiling = f"{kelvin_to_celsius(PHYSICAL_CEILING):.4g} °C"
+    if node.melting_point is None or node.melting_point >= PHYSICAL_CEILING:
+        return PHYSICAL_CEILING, ceiling
+    melts = f"{kelvin_to_celsius(node.melting_point):.4g} °C"
+    return node.melting_point, f"{melts}, the melting point of its material ({node.material})"
+
+
+def unphysical_answer(result: RunOutput, network: ThermalNetwork, steady: SteadyState) -> str | None:
     """Why what a run answers beyond its end, the fitted θ∞ of the balls or a node's steady state, is no temperature
-    a mill reaches (above :data:`PHYSICAL_CEILING`), or None."""
+    a mill reaches (above :data:`PHYSICAL_CEILING`, or a node's melting point), or None."""
     # A fit of a run shorter than its network's time constants is an extrapolation the summary already marks as not
     # describing the run: its θ∞ is no answer of the run, and a short run must not fail on it.
     fit_answers = result.ball_fit.success and not fits_no_exponential(result.t_end, steady)
-    answers = {"the balls' fitted theta_inf": result.ball_fit.theta_inf if fit_answers else math.nan}
+    everywhere = (PHYSICAL_CEILING, f"{kelvin_to_celsius(PHYSICAL_CEILING):.4g} °C")
+    answers = {"the balls' fitted theta_inf": (result.ball_fit.theta_inf if fit_answers else math.nan, everywhere)}
     if steady.solved:
-        answers |= {"the ball's steady state": steady.ball, "the vial's steady state": steady.vial}
-        answers |= {f"the {name}'s steady state": value for name, value in steady.others}
-    for what, value in answers.items():
-        if value > PHYSICAL_CEILING:
+        nodes = {node.name: node for node in network.others}
+        answers |= {
+            "the ball's steady state": (steady.ball, everywhere),
+            "the vial's steady state": (steady.vial, everywhere),
+        }
+        answers |= {
+            f"the {name}'s steady state": (value, node_ceiling(nodes[name]) if name in nodes else everywhere)
+            for name, value in steady.others
+        }
+    for what, (value, (ceiling, said)) in answers.items():
+        if value > ceiling:
             return (
-                f"The run is not physical: {what} is {kelvin_to_celsius(value):.4g} °C, above "
-                f"{kelvin_to_celsius(PHYSICAL_CEILING):.4g} °C, where no mill goes: its heat has almost no way out, "
-                "or far more heat is made than a mill makes. "
+                f"The run is not physical: {what} is {kelvin_to_celsius(value):.4g} °C, above {said}, where no mill "
+                "goes: its heat has almost no way out, or far more heat is made than a mill makes. "
                 "Check the heat paths' coefficients (h_outer, h_inner, the powder's) and the units of the inputs."
             )
     return None

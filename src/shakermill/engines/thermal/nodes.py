@@ -38,7 +38,8 @@ NODE_NAME = "[a-z]+"
 class Node:
     """A lumped heat capacity (J/K) with its ``role`` and the ``title`` tables and figures give it; a ``held`` node
     stays at the ambient temperature (a reservoir). ``keys`` set its capacity and its paths: a message about the node
-    names them."""
+    names them. A node of a material whose melting point is known carries it (K) and the material's name: above it
+    the node is no longer what the model says it is."""
 
     name: str
     role: str
@@ -46,6 +47,8 @@ class Node:
     title: str
     held: bool = False
     keys: tuple[str, ...] = ()
+    melting_point: float | None = None
+    material: str = ""
 
     def __post_init__(self) -> None:
         # Checked where the node is made: a name the summary cannot take would fail every run at its end.

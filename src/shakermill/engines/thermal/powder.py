@@ -23,6 +23,7 @@ from shakermill.engines.thermal.nodes import (
 )
 from shakermill.engines.thermal.paths import newton_cooling
 from shakermill.parameters.groups.powder import PowderCoating, PowderHeat
+from shakermill.parameters.materials import material
 
 # The role of the node (engines/thermal/nodes.py).
 POWDER = "powder"
@@ -42,7 +43,18 @@ def add_node(draft: NetworkDraft) -> None:
     vial, air = draft.one_of_role(VESSEL), draft.one_of_role(GAS)
     keys = ("powder_mass", "powder_heat_capacity", "powder_contact_coefficient")
     capacity = coating.powder_mass * heat.powder_heat_capacity
-    powder = draft.add(Node("powder", POWDER, capacity, "powder", keys=keys))
+    melting = material(heat.powder_material).melting_point if heat.powder_material else None
+    powder = draft.add(
+        Node(
+            "powder",
+            POWDER,
+            capacity,
+            "powder",
+            keys=keys,
+            melting_point=float(melting.value) if melting is not None else None,  # type: ignore[arg-type]
+            material=heat.powder_material,
+        )
+    )
     wall = wall_area(params.vial_diameter, params.vial_length)
     coefficient = heat.powder_contact_coefficient
     draft.paths += [
