@@ -274,11 +274,10 @@ def calibrate_over_assumed(
     runs: Runs,
 ) -> None:
     """``calibrate --with-assumed``: the posterior of the network's free keys and the preset's assumed inputs given the
-    curves, printed, and the preset of its medians written. Its runs are stored in ``runs.folder`` as they finish:
-    after Ctrl-C the same command into it computes only the others."""
-    from shakermill.io.runs import to_jsonable
-    from shakermill.parameters.config import config_preset, values_beyond_preset
-    from shakermill.studies.calibration.joint import calibrate_jointly, write_joint_preset
+    curves, printed, and the preset of its medians written where it is reliable. Its runs are stored in
+    ``runs.folder`` as they finish: after Ctrl-C the same command into it computes only the others."""
+    from shakermill.parameters.config import config_preset
+    from shakermill.studies.calibration.joint import calibrate_jointly
     from shakermill.studies.ensembles.ensemble import check_members
     from shakermill.studies.measured import experiment_curve
     from shakermill.studies.sweeps.executor import Execution, RunsInterrupted
@@ -336,6 +335,16 @@ def calibrate_over_assumed(
             f"interrupted; nothing was written but the runs, kept in {folder}; {resume} to fit from them",
             EXIT_INTERRUPTED,
         )
+    report_joint(joint, run_config, out, json_output, folder)
+
+
+def report_joint(joint: Any, run_config: Any, out: Path | None, json_output: bool, folder: Path) -> None:
+    """A joint calibration's preset written to ``out`` where it is reliable, then its report; an unreliable one says
+    why and exits 1."""
+    from shakermill.io.runs import to_jsonable
+    from shakermill.parameters.config import values_beyond_preset
+    from shakermill.studies.calibration.joint import write_joint_preset
+
     # An unreliable posterior (an emulator that misses runs it did not see, or a chain too short) has no medians a
     # preset should carry, as a network fit that missed its targets has none.
     written = out if out is not None and not joint.problems else None

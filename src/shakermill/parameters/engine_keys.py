@@ -20,6 +20,7 @@ from shakermill.parameters.groups import (
     BallPairs,
     Balls,
     ContactDamping,
+    ContactHeat,
     DemAveraging,
     DemContacts,
     DemStepping,
@@ -99,7 +100,7 @@ class EngineKeys:
 
 
 # The groups every built-in engine reads: the run and its averaged solver, the vial, its drive and stroke, the balls,
-# where one ball starts, the vial's wall and the contacts' damping, the paper's network and its loss to the room.
+# where one ball starts, the vial's wall, the contacts' damping and heat, the paper's network and its loss to the room.
 EVERY_ENGINE = (
     RunControl,
     AveragedSolver,
@@ -110,6 +111,7 @@ EVERY_ENGINE = (
     OneBallStart,
     VialWall,
     ContactDamping,
+    ContactHeat,
     PaperNetwork,
     RoomLoss,
 )

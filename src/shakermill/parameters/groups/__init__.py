@@ -18,7 +18,7 @@ from shakermill.parameters.groups.contacts import BallPairs, ContactDamping, Dem
 from shakermill.parameters.groups.dem import DemAveraging, DemStepping, EnduringContacts, LabFrame
 from shakermill.parameters.groups.geometry import Drive, Stroke, Vial
 from shakermill.parameters.groups.one_d import OneDAveraging, OneDIntegrator
-from shakermill.parameters.groups.paper_network import HeatSplit, NetworkChoice, PaperNetwork, RoomLoss
+from shakermill.parameters.groups.paper_network import ContactHeat, HeatSplit, NetworkChoice, PaperNetwork, RoomLoss
 from shakermill.parameters.groups.run import AveragedSolver, RunControl
 from shakermill.parameters.key_group import KeyGroup
 
@@ -39,6 +39,7 @@ class CoreKeys(
     NetworkChoice,
     RoomLoss,
     PaperNetwork,
+    ContactHeat,
     ContactDamping,
     VialWall,
     OneBallStart,

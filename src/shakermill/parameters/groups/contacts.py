@@ -28,10 +28,19 @@ class VialWall(KeyGroup):
     )
 
 
+# With no ball there is no contact: the keys of a contact's law and of its heat are no input of the run.
+WITH_A_BALL: ReadRule = When(
+    "n_balls",
+    lambda balls: balls >= 1,
+    "with n_balls = {value} there is no contact; it applies to n_balls >= 1",
+)
+
+
 class ContactDamping(KeyGroup):
     """The restitution a ball's contact on the vial is damped to and whether its force may pull."""
 
     title = "contact damping"
+    rule = WITH_A_BALL
 
     # A perfectly plastic contact (0) has no damping ratio. Towards 0 the ball chatters on the face and a
     # run takes more steps (20 times at 0.05, 40 at 1e-6), but it stays correct and finishes.
@@ -54,6 +63,7 @@ class DemContacts(KeyGroup):
     """The 'dem' engine's contacts beyond the 1-D law: Coulomb friction and rolling resistance (MODEL.md §12.3)."""
 
     title = "friction and rolling"
+    rule = WITH_A_BALL
 
     # Coulomb coefficients of dry solids stay below ~1.5; 5 leaves room for rough or adhesive pairs.
     friction: float = quantity(

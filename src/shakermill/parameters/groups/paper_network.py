@@ -1,7 +1,7 @@
-"""The paper's thermal network (MODEL.md §§3-6): the share η of the dissipated energy that is heat and the share λ
-of it that goes to the ball, the ball, vial and air that take it and their start; the vial's loss to the room that
-only the 'paper' network reads; the choice of network; and the 'dem' engine's split of a contact's heat by the
-bodies' effusivities and its conduction through contacts."""
+"""The paper's thermal network (MODEL.md §§3-6): the share η of a contact's dissipated energy that is heat and the
+share λ of it that goes to the ball (read where there is a ball); the ball, vial and air that take it and their start;
+the vial's loss to the room that only the 'paper' network reads; the choice of network; and the 'dem' engine's split
+of a contact's heat by the bodies' effusivities and its conduction through contacts."""
 
 from __future__ import annotations
 
@@ -9,15 +9,17 @@ from typing import Literal
 
 from shakermill.parameters.fields import choice, quantity
 from shakermill.parameters.geometry import end_faces_area
+from shakermill.parameters.groups.contacts import WITH_A_BALL
 from shakermill.parameters.key_group import KeyGroup, only_with_network
 from shakermill.parameters.sources import PAPER
 
 
-class PaperNetwork(KeyGroup):
-    """The paper's network of ball, vial and air (MODEL.md §§3-6, Tables 2-4): the heat η·(dissipation) and its share λ,
-    capacities, convection and exchange, and the temperatures at the start."""
+class ContactHeat(KeyGroup):
+    """The heat of a contact (MODEL.md §3): the share η of its dissipation that is heat and the share λ of that heat
+    that goes to the ball; read where there is a ball to touch."""
 
-    title = "the paper's thermal network"
+    title = "the contacts' heat"
+    rule = WITH_A_BALL
 
     eta: float = quantity(
         "", "fraction η of dissipated power turned into heat", default=0.9, source=f"{PAPER}, Table 4 (η)", ge=0, le=1
@@ -25,6 +27,14 @@ class PaperNetwork(KeyGroup):
     lam: float = quantity(
         "", "fraction λ of the heat that goes to the ball", default=0.368, source=f"{PAPER}, Table 4 (λ)", ge=0, le=1
     )
+
+
+class PaperNetwork(KeyGroup):
+    """The paper's network of ball, vial and air (MODEL.md §§3-6, Tables 2-4): capacities, convection and exchange,
+    and the temperatures at the start."""
+
+    title = "the paper's thermal network"
+
     # The alternatives the spec allows (MODEL.md sections 2-4).
     model: Literal["three_node", "ball_only"] = choice(
         "'three_node': ball, vial and air (this paper); 'ball_only': air held at ambient and no vial "
