@@ -25,7 +25,7 @@ from rich.text import Text
 from typer.core import TyperGroup
 
 from shakermill.engines.budget import BudgetExceeded
-from shakermill.parameters.defaults import DEFAULT_PRESET
+from shakermill.parameters.defaults import DEFAULT_PRESET, DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.errors import ParameterError
 from shakermill.support.atomic import StorageError
 from shakermill.support.version import __version__
@@ -228,15 +228,27 @@ SchedulerOption = Annotated[
 
 
 SchedulerTimeoutOption = Annotated[
-    float,
+    float | None,
     typer.Option(
         "--scheduler-timeout",
         min=0.1,
         max=86400.0,
         metavar="SECONDS",
-        help="Give up connecting to the scheduler after this long.",
+        show_default=f"{DEFAULT_SCHEDULER_TIMEOUT_S:g}",
+        help="With --scheduler: give up connecting to it, or waiting for a worker, after this long.",
     ),
 ]
+
+
+def scheduler_timeout_of(scheduler: str | None, timeout: float | None) -> float:
+    """The wait ``--scheduler-timeout`` allows (its default where not given); refused without a ``--scheduler``,
+    where nothing would wait for it."""
+    if timeout is not None and scheduler is None:
+        raise ParameterError(
+            "scheduler-timeout: bounds the waits for a Dask scheduler, and no --scheduler is given; allowed "
+            "--scheduler-timeout with --scheduler"
+        )
+    return DEFAULT_SCHEDULER_TIMEOUT_S if timeout is None else timeout
 
 
 FullResolutionOption = Annotated[

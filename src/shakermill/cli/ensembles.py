@@ -16,11 +16,13 @@ from shakermill.cli.common import (
     JsonOption,
     PresetOption,
     SchedulerOption,
+    SchedulerTimeoutOption,
     SettingsOption,
     add_plain_row,
     echo_notes,
     fail,
     progress_bar,
+    scheduler_timeout_of,
     stdout_console,
     timestamped_folder,
     user_errors,
@@ -65,6 +67,7 @@ def uncertainty(
         int | None, typer.Option("--workers", "-w", show_default="one per core", help="Local worker processes.")
     ] = None,
     scheduler: SchedulerOption = None,
+    scheduler_timeout: SchedulerTimeoutOption = None,
     full_resolution: FullResolutionOption = False,
     json_output: JsonOption = False,
 ) -> None:
@@ -84,6 +87,7 @@ def uncertainty(
         inputs, posterior, notes = ensemble_inputs(
             config_preset(run_config), run_config.params, assume or [], vary or [], run_config.explicit
         )
+        waits = scheduler_timeout_of(scheduler, scheduler_timeout)
     target = out if out is not None else timestamped_folder("uncertainty")
     try:
         counter = (
@@ -102,6 +106,7 @@ def uncertainty(
                 members,
                 workers=workers,
                 scheduler=scheduler,
+                scheduler_timeout=waits,
                 preset=run_config.preset,
                 posterior=posterior,
                 announce=lambda line: typer.echo(f"uncertainty: {line}", err=True),

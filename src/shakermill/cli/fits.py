@@ -23,6 +23,7 @@ from shakermill.cli.common import (
     JsonOption,
     PresetOption,
     SchedulerOption,
+    SchedulerTimeoutOption,
     SettingsOption,
     add_plain_row,
     fail,
@@ -30,6 +31,7 @@ from shakermill.cli.common import (
     nothing_written_when_interrupted,
     number,
     progress_bar,
+    scheduler_timeout_of,
     stdout_console,
     timestamped_folder,
     user_errors,
@@ -131,6 +133,7 @@ def calibrate(
     runs: RunsOption = None,
     workers: WorkersOption = None,
     scheduler: SchedulerOption = None,
+    scheduler_timeout: SchedulerTimeoutOption = None,
 ) -> None:
     """Fit free parameters to measured curves (the experiment's by default) and/or Table 5 targets by bounded least
     squares; with --with-assumed, over every uncertain input by Bayesian inference."""
@@ -165,10 +168,10 @@ def calibrate(
                 full_resolution,
                 out,
                 json_output,
-                Runs(runs, workers, scheduler),
+                Runs(runs, workers, scheduler, scheduler_timeout_of(scheduler, scheduler_timeout)),
             )
             return
-        check_no_runs(runs, workers, scheduler, members)
+        check_no_runs(runs, workers, scheduler, members, scheduler_timeout)
         with (
             nothing_written_when_interrupted("the fit starts again from the beginning"),
             nothing_written_when_a_run_is_stopped("the fit"),
@@ -244,16 +247,25 @@ def fit_progress(update: Callable[..., None]) -> dict[str, Callable[..., None]]:
 @dataclass(frozen=True)
 class Runs:
     """Where ``calibrate --with-assumed`` keeps its runs (``--runs``) and where they run (``--workers``,
-    ``--scheduler``)."""
+    ``--scheduler`` and how long to wait for it)."""
 
     folder: Path | None
     workers: int | None
     scheduler: str | None
+    scheduler_timeout: float
 
 
-def check_no_runs(runs: Path | None, workers: int | None, scheduler: str | None, members: int | None) -> None:
+def check_no_runs(
+    runs: Path | None, workers: int | None, scheduler: str | None, members: int | None, timeout: float | None
+) -> None:
     """A fit of the network alone runs no design of runs: their options are refused in one line."""
-    options = (("runs", runs), ("workers", workers), ("scheduler", scheduler), ("members", members))
+    options = (
+        ("runs", runs),
+        ("workers", workers),
+        ("scheduler", scheduler),
+        ("scheduler-timeout", timeout),
+        ("members", members),
+    )
     given = [name for name, value in options if value is not None]
     if given:
         raise ParameterError(
@@ -294,7 +306,10 @@ def calibrate_over_assumed(
         )
     check_members(members)
     execution = Execution(
-        runs.workers, runs.scheduler, announce=lambda line: typer.echo(f"calibrate: {line}", err=True)
+        runs.workers,
+        runs.scheduler,
+        runs.scheduler_timeout,
+        announce=lambda line: typer.echo(f"calibrate: {line}", err=True),
     )
     folder = runs.folder if runs.folder is not None else timestamped_folder("calibrate")
     params = run_config.params.replace(solver="averaged", attractor_starts=1)

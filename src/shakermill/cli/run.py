@@ -30,6 +30,7 @@ from shakermill.cli.common import (
     echo_warnings,
     nothing_written_when_interrupted,
     number,
+    scheduler_timeout_of,
     simulate_with_progress,
     stdout_console,
     timestamped_folder,
@@ -37,7 +38,7 @@ from shakermill.cli.common import (
     writing,
 )
 from shakermill.engines.budget import interrupts_held
-from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S, HIT_SPEED
+from shakermill.parameters.defaults import HIT_SPEED
 
 if TYPE_CHECKING:
     from shakermill.parameters.keys import Parameters
@@ -66,7 +67,7 @@ def run(
             help="Advance an averaged run's replicas after the first on this Dask scheduler (tcp://host:8786).",
         ),
     ] = None,
-    scheduler_timeout: SchedulerTimeoutOption = DEFAULT_SCHEDULER_TIMEOUT_S,
+    scheduler_timeout: SchedulerTimeoutOption = None,
 ) -> None:
     """Run one simulation and write its run folder (data, summary, configuration, figures)."""
     from shakermill.io.runs import check_target, import_writers, to_jsonable
@@ -82,7 +83,7 @@ def run(
         target = out if out is not None else timestamped_folder("run")
         check_target(target, overwrite=overwrite)
         preflight(run_config.params)
-        cluster = cluster_for_replicas(run_config.params, scheduler, scheduler_timeout)
+        cluster = cluster_for_replicas(run_config.params, scheduler, scheduler_timeout_of(scheduler, scheduler_timeout))
     import_writers()
     # Unit slips and the solver's choice are said before a possibly long run, the rest once it is known.
     said_first = unit_slip_warnings(run_config.params)

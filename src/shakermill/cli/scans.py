@@ -28,13 +28,14 @@ from shakermill.cli.common import (
     nothing_written_when_interrupted,
     number,
     progress_bar,
+    scheduler_timeout_of,
     stdout_console,
     timestamped_folder,
     user_errors,
     warnings_as_lines,
     writing,
 )
-from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S, PNG_DPI
+from shakermill.parameters.defaults import PNG_DPI
 from shakermill.parameters.errors import ParameterError
 from shakermill.support.limits import MAX_BIFURCATION_VALUES
 
@@ -90,7 +91,7 @@ def sweep(
         int | None, typer.Option("--workers", "-w", show_default="one per core", help="Local worker processes.")
     ] = None,
     scheduler: SchedulerOption = None,
-    scheduler_timeout: SchedulerTimeoutOption = DEFAULT_SCHEDULER_TIMEOUT_S,
+    scheduler_timeout: SchedulerTimeoutOption = None,
     keep_runs: Annotated[
         bool, typer.Option("--keep-runs", help="Also write each point's run folder under DIR/runs.")
     ] = False,
@@ -107,6 +108,7 @@ def sweep(
         run_config = sweep_parameters(config, preset=preset, overrides=settings or [], full_resolution=full_resolution)
         plan = plan_sweep(grid or [], points)
         check_keys_read(run_config.params, plan)
+        waits = scheduler_timeout_of(scheduler, scheduler_timeout)
     target = out if out is not None else timestamped_folder("sweep")
     try:
         counter = "{task.completed}/{task.total} points · {task.fields[running]} running · {task.fields[failed]} failed"
@@ -128,7 +130,7 @@ def sweep(
                 keep_runs=keep_runs,
                 progress=progress,
                 preset=run_config.preset,
-                scheduler_timeout=scheduler_timeout,
+                scheduler_timeout=waits,
                 announce=lambda line: typer.echo(f"sweep: {line}", err=True),
             )
     except SweepFailed as exc:

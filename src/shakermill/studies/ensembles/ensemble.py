@@ -33,6 +33,7 @@ import pandas as pd
 from shakermill.analysis.regime import ACTIVE, PACK
 from shakermill.io.runs import ENSEMBLE_KIND
 from shakermill.parameters.assumed import AssumedInput, keeping_moves, parse_assumption, with_derived
+from shakermill.parameters.defaults import DEFAULT_SCHEDULER_TIMEOUT_S
 from shakermill.parameters.engine_keys import reader_of
 from shakermill.parameters.errors import ParameterError
 from shakermill.parameters.file_models import DERIVED_FROM
@@ -279,12 +280,13 @@ def run_ensemble(
     posterior: LogNormal | None = None,
     announce: Callable[[str], None] | None = None,
     on_start: Callable[[], None] | None = None,
+    scheduler_timeout: float = DEFAULT_SCHEDULER_TIMEOUT_S,
 ) -> Ensemble:
     """Run ``base`` at ``members`` points of a Sobol' design over ``inputs`` and the fitted keys' ``posterior`` (a
     sweep stored in ``out_dir``, resumed where an earlier run of the same ensemble stopped) and analyse the members
     (:func:`analyse`). ``announce`` is told what runs and when the members are being analysed, which takes a while
     (a surrogate cross-validated for each headline); ``on_start`` is told with the first, once every check of the
-    folder and the workers has passed."""
+    folder and the workers has passed. ``scheduler_timeout`` bounds each wait for the ``scheduler``."""
     check_members(members)
     if not inputs and posterior is None:
         raise ParameterError(
@@ -302,6 +304,7 @@ def run_ensemble(
         out_dir,
         workers=workers,
         scheduler=scheduler,
+        scheduler_timeout=scheduler_timeout,
         progress=progress,
         preset=preset,
         kind=ENSEMBLE_KIND,
