@@ -210,6 +210,20 @@ def _file_preset(values: dict[str, Any], path: Path) -> str | None:
 HALVED_ALIASES = {"ball_diameter": "ball_radius"}
 
 
+def halved(alias: str, value: Any) -> float:
+    """The value of the key an alias of :data:`HALVED_ALIASES` stands for (SI): half of ``value``, a length with or
+    without its unit; one line naming the alias for a value that is no length or out of twice the key's range."""
+    key = HALVED_ALIASES[alias]
+    try:
+        length = guards.quantity(alias, value, field_unit(key))
+    except UnitError as exc:
+        raise ParameterError(f"{exc}; allowed {twice_range(key)}") from None
+    # Refused in the user's terms: the radius's range would name a key the user never typed.
+    if not bounds(key).contains(bounds(key).snapped(length / 2.0)):
+        raise ParameterError(f"{alias}: {length:g} {field_unit(key)} is out of range; allowed {twice_range(key)}")
+    return length / 2.0
+
+
 def resolve_aliases(layer: Mapping[str, Any]) -> dict[str, Any]:
     """``layer`` with each alias of :data:`HALVED_ALIASES` replaced by its key, the value converted to SI and halved;
     one line for a layer that gives both, or a value that is no length."""
@@ -219,14 +233,7 @@ def resolve_aliases(layer: Mapping[str, Any]) -> dict[str, Any]:
             continue
         if key in found:
             raise ParameterError(f"{alias}: give {key} or {alias} (twice {key}), not both")
-        try:
-            length = guards.quantity(alias, found.pop(alias), field_unit(key))
-        except UnitError as exc:
-            raise ParameterError(f"{exc}; allowed {twice_range(key)}") from None
-        # Refused in the user's terms: the radius's range would name a key the user never typed.
-        if not bounds(key).contains(bounds(key).snapped(length / 2.0)):
-            raise ParameterError(f"{alias}: {length:g} {field_unit(key)} is out of range; allowed {twice_range(key)}")
-        found[key] = length / 2.0
+        found[key] = halved(alias, found.pop(alias))
     return found
 
 

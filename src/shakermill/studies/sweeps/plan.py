@@ -16,7 +16,14 @@ from typing import Any
 import numpy as np
 
 from shakermill.io.runs import to_jsonable
-from shakermill.parameters.config import HALVED_ALIASES, RunConfig, load_config, parse_overrides, read_config_file
+from shakermill.parameters.config import (
+    HALVED_ALIASES,
+    RunConfig,
+    halved,
+    load_config,
+    parse_overrides,
+    read_config_file,
+)
 from shakermill.parameters.csvinput import read_csv_rows
 from shakermill.parameters.engine_keys import DECIDING, reader_for
 from shakermill.parameters.errors import ParameterError
@@ -74,9 +81,9 @@ def aliased(key: str) -> str:
 
 
 def aliased_value(column: str, value: Any) -> Any:
-    """``value`` of a column or a grid of ``column``, as its key (:func:`aliased`) stores it."""
-    stored = normalize_value(aliased(column), value)
-    return stored / 2.0 if column in HALVED_ALIASES else stored
+    """``value`` of a column or a grid of ``column``, as its key (:func:`aliased`) stores it; an alias's value out of
+    its range is refused in the alias's terms, before any point runs (a point's failure would name the key)."""
+    return halved(column, value) if column in HALVED_ALIASES else normalize_value(column, value)
 
 
 def parse_grid(spec: str, most: int = MAX_SWEEP_POINTS) -> tuple[str, np.ndarray]:
