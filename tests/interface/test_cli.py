@@ -242,7 +242,9 @@ def test_interruption_writes_partial_results_and_exits_130(tmp_path, monkeypatch
 
     # The interruption arrives after the first chunk, inside the library, as a real Ctrl-C would.
     monkeypatch.setattr(
-        SIMULATE_MODULE, "simulate", lambda params, progress=None: real_simulate(params, progress=press_ctrl_c)
+        SIMULATE_MODULE,
+        "simulate",
+        lambda params, progress=None, notice=None: real_simulate(params, progress=press_ctrl_c, notice=notice),
     )
     out = tmp_path / "run"
     result = invoke("run", "--set", "duration=30", "--set", "record_windows=0:0.2", "--out", str(out), "--no-plots")

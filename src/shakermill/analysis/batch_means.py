@@ -48,6 +48,8 @@ def standard_error(values: np.ndarray) -> float:
 
 
 def normalised(values: np.ndarray) -> np.ndarray:
+    if values.size == 0:
+        return values
     scale = abs(values.mean())
     return values / scale if scale > 0 else values
 
@@ -98,7 +100,8 @@ class Grouping:
 
 
 def negligible_spread(values: np.ndarray, negligible: float) -> bool:
-    return bool(values.std() <= negligible * abs(values.mean()))
+    # No batch has no spread to test: a budget that ends before the first batch must not warn on NumPy's empty mean.
+    return values.size == 0 or bool(values.std() <= negligible * abs(values.mean()))
 
 
 def uncorrelated_grouping(series: Sequence[np.ndarray], least: int, negligible: float = 0.0) -> Grouping:
