@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import shakermill as sm
+from shakermill.analysis.impacts import contacts_of
 from shakermill.analysis.stress_energy import stress_spectrum
 
 # Five impacts of the 'dem' engine over 2 s: on the side, between balls, on an end face.
@@ -24,7 +25,7 @@ DEM_IMPACTS = {
 
 
 def test_the_spectrum_of_five_impacts_counted_by_hand():
-    spectrum = stress_spectrum(DEM_IMPACTS, 2.0, (0.01, 0.005))
+    spectrum = stress_spectrum(contacts_of(DEM_IMPACTS), 2.0, (0.01, 0.005))
     # Totals sorted: 0.1, 1, 7, 10, 20 mJ; the median is the third, the 90th percentile 10 + 0.6·(20 − 10) mJ.
     assert spectrum.percentile(50) == pytest.approx(7e-3)
     assert spectrum.percentile(90) == pytest.approx(1.6e-2)
@@ -50,7 +51,7 @@ def test_one_ball_on_the_axis_stresses_head_on_and_hits_no_ball():
         "dissipated_energy": np.array([2e-3, 4e-3]),
         "duration": np.full(2, 5e-5),
     }
-    summary = stress_spectrum(impacts, 1.0).as_summary()
+    summary = stress_spectrum(contacts_of(impacts), 1.0).as_summary()
     assert summary.stress_energy_normal_median_J == summary.stress_energy_median_J == pytest.approx(3e-3)
     assert summary.stress_energy_tangential_p90_J == 0.0
     assert math.isnan(summary.stress_energy_ball_median_J)
@@ -74,7 +75,7 @@ def test_a_lasting_contact_is_no_stress_event_but_the_power_of_steady_grinding()
             )
         },
     }
-    with_lasting, without = stress_spectrum(impacts, 2.0), stress_spectrum(DEM_IMPACTS, 2.0)
+    with_lasting, without = stress_spectrum(contacts_of(impacts), 2.0), stress_spectrum(contacts_of(DEM_IMPACTS), 2.0)
     assert with_lasting.percentile(90) == without.percentile(90)
     assert with_lasting.power() == without.power()
     summary = with_lasting.as_summary()
@@ -82,12 +83,14 @@ def test_a_lasting_contact_is_no_stress_event_but_the_power_of_steady_grinding()
     assert summary.stress_lasting_contacts_hz == pytest.approx(0.5)
     # Given all the contacts dissipated (a contact still running is in no record), the lasting contacts have the rest:
     # 0.4 W less the impacts' 38.1 mJ over 2 s.
-    assert stress_spectrum(impacts, 2.0, dissipated_power=0.4).lasting_power() == pytest.approx(0.4 - 0.01905)
+    assert stress_spectrum(contacts_of(impacts), 2.0, dissipated_power=0.4).lasting_power() == pytest.approx(
+        0.4 - 0.01905
+    )
 
 
 def test_no_impacts_give_no_energies_and_no_power():
     empty = {name: values[:0] for name, values in DEM_IMPACTS.items()}
-    spectrum = stress_spectrum(empty, 5.0, (1e-3,))
+    spectrum = stress_spectrum(contacts_of(empty), 5.0, (1e-3,))
     assert math.isnan(spectrum.percentile(50))
     assert spectrum.power(1e-3) == 0.0
 
@@ -98,7 +101,7 @@ def test_the_stress_power_of_a_run_is_the_power_its_impacts_dissipate():
     of the lasting contacts (none here: the ball flies from end to end) is the summary's dissipated power (but for the
     impact still running at the end)."""
     result = sm.simulate(sm.default_parameters(duration=30.0))
-    spectrum = stress_spectrum(result.impact_columns, result.t_end)
+    spectrum = stress_spectrum(result.contacts(), result.t_end)
     assert spectrum.lasting_power() == 0.0
     assert result.summary.stress_lasting_power_W == pytest.approx(0.0, abs=1e-3 * result.summary.dissipated_power_W)
     assert spectrum.power() == pytest.approx(result.summary.dissipated_power_W, rel=1e-3)
@@ -112,7 +115,7 @@ def test_distinct_thresholds_get_distinct_summary_keys():
     assert threshold_name(1e-3) == "0.001J" and threshold_name(1e-2) == "0.01J" and threshold_name(1000.0) == "1000J"
     assert threshold_name(0.0010000001) == "0.0010000001J" != threshold_name(0.001)
     spectrum = stress_spectrum(
-        {"dissipated_energy": np.array([2e-3]), "duration": np.array([1e-5])}, 1.0, (0.001, 0.0010000001)
+        contacts_of({"dissipated_energy": np.array([2e-3]), "duration": np.array([1e-5])}), 1.0, (0.001, 0.0010000001)
     )
     assert list(spectrum.as_summary().stress_events_above_hz) == ["0.001J", "0.0010000001J"]
 
@@ -137,7 +140,7 @@ def test_kwades_stress_energy_is_the_pairs_relative_kinetic_energy_at_first_touc
         "duration": np.full(3, 1e-4),
     }
     np.testing.assert_allclose(collision_energy(impacts, (1.0, 3.0)), [1.5, 2.0, 1.5], rtol=1e-15)
-    summary = stress_spectrum(impacts, 1.0, masses=(1.0, 3.0), dissipated_power=2.0).as_summary()
+    summary = stress_spectrum(contacts_of(impacts), 1.0, masses=(1.0, 3.0), dissipated_power=2.0).as_summary()
     assert summary.stress_energy_kinetic_median_J == pytest.approx(1.5)
     # One ball on the axis (the 1-D engine's columns have no ball index): its own mass.
     np.testing.assert_allclose(collision_energy({"impact_speed": np.array([3.0])}, (0.5,)), [2.25])
@@ -158,6 +161,6 @@ def test_a_head_on_impact_dissipates_one_minus_e_squared_of_kwades_stress_energy
         "dissipated_energy": np.array([outcome.dissipated_J]),
         "duration": np.array([outcome.contact_time_s]),
     }
-    kinetic = stress_spectrum(impacts, 1.0, masses=params.ball_masses()).percentile(50, "kinetic")
+    kinetic = stress_spectrum(contacts_of(impacts), 1.0, masses=params.ball_masses()).percentile(50, "kinetic")
     assert kinetic == pytest.approx(0.5 * params.ball_mass * 2.0**2, rel=1e-12)
     assert outcome.dissipated_J == pytest.approx((1 - outcome.normal_restitution**2) * kinetic, rel=1e-3)

@@ -249,8 +249,8 @@ class ToyEngine(CoreToy, Averaging):
             self.heat_power / self.params.eta * self.clock,
         )
 
-    def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
-        count = len(impacts["time"])
+    def node_hits(self, impacts: Mapping[str, np.ndarray], weights: np.ndarray | None = None) -> np.ndarray:
+        count = len(impacts["time"]) if weights is None else float(np.sum(weights))
         return np.array([count, count, 0])
 
     def averaged_history(

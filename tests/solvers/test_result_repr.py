@@ -17,7 +17,8 @@ def test_a_results_repr_says_what_ran_its_headlines_and_the_sizes_of_its_data_in
         f"ball °C {result.summary.ball_C:.4g}" in lines[2] and f"heat W {result.summary.heat_power_W:.4g}" in lines[2]
     )
     assert (
-        f"{result.history.times.size} samples of {len(result.history.variables)} series, {len(result.impacts)} impacts"
+        f"{result.history.times.size} samples of {len(result.history.variables)} series, {len(result.impacts)} "
+        "contact records"
     ) in lines[3]
     assert str(result) == text
 

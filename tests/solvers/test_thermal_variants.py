@@ -67,13 +67,19 @@ def test_a_dem_calibration_frees_only_thermal_keys(base):
 
 
 @pytest.mark.slow
-def test_hits_leave_out_contacts_slower_than_the_hit_speed(base):
+def test_hits_are_the_impacts_at_or_above_the_hit_speed_among_contacts_whose_chatter_is_merged(base):
+    """MODEL.md §14.4: the records' chatter merged, touches (slower than touch_speed, 0.1 m/s = HIT_SPEED) left out."""
     result = sm.simulate(base.replace(solver="full", duration=2.0))
-    speeds = np.asarray(result.impact_columns["impact_speed"])
+    contacts = result.contacts()
+    speeds = np.asarray(contacts.columns["impact_speed"])
     hits = speeds[speeds >= HIT_SPEED]
-    assert 0 < hits.size < speeds.size  # resting balls chatter; flying ones hit
-    assert result.summary.impacts.hit_rate_hz == pytest.approx(hits.size / 2.0)
-    assert result.summary.impacts.mean_hit_speed_m_s == pytest.approx(hits.mean())
+    assert 0 < hits.size < speeds.size  # resting balls touch; flying ones hit
+    assert contacts.record_count == result.impact_columns["time"].size > speeds.size  # chatter merged
+    impacts = result.summary.impacts
+    assert impacts.hit_rate_hz == pytest.approx(hits.size / 2.0) == impacts.rate_hz
+    assert impacts.mean_hit_speed_m_s == pytest.approx(hits.mean())
     fast = speeds[speeds >= FAST_IMPACT_SPEED]
     assert 0 < fast.size < hits.size
-    assert result.summary.impacts.fast_rate_hz == pytest.approx(fast.size / 2.0)
+    assert impacts.fast_rate_hz == pytest.approx(fast.size / 2.0)
+    assert impacts.touches_hz == pytest.approx((speeds.size - hits.size) / 2.0)
+    assert impacts.records_hz == pytest.approx(contacts.record_count / 2.0)

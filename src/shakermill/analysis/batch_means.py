@@ -90,8 +90,9 @@ def significant_autocorrelation(r1: float, groups: int) -> bool:
 
 @dataclass(frozen=True)
 class Grouping:
-    """Batches a group, the groups pooled, the largest |lag-1 autocorrelation| of the checked columns' group
-    means, and whether it is insignificant with at least the fewest groups asked for."""
+    """Batches a group, the groups pooled, the largest |lag-1 autocorrelation| of every column's group means as
+    measured (reported as it is, also where a column's spread is too small to matter), and whether those whose spread
+    matters are uncorrelated with at least the fewest groups asked for."""
 
     size: int
     groups: int
@@ -117,8 +118,11 @@ def uncorrelated_grouping(series: Sequence[np.ndarray], least: int, negligible: 
         count = sum(len(part) for part in groups)
         if count < least and found is not None:
             return found
-        r1 = max((abs(lag1_autocorrelation([part[:, column] for part in groups])) for column in tested), default=0.0)
-        found = Grouping(size, count, r1, count >= least and not significant_autocorrelation(r1, count))
+        r1 = [abs(lag1_autocorrelation([part[:, column] for part in groups])) for column in range(pooled.shape[1])]
+        decisive = max((r1[column] for column in tested), default=0.0)
+        found = Grouping(
+            size, count, max(r1, default=0.0), count >= least and not significant_autocorrelation(decisive, count)
+        )
         if found.uncorrelated or count < least:
             return found
         size *= 2

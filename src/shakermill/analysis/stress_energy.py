@@ -2,7 +2,8 @@
 compare between mills rather than one mean speed (Kwade's stress energy and stress number; Burmeister & Kwade,
 Chem. Soc. Rev. 42 (2013) 7660).
 
-A stress event is one impact of a ball on a wall or on another ball: one row of an engine's impact records. Its
+A stress event is one impact of a ball on a wall or on another ball: one of a run's impacts as MODEL.md §14.4 defines
+them (analysis/impacts.py: a contact's chatter merged, touches left out), not one row of its contact records. Its
 stress energy is the energy the contact dissipated over that impact (J), the DEM practice the review describes for
 the energy available to stress the powder caught between the surfaces. It has a normal part, from the damping of
 the normal force, and a tangential part, from tangential damping, sliding and rolling resistance (MODEL.md §12.4);
@@ -15,10 +16,15 @@ Kwade 2013; read as the review summarises it, not re-derived from its sources). 
 an impact brings, of which the dissipated energy is the part the contact turned into heat (1 − e² of it, head-on).
 
 A contact that lasts (a ball rolling or sliding on the wall under a planetary jar's centrifugal load for a good part
-of a second) is recorded as one row too, with all it dissipated while it lasted, and only once it ends: it is no
-stress event but a steady grinding, and it would put joules into the spectrum's tail. A record longer than
-:data:`LASTING_CONTACT_S` is left out of the spectrum, and the power of the lasting contacts is the run's dissipated
-power less that of its impacts, so that a contact still running when the records end counts too.
+of a second) is recorded too, with all it dissipated while it lasted, and only once it ends: it is no stress event but
+a steady grinding, and it would put joules into the spectrum's tail. A contact longer than
+:data:`~shakermill.analysis.impacts.LASTING_CONTACT_S` is left out of the spectrum, and the power of the lasting
+contacts is the run's dissipated power less that of its impacts and touches, so that a contact still running when the
+records end counts too.
+
+Beside the percentiles by count, the energy-weighted ones: the stress energy below which impacts carrying half (90 %)
+of the impacts' energy lie. Many small impacts pull the median by count down; the weighted median says which impacts
+bring the energy.
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from pydantic import Field
 
+from shakermill.analysis.impacts import Contacts
 from shakermill.analysis.sections import Joules, Key, PerSecond, Seconds, Section, Watts
 
 # The energy dissipated per impact (total, its normal and tangential parts) and Kwade's stress energy ½·m*·v_n².
@@ -40,9 +47,6 @@ COMPONENTS = ("total", "normal", "tangential", "kinetic")
 TARGETS = ("all", "wall", "ball")
 # The percentiles of the stress energies the summary reports.
 MEDIAN, P90 = 50.0, 90.0
-# A Hertz impact of steel balls of 5-40 mm lasts 20-600 µs from 10 m/s down to 1 mm/s (its duration grows as R·v^-1/5):
-# a contact of more than a millisecond rolls, slides or rests.
-LASTING_CONTACT_S = 1e-3
 # The 'dem' engine's channels that make up the tangential part (engines/dem/model.py, TOTAL_NAMES).
 TANGENTIAL_CHANNELS = ("dissipated_tangential", "dissipated_sliding", "dissipated_rolling")
 
@@ -69,6 +73,10 @@ class StressSection(Section):
     """Median stress energy of the impacts (the energy each dissipated); NaN without impacts."""
     stress_energy_p90_J: Joules
     """90th percentile of the impacts' stress energy."""
+    stress_energy_weighted_median_J: Joules
+    """Energy-weighted median: the impacts below this stress energy carry half of the impacts' energy."""
+    stress_energy_weighted_p90_J: Joules
+    """Energy-weighted 90th percentile: the impacts below it carry 90 % of the impacts' energy."""
     stress_energy_normal_median_J: Joules
     """Median of the normal part (damping of the normal force)."""
     stress_energy_normal_p90_J: Joules
@@ -102,29 +110,31 @@ class StressSection(Section):
 
 @dataclass(frozen=True)
 class StressSpectrum:
-    """The stress energies of the contacts recorded over ``window`` seconds: each one's normal, tangential and total
-    energy (J), whether it hit the vial or another ball, and whether it lasted (:data:`LASTING_CONTACT_S`)."""
+    """The stress energies of the contacts over ``window`` seconds: each one's normal, tangential and total energy (J),
+    whether it hit the vial or another ball, whether it lasted, and whether it was a touch (MODEL.md §14.4)."""
 
     energies: Mapping[str, np.ndarray]
     hit_ball: np.ndarray
     lasting: np.ndarray
+    touch: np.ndarray
     window: float
     thresholds: tuple[float, ...] = ()
     dissipated_power: float = math.nan  # W: all the contacts dissipated over the window, recorded or not
 
     def of(self, component: str = "total", target: str = "all") -> np.ndarray:
-        """The stress energies (J) of ``component`` of the impacts (the contacts that did not last) on ``target``
-        (:data:`COMPONENTS`, :data:`TARGETS`)."""
-        chosen = ~self.lasting
+        """The stress energies (J) of ``component`` of the impacts (the contacts that were no touch and did not last) on
+        ``target`` (:data:`COMPONENTS`, :data:`TARGETS`)."""
+        chosen = ~self.lasting & ~self.touch
         if target != "all":
             chosen &= self.hit_ball if target == "ball" else ~self.hit_ball
         return self.energies[component][chosen]
 
     def lasting_power(self) -> float:
         """The energy per second (W) the lasting contacts dissipated, rolling, sliding and resting under load: the
-        dissipated power less the impacts' (those recorded, without a dissipated power)."""
+        dissipated power less the impacts' and the touches' (those recorded, without a dissipated power)."""
         if math.isfinite(self.dissipated_power):
-            return self.dissipated_power - self.power()
+            brief = ~self.lasting & self.touch
+            return self.dissipated_power - self.power() - self._per_second(float(self.energies["total"][brief].sum()))
         return self._per_second(float(self.energies["total"][self.lasting].sum()))
 
     def lasting_share(self) -> float:
@@ -146,6 +156,15 @@ class StressSpectrum:
         energies = self.of(component, target)
         return float(np.percentile(energies, q)) if energies.size else math.nan
 
+    def weighted_percentile(self, q: float, component: str = "total") -> float:
+        """The stress energy (J) below which the impacts carry ``q`` % of the impacts' energy of ``component``; NaN
+        without impacts or energy."""
+        energies = np.sort(self.of(component))
+        carried = np.cumsum(energies)
+        if not energies.size or carried[-1] <= 0:
+            return math.nan
+        return float(energies[np.searchsorted(carried, q / 100.0 * carried[-1])])
+
     def events_per_second(self, above: float = 0.0, component: str = "total", target: str = "all") -> float:
         """Stress events per second (1/s) of at least ``above`` J: Kwade's stress frequency above an energy."""
         return self._per_second(float(np.count_nonzero(self.of(component, target) >= above)))
@@ -165,6 +184,8 @@ class StressSpectrum:
             stress_lasting_contacts_hz=self.lasting_per_second(),
             stress_energy_median_J=self.percentile(MEDIAN),
             stress_energy_p90_J=self.percentile(P90),
+            stress_energy_weighted_median_J=self.weighted_percentile(MEDIAN),
+            stress_energy_weighted_p90_J=self.weighted_percentile(P90),
             stress_energy_normal_median_J=self.percentile(MEDIAN, "normal"),
             stress_energy_normal_p90_J=self.percentile(P90, "normal"),
             stress_energy_tangential_median_J=self.percentile(MEDIAN, "tangential"),
@@ -195,27 +216,33 @@ def collision_energy(impacts: Mapping[str, ArrayLike], masses: Sequence[float]) 
 
 
 def stress_spectrum(
-    impacts: Mapping[str, ArrayLike],
+    contacts: Contacts,
     window: float,
     thresholds: Sequence[float] = (),
     dissipated_power: float = math.nan,
     masses: Sequence[float] | None = None,
 ) -> StressSpectrum:
-    """The spectrum of the impact records ``impacts`` (an engine's impact columns) resolved over ``window`` s, in
-    which the contacts dissipated ``dissipated_power`` (W) in all; with the balls' ``masses`` (kg) also Kwade's stress
-    energy of each impact (:func:`collision_energy`; NaN without them)."""
-    total = np.asarray(impacts["dissipated_energy"], dtype=float)
-    if "dissipated_normal" in impacts:
-        normal = np.asarray(impacts["dissipated_normal"], dtype=float)
+    """The spectrum of a run's ``contacts`` (analysis/impacts.py) over ``window`` s, in which they dissipated
+    ``dissipated_power`` (W) in all; with the balls' ``masses`` (kg) also Kwade's stress energy of each impact
+    (:func:`collision_energy`; NaN without them)."""
+    columns = contacts.columns
+    total = np.asarray(columns["dissipated_energy"], dtype=float)
+    if "dissipated_normal" in columns:
+        normal = np.asarray(columns["dissipated_normal"], dtype=float)
         tangential = sum(
-            (np.asarray(impacts[channel], dtype=float) for channel in TANGENTIAL_CHANNELS), np.zeros_like(total)
+            (np.asarray(columns[channel], dtype=float) for channel in TANGENTIAL_CHANNELS), np.zeros_like(total)
         )
     else:
         normal, tangential = total, np.zeros_like(total)
-    hit_ball = np.asarray(impacts["target"]) == "ball" if "target" in impacts else np.zeros(total.size, dtype=bool)
-    lasting = np.asarray(impacts["duration"], dtype=float) > LASTING_CONTACT_S
-    kinetic = collision_energy(impacts, masses) if masses is not None else np.full(total.size, math.nan)
+    hit_ball = np.asarray(columns["target"]) == "ball" if "target" in columns else np.zeros(total.size, dtype=bool)
+    kinetic = collision_energy(columns, masses) if masses is not None else np.full(total.size, math.nan)
     energies = {"total": total, "normal": normal, "tangential": tangential, "kinetic": kinetic}
     return StressSpectrum(
-        energies, hit_ball, lasting, float(window), tuple(sorted(thresholds)), float(dissipated_power)
+        energies,
+        hit_ball,
+        contacts.lasting,
+        contacts.touch,
+        float(window),
+        tuple(sorted(thresholds)),
+        float(dissipated_power),
     )

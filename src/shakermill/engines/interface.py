@@ -166,8 +166,9 @@ class Averaging(Protocol):
     def measured(self) -> Measured:
         """The cumulative quantities the averaged solver averages (:class:`Measured`)."""
 
-    def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
-        """How many of ``impacts`` heated each node of the network."""
+    def node_hits(self, impacts: Mapping[str, np.ndarray], weights: np.ndarray | None = None) -> np.ndarray:
+        """How many of ``impacts`` heated each node of the network, or the sum of their ``weights`` (one value per
+        impact: its duration, for the time a node spends being heated)."""
 
     def averaged_history(
         self,

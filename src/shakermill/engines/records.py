@@ -25,6 +25,9 @@ BALL_TEMPERATURES = "theta_balls"
 # that names the nodes in order (comma-separated): a run's files carry its network's nodes, whatever they are.
 HEAT_INTO_NODES = "heat_into_nodes"
 NODE_NAMES = "node_names"
+# The contact records' column of each pair's Hertz duration at 1 m/s, where an engine records one: what tells a
+# contact's chatter from a new impact (analysis/impacts.py, MODEL.md §14.4).
+HERTZ_SCALE = "hertz_duration_1m_s"
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,7 @@ from shakermill.parameters.groups import (
     Stroke,
     Vial,
     VialWall,
+    WhatAnImpactIs,
     default_of,
     keys_of,
     keys_of_role,
@@ -143,6 +144,7 @@ _DEM_READS = reads_of(
     DemStepping,
     EnduringContacts,
     DemAveraging,
+    WhatAnImpactIs,
     roles=(NETWORK_NODE, CONTACT_COATING),
     kinematics=KINEMATIC_MODELS,
 )

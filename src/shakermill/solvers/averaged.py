@@ -29,6 +29,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from shakermill.analysis.fit import fit_exponential
+from shakermill.analysis.impacts import contacts_of
 from shakermill.engines.budget import RunBudget, hours_or_minutes
 from shakermill.engines.interface import (
     AveragedEngine,
@@ -54,6 +55,7 @@ from shakermill.solvers.result import (
     Result,
     RunOutput,
     conclude,
+    counting_rules,
     summarize,
 )
 
@@ -279,19 +281,24 @@ def _averaged_result(
 
 def time_scale_problem(engine: AveragedEngine, network: ThermalNetwork, means: Means) -> str | None:
     """Why averaging is not valid, or None: every heated node's thermal time constant must exceed the time between
-    the impacts that heat it by TIME_SCALE_SEPARATION, or its temperature follows single impacts. The air, heated
-    only by convection, is smooth between impacts, and its linear response to the fluctuating convection
-    averages exactly."""
+    the contacts that heat it by TIME_SCALE_SEPARATION, or its temperature follows single impacts. That time is the
+    window less the time the node spends in contact, over its contacts (MODEL.md §14.4: chatter merged): a ball that
+    rolls on the wall is heated all along, not by rare impacts. The air, heated only by convection, is smooth
+    between impacts, and its linear response to the fluctuating convection averages exactly."""
     window = means.averages.window
-    hits = engine.node_hits(engine.impact_columns(since=means.averages.transient))
+    contacts = contacts_of(engine.impact_columns(since=means.averages.transient), *counting_rules(engine.params))
+    hits = engine.node_hits(contacts.columns)
+    durations = contacts.columns.get("duration")
+    touching = np.zeros(hits.size) if durations is None else engine.node_hits(contacts.columns, durations)
     conductances = network.node_conductances(means.load.drives)
     for node, count in enumerate(hits):
         capacity = network.nodes[node].capacity
         constant = capacity / conductances[node] if conductances[node] > 0 else math.inf
-        if count and constant < TIME_SCALE_SEPARATION * window / count:
+        between = max(window - touching[node], 0.0) / count if count else 0.0
+        if count and constant < TIME_SCALE_SEPARATION * between:
             return (
                 f"the {network.nodes[node].name}'s thermal time constant ({constant:.3g} s) is not well separated from "
-                f"the time between the impacts that heat it ({window / count:.3g} s): its temperature follows single "
+                f"the time between the contacts that heat it ({between:.3g} s): its temperature follows single "
                 "impacts"
             )
     return None

@@ -14,10 +14,11 @@ import numpy as np
 
 from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
+from shakermill.analysis.impacts import Contacts, contacts_of
 from shakermill.analysis.regime import charge_regime
 from shakermill.analysis.sections import further_nodes
-from shakermill.analysis.steady import SteadyState, fits_no_exponential, run_length_note, steady_state
-from shakermill.analysis.stress_energy import StressSpectrum, stress_spectrum
+from shakermill.analysis.steady import SteadyState, fits_no_exponential, run_length_note, settled_rates, steady_state
+from shakermill.analysis.stress_energy import stress_spectrum
 from shakermill.engines.interface import EngineDescription
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
@@ -147,7 +148,25 @@ class RunOutput:
 
     @property
     def impact_count(self) -> int:
-        return int(self.impact_columns["time"].size)
+        """The impacts among the contact records (MODEL.md §14.4: chatter merged, touches left out)."""
+        return self.contacts().impact_count
+
+    def contacts(self, since: float = -math.inf) -> Contacts:
+        """The contacts of the records that began at ``since`` (s) or later, by the rules of the run's engine
+        (:func:`counting_rules`)."""
+        records = self.impact_columns
+        if since > -math.inf:
+            chosen = records["time"] >= since
+            records = {name: values[chosen] for name, values in records.items()}
+        return contacts_of(records, *counting_rules(self.params))
+
+
+def counting_rules(params: Parameters) -> tuple[float, float]:
+    """The touch speed (m/s) and chatter factor its engine counts impacts by (MODEL.md §14.4); 0 and 0, which count
+    every record, for an engine that reads neither (the 1-D engine's ball bounces between two walls)."""
+    if "touch_speed" not in params.engine_keys.reads:
+        return 0.0, 0.0
+    return params.touch_speed, params.chatter_factor
 
 
 @dataclass(repr=False, kw_only=True)
@@ -186,8 +205,8 @@ class Result(RunOutput):
             f"{self.wall_time:.3g} s>",
             f"  {self.message if len(self.message) <= REPR_MESSAGE else self.message[: REPR_MESSAGE - 1] + '…'}",
             f"  {', '.join(shown)}",
-            f"  data: {self.history.times.size} samples of {len(self.history.variables)} series, {impacts} impacts, "
-            f"{self.window_history.times.size} window samples, {len(summary)} summary keys",
+            f"  data: {self.history.times.size} samples of {len(self.history.variables)} series, {impacts} contact "
+            f"records, {self.window_history.times.size} window samples, {len(summary)} summary keys",
             *(
                 [f"  {len(self.warnings)} warning{'s' if len(self.warnings) != 1 else ''} (.warnings)"]
                 if self.warnings
@@ -217,7 +236,8 @@ class Result(RunOutput):
 
     @cached_property
     def impacts(self) -> pd.DataFrame:
-        """One row per impact, SI units (its engine's ``description.impact_units``)."""
+        """One row per contact record, SI units (its engine's ``description.impact_units``): every contact, chatter
+        and touches included; :meth:`contacts` tells the impacts among them (MODEL.md §14.4)."""
         import pandas as pd
 
         return pd.DataFrame(self.impact_columns)
@@ -425,10 +445,11 @@ def summarize(result: Result) -> Summary:
     duration = max(result.t_end, 1e-300)
     impact_window = result.impact_window if result.impact_window else duration
     dissipated_power = result.energy.dissipated / duration
+    contacts = result.contacts()
     spectrum = stress_spectrum(
-        result.impact_columns, impact_window, params.stress_energy_thresholds, dissipated_power, params.ball_masses()
+        contacts, impact_window, params.stress_energy_thresholds, dissipated_power, params.ball_masses()
     )
-    impacts = impacts_section(result, impact_window)
+    impacts = impacts_section(result, contacts, impact_window)
     several = result.description.several_balls
     return Summary.compose(
         outcome=Outcome(
@@ -443,7 +464,7 @@ def summarize(result: Result) -> Summary:
         steady=result.steady.as_summary(each_ball=several),
         impacts=impacts,
         heat=heat_section(result, dissipated_power),
-        charge=charge_section(result, spectrum, impacts.fast_rate_hz) if several else None,
+        charge=charge_section(result, settled_regime(result, dissipated_power)) if several else None,
         numerics=numerics_section(result),
         inputs=understood_inputs(params),
         stress=spectrum.as_summary(),
@@ -492,45 +513,39 @@ def _hottest(temperatures: np.ndarray) -> float:
     return kelvin_to_celsius(float(np.nanmax(temperatures))) if temperatures.size else math.nan
 
 
-def impacts_section(result: RunOutput, window: float) -> Impacts:
+def impacts_section(result: RunOutput, contacts: Contacts, window: float) -> Impacts:
     """The impacts of the table, which covers ``window`` seconds (the whole run, or the averaging window): their
-    count over the whole run, rates, speeds, energy, and by kind with several balls."""
-    impacts = result.impact_columns
-    count = result.impact_count
+    count over the whole run, rates, speeds, energy, and by kind with several balls; and the contact records and
+    touches beside them (MODEL.md §14.4)."""
+    impacts = contacts.impacts
+    count = contacts.impact_count
     duration = max(result.t_end, 1e-300)
-    rate = count / window if window > 0 else math.nan
-    hit_rate, mean_hit_speed, fast_rate = _hits(impacts["impact_speed"], window)
+    scale = duration / window if window > 0 else math.nan
+    speeds = impacts["impact_speed"]
+    hits = speeds[speeds >= HIT_SPEED]
     on_walls = between_balls = None
     description = result.description
     if description.several_balls:
-        scale = duration / window if window > 0 else math.nan
         wall = int(np.sum(impacts[description.impact_target] != "ball"))
         on_walls, between_balls = int(round(wall * scale)), int(round((count - wall) * scale))
     return Impacts(
-        count=count if result.impact_window is None else int(round(rate * duration)),
-        rate_hz=rate,
-        hit_rate_hz=hit_rate,
-        mean_hit_speed_m_s=mean_hit_speed,
-        fast_rate_hz=fast_rate,
-        mean_speed_m_s=float(impacts["impact_speed"].mean()) if count else math.nan,
-        max_speed_m_s=float(impacts["impact_speed"].max()) if count else math.nan,
+        count=count if result.impact_window is None else int(round(count * scale)),
+        rate_hz=_per_second(count, window),
+        hit_rate_hz=_per_second(hits.size, window),
+        mean_hit_speed_m_s=float(hits.mean()) if hits.size else math.nan,
+        fast_rate_hz=_per_second(int(np.count_nonzero(speeds >= FAST_IMPACT_SPEED)), window),
+        mean_speed_m_s=float(speeds.mean()) if count else math.nan,
+        max_speed_m_s=float(speeds.max()) if count else math.nan,
         mean_dissipated_J=float(impacts["dissipated_energy"].mean()) if count else math.nan,
         on_walls=on_walls,
         between_balls=between_balls,
+        records_hz=_per_second(contacts.record_count, window),
+        touches_hz=_per_second(contacts.touch_count, window),
     )
 
 
-def _hits(speeds: np.ndarray, window: float) -> tuple[float, float, float]:
-    """Hits (impacts at or above HIT_SPEED) per second, their mean speed, and impacts at or above FAST_IMPACT_SPEED
-    per second."""
-    speeds = np.asarray(speeds)
-    hits = speeds[speeds >= HIT_SPEED]
-    fast = np.count_nonzero(speeds >= FAST_IMPACT_SPEED)
-    return (
-        hits.size / window if window > 0 else math.nan,
-        float(hits.mean()) if hits.size else math.nan,
-        fast / window if window > 0 else math.nan,
-    )
+def _per_second(count: int, window: float) -> float:
+    return count / window if window > 0 else math.nan
 
 
 def heat_section(result: Result, dissipated_power: float) -> Heat:
@@ -553,19 +568,49 @@ def heat_section(result: Result, dissipated_power: float) -> Heat:
     )
 
 
-def charge_section(result: RunOutput, spectrum: StressSpectrum, fast_rate: float) -> Charge:
-    """The balls of an engine that moves several: how many, how full the vial, the work of gravity and of the
-    stiffening springs, and the regime of the charge where the share of lasting contacts is known."""
+@dataclass(frozen=True)
+class SettledRegime:
+    """The regime of a charge's settled motion and its measures (MODEL.md §14.2), over the window from ``start`` (s)
+    to the end: the second half of a full run, the averaging window of an averaged one."""
+
+    start: float
+    lasting_share: float
+    fast_impact_rate: float
+    name: str | None
+
+
+def settled_regime(result: RunOutput, dissipated_power: float) -> SettledRegime:
+    """The regime of ``result``'s settled motion, named from the impacts and the dissipation of that window alone,
+    never the start-up's (MODEL.md §14.4); a full run's dissipated power over its window from its cumulative series."""
+    if result.impact_window is None or result.averages is None:
+        start = window = 0.5 * result.t_end
+        dissipated_power = float(np.sum(settled_rates(result.history.times, result.history["dissipated"])))
+        contacts = result.contacts(since=start)
+    else:
+        # The averaged solver's records begin with its window.
+        start, window, contacts = result.averages.transient, result.impact_window, result.contacts()
+    share = stress_spectrum(contacts, window, dissipated_power=dissipated_power).lasting_share()
+    fast = _per_second(int(np.count_nonzero(contacts.impacts["impact_speed"] >= FAST_IMPACT_SPEED)), window)
     params = result.params
-    share = spectrum.lasting_share()
-    frequency = params.omega / (2.0 * math.pi)
+    name = charge_regime(share, fast, params.n_balls, params.frequency) if math.isfinite(share) else None
+    return SettledRegime(start, share, fast, name)
+
+
+def charge_section(result: RunOutput, regime: SettledRegime) -> Charge:
+    """The balls of an engine that moves several: how many, how full the vial, the work of gravity and of the
+    stiffening springs, and the regime of the charge's settled motion where the share of lasting contacts is
+    known."""
+    params = result.params
     return Charge(
         engine=result.description.name,
         n_balls=params.n_balls,
         fill_fraction=params.fill_fraction,
         work_gravity_J=result.energy.work_by_gravity,
         work_stiffening_J=result.energy.work_by_stiffening,
-        regime=charge_regime(share, fast_rate, params.n_balls, frequency) if math.isfinite(share) else None,
+        regime=regime.name,
+        regime_from_s=regime.start,
+        regime_lasting_share=regime.lasting_share,
+        regime_fast_impact_rate_hz=regime.fast_impact_rate,
     )
 
 

@@ -5,6 +5,7 @@ into :class:`~shakermill.solvers.summary.Summary`."""
 
 from __future__ import annotations
 
+import math
 from typing import Annotated
 
 from pydantic import Field
@@ -59,14 +60,18 @@ class EndTemperatures(NodeTemperatures):
 
 
 class Impacts(Section):
-    """The impacts of the run (``summary.impacts``): how many, how often, how fast."""
+    """The impacts of the run (``summary.impacts``): how many, how often, how fast. An impact is a contact as MODEL.md
+    §14.4 defines it: a pair's records that part and touch again within ``chatter_factor`` Hertz durations merged
+    into one, and a contact that begins slower than ``touch_speed`` a touch, not an impact ('dem' engine; the 1-D
+    engine's records are its impacts)."""
 
     count: Annotated[int, Key("impacts")]
     """Impacts in the run (the averaged solver: its window's rate times the duration)."""
     rate_hz: Annotated[PerSecond, Key("impact_rate_hz")]
     """Impacts per second, over the impact table's span (the whole run, or the averaging window)."""
     hit_rate_hz: PerSecond
-    """Impacts per second at or above 0.1 m/s (``HIT_SPEED``): the hits that count, without the chatter."""
+    """Impacts per second at or above 0.1 m/s (``HIT_SPEED``); the impact rate itself at the default
+    ``touch_speed``."""
     mean_hit_speed_m_s: MetresPerSecond
     """Mean speed of those hits; NaN without any."""
     fast_rate_hz: Annotated[PerSecond, Key("fast_impact_rate_hz")]
@@ -81,6 +86,10 @@ class Impacts(Section):
     """Impacts on the vial's walls in the run (an engine of several balls)."""
     between_balls: Annotated[int | None, Key("ball_ball_impacts")] = None
     """Impacts between balls in the run (an engine of several balls)."""
+    records_hz: Annotated[PerSecond, Key("contact_records_hz")] = math.nan
+    """Contact records per second, every touch and chatter included: what the records hold, not impacts."""
+    touches_hz: Annotated[PerSecond, Key("touch_rate_hz")] = math.nan
+    """Touches per second: contacts that began slower than ``touch_speed``."""
 
 
 class Heat(Section):
@@ -116,8 +125,15 @@ class Charge(Section):
     work_stiffening_J: Joules
     """Energy the tangential springs gained by stiffening with the load (``work_by_stiffening``)."""
     regime: Annotated[str | None, Key("charge_regime")] = None
-    """``pack`` (lasting contacts, under one impact above 1 m/s per ball and turn) or ``active`` (MODEL.md §14.2);
-    None where the share of lasting contacts is not known."""
+    """The regime of the settled motion (MODEL.md §14.2), from ``charge_regime_from_s`` to the end, never the start-up:
+    ``pack`` (lasting contacts take at least half the dissipation, and fewer than one impact above 1 m/s per ball and
+    turn) or ``active`` (the rest); None where the share of lasting contacts is not known."""
+    regime_from_s: Annotated[Seconds, Key("charge_regime_from_s")] = math.nan
+    """Where the window the regime is named from begins (s): the second half of a full run, the averaging window."""
+    regime_lasting_share: Annotated[float, Key("charge_regime_lasting_share")] = math.nan
+    """The share of that window's dissipation in contacts lasting over 1 ms."""
+    regime_fast_impact_rate_hz: Annotated[PerSecond, Key("charge_regime_fast_impact_rate_hz")] = math.nan
+    """That window's impacts per second at or above 1 m/s."""
 
 
 class Numerics(Section):
@@ -184,7 +200,8 @@ class Averaging(Section):
     batch_s: Annotated[Seconds, Key("averaging_batch_s")]
     """Length of a batch after grouping to uncorrelated means."""
     batch_autocorrelation: Annotated[float, Key("averaging_batch_autocorrelation")]
-    """The largest |lag-1 autocorrelation| of the batches' heat and velocity term."""
+    """The largest |lag-1 autocorrelation| of the batches used (after grouping) in their total heat and mean velocity
+    term, as measured: also where a spread within the target error spares a column the test."""
     transient_heat_power_W: Annotated[Watts, Key("averaging_transient_heat_power_W")]
     """Mean heat power of the transient cut."""
     converged: Annotated[bool, Key("averaging_converged")]

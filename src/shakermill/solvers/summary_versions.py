@@ -7,7 +7,10 @@ Version 1 has no ``"schema_version"`` (shakermill up to issue 39); it is read wh
 (``exponential_fit_describes_run`` true, as the readers of version 1 assumed) and keys since removed are dropped; a
 document that still does not fit is refused in one line (:class:`SummaryVersionError`). Version 2 (issue 39): the
 flat keys of the schema, with ``"schema_version": 2``. Version 3 (issue 48): the same flat keys, each now the field of
-a typed section that the code computing it builds; a version-2 document is read as it is.
+a typed section that the code computing it builds; a version-2 document is read as it is. Version 4 (issue 50): impacts
+as MODEL.md §14.4 defines them, with the contact records and touches beside them, the energy-weighted stress
+percentiles and the settled regime's window and measures; a version-3 document's impacts were its records, and the keys
+it lacks are NaN.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from shakermill.analysis.sections import RENAMED_NODES
 from shakermill.solvers.summary import Summary, SummaryKeyError, declared, holds_numbers, summary_keys
 
 # The version ``summary.json`` carries as "schema_version"; a document without one is version 1.
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 VERSION_KEY = "schema_version"
 # What a version-1 summary that lacks them meant: the readers of version 1 showed the fit's rows, and an averaged run
 # had one replica before there were several.
@@ -82,6 +85,12 @@ def _from_version_1(values: Mapping[str, Any]) -> dict[str, Any]:
                 name = name.replace(old, new, 1)
         renamed[name] = value
     kept = {name: value for name, value in renamed.items() if _is_declared(name)}
+    return _added_as_nan(kept)
+
+
+def _added_as_nan(kept: dict[str, Any]) -> dict[str, Any]:
+    """``kept`` with the keys added since its version, those every run has and those of every section it has, set to
+    NaN, or to what version 1 meant (:data:`VERSION_1_MEANT`)."""
     sections = {declared(name).section for name in kept}
     for key in summary_keys():
         due = key.required or (key.section in sections and key.in_every_section)
@@ -99,8 +108,18 @@ def _from_version_2(values: Mapping[str, Any]) -> dict[str, Any]:
     return dict(values)
 
 
+def _from_version_3(values: Mapping[str, Any]) -> dict[str, Any]:
+    """A version-3 summary in version 4's keys: the keys of the impacts as §14.4 defines them, NaN (its impacts were
+    its contact records)."""
+    return _added_as_nan(dict(values))
+
+
 # The step from each version to the next, version 1's first.
-MIGRATIONS: tuple[Callable[[Mapping[str, Any]], dict[str, Any]], ...] = (_from_version_1, _from_version_2)
+MIGRATIONS: tuple[Callable[[Mapping[str, Any]], dict[str, Any]], ...] = (
+    _from_version_1,
+    _from_version_2,
+    _from_version_3,
+)
 
 
 def _is_declared(name: str) -> bool:

@@ -4,6 +4,7 @@ its dissipation channels and its impact columns. Plain data: reading it loads no
 from __future__ import annotations
 
 from shakermill.engines.interface import EngineDescription
+from shakermill.engines.records import HERTZ_SCALE
 from shakermill.engines.status import NOT_FINITE, OVERLAP_TOO_LARGE, REACHED_STOP
 from shakermill.parameters.engine_keys import THREE_DIMENSIONAL
 
@@ -42,6 +43,7 @@ IMPACT_UNITS = {
     "max_overlap": "m",
     "duration": "s",
     "conduction": "J/K",
+    HERTZ_SCALE: "s",
 }
 
 DESCRIPTION = EngineDescription(

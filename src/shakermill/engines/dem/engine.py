@@ -28,6 +28,7 @@ from shakermill.engines.interface import (
 from shakermill.engines.records import (
     BALL_TEMPERATURES,
     HEAT_INTO_NODES,
+    HERTZ_SCALE,
     NODE_NAMES,
     EnergyAudit,
     StateHistory,
@@ -36,6 +37,7 @@ from shakermill.engines.records import (
 )
 from shakermill.engines.thermal.network import NetworkLoad, ThermalNetwork
 from shakermill.parameters.keys import Parameters
+from shakermill.physics import contact
 from shakermill.physics.kinematics import fourier_coordinates
 
 INITIAL_RECORDS = 4096
@@ -190,7 +192,9 @@ class DemEngine(CompiledRun, Averaging, Replicas, StepBound, MemoryBound):
         return times
 
     def impact_columns(self, since: float = -math.inf) -> dict[str, np.ndarray]:
-        return impact_columns(self.records, since)
+        columns = impact_columns(self.records, since)
+        columns[HERTZ_SCALE] = hertz_scales(columns["ball"], columns["other_ball"], columns["target"], self.constants)
+        return columns
 
     def counters(self) -> dict[str, int]:
         counters = {name: int(value) for name, value in zip(stepper.COUNTER_NAMES, self.stepper_counters)}
@@ -264,16 +268,19 @@ class DemEngine(CompiledRun, Averaging, Replicas, StepBound, MemoryBound):
         mean_term = float(terms.mean()) if terms.size else math.nan  # an empty mill has no ball to convect
         return NetworkLoad(heat, terms, float(heat.sum()), mean_term, np.asarray(conductances, dtype=float))
 
-    def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
+    def node_hits(self, impacts: Mapping[str, np.ndarray], weights: np.ndarray | None = None) -> np.ndarray:
         """Each ball's contacts, with the vial or another ball; the vial's; each deposit's node every contact of the
-        kinds it takes a share of; the others none."""
+        kinds it takes a share of; the others none (or the sums of the contacts' ``weights``)."""
         n = self.params.n_balls
-        balls = [int(np.sum(impacts["ball"] == ball) + np.sum(impacts["other_ball"] == ball)) for ball in range(n)]
-        hits = np.zeros(len(self.network.nodes), dtype=np.int64)
-        hits[:n] = balls
-        walls = int(np.sum(impacts["target"] != "ball"))
+        weight = np.ones(len(impacts["target"])) if weights is None else np.asarray(weights, dtype=float)
+        own = np.bincount(impacts["ball"], weight, minlength=n) + np.bincount(
+            impacts["other_ball"][impacts["other_ball"] >= 0], weight[impacts["other_ball"] >= 0], minlength=n
+        )
+        hits = np.zeros(len(self.network.nodes))
+        hits[:n] = own[:n]
+        on_wall = impacts["target"] != "ball"
+        walls, pairs = float(weight[on_wall].sum()), float(weight[~on_wall].sum())
         hits[self.network.vial] = walls
-        pairs = len(impacts["target"]) - walls
         k = self.constants
         for index, node in enumerate(k.deposit_nodes):
             shares = k.deposit_shares[:, :, index]
@@ -352,6 +359,23 @@ def impact_columns(records: np.ndarray, since: float = -np.inf) -> dict[str, np.
         "duration": records[:, column["duration"]],
         "conduction": records[:, column["conduction"]],
     }
+
+
+def hertz_scales(ball: np.ndarray, other: np.ndarray, target: np.ndarray, k: model.Constants) -> np.ndarray:
+    """The Hertz duration at 1 m/s (s) of each contact of ``ball`` with the ball ``other`` (≥ 0) or the wall
+    ``target``: of the pair's m*, R* and E* (MODEL.md §12.3), what tells its chatter from a new impact
+    (analysis/impacts.py)."""
+    on_ball = other >= 0
+    partner = np.where(on_ball, other, ball)
+    youngs, poisson = k.youngs_modulus, k.poisson_ratio
+    compliance = (1 - poisson[ball] ** 2) / youngs[ball] + (1 - poisson[partner] ** 2) / youngs[partner]
+    wall = sum(np.where(target == name, index, 0) for index, name in enumerate(model.WALL_NAMES))
+    mass_i, mass_j, radius_i, radius_j = k.mass[ball], k.mass[partner], k.radius[ball], k.radius[partner]
+    return contact.hertz_duration_at_unit_speed(
+        np.where(on_ball, mass_i * mass_j / (mass_i + mass_j), mass_i),
+        np.where(on_ball, radius_i * radius_j / (radius_i + radius_j), k.wall_radius[ball, wall]),
+        np.where(on_ball, 1.0 / compliance, k.wall_modulus[ball]),
+    )
 
 
 def history_of(

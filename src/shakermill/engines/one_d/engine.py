@@ -223,9 +223,9 @@ class OneDimensionalEngine(Averaging):
         power, term = float(heat_rates[0]), float(term_means[0])
         return NetworkLoad(self.network.wall_contact_heat(power), np.array([term]), power, term)
 
-    def node_hits(self, impacts: Mapping[str, np.ndarray]) -> np.ndarray:
+    def node_hits(self, impacts: Mapping[str, np.ndarray], weights: np.ndarray | None = None) -> np.ndarray:
         """Every impact heats the ball and the vial; the air only by convection."""
-        count = len(impacts["time"])
+        count = len(impacts["time"]) if weights is None else float(np.sum(weights))
         return np.array([count, count, 0])
 
     def averaged_history(

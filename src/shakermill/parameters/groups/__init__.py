@@ -15,7 +15,7 @@ from typing import Any
 
 from shakermill.parameters.groups.balls import Balls, OneBallStart, SeveralBalls
 from shakermill.parameters.groups.contacts import BallPairs, ContactDamping, DemContacts, VialWall
-from shakermill.parameters.groups.dem import DemAveraging, DemStepping, EnduringContacts, LabFrame
+from shakermill.parameters.groups.dem import DemAveraging, DemStepping, EnduringContacts, LabFrame, WhatAnImpactIs
 from shakermill.parameters.groups.geometry import Drive, Stroke, Vial
 from shakermill.parameters.groups.one_d import OneDAveraging, OneDIntegrator
 from shakermill.parameters.groups.paper_network import ContactHeat, HeatSplit, NetworkChoice, PaperNetwork, RoomLoss
@@ -26,6 +26,7 @@ from shakermill.parameters.key_group import KeyGroup
 # The core groups, last first: pydantic gathers fields from the last base first, so that they are listed in the order
 # of CORE below.
 class CoreKeys(
+    WhatAnImpactIs,
     DemAveraging,
     EnduringContacts,
     DemStepping,

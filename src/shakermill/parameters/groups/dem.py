@@ -109,3 +109,29 @@ class DemAveraging(KeyGroup):
         ge=1,
         le=64,
     )
+
+
+class WhatAnImpactIs(KeyGroup):
+    """Which of the 'dem' engine's contact records are impacts (MODEL.md §14.4): its counts, rates, spectra and
+    regimes are of impacts so defined; its records keep every contact."""
+
+    title = "what an impact is"
+
+    touch_speed: float = quantity(
+        "m/s",
+        "a contact that begins with a normal approach slower than this is a touch, not an impact",
+        default=0.1,
+        source="MODEL.md §14.4: 0.1 m/s, about the speed at which a Hertz impact of hardened steel begins to yield "
+        "(Johnson 1985, §11.4; recalled, not re-read), a free fall of 0.5 mm",
+        ge=0.0,
+        le=10.0,
+    )
+    chatter_factor: float = quantity(
+        "",
+        "records of one pair that begin again within this many Hertz durations of their approach are one lasting "
+        "contact, its chatter merged; 0 merges none",
+        default=2.0,
+        source="MODEL.md §14.4: about twice the Hertz contact duration of the approach",
+        ge=0.0,
+        le=100.0,
+    )

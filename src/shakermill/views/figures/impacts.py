@@ -12,7 +12,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from shakermill.analysis.stress_energy import LASTING_CONTACT_S, StressSpectrum, stress_spectrum
+from shakermill.analysis.impacts import LASTING_CONTACT_S, Contacts, contacts_of
+from shakermill.analysis.stress_energy import StressSpectrum, stress_spectrum
+from shakermill.solvers.result import counting_rules
 from shakermill.views.figures.common import (
     RunLike,
     add_context,
@@ -75,10 +77,16 @@ def _in_context(run: RunLike, figures: dict[str, Figure]) -> dict[str, Figure]:
     return {name: add_context(figure, context, window) for name, figure in figures.items()}
 
 
+def run_contacts(run: RunLike) -> Contacts:
+    """The contacts of ``run``'s records by the rules of its engine (MODEL.md §14.4)."""
+    return contacts_of(run.impacts, *counting_rules(run.params))
+
+
 def impact_figures(run: RunLike) -> dict[str, Figure]:
     """Histograms of impact speed and dissipated energy, impacts per second at each wall, and (1-D) the
-    impact phases; none without impacts."""
-    impacts = run.impacts
+    impact phases, of the run's impacts (MODEL.md §14.4: its records' chatter merged, touches left out); none
+    without impacts."""
+    impacts = pd.DataFrame(run_contacts(run).impacts)
     if impacts.empty:
         return {}
     balls = several_balls(run.params)
@@ -123,7 +131,7 @@ def run_stress_spectrum(run: RunLike) -> StressSpectrum | None:
     if not window > 0.0:
         return None
     return stress_spectrum(
-        run.impacts,
+        run_contacts(run),
         window,
         run.params.stress_energy_thresholds,
         run.summary.dissipated_power_W,
@@ -144,7 +152,7 @@ def stress_energy_figure(spectrum: StressSpectrum) -> Figure:
     events.set_title(f"Stress frequency ({spectrum.of().size} impacts in {spectrum.window:.3g} s)")
     if spectrum.lasting.any():
         power.set_title(
-            f"Stress power; contacts over {LASTING_CONTACT_S * 1e3:g} ms apart: {spectrum.lasting_power():.3g} W"
+            f"Stress power; contacts lasting over {LASTING_CONTACT_S * 1e3:g} ms: {spectrum.lasting_power():.3g} W"
         )
     return figure
 

@@ -325,14 +325,10 @@ def heating_zoom_figure(run: RunLike, window: xr.Dataset, start: float) -> Figur
 
 
 def impact_span(run: RunLike) -> float:
-    """The seconds the impact table covers: the whole run, or the averaged solver's averaging window.
-
-    The summary's impact rate is the table's impacts over that span, whichever solver wrote it.
-    """
-    rate = run.summary.impacts.rate_hz
-    if not rate > 0.0:
-        return float(run.summary.simulated_s)
-    return len(run.impacts) / float(rate)
+    """The seconds the impact table covers: the whole run, or the averaged solver's averaging window (the
+    summary's ``stress_window_s``; a folder from before the spectrum, the simulated time)."""
+    window = run.summary.stress_window_s
+    return float(window) if window > 0.0 else float(run.summary.simulated_s)
 
 
 def heat_by_channel_figure(run: RunLike) -> Figure:
