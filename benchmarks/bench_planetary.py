@@ -111,7 +111,7 @@ def hour_part(presets: list[str], batch_periods: int | None) -> None:
         print(f"  {spectrum_line(summary)}")
         print("  largest heat paths: " + "; ".join(f"{name} {flow:.3g} W" for name, flow in paths))
         spectrum = stress_spectrum(
-            result.impact_columns,
+            result.contacts(),
             summary.stress_window_s,
             params.stress_energy_thresholds,
             summary.dissipated_power_W,

@@ -363,6 +363,8 @@ ADDED_IN_VERSION_4 = (
     "charge_regime_from_s",
     "charge_regime_lasting_share",
     "charge_regime_fast_impact_rate_hz",
+    "charge_regime_active_share",
+    "charge_regime_switch_interval_s",
 )
 
 

@@ -105,14 +105,18 @@ def negligible_spread(values: np.ndarray, negligible: float) -> bool:
     return values.size == 0 or bool(values.std() <= negligible * abs(values.mean()))
 
 
-def uncorrelated_grouping(series: Sequence[np.ndarray], least: int, negligible: float = 0.0) -> Grouping:
-    """The smallest grouping (1, 2, 4, … batches) of every replica's batch means ``series`` (rows: batches,
-    columns: the quantities checked) whose group means are uncorrelated, with at least ``least`` groups in all;
-    the largest grouping with ``least`` groups, marked correlated, when none is. Columns whose spread is
-    ``negligible`` are not tested."""
+def uncorrelated_grouping(
+    series: Sequence[np.ndarray], least: int, negligible: float = 0.0, smallest: int = 1
+) -> Grouping:
+    """The smallest grouping (1, 2, 4, … batches, at least ``smallest``) of every replica's batch means ``series``
+    (rows: batches, columns: the quantities checked) whose group means are uncorrelated, with at least ``least``
+    groups in all; the largest grouping with ``least`` groups, marked correlated, when none is. Columns whose spread
+    is ``negligible`` are not tested."""
     pooled = np.concatenate(series)
     tested = [column for column in range(pooled.shape[1]) if not negligible_spread(pooled[:, column], negligible)]
     size, found = 1, None
+    while size < smallest:
+        size *= 2
     while True:
         groups = [grouped(part, size) for part in series]
         count = sum(len(part) for part in groups)

@@ -129,3 +129,41 @@ def charge_regime(lasting_share: float, fast_impact_rate: float, n_balls: int, f
     second, the balls and the drive's turns a second (Hz)."""
     rare = fast_impact_rate < PACK_FAST_IMPACTS_PER_BALL_AND_TURN * n_balls * frequency
     return PACK if lasting_share >= PACK_SHARE and rare else ACTIVE
+
+
+# A charge whose batches change regime at least this often after its first (the start-up) switches back and forth: it
+# is intermittent (MODEL.md §14.2), a regime of its own, averaged over batches that hold SWITCHES_PER_BATCH switches.
+INTERMITTENT = "intermittent"
+INTERMITTENT_SWITCHES = 2
+SWITCHES_PER_BATCH = 3
+
+
+@dataclass(frozen=True)
+class Switching:
+    """The regime of each batch of ``batch`` s of a settled motion, in order (:data:`PACK` or :data:`ACTIVE`)."""
+
+    labels: tuple[str, ...]
+    batch: float
+
+    @property
+    def switches(self) -> int:
+        return sum(before != after for before, after in zip(self.labels, self.labels[1:]))
+
+    @property
+    def intermittent(self) -> bool:
+        return self.switches >= INTERMITTENT_SWITCHES
+
+    def share(self, regime: str) -> float:
+        """The share of the batches (of the time) in ``regime``; NaN without batches."""
+        return self.labels.count(regime) / len(self.labels) if self.labels else math.nan
+
+    @property
+    def switch_interval(self) -> float:
+        """The mean time between switches (s); NaN without any."""
+        return len(self.labels) * self.batch / self.switches if self.switches else math.nan
+
+    def batches_holding_switches(self) -> int:
+        """The fewest batches a group must hold for SWITCHES_PER_BATCH switches on average (1 without switches)."""
+        if not self.switches:
+            return 1
+        return max(1, -(-SWITCHES_PER_BATCH * len(self.labels) // self.switches))

@@ -168,7 +168,7 @@ class Averaging(Protocol):
 
     def node_hits(self, impacts: Mapping[str, np.ndarray], weights: np.ndarray | None = None) -> np.ndarray:
         """How many of ``impacts`` heated each node of the network, or the sum of their ``weights`` (one value per
-        impact: its duration, for the time a node spends being heated)."""
+        impact, counted whole on each node it heats: its heat, for what a node gets in impacts at most)."""
 
     def averaged_history(
         self,

@@ -62,6 +62,8 @@ from shakermill.solvers.result import (
 # The thermal time constant of each impact-heated node must exceed the mean time between the impacts that heat it
 # by this factor, or its temperature follows single impacts and the average is not what drives it.
 TIME_SCALE_SEPARATION = 20.0
+# ... where brief contacts bring at least this share of its heat; the rest it gets in lasting contacts, all along.
+IMPULSIVE_SHARE = 0.5
 # Tolerances of the slow network: it is cheap, so it is solved far more accurately than it needs.
 THERMAL_RTOL = 1e-9
 THERMAL_ATOL = 1e-9
@@ -234,9 +236,8 @@ def _from_mechanics(
     network = engine_class.network_for(params)
     measured = mechanics.means
     means = replace(measured, load=measured.load.moved(mechanics.engine.network, network))
-    problem = (
-        means.averages.message if not means.averages.converged else time_scale_problem(mechanics.engine, network, means)
-    )
+    usable = means.averages.converged or means.averages.as_it_stands
+    problem = means.averages.message if not usable else time_scale_problem(mechanics.engine, network, means)
     if problem is not None:
         return _refuse(params, engine_class, mechanics, _not_valid(means.averages, problem), told, budget, started)
     thermal = integrate_network(network, means.load, params)
@@ -276,29 +277,34 @@ def _averaged_result(
         impact_window=averages.window,
         averages=averages,
     )
-    return conclude(output, network, load)
+    result = conclude(output, network, load)
+    if averages.as_it_stands:
+        result.warn(f"averaging: {averages.message}; a longer averaging_max_time narrows it")
+        result.summary = summarize(result)
+    return result
 
 
 def time_scale_problem(engine: AveragedEngine, network: ThermalNetwork, means: Means) -> str | None:
-    """Why averaging is not valid, or None: every heated node's thermal time constant must exceed the time between
-    the contacts that heat it by TIME_SCALE_SEPARATION, or its temperature follows single impacts. That time is the
-    window less the time the node spends in contact, over its contacts (MODEL.md §14.4: chatter merged): a ball that
-    rolls on the wall is heated all along, not by rare impacts. The air, heated only by convection, is smooth
-    between impacts, and its linear response to the fluctuating convection averages exactly."""
+    """Why averaging is not valid, or None: a node heated mostly by brief contacts (its heat in them, counted whole on
+    each body they touch, at least IMPULSIVE_SHARE of its heat) must have a thermal time constant TIME_SCALE_SEPARATION
+    times the time between them, or its temperature follows single impacts. A node heated mostly in lasting contacts
+    (a ball rolling on the wall, MODEL.md §14.4) is heated all along; the air, only by convection, is smooth between
+    impacts, and its linear response to the fluctuating convection averages exactly."""
     window = means.averages.window
     contacts = contacts_of(engine.impact_columns(since=means.averages.transient), *counting_rules(engine.params))
-    hits = engine.node_hits(contacts.columns)
-    durations = contacts.columns.get("duration")
-    touching = np.zeros(hits.size) if durations is None else engine.node_hits(contacts.columns, durations)
+    brief = {name: values[~contacts.lasting] for name, values in contacts.columns.items()}
+    hits = engine.node_hits(brief)
+    impulsive = engine.node_hits(brief, brief["heat_generated"]) / window if window > 0 else np.zeros(hits.size)
     conductances = network.node_conductances(means.load.drives)
     for node, count in enumerate(hits):
+        if not count or impulsive[node] < IMPULSIVE_SHARE * means.load.heat[node]:
+            continue
         capacity = network.nodes[node].capacity
         constant = capacity / conductances[node] if conductances[node] > 0 else math.inf
-        between = max(window - touching[node], 0.0) / count if count else 0.0
-        if count and constant < TIME_SCALE_SEPARATION * between:
+        if constant < TIME_SCALE_SEPARATION * window / count:
             return (
                 f"the {network.nodes[node].name}'s thermal time constant ({constant:.3g} s) is not well separated from "
-                f"the time between the contacts that heat it ({between:.3g} s): its temperature follows single "
+                f"the time between the impacts that heat it ({window / count:.3g} s): its temperature follows single "
                 "impacts"
             )
     return None

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,12 +22,20 @@ from shakermill.analysis.batch_means import (
     standard_error,
     uncorrelated_grouping,
 )
+from shakermill.analysis.impacts import contacts_of
+from shakermill.analysis.regime import ACTIVE, Switching
 from shakermill.engines.interface import Engine, Measured, ProgressCallback
 from shakermill.engines.status import BUDGET_EXCEEDED, REACHED_STOP
 from shakermill.engines.thermal.network import NetworkLoad
 from shakermill.parameters.keys import Parameters, bounds
 from shakermill.solvers.replicas import Replica, ReplicaSet
-from shakermill.solvers.result import INTERRUPTED, INTERRUPTED_MESSAGE, MechanicsAverages
+from shakermill.solvers.result import (
+    INTERRUPTED,
+    INTERRUPTED_MESSAGE,
+    MechanicsAverages,
+    counting_rules,
+    window_regime,
+)
 
 # Simulated seconds per chunk: the granularity of progress reports (tiny steps hand back control sooner,
 # engines/calls.py). Chunk ends shorten a step, so this is part of what makes a run's numbers.
@@ -110,9 +118,10 @@ def measure_means(
     if balls == 0:
         return _nothing_moves(engines[0], first), REACHED_STOP
     cumulative = [[_flat(engine.measured())] for engine in engines]
+    labels: list[str] = []
     limit, limit_name = mechanics_limit(params)
     heartbeat = None if progress is None else lambda t: progress(t, limit)
-    status, converged, message, settled = REACHED_STOP, False, "", None
+    status, converged, as_it_stands, message, settled = REACHED_STOP, False, False, "", None
     with ReplicaSet(engines, threads) as replicas:
         while True:
             t = engines[0].t + batch
@@ -124,8 +133,9 @@ def measure_means(
                 heartbeat(t)
             for series, engine in zip(cumulative, engines):
                 series.append(_flat(engine.measured()))
+            labels.append(batch_regime(params, engines[0], cumulative[0], batch))
             if len(cumulative[0]) > least_rounds(params, len(engines)):
-                settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target)
+                settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target, labels)
                 if settled.ready and all(relative_error(c) <= target for c in settled.checked.T):
                     converged = True
                     message = (
@@ -133,6 +143,9 @@ def measure_means(
                         f"uncorrelated batches of {settled.batch:.3g} s)"
                     )
                     break
+            if t + batch > limit and settled is not None and settled.averaged_as_it_stands():
+                message, as_it_stands = settled.as_it_stands(target, t, limit_name, limit), True
+                break
             if t + batch > limit:
                 message = (
                     f"the averages did not converge to a relative standard error of {target:g} ({key}) in "
@@ -143,8 +156,18 @@ def measure_means(
                 break
     if settled is None:
         # Stopped before convergence was first tested; once tested, the batches have not changed since.
-        settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target)
-    return _means(engines, settled, sources, balls, len(cumulative[0]) - 1, converged, message), status
+        settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target, labels)
+    means = _means(engines, settled, sources, balls, len(cumulative[0]) - 1, converged, message)
+    return replace(means, averages=replace(means.averages, as_it_stands=as_it_stands)), status
+
+
+def batch_regime(params: Parameters, engine: Replica, cumulative: list[np.ndarray], batch: float) -> str:
+    """The regime of the last batch of ``engine`` (the first replica, which keeps its records), from its contacts and
+    its dissipation (the last column of :func:`_flat`); :data:`ACTIVE` where the share is not known."""
+    start = engine.t - batch
+    contacts = contacts_of(engine.impact_columns(since=start), *counting_rules(params))
+    dissipated_power = (cumulative[-1][-1] - cumulative[-2][-1]) / batch
+    return window_regime(params, contacts, batch, float(dissipated_power))[2] or ACTIVE
 
 
 @dataclass(frozen=True)
@@ -161,6 +184,7 @@ class Settled:
     grouping: Grouping
     drifting: bool
     transient_heat_power: float
+    switching: Switching
 
     @property
     def batch(self) -> float:
@@ -170,17 +194,48 @@ class Settled:
     def ready(self) -> bool:
         return self.grouping.uncorrelated and not self.drifting
 
+    def averaged_as_it_stands(self) -> bool:
+        """Whether an intermittent charge whose target error is out of reach within its mechanics is averaged as it
+        stands: over at least INTERMITTENT_GROUPS groups that each hold several switches (MODEL.md §14.2)."""
+        return self.switching.intermittent and self.grouping.groups >= INTERMITTENT_GROUPS
+
+    def as_it_stands(self, target: float, t: float, limit_name: str, limit: float) -> str:
+        """What :meth:`averaged_as_it_stands` averaged, and the error it stands at beside the ``target``."""
+        worst = max(relative_error(column) for column in self.checked.T)
+        switching = self.switching
+        return (
+            f"intermittent charge (active {switching.share(ACTIVE):.0%} of the time, switching every "
+            f"{switching.switch_interval:.3g} s): averaged as it stands after {t:.3g} s of mechanics ({limit_name} = "
+            f"{limit:g} s) over {self.grouping.groups} batches of {self.batch:.3g} s holding about "
+            f"{self.batch / switching.switch_interval:.2g} switches each, lag-1 autocorrelation "
+            f"{self.grouping.autocorrelation:.2f}; its largest relative standard error, {worst:.3g}, is above the "
+            f"target {target:g}"
+        )
+
 
 def _settled(
-    cumulative: list[list[np.ndarray]], base: float, sources: int, balls: int, least: int, target: float
+    cumulative: list[list[np.ndarray]],
+    base: float,
+    sources: int,
+    balls: int,
+    least: int,
+    target: float,
+    labels: Sequence[str],
 ) -> Settled:
     """Cut each replica's transient (MSER on its total heat power and its balls' mean velocity term, White 1997),
     group its batches until their means are uncorrelated, and test the totals for drift (MODEL.md §14.2); a
-    spread or drift within the ``target`` relative error is no concern."""
+    spread or drift within the ``target`` relative error is no concern. A charge whose batches (``labels``, the first
+    replica's regimes) switch back and forth is intermittent: its regimes are its motion, so only its first batch,
+    the start-up, is cut, and its groups hold several switches each."""
     every = [batch_rates(np.array(series), base) for series in cumulative]
-    cuts = [max(mser_truncation(normalised(column)) for column in _totals(rates, sources, balls).T) for rates in every]
+    switching = Switching(tuple(labels[1:]), base)
+    if switching.intermittent:
+        cuts, smallest = [1] * len(every), switching.batches_holding_switches()
+    else:
+        columns = (_totals(rates, sources, balls).T for rates in every)
+        cuts, smallest = [max(mser_truncation(normalised(column)) for column in each) for each in columns], 1
     kept = [rates[cut:] for rates, cut in zip(every, cuts)]
-    grouping = uncorrelated_grouping([_totals(rates, sources, balls) for rates in kept], least, target)
+    grouping = uncorrelated_grouping([_totals(rates, sources, balls) for rates in kept], least, target, smallest)
     rates = np.concatenate([grouped(part, grouping.size) for part in kept])
     # The batches that fill no group are left out of the averages, so they count as transient.
     cuts = [cut + len(part) % grouping.size for cut, part in zip(cuts, kept)]
@@ -194,6 +249,7 @@ def _settled(
         grouping=grouping,
         drifting=grouping.uncorrelated and any(drifts(column, target) for column in totals.T),
         transient_heat_power=_mean(first),
+        switching=switching,
     )
 
 
@@ -282,6 +338,7 @@ def _means(
         batch_length=settled.batch,
         batch_autocorrelation=settled.grouping.autocorrelation,
         transient_heat_power=settled.transient_heat_power,
+        switching=settled.switching,
     )
     load = engines[0].load(*(np.array([_mean(column) for column in part.T]) for part in (heat, terms, conductances)))
     return Means(load, averages)
@@ -302,6 +359,8 @@ def _change(settled: Settled, heat_power: float, error: float) -> str:
     )
 
 
+# The fewest groups of several switches each an intermittent charge is averaged over when its target is out of reach.
+INTERMITTENT_GROUPS = 5
 # A transient whose heat power differs from the settled motion's by more than this share is reported as a change.
 CHANGE_SHARE = 0.1
 

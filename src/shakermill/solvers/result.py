@@ -15,7 +15,7 @@ import numpy as np
 from shakermill.analysis.attractors import AttractorScan
 from shakermill.analysis.fit import ExponentialFit, increment_ratio
 from shakermill.analysis.impacts import Contacts, contacts_of
-from shakermill.analysis.regime import charge_regime
+from shakermill.analysis.regime import ACTIVE, INTERMITTENT, Switching, charge_regime
 from shakermill.analysis.sections import further_nodes
 from shakermill.analysis.steady import SteadyState, fits_no_exponential, run_length_note, settled_rates, steady_state
 from shakermill.analysis.stress_energy import stress_spectrum
@@ -89,6 +89,10 @@ class MechanicsAverages:
     batch_length: float = math.nan
     batch_autocorrelation: float = math.nan
     transient_heat_power: float = math.nan
+    # The regime of each base batch of the first replica after its first (MODEL.md §14.2), and whether an intermittent
+    # charge whose target error was out of reach within its mechanics was averaged with its error as it stands.
+    switching: Switching | None = None
+    as_it_stands: bool = False
 
     def as_summary(self) -> Averaging:
         return Averaging(
@@ -577,11 +581,13 @@ class SettledRegime:
     lasting_share: float
     fast_impact_rate: float
     name: str | None
+    switching: Switching | None = None
 
 
 def settled_regime(result: RunOutput, dissipated_power: float) -> SettledRegime:
     """The regime of ``result``'s settled motion, named from the impacts and the dissipation of that window alone,
-    never the start-up's (MODEL.md §14.4); a full run's dissipated power over its window from its cumulative series."""
+    never the start-up's (MODEL.md §14.4); a full run's dissipated power over its window from its cumulative series.
+    An averaged run whose batches switched back and forth is :data:`INTERMITTENT`."""
     if result.impact_window is None or result.averages is None:
         start = window = 0.5 * result.t_end
         dissipated_power = float(np.sum(settled_rates(result.history.times, result.history["dissipated"])))
@@ -589,18 +595,30 @@ def settled_regime(result: RunOutput, dissipated_power: float) -> SettledRegime:
     else:
         # The averaged solver's records begin with its window.
         start, window, contacts = result.averages.transient, result.impact_window, result.contacts()
+    share, fast, name = window_regime(result.params, contacts, window, dissipated_power)
+    switching = result.averages.switching if result.averages is not None else None
+    if switching is not None and switching.intermittent:
+        name = INTERMITTENT
+    return SettledRegime(start, share, fast, name, switching)
+
+
+def window_regime(
+    params: Parameters, contacts: Contacts, window: float, dissipated_power: float
+) -> tuple[float, float, str | None]:
+    """The share of the dissipation in lasting contacts, the impacts above 1 m/s a second and the regime they name
+    (None where the share is not known) of ``contacts`` over ``window`` s, in which the contacts dissipated
+    ``dissipated_power`` (W)."""
     share = stress_spectrum(contacts, window, dissipated_power=dissipated_power).lasting_share()
     fast = _per_second(int(np.count_nonzero(contacts.impacts["impact_speed"] >= FAST_IMPACT_SPEED)), window)
-    params = result.params
     name = charge_regime(share, fast, params.n_balls, params.frequency) if math.isfinite(share) else None
-    return SettledRegime(start, share, fast, name)
+    return share, fast, name
 
 
 def charge_section(result: RunOutput, regime: SettledRegime) -> Charge:
     """The balls of an engine that moves several: how many, how full the vial, the work of gravity and of the
     stiffening springs, and the regime of the charge's settled motion where the share of lasting contacts is
     known."""
-    params = result.params
+    params, switching = result.params, regime.switching
     return Charge(
         engine=result.description.name,
         n_balls=params.n_balls,
@@ -611,6 +629,8 @@ def charge_section(result: RunOutput, regime: SettledRegime) -> Charge:
         regime_from_s=regime.start,
         regime_lasting_share=regime.lasting_share,
         regime_fast_impact_rate_hz=regime.fast_impact_rate,
+        regime_active_share=switching.share(ACTIVE) if switching is not None else math.nan,
+        regime_switch_interval_s=switching.switch_interval if switching is not None else math.nan,
     )
 
 

@@ -127,13 +127,19 @@ class Charge(Section):
     regime: Annotated[str | None, Key("charge_regime")] = None
     """The regime of the settled motion (MODEL.md §14.2), from ``charge_regime_from_s`` to the end, never the start-up:
     ``pack`` (lasting contacts take at least half the dissipation, and fewer than one impact above 1 m/s per ball and
-    turn) or ``active`` (the rest); None where the share of lasting contacts is not known."""
+    turn), ``active`` (the rest), or ``intermittent`` (an averaged run whose batches switched between the two at least
+    twice: ``charge_regime_active_share`` of the time active, switching every ``charge_regime_switch_interval_s``);
+    None where the share of lasting contacts is not known."""
     regime_from_s: Annotated[Seconds, Key("charge_regime_from_s")] = math.nan
     """Where the window the regime is named from begins (s): the second half of a full run, the averaging window."""
     regime_lasting_share: Annotated[float, Key("charge_regime_lasting_share")] = math.nan
     """The share of that window's dissipation in contacts lasting over 1 ms."""
     regime_fast_impact_rate_hz: Annotated[PerSecond, Key("charge_regime_fast_impact_rate_hz")] = math.nan
     """That window's impacts per second at or above 1 m/s."""
+    regime_active_share: Annotated[float, Key("charge_regime_active_share")] = math.nan
+    """The share of the averaged solver's batches (of its time) that were active; NaN for a full run."""
+    regime_switch_interval_s: Annotated[Seconds, Key("charge_regime_switch_interval_s")] = math.nan
+    """The mean time between the batches' switches of regime; NaN without a switch, and for a full run."""
 
 
 class Numerics(Section):

@@ -1,0 +1,64 @@
+"""An intermittent charge (MODEL.md §14.2): batches that switch between active and pack are a regime of their own,
+not a transient; averaged over groups that hold several switches, with the lag-1 autocorrelation as measured."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from shakermill.analysis.batch_means import uncorrelated_grouping
+from shakermill.analysis.regime import ACTIVE, PACK, SWITCHES_PER_BATCH, Switching
+from shakermill.solvers.driver import INTERMITTENT_GROUPS, _settled
+
+BATCH = 0.3
+
+
+def test_batches_that_switch_back_and_forth_are_intermittent_and_one_change_is_not():
+    """Active, active, pack, pack, pack, active over 6 batches of 0.3 s: two switches, every 0.9 s; half the time
+    active; groups of ceil(3 × 0.9 / 0.3) = 9 batches hold three switches each."""
+    switching = Switching((ACTIVE, ACTIVE, PACK, PACK, PACK, ACTIVE), BATCH)
+    assert switching.switches == 2 and switching.intermittent
+    assert switching.share(ACTIVE) == pytest.approx(0.5) and switching.share(PACK) == pytest.approx(0.5)
+    assert switching.switch_interval == pytest.approx(0.9)
+    assert switching.batches_holding_switches() == SWITCHES_PER_BATCH * 6 // 2 == 9
+    collapsed = Switching((ACTIVE, ACTIVE, PACK, PACK, PACK, PACK), BATCH)
+    assert collapsed.switches == 1 and not collapsed.intermittent  # a change of regime, cut by MSER
+    assert math.isnan(Switching((PACK,) * 4, BATCH).switch_interval)
+
+
+def cumulative_of(heat: np.ndarray) -> list[list[np.ndarray]]:
+    """One replica's cumulative series (heat, velocity term, dissipation: :func:`driver._flat`'s layout with one
+    source, one ball and no contact conductance) of batch rates ``heat`` (W), the term constant."""
+    rates = np.column_stack([heat, np.ones_like(heat), heat / 0.9])
+    totals = np.vstack([np.zeros(3), np.cumsum(rates * BATCH, axis=0)])
+    return [list(totals)]
+
+
+def test_an_intermittent_charge_keeps_all_but_its_start_up_batch_and_groups_batches_that_hold_several_switches():
+    """60 batches, active (26 W) and pack (16 W) in runs of 4: MSER would cut a mixture as a transient; here only the
+    first batch goes, and the groups span at least three switches. The lag-1 autocorrelation of the 0.3-s batches is
+    high (0.5 for runs of 4) and is what a grouping of them reports, whatever the target."""
+    labels = [ACTIVE if (index // 4) % 2 == 0 else PACK for index in range(60)]
+    heat = np.where(np.array(labels) == ACTIVE, 26.0, 16.0)
+    settled = _settled(cumulative_of(heat), BATCH, 1, 1, least=20, target=0.01, labels=labels)
+    assert settled.cuts[0] >= 1 and settled.cuts[0] < 1 + settled.grouping.size
+    assert settled.switching.intermittent
+    assert settled.switching.switches == 14  # runs of 4 after the first batch
+    assert (
+        settled.grouping.size >= settled.switching.batches_holding_switches() == -(-SWITCHES_PER_BATCH * 59 // 14) == 13
+    )
+    assert settled.grouping.groups * settled.grouping.size <= 59
+    single = uncorrelated_grouping([np.column_stack([heat[1:], np.ones(59)])], least=20, negligible=1.0)
+    assert single.size == 1 and single.autocorrelation > 0.4  # reported as measured, though no column is tested
+    assert settled.averaged_as_it_stands() == (settled.grouping.groups >= INTERMITTENT_GROUPS)
+
+
+def test_a_charge_that_changed_regime_once_is_cut_where_it_changed():
+    """Active for 20 batches, then pack for 40: one change, not intermittent; MSER cuts the active start."""
+    labels = [ACTIVE] * 20 + [PACK] * 40
+    heat = np.where(np.array(labels) == ACTIVE, 26.0, 16.0)
+    settled = _settled(cumulative_of(heat), BATCH, 1, 1, least=20, target=0.01, labels=labels)
+    assert not settled.switching.intermittent and settled.cuts[0] >= 20
+    assert not settled.averaged_as_it_stands()
