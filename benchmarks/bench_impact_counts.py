@@ -9,7 +9,8 @@ settled second half: the impact rate, the rate above 1 m/s, the lasting contacts
 charge's motion is chaotic: halving the step changes its trajectory as much as a kick of its start does, so one
 trajectory against another says nothing, and the statistical error of a figure is its spread over the replicas in
 the case's regime (rates: their standard error; percentiles: a bootstrap over those replicas, their impacts pooled).
-A change is within its error when it is less than the two settings' errors combined.
+Each change is given in units of the two settings' errors combined (σ): within 1σ is "less than its statistical
+error"; of six figures compared, about two beyond 1σ (and rarely one beyond 2σ) is what chance alone gives.
 
 Cases: ``pack``, friction 0.3 (a pack from ~0.3 s on for the configured start; some kicked starts stay active), and
 ``active``, friction 0.5 (active for its first ~5 s); each keeps the replicas whose settled half is in its regime. The
@@ -143,16 +144,15 @@ def compare(case: str, replicas: int, duration: float) -> None:
         f"\n{case}: the settled second half ({duration / 2:g} s) of {count} and {count_halved} of {replicas} replicas "
         f"in the {CASES[case][1]} regime"
     )
-    print(f"{'':>26} {'default':>17} {'halved steps':>17} {'change':>10} {'within':>7}")
+    print(f"{'':>26} {'default':>17} {'halved steps':>17} {'change':>10} {'change/σ':>8}")
     for name in default:
         change = halved[name] - default[name]
         combined = math.hypot(default_error[name], halved_error[name])
-        within = "(step)" if name == "contact records /s" else ("yes" if abs(change) <= combined else "no")
-        if not math.isfinite(combined) and name != "contact records /s":
-            within = "n/a"
+        sigmas = abs(change) / combined if combined > 0 else math.nan
+        shown = "(step)" if name == "contact records /s" else (f"{sigmas:.2f}" if math.isfinite(sigmas) else "n/a")
         print(
             f"{name:>26} {default[name]:>9.4g} ±{default_error[name]:<6.2g} {halved[name]:>9.4g} "
-            f"±{halved_error[name]:<6.2g} {change:>+10.3g} {within:>7}"
+            f"±{halved_error[name]:<6.2g} {change:>+10.3g} {shown:>8}"
         )
     print()
 

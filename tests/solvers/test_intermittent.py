@@ -10,7 +10,7 @@ import pytest
 
 from shakermill.analysis.batch_means import uncorrelated_grouping
 from shakermill.analysis.regime import ACTIVE, PACK, SWITCHES_PER_BATCH, Switching
-from shakermill.solvers.driver import INTERMITTENT_GROUPS, _settled
+from shakermill.solvers.driver import INTERMITTENT_GROUPS, _change, _settled
 
 BATCH = 0.3
 
@@ -62,3 +62,16 @@ def test_a_charge_that_changed_regime_once_is_cut_where_it_changed():
     settled = _settled(cumulative_of(heat), BATCH, 1, 1, least=20, target=0.01, labels=labels)
     assert not settled.switching.intermittent and settled.cuts[0] >= 20
     assert not settled.averaged_as_it_stands()
+
+
+def test_a_charge_that_switched_and_then_stayed_a_pack_is_a_pack_after_its_last_change():
+    """`pulverisette7` at friction 0.5 as its averaged run measured it in 0.3-s batches: active to 5.4 s, a pack to
+    10.2 s, active to 24.6 s, then a pack to the end of 120 s of mechanics. MSER cuts at the last change; no switch
+    follows, so it is no intermittent charge, and the run says it switched before."""
+    labels = [ACTIVE] * 18 + [PACK] * 16 + [ACTIVE] * 48 + [PACK] * 318
+    noise = np.random.default_rng(50).normal(0.0, 0.3, len(labels))
+    heat = np.where(np.array(labels) == ACTIVE, 23.3, 19.1) + noise
+    settled = _settled(cumulative_of(heat), BATCH, 1, 1, least=20, target=0.01, labels=labels)
+    assert not settled.switching.intermittent and settled.switching.share(PACK) == 1.0
+    assert 82 <= settled.cuts[0] <= 200 and settled.switches_before == 3  # MSER cuts past the last change
+    assert "having switched between active and pack 3 times before" in _change(settled, 19.1, 0.01)

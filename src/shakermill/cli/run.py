@@ -16,6 +16,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from shakermill.analysis.regime import INTERMITTENT
 from shakermill.cli.common import (
     EXIT_FAILED_RUN,
     EXIT_INTERRUPTED,
@@ -405,8 +406,22 @@ def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, st
     # Kwade's ½·m*·v_n² beside the energy dissipated, and how much of the dissipation neither describes.
     rows.append(
         (
+            "contact records; touches (< touch_speed, not impacts)",
+            f"{number(s.impacts.records_hz, '.4g')}; {number(s.impacts.touches_hz, '.4g')}",
+            "Hz",
+        )
+    )
+    rows.append(
+        (
             "stress energy dissipated per impact: median; p90",
             f"{number(s.stress_energy_median_J, '.3g')}; {number(s.stress_energy_p90_J, '.3g')}",
+            "J",
+        )
+    )
+    rows.append(
+        (
+            "... energy-weighted: median; p90",
+            f"{number(s.stress_energy_weighted_median_J, '.3g')}; {number(s.stress_energy_weighted_p90_J, '.3g')}",
             "J",
         )
     )
@@ -428,8 +443,18 @@ def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, st
     if charge.regime is not None:
         rows.append(
             (
-                "motion (pack: lasting contacts, under one impact > 1 m/s a ball and turn; else active)",
-                f"{charge.regime}, {number(s.impacts.fast_rate_hz, '.4g')} impacts > 1 m/s a second",
+                f"motion from {number(charge.regime_from_s, '.3g')} s (pack: lasting contacts, under one impact "
+                "> 1 m/s a ball and turn; else active)",
+                f"{charge.regime}, {number(charge.regime_fast_impact_rate_hz, '.4g')} impacts > 1 m/s a second, "
+                f"{number(100 * charge.regime_lasting_share, '.3g')} % in lasting contacts",
+                "",
+            )
+        )
+    if charge.regime == INTERMITTENT:
+        rows.append(
+            (
+                "intermittent: share of the time active (%); time between switches (s)",
+                f"{number(100 * charge.regime_active_share, '.3g')}; {number(charge.regime_switch_interval_s, '.3g')}",
                 "",
             )
         )

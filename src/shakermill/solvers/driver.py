@@ -185,6 +185,7 @@ class Settled:
     drifting: bool
     transient_heat_power: float
     switching: Switching
+    switches_before: int = 0
 
     @property
     def batch(self) -> float:
@@ -225,15 +226,16 @@ def _settled(
     """Cut each replica's transient (MSER on its total heat power and its balls' mean velocity term, White 1997),
     group its batches until their means are uncorrelated, and test the totals for drift (MODEL.md §14.2); a
     spread or drift within the ``target`` relative error is no concern. A charge whose batches (``labels``, the first
-    replica's regimes) switch back and forth is intermittent: its regimes are its motion, so only its first batch,
-    the start-up, is cut, and its groups hold several switches each."""
+    replica's regimes) still switch back and forth after that cut is intermittent: its regimes are its motion, so only
+    its first batch, the start-up, is cut, and its groups hold several switches each. One that stopped switching
+    before the cut (a planetary charge that tried a pack twice before it stayed one) is of the regime it stayed in."""
     every = [batch_rates(np.array(series), base) for series in cumulative]
-    switching = Switching(tuple(labels[1:]), base)
+    columns = (_totals(rates, sources, balls).T for rates in every)
+    cuts, smallest = [max(mser_truncation(normalised(column)) for column in each) for each in columns], 1
+    switching = Switching(tuple(labels[cuts[0] :]), base)
     if switching.intermittent:
+        switching = Switching(tuple(labels[1:]), base)
         cuts, smallest = [1] * len(every), switching.batches_holding_switches()
-    else:
-        columns = (_totals(rates, sources, balls).T for rates in every)
-        cuts, smallest = [max(mser_truncation(normalised(column)) for column in each) for each in columns], 1
     kept = [rates[cut:] for rates, cut in zip(every, cuts)]
     grouping = uncorrelated_grouping([_totals(rates, sources, balls) for rates in kept], least, target, smallest)
     rates = np.concatenate([grouped(part, grouping.size) for part in kept])
@@ -250,6 +252,7 @@ def _settled(
         drifting=grouping.uncorrelated and any(drifts(column, target) for column in totals.T),
         transient_heat_power=_mean(first),
         switching=switching,
+        switches_before=Switching(tuple(labels[1 : cuts[0]]), base).switches,
     )
 
 
@@ -353,9 +356,11 @@ def _change(settled: Settled, heat_power: float, error: float) -> str:
         return ""
     if abs(before - heat_power) <= max(CHANGE_SHARE * abs(heat_power), DRIFT_SIGMAS * error):
         return ""
+    switched = settled.switches_before
+    tried = f", having switched between active and pack {switched} times before" if switched > 1 else ""
     return (
         f"; the motion changed at t = {cut * settled.base:.3g} s (heat power {before:.3g} W before, "
-        f"{heat_power:.3g} W after): the averages are of the motion after the change"
+        f"{heat_power:.3g} W after{tried}): the averages are of the motion after the change"
     )
 
 
