@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from shakermill.analysis.batch_means import uncorrelated_grouping
+from shakermill.analysis.batch_means import lag1_autocorrelation, uncorrelated_grouping
 from shakermill.analysis.regime import ACTIVE, PACK, SWITCHES_PER_BATCH, Switching
-from shakermill.solvers.driver import INTERMITTENT_GROUPS, _change, _settled
+from shakermill.solvers.driver import INTERMITTENT_GROUPS, _change, _settled, correlated_error
 
 BATCH = 0.3
 
@@ -75,3 +75,14 @@ def test_a_charge_that_switched_and_then_stayed_a_pack_is_a_pack_after_its_last_
     assert not settled.switching.intermittent and settled.switching.share(PACK) == 1.0
     assert 82 <= settled.cuts[0] <= 200 and settled.switches_before == 3  # MSER cuts past the last change
     assert "having switched between active and pack 3 times before" in _change(settled, 19.1, 0.01)
+
+
+def test_the_error_of_correlated_batches_is_widened_by_their_memory_and_that_of_uncorrelated_ones_is_not():
+    """r₁ = 0.5 over 40 batches (significant: 2/√40 = 0.32) widens the standard error by √(1.5/0.5) = √3."""
+    correlated = np.repeat([1.0, 2.0, 1.5, 2.5, 0.5, 3.0, 2.0, 1.0, 2.5, 1.5], 4)
+    r1 = lag1_autocorrelation([correlated])
+    assert r1 > 2 / math.sqrt(40)
+    plain = correlated.std(ddof=1) / math.sqrt(40)
+    assert correlated_error(correlated) == pytest.approx(plain * math.sqrt((1 + r1) / (1 - r1)))
+    alternating = np.tile([1.0, 2.0], 20)  # r₁ < 0: no widening
+    assert correlated_error(alternating) == pytest.approx(alternating.std(ddof=1) / math.sqrt(40))

@@ -16,9 +16,11 @@ from shakermill.analysis.batch_means import (
     batch_rates,
     drifts,
     grouped,
+    lag1_autocorrelation,
     mser_truncation,
     normalised,
     relative_error,
+    significant_autocorrelation,
     standard_error,
     uncorrelated_grouping,
 )
@@ -138,10 +140,7 @@ def measure_means(
                 settled = _settled(cumulative, batch, sources, balls, params.averaging_min_batches, target, labels)
                 if settled.ready and all(relative_error(c) <= target for c in settled.checked.T):
                     converged = True
-                    message = (
-                        f"converged after {t:.3g} s of mechanics{_in_each(engines)} ({settled.grouping.groups} "
-                        f"uncorrelated batches of {settled.batch:.3g} s)"
-                    )
+                    message = f"converged after {t:.3g} s of mechanics{_in_each(engines)} ({settled.batches_said()})"
                     break
             if t + batch > limit and settled is not None and settled.averaged_as_it_stands():
                 message, as_it_stands = settled.as_it_stands(target, t, limit_name, limit), True
@@ -194,6 +193,18 @@ class Settled:
     @property
     def ready(self) -> bool:
         return self.grouping.uncorrelated and not self.drifting
+
+    def batches_said(self) -> str:
+        """The batches averaged over, in words, with their lag-1 autocorrelation as measured: uncorrelated, or
+        correlated with a spread within the target (whose variance of the mean is no more than their own)."""
+        grouping = self.grouping
+        kind = (
+            "correlated" if significant_autocorrelation(grouping.autocorrelation, grouping.groups) else "uncorrelated"
+        )
+        return (
+            f"{grouping.groups} {kind} batches of {self.batch:.3g} s, lag-1 autocorrelation "
+            f"{grouping.autocorrelation:.2f}"
+        )
 
     def averaged_as_it_stands(self) -> bool:
         """Whether an intermittent charge whose target error is out of reach within its mechanics is averaged as it
@@ -327,10 +338,10 @@ def _means(
     pooled_window = sum(rounds - cut for cut in settled.cuts) * settled.base
     averages = MechanicsAverages(
         heat_power=_mean(total_heat),
-        heat_power_stderr=standard_error(total_heat),
+        heat_power_stderr=correlated_error(total_heat),
         dissipated_power=_mean(rates[:, -1]),
         velocity_term=_mean(mean_terms),
-        velocity_term_stderr=standard_error(mean_terms),
+        velocity_term_stderr=correlated_error(mean_terms),
         transient=settled.cuts[0] * settled.base,
         window=(rounds - settled.cuts[0]) * settled.base,
         batches=len(rates),
@@ -345,6 +356,15 @@ def _means(
     )
     load = engines[0].load(*(np.array([_mean(column) for column in part.T]) for part in (heat, terms, conductances)))
     return Means(load, averages)
+
+
+def correlated_error(values: np.ndarray) -> float:
+    """The standard error of the mean of batch means ``values``, widened by √((1 + r₁)/(1 − r₁)) where their lag-1
+    autocorrelation r₁ is positive and significant (an AR(1) memory): correlated batches, averaged because their
+    spread is within the target, know their mean less well than their count says (MODEL.md §14.2)."""
+    r1 = lag1_autocorrelation([values]) if values.size > 2 else 0.0
+    correlated = 0.0 < r1 < 1.0 and significant_autocorrelation(r1, values.size)
+    return standard_error(values) * (math.sqrt((1.0 + r1) / (1.0 - r1)) if correlated else 1.0)
 
 
 def _change(settled: Settled, heat_power: float, error: float) -> str:
