@@ -17,8 +17,12 @@ Cases: ``pack``, friction 0.3 (a pack from ~0.3 s on for the configured start; s
 intermittent charge of friction 0.5 switches every few seconds and needs tens of simulated seconds a replica: not
 measured here (issue 50).
 
+Part ``--averaged``: the averaged run of ``pulverisette7`` at friction 0.5 as shipped, which switches between active
+and pack before it settles: its status, regime, message and the lag-1 autocorrelation of the batches it used.
+
     .venv/bin/python benchmarks/bench_impact_counts.py                   # both cases, 6 replicas each (~6 CPU-min)
-    .venv/bin/python benchmarks/bench_impact_counts.py --cases pack --replicas 10
+    .venv/bin/python benchmarks/bench_impact_counts.py --cases pack --replicas 12 --duration 3
+    .venv/bin/python benchmarks/bench_impact_counts.py --cases "" --averaged   # ~4 CPU-min
 """
 
 from __future__ import annotations
@@ -157,14 +161,38 @@ def compare(case: str, replicas: int, duration: float) -> None:
     print()
 
 
+def averaged_run() -> None:
+    before = cpu_seconds()
+    result = sm.simulate(sm.default_parameters("pulverisette7", engine="dem", solver="averaged", friction=0.5))
+    summary = result.summary
+    print(f"averaged pulverisette7 at friction 0.5: status {result.status}, {cpu_seconds() - before:.0f} CPU-s")
+    print(f"  {result.message}")
+    if summary.charge is not None and summary.averaging is not None:
+        print(
+            f"  charge_regime {summary.charge.regime} from {summary.charge.regime_from_s:.3g} s; heat power "
+            f"{summary.averaging.heat_power_W:.5g} ± {summary.averaging.heat_power_stderr_W:.2g} W; lag-1 "
+            f"autocorrelation {summary.averaging.batch_autocorrelation:.2f} of {summary.averaging.batches} batches "
+            f"of {summary.averaging.batch_s:.3g} s"
+        )
+    for warning in result.warnings:
+        print(f"  warning: {warning}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", default=",".join(CASES), help="comma-separated: " + ", ".join(CASES))
     parser.add_argument("--replicas", type=int, default=6, help="replicas of each case and step")
     parser.add_argument("--duration", type=float, default=1.5, help="simulated seconds of each replica (s)")
+    parser.add_argument("--averaged", action="store_true", help="also the averaged run at friction 0.5")
     arguments = parser.parse_args()
-    for case in arguments.cases.split(","):
+    cases = [case for case in arguments.cases.split(",") if case]
+    unknown = [case for case in cases if case not in CASES]
+    if unknown:
+        parser.error(f"--cases: {unknown[0]!r} is none of {', '.join(CASES)}")
+    for case in cases:
         compare(case, arguments.replicas, arguments.duration)
+    if arguments.averaged:
+        averaged_run()
 
 
 if __name__ == "__main__":

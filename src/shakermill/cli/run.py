@@ -45,6 +45,7 @@ if TYPE_CHECKING:
     from shakermill.parameters.keys import Parameters
     from shakermill.solvers.result import Result
     from shakermill.solvers.summary import Summary
+    from shakermill.solvers.summary_sections import Charge
 
 FIGURES_FOLDER = "figures"
 
@@ -440,6 +441,18 @@ def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, st
             "%",
         )
     )
+    rows.extend(regime_rows(charge))
+    heat = [s.heat_by_channel_W.get(channel) for channel in channels]
+    if any(value is not None for value in heat):
+        # The averaged solver has no split by channel: its heat comes from the thermal network's means.
+        rows.append((f"heat by channel: {'; '.join(channels)}", "; ".join(number(value, ".3g") for value in heat), "W"))
+    return rows
+
+
+def regime_rows(charge: Charge) -> list[tuple[str, str, str]]:
+    """The run table's rows of the regime of a charge's settled motion and, for an intermittent one, how it
+    switches."""
+    rows = []
     if charge.regime is not None:
         rows.append(
             (
@@ -458,10 +471,6 @@ def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, st
                 "",
             )
         )
-    heat = [s.heat_by_channel_W.get(channel) for channel in channels]
-    if any(value is not None for value in heat):
-        # The averaged solver has no split by channel: its heat comes from the thermal network's means.
-        rows.append((f"heat by channel: {'; '.join(channels)}", "; ".join(number(value, ".3g") for value in heat), "W"))
     return rows
 
 
