@@ -16,7 +16,6 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from shakermill.analysis.regime import INTERMITTENT
 from shakermill.cli.common import (
     EXIT_FAILED_RUN,
     EXIT_INTERRUPTED,
@@ -452,6 +451,8 @@ def several_ball_rows(s: Summary, channels: Sequence[str]) -> list[tuple[str, st
 def regime_rows(charge: Charge) -> list[tuple[str, str, str]]:
     """The run table's rows of the regime of a charge's settled motion and, for an intermittent one, how it
     switches."""
+    from shakermill.analysis.regime import INTERMITTENT  # NumPy with it: not on the path of --help
+
     rows = []
     if charge.regime is not None:
         rows.append(
