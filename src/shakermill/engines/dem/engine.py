@@ -192,7 +192,8 @@ class DemEngine(CompiledRun, Averaging, Replicas, StepBound, MemoryBound):
         return times
 
     def impact_columns(self, since: float = -math.inf) -> dict[str, np.ndarray]:
-        columns = impact_columns(self.records, since)
+        # The rows it selects are copied there: no copy of every record first (the averaged solver asks each batch).
+        columns = impact_columns(self._records[: self._count], since)
         columns[HERTZ_SCALE] = hertz_scales(columns["ball"], columns["other_ball"], columns["target"], self.constants)
         return columns
 
