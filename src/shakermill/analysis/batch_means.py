@@ -105,6 +105,11 @@ def negligible_spread(values: np.ndarray, negligible: float) -> bool:
     return values.size == 0 or bool(values.std() <= negligible * abs(values.mean()))
 
 
+def power_of_two_at_least(count: int) -> int:
+    """The smallest group size of :func:`uncorrelated_grouping` (1, 2, 4, …) that holds ``count`` batches."""
+    return 1 << max(0, math.ceil(math.log2(count))) if count > 1 else 1
+
+
 def uncorrelated_grouping(
     series: Sequence[np.ndarray], least: int, negligible: float = 0.0, smallest: int = 1
 ) -> Grouping:
@@ -114,9 +119,7 @@ def uncorrelated_grouping(
     is ``negligible`` are not tested."""
     pooled = np.concatenate(series)
     tested = [column for column in range(pooled.shape[1]) if not negligible_spread(pooled[:, column], negligible)]
-    size, found = 1, None
-    while size < smallest:
-        size *= 2
+    size, found = power_of_two_at_least(smallest), None
     while True:
         groups = [grouped(part, size) for part in series]
         count = sum(len(part) for part in groups)

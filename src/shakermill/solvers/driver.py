@@ -19,6 +19,7 @@ from shakermill.analysis.batch_means import (
     lag1_autocorrelation,
     mser_truncation,
     normalised,
+    power_of_two_at_least,
     relative_error,
     significant_autocorrelation,
     standard_error,
@@ -209,7 +210,8 @@ class Settled:
     def averaged_as_it_stands(self) -> bool:
         """Whether an intermittent charge whose target error is out of reach within its mechanics is averaged as it
         stands: over at least INTERMITTENT_GROUPS groups that each hold several switches (MODEL.md §14.2)."""
-        return self.switching.intermittent and self.grouping.groups >= INTERMITTENT_GROUPS
+        holding = self.grouping.size >= self.switching.batches_holding_switches()
+        return self.switching.intermittent and holding and self.grouping.groups >= INTERMITTENT_GROUPS
 
     def as_it_stands(self, target: float, t: float, limit_name: str, limit: float) -> str:
         """What :meth:`averaged_as_it_stands` averaged, and the error it stands at beside the ``target``."""
@@ -237,16 +239,17 @@ def _settled(
     """Cut each replica's transient (MSER on its total heat power and its balls' mean velocity term, White 1997),
     group its batches until their means are uncorrelated, and test the totals for drift (MODEL.md §14.2); a
     spread or drift within the ``target`` relative error is no concern. A charge whose batches (``labels``, the first
-    replica's regimes) still switch back and forth after that cut is intermittent: its regimes are its motion, so only
-    its first batch, the start-up, is cut, and its groups hold several switches each. One that stopped switching
+    replica's regimes) still switch back and forth after that cut is intermittent: once its batches fill
+    INTERMITTENT_GROUPS groups that each hold several switches, its regimes are its motion, so only its first batch,
+    the start-up, is cut. One that stopped switching
     before the cut (a planetary charge that tried a pack twice before it stayed one) is of the regime it stayed in."""
     every = [batch_rates(np.array(series), base) for series in cumulative]
     columns = (_totals(rates, sources, balls).T for rates in every)
     cuts, smallest = [max(mser_truncation(normalised(column)) for column in each) for each in columns], 1
     switching = Switching(tuple(labels[cuts[0] :]), base)
-    if switching.intermittent:
-        switching = Switching(tuple(labels[1:]), base)
-        cuts, smallest = [1] * len(every), switching.batches_holding_switches()
+    whole = Switching(tuple(labels[1:]), base)
+    if switching.intermittent and _groups_of_switches(whole) >= INTERMITTENT_GROUPS:
+        switching, cuts, smallest = whole, [1] * len(every), whole.batches_holding_switches()
     kept = [rates[cut:] for rates, cut in zip(every, cuts)]
     grouping = uncorrelated_grouping([_totals(rates, sources, balls) for rates in kept], least, target, smallest)
     rates = np.concatenate([grouped(part, grouping.size) for part in kept])
@@ -265,6 +268,11 @@ def _settled(
         switching=switching,
         switches_before=Switching(tuple(labels[1 : cuts[0]]), base).switches,
     )
+
+
+def _groups_of_switches(switching: Switching) -> int:
+    """How many groups that each hold several switches (a power of two batches, as grouped) the batches fill."""
+    return len(switching.labels) // power_of_two_at_least(switching.batches_holding_switches())
 
 
 def _longer_window_hint(settled: Settled | None, t: float, target: float, limit_name: str) -> str:
@@ -372,7 +380,7 @@ def _change(settled: Settled, heat_power: float, error: float) -> str:
     more than CHANGE_SHARE and by more than DRIFT_SIGMAS standard errors lasted past the start-up
     (LEAST_BATCHES_PER_REPLICA batches) is a motion of its own, not the start from rest (MODEL.md §14.2)."""
     before, cut = settled.transient_heat_power, settled.cuts[0]
-    if cut < LEAST_BATCHES_PER_REPLICA or not math.isfinite(before):
+    if cut < LEAST_BATCHES_PER_REPLICA or not (math.isfinite(before) and math.isfinite(heat_power)):
         return ""
     if abs(before - heat_power) <= max(CHANGE_SHARE * abs(heat_power), DRIFT_SIGMAS * error):
         return ""
