@@ -242,7 +242,8 @@ def _settled(
     replica's regimes) still switch back and forth after that cut is intermittent: once its batches fill
     INTERMITTENT_GROUPS groups that each hold several switches, its regimes are its motion, so only its first batch,
     the start-up, is cut. One that stopped switching
-    before the cut (a planetary charge that tried a pack twice before it stayed one) is of the regime it stayed in."""
+    before the cut (a planetary charge that tried a pack once, turned active again and stayed a pack) is of the regime
+    it stayed in."""
     every = [batch_rates(np.array(series), base) for series in cumulative]
     columns = (_totals(rates, sources, balls).T for rates in every)
     cuts, smallest = [max(mser_truncation(normalised(column)) for column in each) for each in columns], 1
