@@ -58,6 +58,16 @@ class Contacts:
     def record_count(self) -> int:
         return int(self.records.sum())
 
+    def since(self, start: float) -> Contacts:
+        """The contacts that began at ``start`` (s) or later."""
+        chosen = self.columns["time"] >= start
+        return Contacts(
+            {name: values[chosen] for name, values in self.columns.items()},
+            self.touch[chosen],
+            self.lasting[chosen],
+            self.records[chosen],
+        )
+
 
 def contacts_of(records: Mapping[str, ArrayLike], touch_speed: float = 0.0, chatter_factor: float = 0.0) -> Contacts:
     """The contacts of an engine's contact ``records`` (its impact columns): records of one pair that begin within

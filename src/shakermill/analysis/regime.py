@@ -13,6 +13,7 @@ import itertools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -149,7 +150,7 @@ class Switching:
     labels: tuple[str, ...]
     batch: float
 
-    @property
+    @cached_property
     def persistent(self) -> tuple[str, ...]:
         """The labels with every run shorter than PERSISTENT_BATCHES taken as the regime before it (the first run,
         as the first regime that persists): the regimes the motion held."""

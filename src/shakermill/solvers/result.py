@@ -156,13 +156,10 @@ class RunOutput:
         return self.contacts().impact_count
 
     def contacts(self, since: float = -math.inf) -> Contacts:
-        """The contacts of the records that began at ``since`` (s) or later, by the rules of the run's engine
-        (:func:`counting_rules`)."""
-        records = self.impact_columns
-        if since > -math.inf:
-            chosen = records["time"] >= since
-            records = {name: values[chosen] for name, values in records.items()}
-        return contacts_of(records, *counting_rules(self.params))
+        """The run's contacts by the rules of its engine (:func:`counting_rules`), merged over all its records, that
+        began at ``since`` (s) or later."""
+        contacts = contacts_of(self.impact_columns, *counting_rules(self.params))
+        return contacts if since == -math.inf else contacts.since(since)
 
 
 def counting_rules(params: Parameters) -> tuple[float, float]:
@@ -468,7 +465,7 @@ def summarize(result: Result) -> Summary:
         steady=result.steady.as_summary(each_ball=several),
         impacts=impacts,
         heat=heat_section(result, dissipated_power),
-        charge=charge_section(result, settled_regime(result, dissipated_power)) if several else None,
+        charge=charge_section(result, settled_regime(result, contacts, dissipated_power)) if several else None,
         numerics=numerics_section(result),
         inputs=understood_inputs(params),
         stress=spectrum.as_summary(),
@@ -584,17 +581,17 @@ class SettledRegime:
     switching: Switching | None = None
 
 
-def settled_regime(result: RunOutput, dissipated_power: float) -> SettledRegime:
-    """The regime of ``result``'s settled motion, named from the impacts and the dissipation of that window alone,
+def settled_regime(result: RunOutput, contacts: Contacts, dissipated_power: float) -> SettledRegime:
+    """The regime of ``result``'s settled motion, named from its ``contacts`` and the dissipation of that window alone,
     never the start-up's (MODEL.md §14.4); a full run's dissipated power over its window from its cumulative series.
     An averaged run whose batches switched back and forth is :data:`INTERMITTENT`."""
     if result.impact_window is None or result.averages is None:
         start = window = 0.5 * result.t_end
         dissipated_power = float(np.sum(settled_rates(result.history.times, result.history["dissipated"])))
-        contacts = result.contacts(since=start)
+        contacts = contacts.since(start)
     else:
         # The averaged solver's records begin with its window.
-        start, window, contacts = result.averages.transient, result.impact_window, result.contacts()
+        start, window = result.averages.transient, result.impact_window
     share, fast, name = window_regime(result.params, contacts, window, dissipated_power)
     switching = result.averages.switching if result.averages is not None else None
     if switching is not None and switching.intermittent:
